@@ -1,0 +1,18 @@
+"""specdesign: fatigue-based specifications and controller design for wind-turbine pitch control.
+
+The design loop, one module a step:
+
+- :mod:`specdesign.wind`: rotor-effective wind spectra and turbulent time series.
+- :mod:`specdesign.turbine`: the embedded IEA 15 MW reduced model, trim, linearisation, ROSCO baseline.
+- :mod:`specdesign.closedloop`: closed-loop maps T_{y,w}(jω) for any controller set.
+- :mod:`specdesign.spectral`: spectral moments, Dirlik & co., DEL, damage sensitivity ΔD%(ω).
+- :mod:`specdesign.fatigue`: rainflow counting, S-N curves, Palmgren-Miner, DEL from time series.
+- :mod:`specdesign.spec`: notch-shaped specifications W_y(s) that promise a fatigue reduction.
+- :mod:`specdesign.simulate`: batched nonlinear time-domain simulation.
+- :mod:`specdesign.validate`: rainflow validation, indicators, the paper's tables.
+- :mod:`specdesign.openfast`: OpenFAST file adapters (.lin, .out/.outb).
+
+Generic control design (QFT, loop shaping, H∞) lives in the sibling package :mod:`loopshaping`.
+Units are SI throughout; frequencies in rad/s; PSDs one-sided per rad/s.
+"""
+__version__ = "0.1.0"

@@ -1,0 +1,66 @@
+"""Input validation shared by every module: checks at the door that name the argument.
+
+Each function returns the validated array (float64, C-contiguous) or raises a ValueError /
+TypeError whose message names the argument and says how to fix it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["as_omega", "as_psd", "as_signal", "positive_scalar"]
+
+
+def as_omega(omega, name: str = "omega", *, allow_zero: bool = True) -> np.ndarray:
+    """Validate a frequency grid in rad/s: 1-D, finite, strictly increasing, non-negative."""
+    w = np.asarray(omega, dtype=float)
+    if w.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D grid of frequencies in rad/s, got shape {w.shape}")
+    if w.size < 2:
+        raise ValueError(f"{name} needs at least 2 frequencies, got {w.size}")
+    if not np.all(np.isfinite(w)):
+        raise ValueError(f"{name} contains NaN or inf; pass finite frequencies in rad/s")
+    if np.any(np.diff(w) <= 0):
+        i = int(np.argmax(np.diff(w) <= 0))
+        raise ValueError(
+            f"{name} must be strictly increasing (rad/s); {name}[{i}]={w[i]!r} >= {name}[{i + 1}]={w[i + 1]!r}. "
+            "Sort it (np.sort) and remove duplicates (np.unique)."
+        )
+    if w[0] < 0 or (not allow_zero and w[0] == 0):
+        raise ValueError(f"{name} must be {'non-negative' if allow_zero else 'positive'} (one-sided, rad/s), got {name}[0]={w[0]!r}")
+    return np.ascontiguousarray(w)
+
+
+def as_psd(psd, n: int, name: str = "psd") -> np.ndarray:
+    """Validate a one-sided PSD stack of shape (..., n): finite, non-negative."""
+    s = np.asarray(psd, dtype=float)
+    if s.ndim == 0 or s.shape[-1] != n:
+        raise ValueError(f"{name} must have shape (..., {n}) to match the frequency grid, got {s.shape}")
+    if not np.all(np.isfinite(s)):
+        raise ValueError(f"{name} contains NaN or inf values")
+    if np.any(s < 0):
+        idx = np.unravel_index(int(np.argmin(s)), s.shape)
+        raise ValueError(f"{name} must be non-negative (a one-sided PSD); {name}{list(idx)}={s[idx]!r}")
+    return np.ascontiguousarray(s)
+
+
+def as_signal(x, name: str = "x", *, min_samples: int = 2) -> np.ndarray:
+    """Validate a 1-D, finite time series."""
+    a = np.asarray(x, dtype=float)
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D time series, got shape {a.shape}")
+    if a.size < min_samples:
+        raise ValueError(f"{name} needs at least {min_samples} samples, got {a.size}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} contains NaN or inf; remove or interpolate them first")
+    return np.ascontiguousarray(a)
+
+
+def positive_scalar(value, name: str) -> float:
+    """Validate a finite, strictly positive real scalar."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+    if not np.isfinite(v) or v <= 0:
+        raise ValueError(f"{name}={value!r} must be finite and > 0")
+    return v

@@ -1,0 +1,23 @@
+"""OpenFAST file adapters: arrays and labels in, no physics.
+
+- :func:`read_linearization` (``.lin`` files → azimuth-averaged, MBC-transformed named LTI)
+- :func:`read_outputs` (``.out`` / ``.outb`` → named channels with units)
+"""
+from __future__ import annotations
+
+_LAZY = {
+    "read_linearization": ".lin",
+    "LinearizationData": ".lin",
+    "read_outputs": ".outputs",
+    "OpenFASTOutput": ".outputs",
+}
+
+__all__ = list(_LAZY)
+
+
+def __getattr__(name):  # the adapters import openfast-io only when used
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name], __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

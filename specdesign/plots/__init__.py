@@ -1,0 +1,4 @@
+"""Figures: results in, matplotlib axes out (no plt.show()).
+
+Submodules by step of the design loop; matplotlib is imported only here.
+"""
