@@ -1,0 +1,235 @@
+"""OpenFAST time-series outputs (``.out`` text, ``.outb`` binary) → named SI channels.
+
+An adapter: arrays and labels in, no physics. Parsing is delegated to openfast-io's
+``FAST_output_reader`` (``load_ascii_output`` / ``load_binary_output``); this module adds
+what that reader leaves out: detection of a binary file carrying a ``.out`` name, clear
+errors for truncated files and missing channels (naming file, line and channel), and
+conversion of every selected channel to SI with its original unit recorded.
+
+Unit conversions (exact factors): rpm → rad/s (×2π/60), deg → rad, deg/s → rad/s,
+kN·m → N·m (×1e3), kN → N, kW → W (×1e3), MW → W, MN·m → N·m. Units already SI (s, m,
+m/s, m/s^2, rad, rad/s, N, N·m, W, -) pass through; any other unit is kept unchanged
+and recorded as such (``si_unit == original unit``).
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["OpenFASTOutput", "read_outputs", "to_si"]
+
+# original unit (lower case, spaces removed) → (SI unit, factor)
+_UNITS = {
+    "rpm": ("rad/s", 2.0 * math.pi / 60.0),
+    "deg": ("rad", math.pi / 180.0),
+    "deg/s": ("rad/s", math.pi / 180.0),
+    "deg/s^2": ("rad/s^2", math.pi / 180.0),
+    "kn-m": ("N·m", 1e3),
+    "knm": ("N·m", 1e3),
+    "kn·m": ("N·m", 1e3),
+    "kn*m": ("N·m", 1e3),
+    "mn-m": ("N·m", 1e6),
+    "n-m": ("N·m", 1.0),
+    "nm": ("N·m", 1.0),
+    "kn": ("N", 1e3),
+    "n": ("N", 1.0),
+    "kw": ("W", 1e3),
+    "mw": ("W", 1e6),
+    "w": ("W", 1.0),
+    "rad": ("rad", 1.0),
+    "rad/s": ("rad/s", 1.0),
+    "s": ("s", 1.0),
+    "sec": ("s", 1.0),
+    "m": ("m", 1.0),
+    "m/s": ("m/s", 1.0),
+    "m/s^2": ("m/s^2", 1.0),
+}
+
+
+def to_si(unit: str) -> tuple[str, float]:
+    """Return ``(si_unit, factor)`` for an OpenFAST unit string (``"(rpm)"`` or ``"rpm"``).
+
+    Multiply a channel by ``factor`` to express it in ``si_unit``; unknown units map to
+    themselves with factor 1.0.
+    """
+    u = unit.strip()
+    if u.startswith("(") and u.endswith(")"):
+        u = u[1:-1]
+    key = u.replace(" ", "").lower()
+    if key in _UNITS:
+        return _UNITS[key]
+    return u, 1.0
+
+
+@dataclass(frozen=True)
+class OpenFASTOutput:
+    """Channels of one OpenFAST output file, in SI.
+
+    Attributes
+    ----------
+    path : Path of the file read.
+    time : (n,) simulation time in s.
+    channels : dict name → (n,) array in SI (see the module docstring for the conversions).
+    units : dict name → SI unit of the array in ``channels``.
+    original_units : dict name → unit written in the file (e.g. ``"rpm"``, ``"kN-m"``).
+    description : the file's description line.
+    """
+
+    path: Path
+    time: np.ndarray
+    channels: dict = field(repr=False)
+    units: dict
+    original_units: dict
+    description: str = ""
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self.channels:
+            raise KeyError(f"channel {name!r} not in {self.path.name}; available: {sorted(self.channels)}")
+        return self.channels[name]
+
+    @property
+    def dt(self) -> float:
+        """Output time step in s (mean spacing of ``time``)."""
+        return float((self.time[-1] - self.time[0]) / (self.time.size - 1))
+
+    @property
+    def duration(self) -> float:
+        """Span of the record in s, ``time[-1] - time[0] + dt`` (one sample per step)."""
+        return float(self.time[-1] - self.time[0]) + self.dt
+
+
+def _is_binary(path: Path) -> bool:
+    # OpenFAST text outputs are ASCII; the binary header starts with a small int16 file ID
+    # whose high byte is 0, so a NUL in the first block is a reliable tell.
+    with open(path, "rb") as f:
+        head = f.read(512)
+    if b"\x00" in head:
+        return True
+    try:
+        head.decode("ascii")
+    except UnicodeDecodeError:
+        return True
+    return False
+
+
+def _read_text(path: Path):
+    from openfast_io.FAST_output_reader import load_ascii_output
+
+    try:
+        data, info = load_ascii_output(str(path))
+    except ValueError:
+        # openfast-io builds one array from all rows; find the offending line ourselves.
+        with open(path) as f:
+            lines = f.readlines()
+        if len(lines) < 8:
+            raise ValueError(f"{path}: truncated OpenFAST text output, only {len(lines)} lines (the header alone has 8)") from None
+        ncol = len(lines[6].split())
+        for i, line in enumerate(lines[8:], start=9):
+            parts = line.split()
+            try:
+                [float(p) for p in parts]
+                ok = len(parts) == ncol
+            except ValueError:
+                ok = False
+            if not ok:
+                raise ValueError(
+                    f"{path}, line {i}: expected {ncol} numbers (one per channel), got {len(parts)} fields "
+                    f"{line.strip()[:60]!r}; the file is truncated or corrupt"
+                ) from None
+        raise
+    names, units = info["attribute_names"], info["attribute_units"]
+    if len(names) != len(units):
+        raise ValueError(f"{path}, lines 7-8: {len(names)} channel names but {len(units)} units")
+    if data.ndim != 2 or data.shape[0] == 0:
+        raise ValueError(f"{path}: no data rows after the 8-line header (truncated file?)")
+    if data.shape[1] != len(names):
+        raise ValueError(f"{path}: {data.shape[1]} data columns but {len(names)} channel names (line 7)")
+    return data, names, units, info.get("description", "")
+
+
+def _read_binary(path: Path):
+    from openfast_io.FAST_output_reader import load_binary_output
+
+    try:
+        data, info, _ = load_binary_output(str(path))
+    except Exception as e:  # openfast-io raises struct.error or a bare Exception on short reads
+        raise ValueError(f"{path}: truncated or corrupt OpenFAST binary output ({e})") from None
+    names, units = info["attribute_names"], info["attribute_units"]
+    if data.shape[1] != len(names):
+        raise ValueError(f"{path}: {data.shape[1]} data columns but {len(names)} channel names")
+    return data, names, units, info.get("description", "")
+
+
+def _read_one(path, channels) -> OpenFASTOutput:
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"OpenFAST output {path} does not exist")
+    ext = path.suffix.lower()
+    if ext not in (".out", ".outb"):
+        raise ValueError(f"{path}: unsupported extension {ext!r}; expected .out (text) or .outb (binary)")
+    binary = _is_binary(path)
+    if ext == ".out" and binary:
+        raise ValueError(
+            f"{path}: this file is binary but carries a text '.out' name; rename it to '.outb' "
+            "(OpenFAST writes binary outputs with OutFileFmt = 2 as .outb)"
+        )
+    if ext == ".outb" and not binary:
+        raise ValueError(f"{path}: this file is text but carries a binary '.outb' name; rename it to '.out'")
+    data, names, units, desc = (_read_binary if binary else _read_text)(path)
+    if not np.all(np.isfinite(data)):
+        r, c = np.argwhere(~np.isfinite(data))[0]
+        raise ValueError(f"{path}: channel {names[c]!r} has a non-finite value at row {r}")
+    idx = {n: i for i, n in enumerate(names)}
+    time_name = next((n for n in names if n.lower() == "time"), names[0])
+    wanted = [n for n in names if n != time_name] if channels is None else list(channels)
+    missing = [n for n in wanted if n not in idx]
+    if missing:
+        raise ValueError(f"{path}: channel(s) {missing} not found; available: {[n for n in names if n != time_name]}")
+    t_unit, t_fac = to_si(units[idx[time_name]])
+    time = data[:, idx[time_name]] * t_fac
+    out, si_units, orig = {}, {}, {}
+    for n in wanted:
+        si, fac = to_si(units[idx[n]])
+        out[n] = np.ascontiguousarray(data[:, idx[n]] * fac)
+        si_units[n] = si
+        orig[n] = units[idx[n]]
+    if time.size < 2:
+        raise ValueError(f"{path}: needs at least 2 time steps, got {time.size} (truncated file?)")
+    return OpenFASTOutput(path=path, time=time, channels=out, units=si_units, original_units=orig, description=desc)
+
+
+def read_outputs(paths, channels=None):
+    """Read OpenFAST ``.out`` (text) / ``.outb`` (binary) outputs and convert channels to SI.
+
+    Parameters
+    ----------
+    paths : str or PathLike, or a sequence of them.
+    channels : sequence of channel names (e.g. ``["GenSpeed", "TwrBsMyt", "BldPitch1",
+        "GenPwr"]``), or None for every channel. Names are matched exactly (OpenFAST spelling).
+
+    Returns
+    -------
+    OpenFASTOutput for a single path, else a list of them in the order given.
+
+    Raises
+    ------
+    ValueError naming the file (and the line or channel) for a binary file with a ``.out``
+    name, a truncated or corrupt file, or a missing channel. FileNotFoundError for a path
+    that does not exist.
+    """
+    if channels is not None:
+        if isinstance(channels, str):
+            channels = [channels]
+        channels = list(channels)
+        if not all(isinstance(c, str) for c in channels):
+            raise TypeError("channels must be a sequence of channel-name strings, e.g. ['GenSpeed', 'TwrBsMyt']")
+    if isinstance(paths, (str, os.PathLike)):
+        return _read_one(paths, channels)
+    paths = list(paths)
+    if not paths:
+        raise ValueError("paths is empty; pass one or more .out/.outb files")
+    return [_read_one(p, channels) for p in paths]
