@@ -1,0 +1,397 @@
+"""Time-domain fatigue: ASTM E1049 rainflow counting, S-N curves, Palmgren-Miner, DEL.
+
+Conventions (see WORKBENCH.md): S-N curves are range-based, N(S) = (S_ref/S)^m with S the
+cycle **range** (peak to valley, not the amplitude); half cycles count 0.5; the damage
+equivalent load uses the 1 Hz convention, DEL = (Σ n_i S_i^m / N_eq)^(1/m) with
+N_eq = duration · n_eq_rate (n_eq_rate = 1 Hz by default). Loads keep the units of the
+signal (N·m in, N·m out).
+
+The rainflow counter is a compiled (numba) three-point ASTM E1049 counter on the turning
+points. It reproduces, cycle for cycle and in the same order, the cycles of
+``rainflow.extract_cycles`` (the reference pure-Python implementation), with one deliberate
+exception: a constant signal gives no cycles here, whereas ``rainflow`` emits one zero-range
+half cycle (which carries no damage anyway).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ._checks import as_signal, positive_scalar
+
+__all__ = [
+    "Cycles",
+    "rainflow",
+    "SNCurve",
+    "miner_damage",
+    "goodman_ranges",
+    "del_rainflow",
+    "VarianceDamageFit",
+    "fit_variance_damage",
+    "economic_cost",
+]
+
+
+@dataclass(frozen=True)
+class Cycles:
+    """Rainflow cycles of one signal.
+
+    Attributes
+    ----------
+    ranges : ndarray
+        Cycle ranges (peak-to-valley), in the units of the signal.
+    means : ndarray
+        Cycle means, in the units of the signal.
+    counts : ndarray
+        1.0 for full cycles, 0.5 for half cycles of the residue.
+    """
+
+    ranges: np.ndarray
+    means: np.ndarray
+    counts: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.ranges.size)
+
+    @property
+    def total(self) -> float:
+        """Number of cycles, half cycles counted 0.5."""
+        return float(self.counts.sum())
+
+
+@njit(cache=True)
+def _reversals(x, out):
+    """Turning points of x into out; returns how many.
+
+    Mirrors ``rainflow.reversals``: the first and last samples are always kept, plateaus
+    collapse to one point, and a point is a reversal when the sign of the slope changes.
+    """
+    n = x.size
+    if n == 0:
+        return 0
+    out[0] = x[0]
+    if n == 1:
+        return 1
+    k = 1
+    xc = x[1]
+    d_last = xc - x[0]
+    for i in range(2, n):
+        xn = x[i]
+        if xn == xc:
+            continue
+        d_next = xn - xc
+        # Branch-free write: the slope sign of noisy signals is unpredictable, so always
+        # store and advance only on a reversal.
+        out[k] = xc
+        k += d_last * d_next < 0
+        xc = xn
+        d_last = d_next
+    if n > 2:
+        out[k] = x[n - 1]
+        k += 1
+    return k
+
+
+@njit(cache=True)
+def _count(tp, n_tp, half_rule, ranges, means, counts):
+    """Three-point ASTM E1049 counting of the turning points tp[:n_tp]; returns the number of cycles.
+
+    The stack is a slice [start, top) of one preallocated buffer: popping the left end (the
+    half-cycle rule) only moves ``start``. With ``half_rule`` False (periodic records rotated
+    to start at their maximum) a range that contains the start point is counted as a full
+    cycle, which closes the residue.
+    """
+    stack = np.empty(n_tp)
+    start = 0
+    top = 0
+    nc = 0
+    for i in range(n_tp):
+        stack[top] = tp[i]
+        top += 1
+        while top - start >= 3:
+            x1 = stack[top - 3]
+            x2 = stack[top - 2]
+            x3 = stack[top - 1]
+            if abs(x3 - x2) < abs(x2 - x1):
+                break
+            ranges[nc] = abs(x1 - x2)
+            means[nc] = 0.5 * (x1 + x2)
+            if top - start == 3 and half_rule:
+                counts[nc] = 0.5
+                start += 1
+            else:
+                counts[nc] = 1.0
+                stack[top - 3] = x3
+                top -= 2
+            nc += 1
+    while top - start > 1:
+        ranges[nc] = abs(stack[start] - stack[start + 1])
+        means[nc] = 0.5 * (stack[start] + stack[start + 1])
+        counts[nc] = 0.5
+        nc += 1
+        start += 1
+    return nc
+
+
+@njit(cache=True)
+def _rainflow_half(x):
+    tp = np.empty(x.size)
+    n_tp = _reversals(x, tp)
+    ranges = np.empty(n_tp)
+    means = np.empty(n_tp)
+    counts = np.empty(n_tp)
+    nc = _count(tp, n_tp, True, ranges, means, counts)
+    return ranges[:nc], means[:nc], counts[:nc]
+
+
+@njit(cache=True)
+def _rainflow_periodic(x):
+    n = x.size
+    tp = np.empty(n + 1)
+    n_tp = _reversals(x, tp)
+    # Rotate to start at the (first) maximum and close the loop on it; the junction
+    # between the last and first sample may not be a reversal, so re-extract.
+    k = 0
+    for i in range(1, n_tp):
+        if tp[i] > tp[k]:
+            k = i
+    rot = np.empty(n_tp + 1)
+    j = 0
+    for i in range(k, n_tp):
+        rot[j] = tp[i]
+        j += 1
+    for i in range(0, k + 1):
+        rot[j] = tp[i]
+        j += 1
+    n_tp = _reversals(rot[:j], tp)
+    ranges = np.empty(n_tp)
+    means = np.empty(n_tp)
+    counts = np.empty(n_tp)
+    nc = _count(tp, n_tp, False, ranges, means, counts)
+    return ranges[:nc], means[:nc], counts[:nc]
+
+
+def rainflow(x, residue: str = "half") -> Cycles:
+    """Rainflow-count a time series (ASTM E1049 three-point method, exact, no binning).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        The load or stress history (any unit; ranges and means come out in the same unit).
+    residue : {"half", "periodic"}
+        "half" (default): the residue left after counting is counted as half cycles (0.5),
+        exactly as ``rainflow.extract_cycles``. "periodic": the record is treated as one
+        period of a periodic signal: it is rotated to start (and end) at its maximum, which
+        closes the residue into full cycles (the unbiased choice for periodic records).
+
+    Returns
+    -------
+    Cycles
+        ``ranges`` (peak to valley), ``means`` and ``counts`` (1.0 or 0.5), in counting order.
+        A constant signal gives no cycles.
+    """
+    if residue not in ("half", "periodic"):
+        raise ValueError(f"residue={residue!r} must be 'half' or 'periodic'")
+    a = as_signal(x, "x")
+    if a.size == 2:
+        # rainflow.extract_cycles finds a single reversal in two samples: no cycle.
+        empty = np.empty(0)
+        return Cycles(empty, empty.copy(), empty.copy())
+    r, mu, c = (_rainflow_periodic if residue == "periodic" else _rainflow_half)(a)
+    if r.size and r.max() == 0.0:
+        # Only a constant signal yields zero ranges (one zero half cycle in rainflow).
+        r, mu, c = r[:0], mu[:0], c[:0]
+    return Cycles(r, mu, c)
+
+
+@dataclass(frozen=True)
+class SNCurve:
+    """Range-based S-N (Wöhler) curve N(S) = (S_ref/S)^m, optionally bilinear.
+
+    S is the cycle **range**. With ``knee_cycles`` set, the curve continues below the knee
+    range S_knee = S_ref · knee_cycles^(-1/m) with slope ``m2``:
+    N(S) = knee_cycles · (S_knee/S)^m2 for S < S_knee.
+
+    Parameters
+    ----------
+    m : float
+        Wöhler exponent (> 0), e.g. 4 for steel, 10 for glass fibre.
+    s_ref : float
+        Range that fails in one cycle (the intercept), in load units. Default 1.
+    knee_cycles : float or None
+        Cycle count at the knee (e.g. 1e7), None for a single slope.
+    m2 : float or None
+        Exponent below the knee (required with ``knee_cycles``); use a large value for an
+        endurance limit.
+    """
+
+    m: float
+    s_ref: float = 1.0
+    knee_cycles: float | None = None
+    m2: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "m", positive_scalar(self.m, "m"))
+        object.__setattr__(self, "s_ref", positive_scalar(self.s_ref, "s_ref"))
+        if (self.knee_cycles is None) != (self.m2 is None):
+            raise ValueError("knee_cycles and m2 go together: give both for a bilinear curve or neither")
+        if self.knee_cycles is not None:
+            object.__setattr__(self, "knee_cycles", positive_scalar(self.knee_cycles, "knee_cycles"))
+            object.__setattr__(self, "m2", positive_scalar(self.m2, "m2"))
+
+    @property
+    def knee_range(self) -> float | None:
+        """Range at the knee (load units), or None for a single-slope curve."""
+        if self.knee_cycles is None:
+            return None
+        return self.s_ref * self.knee_cycles ** (-1.0 / self.m)
+
+    def cycles_to_failure(self, ranges) -> np.ndarray:
+        """N(S) for ranges S (load units); a zero range never fails (inf)."""
+        s = np.asarray(ranges, dtype=float)
+        with np.errstate(divide="ignore"):
+            n = (self.s_ref / s) ** self.m
+            if self.knee_cycles is not None:
+                sk = self.knee_range
+                n = np.where(s < sk, self.knee_cycles * (sk / s) ** self.m2, n)
+        return n
+
+
+def miner_damage(ranges, counts, sn: SNCurve) -> float:
+    """Palmgren-Miner damage Σ n_i / N(S_i) (dimensionless) for cycle ranges S_i (load units).
+
+    ``counts`` are the cycle counts n_i (0.5 for half cycles); ``sn`` is a range-based
+    :class:`SNCurve`.
+    """
+    if not isinstance(sn, SNCurve):
+        raise TypeError(f"sn must be an SNCurve, got {type(sn).__name__}")
+    s = np.asarray(ranges, dtype=float)
+    n = np.asarray(counts, dtype=float)
+    if s.shape != n.shape or s.ndim != 1:
+        raise ValueError(f"ranges and counts must be 1-D of the same length, got {s.shape} and {n.shape}")
+    if not (np.all(np.isfinite(s)) and np.all(s >= 0)):
+        raise ValueError("ranges must be finite and >= 0 (cycle ranges, peak to valley)")
+    if not (np.all(np.isfinite(n)) and np.all(n >= 0)):
+        raise ValueError("counts must be finite and >= 0")
+    return float(np.sum(n / sn.cycles_to_failure(s)))
+
+
+def goodman_ranges(ranges, means, ultimate) -> np.ndarray:
+    """Goodman mean correction: equivalent zero-mean ranges S/(1 - |mean|/ultimate).
+
+    ``ultimate`` is the ultimate load in the units of the signal. Tensile and compressive
+    means are both treated as harmful (|mean|), the usual conservative choice for bending
+    moments. A cycle whose |mean| reaches the ultimate load is a static failure: ValueError.
+    """
+    su = positive_scalar(ultimate, "ultimate")
+    s = np.asarray(ranges, dtype=float)
+    mu = np.abs(np.asarray(means, dtype=float))
+    if s.shape != mu.shape:
+        raise ValueError(f"ranges and means must have the same shape, got {s.shape} and {mu.shape}")
+    if np.any(mu >= su):
+        raise ValueError(f"ultimate={su!r} must exceed every |cycle mean| (max {mu.max()!r}); a mean at the ultimate load is a static failure")
+    return s / (1.0 - mu / su)
+
+
+def del_rainflow(x, m, duration, n_eq_rate: float = 1.0, *, ultimate=None, residue: str = "half") -> float:
+    """Damage equivalent load of a time series, DEL = (Σ n_i S_i^m / N_eq)^(1/m).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Load history (e.g. N·m); the DEL is a **range** in the same unit.
+    m : float
+        Wöhler exponent (> 0).
+    duration : float
+        Length of the record in seconds.
+    n_eq_rate : float
+        Equivalent cycle rate in Hz (default 1 Hz): N_eq = duration · n_eq_rate.
+    ultimate : float or None
+        Ultimate load for the Goodman mean correction (:func:`goodman_ranges`); None: no correction.
+    residue : {"half", "periodic"}
+        Residue handling of :func:`rainflow`.
+    """
+    m = positive_scalar(m, "m")
+    n_eq = positive_scalar(duration, "duration") * positive_scalar(n_eq_rate, "n_eq_rate")
+    c = rainflow(x, residue=residue)
+    s = c.ranges if ultimate is None else goodman_ranges(c.ranges, c.means, ultimate)
+    return float((np.sum(c.counts * s**m) / n_eq) ** (1.0 / m))
+
+
+@dataclass(frozen=True)
+class VarianceDamageFit:
+    """Power-law surrogate ln(L_ult^m · D) = a · ln(Var) + b (natural logarithms).
+
+    D is the Miner damage of a record for N = (L_ult/S)^m (S the range), Var its variance.
+    """
+
+    a: float
+    b: float
+    m: float
+    ultimate: float
+    residual_std: float
+
+    def predict(self, variance) -> np.ndarray:
+        """Damage D predicted for variance(s) in load units squared: e^b Var^a / L_ult^m."""
+        v = np.asarray(variance, dtype=float)
+        if np.any(~np.isfinite(v)) or np.any(v <= 0):
+            raise ValueError("variance must be finite and > 0 (load units squared)")
+        return np.exp(self.b) * v**self.a / self.ultimate**self.m
+
+
+def fit_variance_damage(records, m, *, ultimate=1.0) -> VarianceDamageFit:
+    """Fit ln(L_ult^m · D) = a ln(Var) + b over a set of load histories (least squares).
+
+    Parameters
+    ----------
+    records : sequence of 1-D arrays (or a 2-D array, one record per row)
+        Load histories (load units); at least two with different variances.
+    m : float
+        Wöhler exponent (> 0); fit one surrogate per exponent.
+    ultimate : float
+        Ultimate load L_ult (load units), the S_ref of the range-based S-N curve; default 1.
+
+    Returns
+    -------
+    VarianceDamageFit
+        With ``a``, ``b``, the residual standard deviation of the log fit and ``predict``.
+    """
+    m = positive_scalar(m, "m")
+    su = positive_scalar(ultimate, "ultimate")
+    recs = [as_signal(r, f"records[{i}]", min_samples=3) for i, r in enumerate(records)]
+    if len(recs) < 2:
+        raise ValueError(f"records needs at least 2 load histories to fit a and b, got {len(recs)}")
+    sn = SNCurve(m, su)
+    var = np.array([np.var(r) for r in recs])
+    dmg = np.array([miner_damage(c.ranges, c.counts, sn) for c in map(rainflow, recs)])
+    if np.any(var <= 0) or np.any(dmg <= 0):
+        raise ValueError("records must not contain constant signals (zero variance, zero damage)")
+    lx = np.log(var)
+    if np.ptp(lx) == 0:
+        raise ValueError("records all have the same variance; a and b are not identifiable")
+    ly = np.log(su**m * dmg)
+    a, b = np.polyfit(lx, ly, 1)
+    res = ly - (a * lx + b)
+    dof = max(len(recs) - 2, 1)
+    return VarianceDamageFit(float(a), float(b), m, su, float(np.sqrt(np.sum(res**2) / dof)))
+
+
+def economic_cost(damages, weights) -> np.ndarray:
+    """Economic fatigue cost J = Σ_i π_i D_i over the last axis.
+
+    ``damages`` has shape (..., n_components) (dimensionless Miner damages, or damage
+    rates); ``weights`` the n_components costs π_i (currency per unit damage, >= 0).
+    """
+    d = np.asarray(damages, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    if w.ndim != 1:
+        raise ValueError(f"weights must be 1-D (one cost per component), got shape {w.shape}")
+    if d.ndim == 0 or d.shape[-1] != w.size:
+        raise ValueError(f"damages must have shape (..., {w.size}) to match weights, got {d.shape}")
+    if not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ValueError("weights must be finite and >= 0 (economic cost per unit damage)")
+    if not np.all(np.isfinite(d)) or np.any(d < 0):
+        raise ValueError("damages must be finite and >= 0")
+    return d @ w
