@@ -1,0 +1,445 @@
+"""Spectral fatigue: moments, damage rates (narrow-band, Dirlik, Tovo-Benasciutti, ...), DEL,
+and the damage sensitivity ΔD%(ω) of the seed paper's Eq. (7).
+
+Conventions (see WORKBENCH.md):
+
+- ω in rad/s; PSDs one-sided per rad/s (∫₀^∞ S(ω) dω = variance), in load units² per rad/s.
+- Spectral moments m_n = ∫ ω^n S(ω) dω by the trapezoid rule on the given (possibly
+  non-uniform) grid; rates derived from them are in Hz (cycles or peaks per second).
+- S-N curve range-based with S_ref = 1: N(S) = S^(-m), S the cycle **range**. The damage
+  rate is then E[Σ S_i^m] per second (load units^m / s); any other intercept divides it by
+  S_ref^m.
+- DEL at 1 Hz: DEL = (damage_rate / n_eq_rate)^(1/m), a range in load units.
+- Every function works on PSD stacks of shape (..., n): thousands of spectra are one call.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import gamma
+
+from ._checks import as_omega, as_psd, positive_scalar
+
+__all__ = [
+    "METHODS",
+    "trapezoid_weights",
+    "moments",
+    "SpectralStats",
+    "spectral_stats",
+    "damage_rate",
+    "del_spectral",
+    "dirlik_range_pdf",
+    "sensitivity",
+    "predicted_change",
+    "Change",
+    "exact_change",
+]
+
+# Every method is a closed form in these moments, so they are integrated once per spectrum.
+_ORDERS = (0.0, 0.75, 1.0, 1.5, 2.0, 4.0)
+# Below this bandwidth gap 1 - α2, Dirlik's coefficients are 0/0 and lose all digits; the
+# narrow-band (Rayleigh) result is their limit and is what a single-line spectrum should give.
+_NARROW = 1e-9
+
+
+def trapezoid_weights(omega) -> np.ndarray:
+    """Trapezoid quadrature weights w_k (rad/s) on a non-uniform grid: ∫ f dω ≈ Σ w_k f(ω_k)."""
+    w = as_omega(omega)
+    d = np.diff(w)
+    q = np.zeros_like(w)
+    q[:-1] += 0.5 * d
+    q[1:] += 0.5 * d
+    return q
+
+
+def _moment_matrix(w: np.ndarray, orders) -> np.ndarray:
+    # Column j holds w_k ω_k^n_j, so moments of a stack are one matrix product psd @ A.
+    q = trapezoid_weights(w)
+    return np.stack([q * w**n for n in orders], axis=-1)
+
+
+def moments(omega, psd, orders=(0, 1, 2, 4)) -> np.ndarray:
+    """Spectral moments m_n = ∫ ω^n S(ω) dω (trapezoid rule on the given grid).
+
+    Parameters
+    ----------
+    omega : array_like, shape (n,)
+        Strictly increasing, non-negative frequencies in rad/s.
+    psd : array_like, shape (..., n)
+        One-sided PSD(s) per rad/s.
+    orders : sequence of float
+        Moment orders n (>= 0, real).
+
+    Returns
+    -------
+    ndarray, shape (..., len(orders))
+        m_n in (load units)² (rad/s)^n.
+    """
+    w = as_omega(omega)
+    s = as_psd(psd, w.size)
+    o = np.atleast_1d(np.asarray(orders, dtype=float))
+    if o.ndim != 1 or not np.all(np.isfinite(o)) or np.any(o < 0):
+        raise ValueError(f"orders must be a sequence of finite, non-negative moment orders, got {orders!r}")
+    return s @ _moment_matrix(w, o)
+
+
+@dataclass(frozen=True)
+class SpectralStats:
+    """Spectral moments of a PSD stack, integrated once, and the parameters derived from them.
+
+    Each attribute has the stack shape (...). m_n in (load units)² (rad/s)^n.
+    """
+
+    m0: np.ndarray
+    m075: np.ndarray
+    m1: np.ndarray
+    m15: np.ndarray
+    m2: np.ndarray
+    m4: np.ndarray
+
+    @classmethod
+    def _from_array(cls, mom):
+        return cls(*(mom[..., j] for j in range(len(_ORDERS))))
+
+    @property
+    def nu0(self):
+        """Mean up-crossing rate of the mean level, Hz: √(m2/m0)/(2π)."""
+        return _safe_div_sqrt(self.m2, self.m0) / (2 * np.pi)
+
+    @property
+    def nu_p(self):
+        """Peak rate, Hz: √(m4/m2)/(2π)."""
+        return _safe_div_sqrt(self.m4, self.m2) / (2 * np.pi)
+
+    @property
+    def alpha1(self):
+        """Bandwidth parameter α1 = m1/√(m0 m2) (1 for a single line)."""
+        return _safe_div(self.m1, np.sqrt(self.m0 * self.m2))
+
+    @property
+    def alpha2(self):
+        """Irregularity factor α2 = m2/√(m0 m4) (1 for a single line)."""
+        return _safe_div(self.m2, np.sqrt(self.m0 * self.m4))
+
+    @property
+    def alpha075(self):
+        """Bandwidth parameter α0.75 = m0.75/√(m0 m1.5)."""
+        return _safe_div(self.m075, np.sqrt(self.m0 * self.m15))
+
+
+def _safe_div(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    ok = b != 0
+    return np.where(ok, a / np.where(ok, b, 1.0), 0.0)
+
+
+def _safe_div_sqrt(a, b):
+    return np.sqrt(_safe_div(a, b))
+
+
+def spectral_stats(omega, psd) -> SpectralStats:
+    """Integrate the moments m0, m0.75, m1, m1.5, m2, m4 of a PSD stack (..., n) once."""
+    return SpectralStats._from_array(moments(omega, psd, _ORDERS))
+
+
+# --- damage rates from moments ---------------------------------------------------------
+# Each takes the moment tuple (m0, m075, m1, m15, m2, m4) of equal-shape arrays and the
+# exponent m, and returns E[Σ S^m] per second for N = S^(-m), S the range. They are written
+# to accept complex moments so that the analytic sensitivity can use the complex step.
+# Spectra with m0 = 0 or m2 = 0 (no variance, or nothing but a static offset) carry no
+# cycles: their damage is set to zero by the caller.
+
+
+def _nb(mo, m):
+    m0, _, _, _, m2, _ = mo
+    nu0 = np.sqrt(m2 / m0) / (2 * np.pi)
+    # Rayleigh amplitudes with variance m0; range = 2 × amplitude.
+    return nu0 * (2.0 * np.sqrt(2.0 * m0)) ** m * gamma(1.0 + m / 2.0)
+
+
+def _dirlik_coefficients(mo):
+    m0, _, m1, _, m2, m4 = mo
+    xm = (m1 / m0) * np.sqrt(m2 / m4)
+    g = m2 / np.sqrt(m0 * m4)
+    g1 = 2.0 * (xm - g**2) / (1.0 + g**2)
+    r = (g - xm - g1**2) / (1.0 - g - g1 + g1**2)
+    g2 = (1.0 - g - g1 + g1**2) / (1.0 - r)
+    g3 = 1.0 - g1 - g2
+    q = 1.25 * (g - g3 - g2 * r) / g1
+    return g1, g2, g3, r, q
+
+
+def _abs(z):
+    # |z| that stays complex-analytic for a small imaginary (complex-step) perturbation.
+    return z * np.sign(np.real(z))
+
+
+def _dirlik(mo, m):
+    m0, _, _, _, m2, m4 = mo
+    g1, g2, g3, r, q = _dirlik_coefficients(mo)
+    nu_p = np.sqrt(m4 / m2) / (2 * np.pi)
+    bracket = g1 * q**m * gamma(1.0 + m) + np.sqrt(2.0) ** m * gamma(1.0 + m / 2.0) * (g2 * _abs(r) ** m + g3)
+    return nu_p * (2.0 * np.sqrt(m0)) ** m * bracket
+
+
+def _tb(mo, m):
+    m0, _, m1, _, m2, m4 = mo
+    a1 = m1 / np.sqrt(m0 * m2)
+    a2 = m2 / np.sqrt(m0 * m4)
+    # Tovo-Benasciutti 2005 weight (FLife "method 2").
+    b = (a1 - a2) * (1.112 * (1 + a1 * a2 - (a1 + a2)) * np.exp(2.11 * a2) + (a1 - a2)) / (a2 - 1) ** 2
+    return _nb(mo, m) * (b + (1.0 - b) * a2 ** (m - 1.0))
+
+
+def _alpha075(mo, m):
+    m0, m075, _, m15, _, _ = mo
+    return _nb(mo, m) * (m075 / np.sqrt(m0 * m15)) ** 2
+
+
+def _zhao_baker(mo, m):
+    m0, _, _, _, m2, m4 = mo
+    a2 = m2 / np.sqrt(m0 * m4)
+    a = 8.0 - 7.0 * a2
+    b = np.where(np.real(a2) < 0.9, 1.1 + 0 * a2, 1.1 + 9.0 * (a2 - 0.9))
+    w = (1.0 - a2) / (1.0 - np.sqrt(2.0 / np.pi) * gamma(1.0 + 1.0 / b) * a ** (-1.0 / b))
+    nu_p = np.sqrt(m4 / m2) / (2 * np.pi)
+    amp = w * a ** (-m / b) * gamma(1.0 + m / b) + (1.0 - w) * 2.0 ** (0.5 * m) * gamma(1.0 + 0.5 * m)
+    # Method 1 of Zhao & Baker, on amplitudes; ranges add 2^m.
+    return nu_p * 2.0**m * m0 ** (0.5 * m) * amp
+
+
+_METHODS = {
+    "narrowband": _nb,
+    "dirlik": _dirlik,
+    "tovo_benasciutti": _tb,
+    "alpha075": _alpha075,
+    "zhao_baker": _zhao_baker,
+}
+METHODS = tuple(_METHODS)
+
+
+def _check_method(method):
+    if method not in _METHODS:
+        raise ValueError(f"method={method!r} is not known; choose one of {METHODS}")
+    return _METHODS[method]
+
+
+def _damage_from_moments(mom, m, method):
+    """Damage rate for a moment array (..., 6) in _ORDERS; handles degenerate spectra."""
+    f = _check_method(method)
+    re = np.real(mom)
+    m0, m2, m4 = re[..., 0], re[..., 4], re[..., 5]
+    alive = (m0 > 0) & (m2 > 0)
+    safe = np.where(alive[..., None], mom, 1.0)
+    mo = tuple(safe[..., j] for j in range(len(_ORDERS)))
+    with np.errstate(all="ignore"):
+        d = f(mo, m)
+        if method in ("dirlik", "tovo_benasciutti", "zhao_baker"):
+            # α2 → 1 (a single spectral line): their coefficients are 0/0 there; the
+            # narrow-band result is the limit of all of them.
+            a2 = np.real(mo[4]) / np.sqrt(np.real(mo[0]) * np.real(mo[5]))
+            narrow = ((1.0 - a2) < _NARROW) | ~np.isfinite(d)
+            d = np.where(narrow, _nb(mo, m), d)
+    return np.where(alive, d, 0.0)
+
+
+def _prepare(omega, psd, m):
+    w = as_omega(omega)
+    s = as_psd(psd, w.size)
+    return w, s, positive_scalar(m, "m")
+
+
+def damage_rate(omega, psd, m, method: str = "dirlik") -> np.ndarray:
+    """Fatigue damage per second of a Gaussian load with one-sided PSD S(ω).
+
+    Parameters
+    ----------
+    omega : array_like, shape (n,)
+        Frequencies, rad/s (strictly increasing, >= 0).
+    psd : array_like, shape (..., n)
+        One-sided PSD(s) per rad/s, load units² s/rad.
+    m : float
+        Wöhler exponent (> 0, any real) of the range-based S-N curve N = S^(-m) (S_ref = 1;
+        for another intercept divide the result by S_ref^m).
+    method : str
+        "narrowband", "dirlik", "tovo_benasciutti" (TB 2005, FLife's "method 2"),
+        "alpha075" (Benasciutti's α0.75 correction) or "zhao_baker" (method 1).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        E[Σ S_i^m] per second (load units^m / s). Zero for an all-zero PSD; the narrow-band
+        limit for a (near) single-line PSD.
+    """
+    w, s, m = _prepare(omega, psd, m)
+    _check_method(method)
+    return _damage_from_moments(s @ _moment_matrix(w, _ORDERS), m, method)
+
+
+def del_spectral(omega, psd, m, method: str = "dirlik", n_eq_rate: float = 1.0) -> np.ndarray:
+    """Damage equivalent load (a range, load units) at ``n_eq_rate`` Hz (default 1 Hz).
+
+    DEL = (damage_rate / n_eq_rate)^(1/m): the constant range that, cycled n_eq_rate times a
+    second, does the damage of the spectrum. Same arguments as :func:`damage_rate`.
+    """
+    rate = positive_scalar(n_eq_rate, "n_eq_rate")
+    m = positive_scalar(m, "m")
+    return (damage_rate(omega, psd, m, method) / rate) ** (1.0 / m)
+
+
+def dirlik_range_pdf(omega, psd, ranges) -> np.ndarray:
+    """Dirlik's probability density of cycle **ranges** (1/load unit).
+
+    Parameters
+    ----------
+    omega, psd
+        Grid in rad/s and PSD stack (..., n) per rad/s.
+    ranges : array_like, shape (k,)
+        Ranges S >= 0 (load units) at which to evaluate the density.
+
+    Returns
+    -------
+    ndarray, shape (..., k)
+        p(S), integrating to 1 over S in [0, ∞). Rayleigh (narrow-band) for a single-line
+        spectrum; zeros for an all-zero one.
+    """
+    w = as_omega(omega)
+    s = as_psd(psd, w.size)
+    r = np.asarray(ranges, dtype=float)
+    if r.ndim != 1 or not np.all(np.isfinite(r)) or np.any(r < 0):
+        raise ValueError("ranges must be a 1-D array of finite, non-negative cycle ranges (load units)")
+    mom = s @ _moment_matrix(w, _ORDERS)
+    alive = (mom[..., 0] > 0) & (mom[..., 4] > 0)
+    mom = np.where(alive[..., None], mom, 1.0)
+    mo = tuple(mom[..., j] for j in range(len(_ORDERS)))
+    with np.errstate(all="ignore"):
+        g1, g2, g3, rr, q = (c[..., None] for c in _dirlik_coefficients(mo))
+        sd = np.sqrt(mo[0])[..., None]
+        z = r / (2.0 * sd)
+        p = (g1 / q * np.exp(-z / q) + g2 * z / rr**2 * np.exp(-(z**2) / (2 * rr**2)) + g3 * z * np.exp(-(z**2) / 2)) / (2 * sd)
+        a2 = (mo[4] / np.sqrt(mo[0] * mo[5]))[..., None]
+        rayleigh = z * np.exp(-(z**2) / 2) / (2 * sd)
+        p = np.where(((1.0 - a2) < _NARROW) | ~np.isfinite(p), rayleigh, p)
+    return np.where(alive[..., None], p, 0.0)
+
+
+def sensitivity(omega, psd, m, reduction: float = 0.01, method: str = "dirlik", analytic: bool = False) -> np.ndarray:
+    """Damage sensitivity ΔD%(ω) of the seed paper's Eq. (7), for every grid frequency.
+
+    ΔD%(ω_k) = 100 · (D_0 − D_k)/D_0, where D_k is the damage of the PSD with its value at ω_k
+    reduced by ``reduction`` (0.01 = the paper's 1 %). Moments are linear in S, so the N
+    modified spectra are one moment update, m_n − reduction · w_k ω_k^n S_k (w_k the
+    trapezoid weights), and the damage formula is evaluated once on all N moment sets.
+
+    Parameters
+    ----------
+    omega : array_like, shape (n,)
+        Grid, rad/s.
+    psd : array_like, shape (..., n)
+        One-sided PSD(s) per rad/s.
+    m : float
+        Wöhler exponent (> 0).
+    reduction : float
+        Relative reduction of S at one frequency, in (0, 1]; ignored with ``analytic``.
+    method : str
+        Damage method (see :func:`damage_rate`).
+    analytic : bool
+        If True, the limit reduction → 0 scaled to 1 %: 100 · 0.01 · S_k ∂D/∂S_k / D_0 from
+        exact (complex-step) derivatives of the damage with respect to the moments.
+
+    Returns
+    -------
+    ndarray, shape (..., n)
+        ΔD% per grid point (percent of D_0 for a 1 % reduction at that point; positive =
+        less damage). Zero for an all-zero PSD.
+    """
+    w, s, m = _prepare(omega, psd, m)
+    _check_method(method)
+    a = _moment_matrix(w, _ORDERS)  # (n, 6)
+    mom0 = s @ a  # (..., 6)
+    d0 = _damage_from_moments(mom0, m, method)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if analytic:
+            # Complex step: D(m + i h e_j) has imaginary part h ∂D/∂m_j with no cancellation.
+            grads = []
+            for j in range(len(_ORDERS)):
+                h = 1e-30 * np.maximum(np.abs(mom0[..., j]), 1e-300)
+                mc = mom0.astype(complex)
+                mc[..., j] += 1j * h
+                grads.append(np.imag(_damage_from_moments(mc, m, method)) / h)
+            dlogd = np.stack(grads, axis=-1) / d0[..., None]  # (..., 6)
+            out = 100.0 * 0.01 * s * (dlogd @ a.T)
+        else:
+            red = float(reduction)
+            if not 0 < red <= 1:
+                raise ValueError(f"reduction={reduction!r} must be in (0, 1] (0.01 is a 1 % reduction of S at one frequency)")
+            delta = red * s[..., :, None] * a  # (..., n, 6): Δm_n for each frequency k
+            dk = _damage_from_moments(mom0[..., None, :] - delta, m, method)
+            out = 100.0 * (d0[..., None] - dk) / d0[..., None]
+    return np.where((d0 > 0)[..., None], out, 0.0)
+
+
+def predicted_change(omega, sensitivity, t_mag2, w_mag2) -> np.ndarray:
+    """Predicted damage reduction (%) of a specification, the seed paper's Eq. (10).
+
+    ΔD_W = Σ_ω ΔD%(ω) · (|T(iω)|² − |W(iω)|²)/|T(iω)|² · 100, summed over the grid points
+    exactly as written (ΔD% is defined per grid point, so no quadrature weights).
+
+    Parameters
+    ----------
+    omega : array_like, shape (n,)
+        Grid in rad/s on which ``sensitivity`` was computed.
+    sensitivity : array_like, shape (..., n)
+        ΔD%(ω) from :func:`sensitivity` (per 1 % reduction).
+    t_mag2, w_mag2 : array_like, shape (..., n)
+        |T(iω)|² of the baseline and |W(iω)|² of the specification (any consistent unit).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Predicted reduction of damage in percent (positive = less damage). Grid points where
+        |T|² = 0 carry no spectrum and contribute nothing.
+    """
+    w = as_omega(omega)
+    dd = np.asarray(sensitivity, dtype=float)
+    t2 = np.asarray(t_mag2, dtype=float)
+    w2 = np.asarray(w_mag2, dtype=float)
+    for name, v in (("sensitivity", dd), ("t_mag2", t2), ("w_mag2", w2)):
+        if v.ndim == 0 or v.shape[-1] != w.size:
+            raise ValueError(f"{name} must have shape (..., {w.size}) to match omega, got {v.shape}")
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"{name} contains NaN or inf")
+    if np.any(t2 < 0) or np.any(w2 < 0):
+        raise ValueError("t_mag2 and w_mag2 are squared magnitudes |T|², |W|² and must be >= 0")
+    ok = t2 > 0
+    ds = np.where(ok, (t2 - w2) / np.where(ok, t2, 1.0) * 100.0, 0.0)
+    return np.sum(dd * ds, axis=-1)
+
+
+@dataclass(frozen=True)
+class Change:
+    """Exact change between two spectra (percent; positive = reduction)."""
+
+    damage_reduction: np.ndarray
+    del_reduction: np.ndarray
+    damage_before: np.ndarray
+    damage_after: np.ndarray
+
+
+def exact_change(omega, psd_before, psd_after, m, method: str = "dirlik") -> Change:
+    """Exact damage and DEL reduction (%) from ``psd_before`` to ``psd_after`` (both (..., n) per rad/s).
+
+    damage_reduction = 100 (1 − D_after/D_before); del_reduction = 100 (1 − (D_after/D_before)^(1/m)),
+    with D the damage rate of ``method`` (see :func:`damage_rate`).
+    """
+    w = as_omega(omega)
+    before = as_psd(psd_before, w.size, "psd_before")
+    after = as_psd(psd_after, w.size, "psd_after")
+    m = positive_scalar(m, "m")
+    d0 = damage_rate(w, before, m, method)
+    d1 = damage_rate(w, after, m, method)
+    if np.any(d0 <= 0):
+        raise ValueError("psd_before has zero damage (all-zero spectrum); a relative change is undefined")
+    ratio = d1 / d0
+    return Change(100.0 * (1.0 - ratio), 100.0 * (1.0 - ratio ** (1.0 / m)), d0, d1)
