@@ -200,8 +200,8 @@ def rainflow(x, residue: str = "half") -> Cycles:
         empty = np.empty(0)
         return Cycles(empty, empty.copy(), empty.copy())
     r, mu, c = (_rainflow_periodic if residue == "periodic" else _rainflow_half)(a)
-    if r.size and r.max() == 0.0:
-        # Only a constant signal yields zero ranges (one zero half cycle in rainflow).
+    if r.size == 1 and r[0] == 0.0 and a.max() == a.min():
+        # A constant signal: rainflow.extract_cycles reports one zero-range half cycle.
         r, mu, c = r[:0], mu[:0], c[:0]
     return Cycles(r, mu, c)
 
