@@ -1,0 +1,623 @@
+"""Batched time-domain simulation of the turbine in closed loop with any pitch controller.
+
+The plant is the compiled right-hand side of :mod:`specdesign.turbine` (the same function the
+linearisation differentiates), integrated by fixed-step RK4 inside one ``@njit`` loop that
+runs all seeds and wind speeds in parallel (``prange`` over runs). The wind is linearly
+interpolated between its samples for the RK4 stages; the pitch command and generator
+torque are held over a step (the controller is discrete, sampled at the simulation step).
+
+Controller convention (as everywhere in the workbench)::
+
+    β_cmd = β₀ − C_β·(Ω_g − Ω_rated) + C_atd·ẋ_top
+
+with C_β the pitch controller on the generator speed (β = −C·Ω_g in deviations) and an
+optional active-tower-damping controller C_atd on the tower-top fore-aft velocity (m/s),
+summed into the pitch command. β₀ is the trim pitch at the run's mean wind speed.
+
+Gain scheduling (``ScheduledController``): K local controllers, each designed at a
+scheduling pitch β_k, all run in parallel on the same measurements; their outputs are
+blended with piecewise-linear weights in a low-pass-filtered pitch command β_f (output
+blending, as in the seed paper). For ROSCO's PI, whose local controllers share the filter
+and differ only in their gains, output blending equals ROSCO's interpolated gains applied
+to a common integral of the error (ROSCO integrates K_i(β)·e instead; the two coincide at
+a fixed operating point and differ only while β_f moves).
+
+Three controller kinds are accepted wherever a controller is asked for: a python-control
+LTI system (SISO, proper; discretised by Tustin at the simulation step), a
+``loopshaping.controller.Controller`` (its ``.tf()``), a ``ScheduledController``, or a
+Python callable ``f(t, y) -> pitch_cmd`` (the slow path: called once per step with ``y`` a
+dict of the model outputs, each an array over all runs, returning the absolute pitch
+command in rad for all runs; use it for MPC or other time-domain controllers).
+
+A linear simulation of the same closed loop (``linear=True``) integrates the linearisation
+``model.linearize(v)`` with the same loop, the same RK4 step and the same discrete
+controller, so differences between the two are the plant's nonlinearity only.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit, prange
+
+from ._checks import positive_scalar
+
+__all__ = [
+    "KernelPlant",
+    "ScheduledController",
+    "SimulationResult",
+    "turbine_plant",
+    "scheduled",
+    "rosco_scheduled",
+    "discretize",
+    "simulate",
+    "linear_plant_params",
+]
+
+#: Default low-pass corner of the scheduling pitch filter (rad/s): slow enough that the
+#: scheduling variable follows the mean operating point rather than the turbulence
+#: (ROSCO filters its scheduling pitch at 0.1 × the 1 rad/s speed-filter corner).
+SCHEDULE_FILTER_OMEGA = 0.1
+
+
+# ----------------------------------------------------------------------------- plant
+@dataclass(frozen=True)
+class KernelPlant:
+    """A plant given by a compiled kernel pair, as :mod:`specdesign.turbine` defines it.
+
+    rhs, outputs : ``@njit`` functions ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` and
+        ``outputs(x, wind, pitch_cmd, gen_torque, p, y)`` (SI units).
+    params : flat float64 parameter array ``p``.
+    output_names : names of ``y`` in order; must contain ``gen_speed`` (rad/s),
+        ``tower_top_vel`` (m/s) and ``pitch`` (rad).
+    trim : ``trim(wind_speed) -> (x0, pitch0 rad, gen_torque N·m)`` steady operating point.
+    rated_speed : generator-speed reference Ω_rated (rad/s).
+    linearize : optional ``linearize(wind_speed) -> control.StateSpace`` with inputs
+        (wind, pitch_cmd, gen_torque) and outputs ``output_names``, deviations from trim.
+    """
+
+    rhs: object
+    outputs: object
+    params: np.ndarray = field(repr=False)
+    output_names: tuple
+    trim: object = field(repr=False)
+    rated_speed: float
+    linearize: object = field(default=None, repr=False)
+    name: str = "plant"
+
+    def index(self, name: str) -> int:
+        if name not in self.output_names:
+            raise ValueError(f"output {name!r} not among the plant outputs {self.output_names}")
+        return self.output_names.index(name)
+
+
+def turbine_plant(model=None) -> KernelPlant:
+    """Wrap a :class:`specdesign.turbine.TurbineModel` (default: ``iea15mw()``) as a KernelPlant."""
+    from . import turbine
+
+    if model is None:
+        model = turbine.iea15mw()
+    if isinstance(model, KernelPlant):
+        return model
+
+    def trim(v):
+        op = model.trim(v)
+        return np.array(op.x, dtype=float), float(op.pitch), float(op.gen_torque)
+
+    return KernelPlant(
+        rhs=turbine.rhs,
+        outputs=turbine.outputs,
+        params=np.ascontiguousarray(model.kernel_params(), dtype=float),
+        output_names=tuple(turbine.OUTPUT_NAMES),
+        trim=trim,
+        rated_speed=float(model.rated_rotor_speed),
+        linearize=model.linearize,
+        name=model.name,
+    )
+
+
+# ----------------------------------------------------------------------------- linear kernel
+# Parameter layout of the linear kernel: [nx, ny, u0(3), y0(ny), A, B(nx×3), C(ny×nx), D(ny×3)]
+@njit(cache=True)
+def _lin_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
+    nx = int(p[0])
+    ny = int(p[1])
+    du0 = wind - p[2]
+    du1 = pitch_cmd - p[3]
+    du2 = gen_torque - p[4]
+    a = 5 + ny
+    b = a + nx * nx
+    for i in range(nx):
+        s = p[b + 3 * i] * du0 + p[b + 3 * i + 1] * du1 + p[b + 3 * i + 2] * du2
+        for j in range(nx):
+            s += p[a + i * nx + j] * x[j]
+        dx[i] = s
+
+
+@njit(cache=True)
+def _lin_outputs(x, wind, pitch_cmd, gen_torque, p, y):
+    nx = int(p[0])
+    ny = int(p[1])
+    du0 = wind - p[2]
+    du1 = pitch_cmd - p[3]
+    du2 = gen_torque - p[4]
+    c = 5 + ny + nx * nx + 3 * nx
+    d = c + ny * nx
+    for i in range(ny):
+        s = p[5 + i] + p[d + 3 * i] * du0 + p[d + 3 * i + 1] * du1 + p[d + 3 * i + 2] * du2
+        for j in range(nx):
+            s += p[c + i * nx + j] * x[j]
+        y[i] = s
+
+
+def linear_plant_params(sys, u0, y0) -> np.ndarray:
+    """Flat parameter array of the linear kernel for ``sys`` (deviation model, inputs
+    wind/pitch_cmd/gen_torque in that order) around inputs ``u0`` and outputs ``y0`` (SI)."""
+    A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
+    if B.shape[1] != 3:
+        raise ValueError(f"linear plant must have 3 inputs (wind, pitch_cmd, gen_torque), got {B.shape[1]}")
+    nx, ny = A.shape[0], C.shape[0]
+    return np.concatenate([[nx, ny], np.asarray(u0, float), np.asarray(y0, float), A.ravel(), B.ravel(), C.ravel(), D.ravel()])
+
+
+# ----------------------------------------------------------------------------- controllers
+def _as_lti(c, name):
+    import control
+
+    if hasattr(c, "tf") and callable(c.tf) and not isinstance(c, control.LTI):
+        c = c.tf()
+    if not isinstance(c, control.LTI):
+        raise TypeError(f"{name} must be a python-control LTI system or a loopshaping Controller, got {type(c).__name__}")
+    if c.ninputs != 1 or c.noutputs != 1:
+        raise ValueError(f"{name} must be SISO, got {c.noutputs}×{c.ninputs}")
+    if c.isdtime(strict=True):
+        raise ValueError(f"{name} is discrete-time; pass the continuous controller (it is discretised at the simulation step)")
+    return c
+
+
+def discretize(controller, dt):
+    """Tustin discretisation of a SISO continuous controller at step ``dt`` (s).
+
+    Returns ``(A, B, C, D)`` float arrays of shapes (n, n), (n,), (n,), scalar D (a 1-tuple
+    array) of the discrete state-space form x⁺ = A x + B u, y = C x + D u.
+    Raises ValueError for an improper controller (more zeros than poles).
+    """
+    import control
+
+    dt = positive_scalar(dt, "dt")
+    c = _as_lti(controller, "controller")
+    if isinstance(c, control.TransferFunction):
+        num, den = np.atleast_1d(np.squeeze(c.num[0][0])), np.atleast_1d(np.squeeze(c.den[0][0]))
+        num = np.trim_zeros(num, "f")
+        if num.size > np.trim_zeros(den, "f").size:
+            raise ValueError("controller is improper (more zeros than poles); add a roll-off pole")
+    s = control.ss(c)
+    n = s.nstates
+    if n == 0:
+        return np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.array([float(np.squeeze(s.D))])
+    d = control.c2d(s, dt, method="tustin")
+    return (np.asarray(d.A, float), np.asarray(d.B, float).ravel(), np.asarray(d.C, float).ravel(),
+            np.array([float(np.squeeze(d.D))]))
+
+
+@dataclass(frozen=True)
+class ScheduledController:
+    """Local pitch (and optional ATD) controllers blended by output on filtered pitch.
+
+    schedule_pitch : (K,) increasing scheduling pitches β_k (rad), one per local controller.
+    pitch : K continuous SISO controllers C_β,k on the generator speed (β = −C·Ω_g).
+    atd : K continuous SISO controllers on tower-top velocity (β += C_atd·ẋ_top), or None.
+    filter_omega : corner (rad/s) of the first-order low-pass on the pitch command that
+        gives the scheduling variable.
+    name : label used in tables and figures.
+    """
+
+    schedule_pitch: np.ndarray
+    pitch: tuple
+    atd: tuple | None = None
+    filter_omega: float = SCHEDULE_FILTER_OMEGA
+    name: str = "controller"
+
+    def __post_init__(self):
+        b = np.atleast_1d(np.asarray(self.schedule_pitch, dtype=float))
+        if b.ndim != 1 or b.size < 1 or np.any(np.diff(b) <= 0) or not np.all(np.isfinite(b)):
+            raise ValueError(f"schedule_pitch must be a 1-D strictly increasing array of pitches in rad, got {b}")
+        object.__setattr__(self, "schedule_pitch", b)
+        if len(self.pitch) != b.size:
+            raise ValueError(f"pitch needs one controller per scheduling pitch ({b.size}), got {len(self.pitch)}")
+        if self.atd is not None and len(self.atd) != b.size:
+            raise ValueError(f"atd needs one controller per scheduling pitch ({b.size}), got {len(self.atd)}")
+        positive_scalar(self.filter_omega, "filter_omega")
+
+    def local(self, k: int):
+        """(C_β, C_atd or None) of the k-th local controller."""
+        return self.pitch[k], (None if self.atd is None else self.atd[k])
+
+
+def scheduled(model, pitch, atd=None, *, filter_omega=SCHEDULE_FILTER_OMEGA, name="designed") -> ScheduledController:
+    """Build a ScheduledController from controllers designed per wind speed.
+
+    pitch : dict wind speed (m/s) → pitch controller C_β (LTI or Controller).
+    atd : dict wind speed (m/s) → ATD controller, same keys, or None.
+    model : TurbineModel or KernelPlant whose trim gives each wind speed's scheduling pitch.
+    """
+    if not isinstance(pitch, dict) or not pitch:
+        raise TypeError("pitch must be a non-empty dict {wind_speed_m_s: controller}")
+    if atd is not None and set(atd) != set(pitch):
+        raise ValueError(f"atd must have the same wind speeds as pitch: {sorted(pitch)} vs {sorted(atd)}")
+    plant = turbine_plant(model)
+    vs = sorted(pitch)
+    b = np.array([plant.trim(v)[1] for v in vs])
+    order = np.argsort(b)
+    vs = [vs[i] for i in order]
+    return ScheduledController(
+        schedule_pitch=b[order],
+        pitch=tuple(_as_lti(pitch[v], f"pitch[{v}]") for v in vs),
+        atd=None if atd is None else tuple(_as_lti(atd[v], f"atd[{v}]") for v in vs),
+        filter_omega=filter_omega,
+        name=name,
+    )
+
+
+def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO") -> ScheduledController:
+    """The ROSCO baseline PI (tower damping off) with its gain schedule on filtered pitch.
+
+    Local controllers are ``turbine.rosco_baseline(model, v)`` at ``wind_speeds`` (m/s;
+    default every 1 m/s over the model's above-rated range), blended by output.
+    """
+    from . import turbine
+
+    if model is None:
+        model = turbine.iea15mw()
+    if wind_speeds is None:
+        lo, hi = getattr(model, "wind_range", (11.0, 25.0))
+        wind_speeds = np.arange(math.ceil(lo) + 1.0, hi + 0.5, 1.0)
+    return scheduled(model, {float(v): turbine.rosco_baseline(model, float(v)) for v in wind_speeds}, name=name)
+
+
+def _bank(controller, dt):
+    """Discrete arrays of one controller (K local 2-input controllers) and its filter corner."""
+    if not isinstance(controller, ScheduledController):
+        controller = ScheduledController(np.zeros(1), (_as_lti(controller, "controller"),), None, name="controller")
+    mats = []
+    for k in range(controller.schedule_pitch.size):
+        cb, ca = controller.local(k)
+        Ab, Bb, Cb, Db = discretize(cb, dt)
+        if ca is None:
+            Aa, Ba, Ca, Da = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1)
+        else:
+            Aa, Ba, Ca, Da = discretize(ca, dt)
+        nb, na = Ab.shape[0], Aa.shape[0]
+        A = np.zeros((nb + na, nb + na))
+        A[:nb, :nb], A[nb:, nb:] = Ab, Aa
+        B = np.zeros((nb + na, 2))
+        B[:nb, 0], B[nb:, 1] = Bb, Ba
+        mats.append((A, B, np.concatenate([Cb, Ca]), np.array([Db[0], Da[0]])))
+    return controller.schedule_pitch, mats, controller.filter_omega
+
+
+# ----------------------------------------------------------------------------- compiled loop
+@njit(cache=True)
+def _wind_at(w, wdt, t):
+    s = t / wdt
+    i = int(s)
+    if i >= w.size - 1:
+        return w[w.size - 1]
+    f = s - i
+    return w[i] * (1.0 - f) + w[i + 1] * f
+
+
+@njit(cache=True)
+def _rk4(rhs, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
+    n = x.size
+    rhs(x, _wind_at(w, wdt, t), beta_cmd, torque, p, k1)
+    for i in range(n):
+        xt[i] = x[i] + 0.5 * dt * k1[i]
+    wm = _wind_at(w, wdt, t + 0.5 * dt)
+    rhs(xt, wm, beta_cmd, torque, p, k2)
+    for i in range(n):
+        xt[i] = x[i] + 0.5 * dt * k2[i]
+    rhs(xt, wm, beta_cmd, torque, p, k3)
+    for i in range(n):
+        xt[i] = x[i] + dt * k3[i]
+    rhs(xt, _wind_at(w, wdt, t + dt), beta_cmd, torque, p, k4)
+    for i in range(n):
+        x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+
+
+@njit(cache=True)
+def _run_one(rhs, outfn, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
+             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr):
+    nx = x.size
+    nc = Ad.shape[1]
+    k1 = np.empty(nx)
+    k2 = np.empty(nx)
+    k3 = np.empty(nx)
+    k4 = np.empty(nx)
+    xt = np.empty(nx)
+    y = np.empty(ny)
+    xc = np.zeros((K, nc))
+    xn = np.empty(nc)
+    uk = np.empty(K)
+    bcmd = beta0
+    bf = beta0
+    j = 0
+    for k in range(nsteps):
+        t = k * dt
+        outfn(x, _wind_at(w, wdt, t), bcmd, torque, p, y)
+        if k % rec_every == 0:
+            for i in range(ny):
+                Yr[i, j] = y[i]
+            Yr[ny, j] = bcmd
+            j += 1
+        e = -(y[i_speed] - omega_ref)
+        v = y[i_vel]
+        for q in range(K):
+            s = Dd[q, 0] * e + Dd[q, 1] * v
+            for i in range(nc):
+                s += Cd[q, i] * xc[q, i]
+            uk[q] = s
+            for i in range(nc):
+                a = Bd[q, i, 0] * e + Bd[q, i, 1] * v
+                for m in range(nc):
+                    a += Ad[q, i, m] * xc[q, m]
+                xn[i] = a
+            for i in range(nc):
+                xc[q, i] = xn[i]
+        # Output blending: piecewise-linear weights in the filtered pitch, clamped at the ends.
+        if K == 1 or bf <= sched_pitch[0]:
+            u = uk[0]
+        elif bf >= sched_pitch[K - 1]:
+            u = uk[K - 1]
+        else:
+            q = 0
+            while sched_pitch[q + 1] < bf:
+                q += 1
+            f = (bf - sched_pitch[q]) / (sched_pitch[q + 1] - sched_pitch[q])
+            u = (1.0 - f) * uk[q] + f * uk[q + 1]
+        bcmd = beta0 + u
+        bf += a_filt * (bcmd - bf)
+        _rk4(rhs, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
+
+
+@njit(cache=True, parallel=True)
+def _run_batch(rhs, outfn, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
+               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y):
+    """All runs, one per prange iteration; the controller bank is shared by the batch."""
+    K = sched_pitch.size
+    for r in prange(X0.shape[0]):
+        x = X0[r].copy()
+        _run_one(rhs, outfn, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
+                 beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r])
+
+
+@njit(cache=True, parallel=True)
+def _step_all(rhs, outfn, P, X, W, wdt, t, dt, bcmd, torque, Y):
+    """One RK4 step of every run with a given pitch command, then the outputs at t + dt."""
+    for r in prange(X.shape[0]):
+        nx = X.shape[1]
+        k1 = np.empty(nx)
+        k2 = np.empty(nx)
+        k3 = np.empty(nx)
+        k4 = np.empty(nx)
+        xt = np.empty(nx)
+        x = X[r]
+        _rk4(rhs, x, W[r], wdt, t, dt, bcmd[r], torque[r], P[r], k1, k2, k3, k4, xt)
+        y = Y[r]
+        outfn(x, _wind_at(W[r], wdt, t + dt), bcmd[r], torque[r], P[r], y)
+
+
+@njit(cache=True, parallel=True)
+def _outputs_all(outfn, P, X, W, wdt, t, bcmd, torque, Y):
+    for r in prange(X.shape[0]):
+        y = Y[r]
+        outfn(X[r], _wind_at(W[r], wdt, t), bcmd[r], torque[r], P[r], y)
+
+
+# ----------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class SimulationResult:
+    """Time series of a batch of runs, shaped (n_wind_speeds, n_seeds, n_samples).
+
+    time : (n,) s, from the end of the discarded transient (starts at 0).
+    wind_speeds : (W,) mean wind speeds, m/s. seeds : (S,) integer seeds (None if the wind
+    was given). outputs : dict output name → (W, S, n) array in SI, plus ``pitch_cmd`` (rad)
+    and ``wind`` (m/s, the rotor-effective wind that drove the run).
+    dt : sample spacing of ``time`` (s); sim_dt : integration step (s); linear : True if
+    the linearised plant was integrated; controller : label.
+    """
+
+    time: np.ndarray
+    wind_speeds: np.ndarray
+    seeds: np.ndarray | None
+    outputs: dict = field(repr=False)
+    dt: float
+    sim_dt: float
+    linear: bool = False
+    controller: str = "controller"
+
+    def __getitem__(self, name):
+        if name not in self.outputs:
+            raise KeyError(f"no output {name!r}; available: {sorted(self.outputs)}")
+        return self.outputs[name]
+
+    @property
+    def duration(self) -> float:
+        """Length of each recorded run, s (n_samples × dt)."""
+        return float(self.time.size * self.dt)
+
+
+def seed_for(wind_speed: float, seed: int) -> int:
+    """Integer seed of the wind series for (wind speed, seed): ``seed·1000 + round(10·v)``.
+
+    Every (v, seed) pair gets its own series (v < 100 m/s), and two controllers run with the
+    same seed see exactly the same wind: the paired comparison of the validation.
+    """
+    return int(seed) * 1000 + int(round(10.0 * float(wind_speed)))
+
+
+def wind_series(plant_radius, wind_speeds, seeds, duration, dt, turbulence_class="B"):
+    """Rotor-effective wind (W, S, n) in m/s: mean plus :func:`specdesign.wind.synthesize` of
+    :func:`specdesign.wind.rotor_effective_spectrum` at each mean speed, seeds from :func:`seed_for`."""
+    from . import wind as wmod
+
+    out = []
+    for v in wind_speeds:
+        def spec(om, v=v):
+            return wmod.rotor_effective_spectrum(om, v, plant_radius, turbulence_class=turbulence_class)
+
+        s = wmod.synthesize(spec, duration, dt, [seed_for(v, s) for s in seeds])
+        out.append(v + np.asarray(s, dtype=float))
+    return np.stack(out)
+
+
+def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=600.0, dt=0.02,
+             record_dt=0.1, transient=60.0, wind_dt=None, turbulence_class="B", linear=False,
+             wind_rotor_radius=None) -> SimulationResult:
+    """Simulate the closed loop for every (wind speed, seed), all runs batched.
+
+    Parameters
+    ----------
+    plant : TurbineModel (e.g. ``turbine.iea15mw()``) or KernelPlant.
+    controller : LTI, loopshaping Controller, ScheduledController, or callable ``f(t, y)``
+        (see the module docstring for the sign convention and the callable contract).
+    wind_speeds : mean wind speeds, m/s (W of them).
+    seeds : integer seeds (S of them) for the turbulent wind; or give ``wind`` instead.
+    wind : optional (W, S, n_w) rotor-effective wind in m/s sampled every ``wind_dt`` s,
+        covering ``transient + duration``.
+    duration : recorded length of each run, s. transient : simulated before the record
+        starts (discarded), s. dt : integration and controller step, s. record_dt : sample
+        spacing of the recorded outputs, s (a multiple of ``dt``).
+    linear : integrate the linearisation at each wind speed instead of the nonlinear model.
+
+    Returns
+    -------
+    SimulationResult with outputs (W, S, n) for every plant output, ``pitch_cmd`` and ``wind``.
+    """
+    plant = turbine_plant(plant) if not isinstance(plant, KernelPlant) else plant
+    dt = positive_scalar(dt, "dt")
+    duration = positive_scalar(duration, "duration")
+    record_dt = positive_scalar(record_dt, "record_dt")
+    transient = float(transient)
+    if not transient >= 0:
+        raise ValueError(f"transient={transient!r} must be >= 0 s")
+    rec_every = int(round(record_dt / dt))
+    if rec_every < 1 or abs(rec_every * dt - record_dt) > 1e-9 * record_dt:
+        raise ValueError(f"record_dt={record_dt} must be a whole multiple of dt={dt}")
+    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    if vs.ndim != 1 or not np.all(np.isfinite(vs)) or np.any(vs <= 0):
+        raise ValueError(f"wind_speeds must be a 1-D array of positive mean wind speeds in m/s, got {wind_speeds!r}")
+    total = transient + duration
+    nsteps = int(round(total / dt))
+    if wind is None:
+        if seeds is None:
+            raise ValueError("give either seeds (turbulent wind is synthesised) or wind (W, S, n) in m/s")
+        seeds = np.atleast_1d(np.asarray(seeds, dtype=np.int64))
+        wind_dt = dt if wind_dt is None else positive_scalar(wind_dt, "wind_dt")
+        radius = wind_rotor_radius
+        if radius is None:
+            from . import turbine
+
+            radius = turbine.iea15mw().rotor_radius
+        wind = wind_series(radius, vs, seeds, total + wind_dt, wind_dt, turbulence_class)
+    else:
+        wind = np.asarray(wind, dtype=float)
+        if wind.ndim != 3 or wind.shape[0] != vs.size:
+            raise ValueError(f"wind must have shape (n_wind_speeds={vs.size}, n_seeds, n_samples), got {wind.shape}")
+        if wind_dt is None:
+            raise ValueError("wind_dt (s) is required with an explicit wind array")
+        wind_dt = positive_scalar(wind_dt, "wind_dt")
+        if (wind.shape[2] - 1) * wind_dt < total - 1e-9:
+            raise ValueError(f"wind covers {(wind.shape[2] - 1) * wind_dt:g} s but transient + duration = {total:g} s")
+        if not np.all(np.isfinite(wind)):
+            raise ValueError("wind contains NaN or inf")
+        seeds = None if seeds is None else np.atleast_1d(np.asarray(seeds))
+    W, S = wind.shape[:2]
+    R = W * S
+    Wr = np.ascontiguousarray(wind.reshape(R, -1))
+    ny = len(plant.output_names)
+    i_speed, i_vel = plant.index("gen_speed"), plant.index("tower_top_vel")
+
+    trims = [plant.trim(v) for v in vs]
+    beta0 = np.repeat([t[1] for t in trims], S)
+    torque = np.repeat([t[2] for t in trims], S)
+    if linear:
+        if plant.linearize is None:
+            raise ValueError("linear=True needs a plant with a linearize method")
+        rhs, outfn = _lin_rhs, _lin_outputs
+        rows, x0s = [], []
+        for v, (x0, b0, tq) in zip(vs, trims):
+            sys = plant.linearize(v)
+            y0 = np.empty(ny)
+            plant.outputs(np.asarray(x0, float), float(v), b0, tq, plant.params, y0)
+            rows.append(linear_plant_params(sys, [v, b0, tq], y0))
+            x0s.append(np.zeros(sys.nstates))
+        P = np.repeat(np.stack(rows), S, axis=0)
+        X0 = np.repeat(np.stack(x0s), S, axis=0)
+    else:
+        rhs, outfn = plant.rhs, plant.outputs
+        P = np.ascontiguousarray(np.broadcast_to(plant.params, (R, plant.params.size)))
+        X0 = np.repeat(np.stack([np.asarray(t[0], float) for t in trims]), S, axis=0)
+    X0 = np.ascontiguousarray(X0)
+    n_rec = (nsteps + rec_every - 1) // rec_every
+    Y = np.empty((R, ny + 1, n_rec))
+    omega_ref = np.full(R, plant.rated_speed)
+
+    if callable(controller) and not _is_lti_like(controller) and not isinstance(controller, ScheduledController):
+        label = getattr(controller, "__name__", "callable")
+        _run_callable(controller, rhs, outfn, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y, plant.output_names)
+    else:
+        label = getattr(controller, "name", "controller")
+        sched_pitch, mats, fw = _bank(controller, dt)
+        K = sched_pitch.size
+        nc = max(1, max(m[0].shape[0] for m in mats))
+        Ad = np.zeros((K, nc, nc))
+        Bd = np.zeros((K, nc, 2))
+        Cd = np.zeros((K, nc))
+        Dd = np.zeros((K, 2))
+        for q, (A, B, C, D) in enumerate(mats):
+            n = A.shape[0]
+            Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :] = A, B, C, D
+        a_filt = 1.0 - math.exp(-fw * dt)
+        _run_batch(rhs, outfn, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
+                   beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y)
+
+    skip = int(round(transient / record_dt))
+    t_rec = np.arange(n_rec) * record_dt
+    keep = slice(skip, skip + int(round(duration / record_dt)))
+    outs = {name: Y[:, i, keep].reshape(W, S, -1) for i, name in enumerate(plant.output_names)}
+    outs["pitch_cmd"] = Y[:, ny, keep].reshape(W, S, -1)
+    # The wind at the recorded instants, for spectra and plots.
+    idx_t = t_rec[keep]
+    outs["wind"] = np.stack([np.interp(idx_t, np.arange(Wr.shape[1]) * wind_dt, Wr[r]) for r in range(R)]).reshape(W, S, -1)
+    return SimulationResult(
+        time=idx_t - idx_t[0], wind_speeds=vs, seeds=seeds, outputs=outs, dt=record_dt, sim_dt=dt,
+        linear=linear, controller=str(label),
+    )
+
+
+def _is_lti_like(c) -> bool:
+    import control
+
+    return isinstance(c, control.LTI) or (hasattr(c, "tf") and callable(getattr(c, "tf")))
+
+
+def _run_callable(fn, rhs, outfn, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names):
+    X = X0.copy()
+    R = X.shape[0]
+    bcmd = beta0.copy()
+    y = np.empty((R, ny))
+    _outputs_all(outfn, P, X, Wr, wdt, 0.0, bcmd, torque, y)
+    j = 0
+    for k in range(nsteps):
+        t = k * dt
+        cmd = np.asarray(fn(t, {n: y[:, i].copy() for i, n in enumerate(names)}), dtype=float)
+        if cmd.shape != (R,) or not np.all(np.isfinite(cmd)):
+            raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}")
+        if k % rec_every == 0:
+            Y[:, :ny, j] = y
+            Y[:, ny, j] = bcmd  # the command held during the previous step, as in the compiled loop
+            j += 1
+        bcmd = cmd
+        _step_all(rhs, outfn, P, X, Wr, wdt, t, dt, bcmd, torque, y)
