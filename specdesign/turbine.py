@@ -482,6 +482,13 @@ class TurbineModel:
             D[:, k] = (yp - ym) / (2 * hu[k])
         return A, B, C, D
 
+    def rated_wind_speed(self) -> float:
+        """Lowest wind speed (m/s) at which rated torque is reached at rated speed and minimum pitch."""
+        from scipy.optimize import brentq
+
+        omega, torque = self.rated_rotor_speed, self.rated_generator_torque
+        return float(brentq(lambda v: self._aero_torque(v, omega, self.pitch_min) - torque, 5.0, 20.0, xtol=1e-10))
+
     def linearize(self, wind_speed):
         """Linear model at the trim for ``wind_speed`` (m/s, 11-25): a ``control.StateSpace``
         with inputs ``wind`` (m/s), ``pitch_cmd`` (rad), ``gen_torque`` (N·m), outputs
@@ -531,3 +538,97 @@ def iea15mw() -> TurbineModel:
         cp_table=cp,
         ct_table=ct,
     )
+
+
+# ----------------------------------------------------------------------------- ROSCO baseline
+@dataclass(frozen=True)
+class RoscoSchedule:
+    """ROSCO's pitch PI gain schedule computed from a :class:`TurbineModel`.
+
+    Arrays over ``v`` (m/s): ``pitch_op`` (rad), ``Kp`` (s), ``Ki`` (-), and the first-order
+    rotor model δΩ̇ = A δΩ + B_beta δβ + B_wind δv: ``A`` (1/s), ``B_beta`` (1/s²),
+    ``B_wind`` (rad/m). ``A_fit`` and ``B_beta_fit`` are the straight-line fits over ``v`` that
+    ROSCO's tuning uses for the gains (``second_order_PI(..., linearize=True)``).
+    Gains follow ROSCO's sign: pitch = Kp·e + Ki∫e with e = reference − filtered speed.
+    """
+
+    v: np.ndarray
+    pitch_op: np.ndarray
+    Kp: np.ndarray
+    Ki: np.ndarray
+    A: np.ndarray
+    B_beta: np.ndarray
+    B_wind: np.ndarray
+    A_fit: np.ndarray
+    B_beta_fit: np.ndarray
+    omega_pc: float
+    zeta_pc: float
+
+
+def _rotor_coefficients(model: TurbineModel, v: float):
+    """(pitch_op, A, B_beta, B_wind) of the rotor equation at the trim, from the kernel's Jacobian."""
+    op = model.trim(v)
+    A, B, _, _ = model.jacobians(op)
+    # Row 0 is δΩ̇; column 3 is the pitch state, input 0 the wind.
+    return op.pitch, A[0, 0], A[0, 3], B[0, 0]
+
+
+def rosco_gain_schedule(model: TurbineModel, wind_speeds=None, *, omega_pc: float = 0.2, zeta_pc: float = 1.0) -> RoscoSchedule:
+    """ROSCO's pitch PI schedule by pole placement on the first-order rotor model.
+
+    With e = Ω_ref − Ω and β = Kp·e + Ki∫e, the closed rotor loop is
+    s² + (B_β·Kp − A)s + B_β·Ki; matching s² + 2ζ_pc ω_pc s + ω_pc² gives
+    Kp = (2ζ_pc ω_pc + A)/B_β and Ki = ω_pc²/B_β, where, as in ROSCO, A and B_β are replaced
+    by their straight-line fits over ``wind_speeds``.
+
+    wind_speeds (m/s): default ROSCO's grid, 30 speeds from rated (exclusive) to 25 m/s.
+    omega_pc (rad/s), zeta_pc (-): desired closed-loop rotor-speed poles.
+    """
+    omega_pc = positive_scalar(omega_pc, "omega_pc")
+    zeta_pc = positive_scalar(zeta_pc, "zeta_pc")
+    if wind_speeds is None:
+        wind_speeds = np.linspace(model.rated_wind_speed(), model.wind_range[1], 31)[1:]
+    v = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    if v.ndim != 1 or v.size < 2:
+        raise ValueError(f"wind_speeds must be a 1-D array of at least 2 speeds in m/s (the gains use a line fit), got shape {v.shape}")
+    rows = np.array([_rotor_coefficients(model, s) for s in v])
+    pitch, A, Bb, Bw = rows.T
+    A_fit = np.polyval(np.polyfit(v, A, 1), v)
+    B_fit = np.polyval(np.polyfit(v, Bb, 1), v)
+    return RoscoSchedule(
+        v=v, pitch_op=pitch, Kp=(2 * zeta_pc * omega_pc + A_fit) / B_fit, Ki=omega_pc**2 / B_fit,
+        A=A, B_beta=Bb, B_wind=Bw, A_fit=A_fit, B_beta_fit=B_fit, omega_pc=omega_pc, zeta_pc=zeta_pc,
+    )
+
+
+def speed_filter(corner: float = 1.0081, damping: float = 0.7):
+    """ROSCO's 2nd-order generator-speed low-pass F(s) = ω_f²/(s² + 2ζω_f s + ω_f²), ω_f in rad/s."""
+    import control
+
+    wf = positive_scalar(corner, "corner")
+    z = positive_scalar(damping, "damping")
+    return control.tf([wf**2], [1.0, 2 * z * wf, wf**2])
+
+
+def rosco_baseline(model: TurbineModel, wind_speed, *, omega_pc: float = 0.2, zeta_pc: float = 1.0, schedule: RoscoSchedule | None = None):
+    """ROSCO's baseline pitch controller at ``wind_speed`` (m/s) as C(s) = (Kp + Ki/s)·F_lpf(s).
+
+    Sign convention of the workbench: β = −C·Ω_g (pitch in rad, generator speed in rad/s), so
+    ROSCO's negative gains on e = reference − speed give C directly, and L = C·P_{Ω,β} has both
+    factors negative at low frequency. Kp, Ki come from the straight-line fits of
+    :func:`rosco_gain_schedule` (default grid) evaluated at ``wind_speed``; F_lpf is
+    :func:`speed_filter`. Tower damping off, as in the paper's baseline.
+    """
+    import control
+
+    v = model._check_wind(wind_speed)
+    if schedule is None:
+        schedule = rosco_gain_schedule(model, omega_pc=omega_pc, zeta_pc=zeta_pc)
+    pa = np.polyfit(schedule.v, schedule.A, 1)
+    pb = np.polyfit(schedule.v, schedule.B_beta, 1)
+    a, b = np.polyval(pa, v), np.polyval(pb, v)
+    kp = (2 * schedule.zeta_pc * schedule.omega_pc + a) / b
+    ki = schedule.omega_pc**2 / b
+    pi = control.tf([kp, ki], [1.0, 0.0])
+    c = pi * speed_filter()
+    return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=f"ROSCO_PI@{v:g}mps")
