@@ -502,7 +502,7 @@ class TurbineModel:
         return control.ss(
             A, B, C, D,
             inputs=list(INPUT_NAMES), outputs=list(OUTPUT_NAMES), states=list(STATE_NAMES),
-            name=f"{self.name}@{op.wind_speed:g}mps",
+            name=f"{self.name}@{op.wind_speed:g}mps".replace(".", "p"),
         )
 
 
@@ -631,4 +631,4 @@ def rosco_baseline(model: TurbineModel, wind_speed, *, omega_pc: float = 0.2, ze
     ki = schedule.omega_pc**2 / b
     pi = control.tf([kp, ki], [1.0, 0.0])
     c = pi * speed_filter()
-    return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=f"ROSCO_PI@{v:g}mps")
+    return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=f"ROSCO_PI@{v:g}mps".replace(".", "p"))

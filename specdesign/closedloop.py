@@ -1,0 +1,210 @@
+"""Closed-loop maps wind → output for a pitch controller and an optional tower-damping loop.
+
+Sign convention (WORKBENCH.md): the pitch command is
+
+    β_cmd = −C_β·Ω_g − C_atd·z,
+
+C_β the pitch controller on generator speed Ω_g (ROSCO's PI with its speed filter, see
+:func:`specdesign.turbine.rosco_baseline`) and C_atd the active tower damping (ATD)
+controller on the tower-motion measurement z (``tower_top_vel`` by default). Both are
+negative feedback; L = C_β·P_{Ω,β} is the loop QFT shapes. The generator-torque input is held
+constant (zero deviation), as above rated.
+
+Closing the loops by hand gives, with Δ = 1 + C_β P_{Ω,β} + C_atd P_{z,β},
+
+    T_{y,w} = [P_{y,w} + C_β(P_{y,w}P_{Ω,β} − P_{y,β}P_{Ω,w}) + C_atd(P_{y,w}P_{z,β} − P_{y,β}P_{z,w})] / Δ
+
+(Eq. 4 of the paper is y = Ω_g without ATD, Eq. 5 y = MyT). :func:`closed_loop` builds the
+same system with ``control.interconnect``; the tests check the two agree.
+"""
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+
+import numpy as np
+
+from ._checks import as_omega, as_psd, positive_scalar
+
+__all__ = [
+    "ClosedLoopUnstableWarning",
+    "closed_loop",
+    "check_stability",
+    "frequency_response",
+    "t_output_wind",
+    "t_gen_speed_wind",
+    "t_tower_wind",
+    "output_psd",
+    "closed_loop_del",
+]
+
+
+class ClosedLoopUnstableWarning(UserWarning):
+    """A closed loop has poles with non-negative real part."""
+
+
+def _named_siso(sys, name, inp, out):
+    import control
+
+    if isinstance(sys, (int, float)):
+        sys = control.tf([float(sys)], [1.0])
+    if not isinstance(sys, control.LTI):
+        raise TypeError(f"{name} must be a python-control LTI system (tf or ss), got {type(sys).__name__}")
+    if sys.ninputs != 1 or sys.noutputs != 1:
+        raise ValueError(f"{name} must be SISO, got {sys.noutputs} outputs × {sys.ninputs} inputs")
+    ss = control.ss(sys)
+    return control.ss(ss.A, ss.B, ss.C, ss.D, inputs=[inp], outputs=[out], name=name)
+
+
+def _require(sys, name, inputs=(), outputs=()):
+    missing = [s for s in inputs if s not in sys.input_labels] + [s for s in outputs if s not in sys.output_labels]
+    if missing:
+        raise ValueError(
+            f"{name} lacks the named signals {missing}; it has inputs {sys.input_labels} and outputs "
+            f"{sys.output_labels} (build it with specdesign.turbine or name them with control's inputs=/outputs=)"
+        )
+
+
+def closed_loop(plant, pitch_controller, atd_controller=None, atd_measurement="tower_top_vel", *, warn=True):
+    """Close the pitch (and optional ATD) loop around ``plant`` with ``control.interconnect``.
+
+    plant: named LTI with inputs ``wind`` and ``pitch_cmd`` (others, e.g. ``gen_torque``, held
+    at zero) and outputs including ``gen_speed`` and, with ATD, ``atd_measurement``.
+    pitch_controller: SISO LTI C_β (gen_speed rad/s → pitch rad); atd_controller: SISO LTI
+    C_atd (measurement → pitch rad) or None. Returns a StateSpace with input ``wind`` and
+    outputs all plant outputs plus ``pitch_cmd``; warns :class:`ClosedLoopUnstableWarning`
+    when unstable (``warn=False`` to skip the check).
+    """
+    import control
+
+    if not isinstance(plant, control.LTI):
+        raise TypeError(f"plant must be a named python-control LTI system, got {type(plant).__name__}")
+    needed = ["gen_speed"] + ([atd_measurement] if atd_controller is not None else [])
+    _require(plant, "plant", inputs=("wind", "pitch_cmd"), outputs=needed)
+    p = control.ss(plant)[list(plant.output_labels), ["wind", "pitch_cmd"]]
+    p = control.ss(p.A, p.B, p.C, p.D, inputs=["wind", "pitch_cmd"], outputs=list(plant.output_labels), name="plant")
+    systems = [p, _named_siso(pitch_controller, "pitch_controller", "gen_speed", "u_pitch")]
+    terms = ["-u_pitch"]
+    if atd_controller is not None:
+        systems.append(_named_siso(atd_controller, "atd_controller", atd_measurement, "u_atd"))
+        terms.append("-u_atd")
+    systems.append(control.summing_junction(inputs=terms, output="pitch_cmd", name="pitch_sum"))
+    outlist = list(plant.output_labels) + ["pitch_cmd"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", category=UserWarning)  # unused-signal notices for plant outputs
+        sys = control.interconnect(systems, inplist=["wind"], outlist=outlist, inputs=["wind"], outputs=outlist, name="closed_loop")
+    if warn:
+        check_stability(sys, "closed loop")
+    return sys
+
+
+def check_stability(sys, name="system", tol=0.0):
+    """True when every pole of ``sys`` has real part < −tol (1/s); otherwise warn
+    :class:`ClosedLoopUnstableWarning` naming ``name`` and listing the offending poles, and return False.
+    """
+    poles = np.asarray(sys.poles())
+    bad = poles[poles.real >= -tol]
+    if bad.size:
+        listing = ", ".join(f"{z.real:.4g}{z.imag:+.4g}j" for z in np.sort_complex(bad))
+        warnings.warn(f"{name} is unstable: poles with Re ≥ {-tol:g} 1/s: {listing}", ClosedLoopUnstableWarning, stacklevel=2)
+        return False
+    return True
+
+
+def frequency_response(sys, omega, output, input="wind"):
+    """Complex frequency response of ``sys[output, input]`` at s = jω (omega in rad/s).
+
+    ``sys`` is a named python-control LTI system; units are those of the output per unit input.
+    """
+    import control
+
+    w = as_omega(omega, "omega")
+    if not isinstance(sys, control.LTI):
+        raise TypeError(f"sys must be a python-control LTI system, got {type(sys).__name__}")
+    _require(sys, "sys", inputs=(input,), outputs=(output,))
+    i = sys.input_labels.index(input)
+    o = sys.output_labels.index(output)
+    return np.asarray(sys(1j * w, squeeze=False))[o, i, :]
+
+
+def _response(P, omega, output, input):
+    """P is an LTI plant or a mapping {(output, input): complex array on omega}."""
+    if isinstance(P, Mapping):
+        try:
+            r = np.asarray(P[(output, input)], dtype=complex)
+        except KeyError:
+            raise ValueError(f"P has no response for (output, input) = {(output, input)!r}; keys: {sorted(P)}") from None
+        if r.shape != omega.shape:
+            raise ValueError(f"P[{(output, input)!r}] has shape {r.shape}, expected {omega.shape} to match omega")
+        return r
+    return frequency_response(P, omega, output, input)
+
+
+def _controller(C, omega, name):
+    import control
+
+    if C is None:
+        return np.zeros(omega.shape, complex)
+    if isinstance(C, control.LTI):
+        if C.ninputs != 1 or C.noutputs != 1:
+            raise ValueError(f"{name} must be SISO")
+        return np.asarray(C(1j * omega, squeeze=False))[0, 0, :]
+    c = np.asarray(C, dtype=complex)
+    if c.shape != omega.shape:
+        raise ValueError(f"{name} as a frequency response must have shape {omega.shape} to match omega, got {c.shape}")
+    return c
+
+
+def t_output_wind(P, C, omega, output, atd_controller=None, atd_measurement="tower_top_vel"):
+    """Closed-loop response wind → ``output`` at jω by the explicit formula (module docstring).
+
+    P: named plant LTI or a mapping {(output, input): response}; C: pitch controller (LTI or its
+    complex response on omega), sign β = −C·Ω_g; atd_controller likewise on
+    ``atd_measurement``. omega in rad/s. Returns a complex array (output units per m/s).
+    """
+    w = as_omega(omega, "omega")
+    c = _controller(C, w, "C")
+    p_yw, p_yb = _response(P, w, output, "wind"), _response(P, w, output, "pitch_cmd")
+    p_ow, p_ob = _response(P, w, "gen_speed", "wind"), _response(P, w, "gen_speed", "pitch_cmd")
+    num = p_yw + c * (p_yw * p_ob - p_yb * p_ow)
+    den = 1 + c * p_ob
+    if atd_controller is not None:
+        k = _controller(atd_controller, w, "atd_controller")
+        p_zw, p_zb = _response(P, w, atd_measurement, "wind"), _response(P, w, atd_measurement, "pitch_cmd")
+        num = num + k * (p_yw * p_zb - p_yb * p_zw)
+        den = den + k * p_zb
+    return num / den
+
+
+def t_gen_speed_wind(P, C, omega, **atd):
+    """Eq. (4): T_{Ω,w} = P_{Ω,w}/(1 + C·P_{Ω,β}) at jω ((rad/s) per (m/s)); see :func:`t_output_wind`."""
+    return t_output_wind(P, C, omega, "gen_speed", **atd)
+
+
+def t_tower_wind(P, C, omega, **atd):
+    """Corrected Eq. (5): T_{MyT,w} = [P_{MyT,w} + C(P_{MyT,w}P_{Ω,β} − P_{MyT,β}P_{Ω,w})]/(1 + C·P_{Ω,β})
+    at jω (N·m per m/s); see :func:`t_output_wind`."""
+    return t_output_wind(P, C, omega, "tower_base_my", **atd)
+
+
+def output_psd(sys, omega, wind_psd, output, input="wind"):
+    """One-sided output PSD S_y = |T_{y,w}(jω)|²·S_W(ω) (output units² per rad/s).
+
+    sys: closed-loop (or open-loop) named LTI; wind_psd: S_W on omega ((m/s)² per rad/s).
+    """
+    w = as_omega(omega, "omega")
+    s_w = as_psd(wind_psd, w.size, "wind_psd")
+    return np.abs(frequency_response(sys, w, output, input)) ** 2 * s_w
+
+
+def closed_loop_del(sys, omega, wind_psd, m, output="tower_base_my", method="dirlik", input="wind"):
+    """Damage-equivalent load at 1 Hz of ``output`` from its spectrum |T|²·S_W (a RANGE, output units).
+
+    S-N curve N(S) = (S_ref/S)^m with S the cycle range; m the Wöhler exponent; method one of
+    :func:`specdesign.spectral.damage_rate`'s ("dirlik", "narrowband", "tovo_benasciutti", ...).
+    """
+    from .spectral import del_spectral
+
+    m = positive_scalar(m, "m")
+    w = as_omega(omega, "omega")
+    return float(del_spectral(w, output_psd(sys, w, wind_psd, output, input), m, method))
