@@ -1,0 +1,96 @@
+"""Validation figures: Welch vs linear prediction (paper Fig. 8), time series (Fig. 9),
+predicted vs rainflow DEL reduction (Fig. 10). Results in, axes out; no plt.show()."""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["plot_spectra", "plot_time_series", "plot_reductions"]
+
+_UNITS = {"gen_speed": ("Generator speed", "(rad/s)²/(rad/s)"), "tower_base_my": ("Tower-base fore-aft moment", "(N·m)²/(rad/s)")}
+
+
+def _axes(ax, **kw):
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(**kw)
+    return ax
+
+
+def plot_spectra(campaign, wind_speed, output="tower_base_my", *, controllers=None, ax=None):
+    """Fig. 8: seed-averaged Welch PSD (solid) and linear prediction |T|²S_W (dashed) of
+    ``output`` at ``wind_speed`` (m/s) for each controller of a :class:`~specdesign.validate.Campaign`.
+    Log-log axes, ω in rad/s, PSD per rad/s. Returns the axes."""
+    ax = _axes(ax)
+    i = int(np.argmin(np.abs(campaign.wind_speeds - float(wind_speed))))
+    if abs(campaign.wind_speeds[i] - float(wind_speed)) > 1e-9:
+        raise ValueError(f"wind_speed={wind_speed} m/s is not in the campaign {campaign.wind_speeds.tolist()}")
+    if output not in campaign.welch:
+        raise ValueError(f"output={output!r} must be one of {sorted(campaign.welch)}")
+    names = campaign.controllers if controllers is None else controllers
+    w = campaign.omega
+    sel = w > 0
+    for k, name in enumerate(names):
+        c = campaign.index(name)
+        color = f"C{k}"
+        ax.loglog(w[sel], campaign.welch[output][c, i][sel], color=color, label=f"{name} simulation (Welch)")
+        pred = campaign.predicted_psd[output][c, i][sel]
+        if np.any(np.isfinite(pred)):
+            ax.loglog(w[sel], pred, color=color, ls="--", label=f"{name} linear |T|²S_W")
+    label, unit = _UNITS.get(output, (output, "SI²/(rad/s)"))
+    ax.set_xlabel("ω (rad/s)")
+    ax.set_ylabel(f"PSD {unit}")
+    ax.set_title(f"{label}, {campaign.wind_speeds[i]:g} m/s")
+    ax.legend(fontsize="small")
+    ax.grid(True, which="both", alpha=0.3)
+    return ax
+
+
+def plot_time_series(series, wind_speed, *, seed_index=0, controllers=None, axes=None):
+    """Fig. 9: generator speed (rpm), tower-base moment (MN·m), power (MW) and pitch (deg) of
+    one seed at ``wind_speed`` (m/s) for each controller.
+
+    series : dict controller → :class:`~specdesign.simulate.SimulationResult` (e.g.
+    ``Campaign.series``). axes : four stacked axes or None (a new figure). Returns the axes.
+    """
+    if axes is None:
+        import matplotlib.pyplot as plt
+
+        _, axes = plt.subplots(4, 1, figsize=(8, 8), sharex=True)
+    axes = np.asarray(axes).ravel()
+    if axes.size != 4:
+        raise ValueError(f"axes must hold 4 axes (speed, moment, power, pitch), got {axes.size}")
+    names = list(series) if controllers is None else controllers
+    panels = [
+        ("gen_speed", 60 / (2 * np.pi), "Gen. speed (rpm)"),
+        ("tower_base_my", 1e-6, "Tower-base My (MN·m)"),
+        ("power", 1e-6, "Power (MW)"),
+        ("pitch", 180 / np.pi, "Pitch (deg)"),
+    ]
+    for k, name in enumerate(names):
+        r = series[name]
+        i = int(np.argmin(np.abs(r.wind_speeds - float(wind_speed))))
+        if abs(r.wind_speeds[i] - float(wind_speed)) > 1e-9:
+            raise ValueError(f"wind_speed={wind_speed} m/s was not simulated for {name}")
+        for ax, (key, scale, ylabel) in zip(axes, panels):
+            ax.plot(r.time, r[key][i, seed_index] * scale, color=f"C{k}", lw=0.8, label=name)
+            ax.set_ylabel(ylabel)
+    axes[-1].set_xlabel("time (s)")
+    axes[0].legend(fontsize="small", loc="upper right")
+    axes[0].set_title(f"{float(wind_speed):g} m/s, seed index {seed_index}")
+    return axes
+
+
+def plot_reductions(acc, *, ax=None):
+    """Fig. 10: tower-base DEL reduction (%) vs mean wind speed (m/s): linear prediction and
+    rainflow evaluation with ±1 standard error bars (paired seeds). ``acc`` is an
+    :class:`~specdesign.validate.Acceptance`. Returns the axes."""
+    ax = _axes(ax)
+    ax.plot(acc.wind_speeds, acc.predicted, "o--", label="linear prediction (Dirlik on |T|²S_W)")
+    ax.errorbar(acc.wind_speeds, acc.rainflow, yerr=acc.se, fmt="s-", capsize=3,
+                label=f"rainflow ({acc.n_seeds} paired seeds, ±1 SE)")
+    ax.set_xlabel("mean wind speed (m/s)")
+    ax.set_ylabel("tower-base DEL reduction (%)")
+    ax.legend(fontsize="small")
+    ax.grid(True, alpha=0.3)
+    return ax

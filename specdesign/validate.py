@@ -1,0 +1,763 @@
+"""Offline validation: indicators, spectra, paired-seed statistics and the paper's Tables 2-3.
+
+Works on arrays, so the same post-processing serves :func:`specdesign.simulate.simulate` runs
+and the user's OpenFAST outputs (:func:`series_from_openfast`).
+
+Indicators per run (the paper's four, plus pitch rate): tower-base DEL by rainflow (a range,
+N·m, 1 Hz convention, Wöhler exponent m = 4 by default), generator-speed SD (rad/s), mean
+electrical power (W), pitch SD (rad) and pitch-rate SD (rad/s).
+
+Per wind speed, seeds are pooled the way fatigue adds up: DEL over S seeds of equal length
+is (mean_s DEL_s^m)^{1/m} (the DEL of the concatenated damage), SDs are pooled as
+√(mean_s var_s), the power is the plain mean. A *relative change* designed vs baseline is
+100·(X_designed/X_baseline − 1) %; a *reduction* is minus that. Both controllers see the same
+seeds (paired), and standard errors come from the jackknife over paired seeds (delete one
+seed from both controllers), or a seeded paired bootstrap.
+
+Weibull mean (Table 2's "Mean" column): Σ w_i c_i with w_i = f(v_i)/Σ_j f(v_j), f the Weibull
+pdf with k = 2.2, A = 11.29 m/s evaluated at the operating points. This reproduces the means
+printed in the paper's Table 2 from its per-speed values (tested).
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ._checks import positive_scalar
+
+__all__ = [
+    "WEIBULL_K",
+    "WEIBULL_A",
+    "OPENFAST_CHANNELS",
+    "weibull_weights",
+    "welch_psd",
+    "Indicators",
+    "indicators",
+    "series_from_openfast",
+    "closed_loop_response",
+    "LinearPrediction",
+    "linear_prediction",
+    "PairedChange",
+    "paired_change",
+    "Campaign",
+    "run_campaign",
+    "Table",
+    "table2",
+    "table3",
+    "Acceptance",
+    "acceptance",
+    "load_controller",
+    "run_config",
+]
+
+WEIBULL_K = 2.2
+WEIBULL_A = 11.29
+#: OpenFAST channel → workbench output name.
+OPENFAST_CHANNELS = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power"}
+_INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd")
+_LABELS = {
+    "gen_speed_sd": "Generator speed SD",
+    "mean_power": "Mean power",
+    "tower_del": "Tower base DEL",
+    "pitch_sd": "Pitch activity (SD)",
+    "pitch_rate_sd": "Pitch rate SD",
+}
+
+
+# ----------------------------------------------------------------------------- basics
+def weibull_weights(wind_speeds, k: float = WEIBULL_K, scale: float = WEIBULL_A) -> np.ndarray:
+    """Weights of the operating points: Weibull pdf at each wind speed, normalised to sum 1.
+
+    f(v) = (k/A)(v/A)^{k−1} exp(−(v/A)^k), w_i = f(v_i)/Σ f(v_j); v and A in m/s.
+    """
+    v = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    if v.ndim != 1 or v.size == 0 or np.any(~np.isfinite(v)) or np.any(v <= 0):
+        raise ValueError(f"wind_speeds must be positive mean wind speeds in m/s, got {wind_speeds!r}")
+    k = positive_scalar(k, "k")
+    a = positive_scalar(scale, "scale")
+    f = (k / a) * (v / a) ** (k - 1) * np.exp(-((v / a) ** k))
+    return f / f.sum()
+
+
+def welch_psd(x, dt, nperseg: int | None = None, axis: int = -1):
+    """One-sided Welch PSD per rad/s of ``x`` sampled every ``dt`` s.
+
+    scipy's ``welch`` with ``fs = 1/dt`` returns f (Hz) and P(f) per Hz, one-sided. With
+    ω = 2πf the density per rad/s is S(ω) = P(f)/(2π), so that ∫ S dω = ∫ P df = variance.
+    Default segment: 2^k samples closest to 1/6 of the record (≈ 100 s for 600 s), Hann window,
+    50 % overlap, mean removed per segment.
+
+    Returns (omega rad/s, psd) with psd shaped like x with ``axis`` replaced by frequency.
+    """
+    from scipy.signal import welch
+
+    x = np.asarray(x, dtype=float)
+    dt = positive_scalar(dt, "dt")
+    n = x.shape[axis]
+    if nperseg is None:
+        nperseg = int(2 ** max(4, round(math.log2(max(n / 6, 16)))))
+    nperseg = min(int(nperseg), n)
+    f, p = welch(x, fs=1.0 / dt, nperseg=nperseg, axis=axis)
+    return 2.0 * np.pi * f, p / (2.0 * np.pi)
+
+
+# ----------------------------------------------------------------------------- indicators
+@dataclass(frozen=True)
+class Indicators:
+    """Per-run indicators, each an array shaped like the runs (e.g. (W, S)).
+
+    tower_del : tower-base DEL (N·m, a range, 1 Hz), m : its Wöhler exponent.
+    gen_speed_sd (rad/s), mean_power (W), pitch_sd (rad), pitch_rate_sd (rad/s).
+    duration : record length used for N_eq (s).
+    """
+
+    tower_del: np.ndarray
+    gen_speed_sd: np.ndarray
+    mean_power: np.ndarray
+    pitch_sd: np.ndarray
+    pitch_rate_sd: np.ndarray
+    m: float
+    duration: float
+
+    def as_dict(self) -> dict:
+        return {k: getattr(self, k) for k in _INDICATORS}
+
+
+def indicators(series, dt, m: float = 4.0) -> Indicators:
+    """Indicators of every run in ``series``.
+
+    series : dict with ``tower_base_my`` (N·m), ``gen_speed`` (rad/s), ``power`` (W) and
+        ``pitch`` (rad), each shaped (..., n) (a :class:`~specdesign.simulate.SimulationResult`
+        qualifies, as does :func:`series_from_openfast`).
+    dt : sample spacing (s). m : Wöhler exponent of the tower-base DEL (S-N with S the range).
+    """
+    from .fatigue import del_rainflow
+
+    dt = positive_scalar(dt, "dt")
+    m = positive_scalar(m, "m")
+    get = series.__getitem__
+    try:
+        my, om, pw, pb = (np.asarray(get(k), dtype=float) for k in ("tower_base_my", "gen_speed", "power", "pitch"))
+    except KeyError as e:
+        raise ValueError(f"series lacks {e}; it needs tower_base_my, gen_speed, power and pitch") from None
+    if not (my.shape == om.shape == pw.shape == pb.shape) or my.shape[-1] < 2:
+        raise ValueError(f"series arrays must share a shape (..., n ≥ 2); got {my.shape}, {om.shape}, {pw.shape}, {pb.shape}")
+    n = my.shape[-1]
+    duration = n * dt
+    flat = my.reshape(-1, n)
+    dels = np.array([del_rainflow(row, m, duration) for row in flat]).reshape(my.shape[:-1])
+    return Indicators(
+        tower_del=dels,
+        gen_speed_sd=om.std(axis=-1),
+        mean_power=pw.mean(axis=-1),
+        pitch_sd=pb.std(axis=-1),
+        pitch_rate_sd=(np.diff(pb, axis=-1) / dt).std(axis=-1),
+        m=m,
+        duration=duration,
+    )
+
+
+def series_from_openfast(outputs, channels=OPENFAST_CHANNELS):
+    """Stack OpenFAST outputs (from :func:`specdesign.openfast.read_outputs`) into workbench series.
+
+    Returns (series dict name → (n_files, n) SI arrays, dt s). All files must share dt and
+    length (cut them to a common length first if needed).
+    """
+    from .openfast import OpenFASTOutput
+
+    outs = [outputs] if isinstance(outputs, OpenFASTOutput) else list(outputs)
+    if not outs:
+        raise ValueError("outputs is empty; pass one or more OpenFASTOutput objects")
+    dts = [o.dt for o in outs]
+    lens = [o.time.size for o in outs]
+    if max(dts) - min(dts) > 1e-9 * max(dts) or len(set(lens)) != 1:
+        raise ValueError(f"outputs must share dt and length; got dt {sorted(set(dts))} s and lengths {sorted(set(lens))}")
+    series = {}
+    for ch, name in channels.items():
+        for o in outs:
+            if ch not in o.channels:
+                raise ValueError(f"{o.path}: channel {ch!r} was not read; pass channels={list(channels)} to read_outputs")
+        series[name] = np.stack([o.channels[ch] for o in outs])
+    return series, dts[0]
+
+
+# ----------------------------------------------------------------------------- linear prediction
+def _local_response(controller, model, wind_speed, s):
+    """(C_β(s), C_atd(s)) of a controller at a wind speed, blended as the simulator blends."""
+    from .simulate import ScheduledController, _as_lti, turbine_plant
+
+    if isinstance(controller, ScheduledController):
+        b0 = turbine_plant(model).trim(wind_speed)[1]
+        K = controller.schedule_pitch.size
+        w = np.array([np.interp(b0, controller.schedule_pitch, np.eye(K)[q]) for q in range(K)])
+        cb = sum(w[q] * np.asarray(controller.pitch[q](s)) for q in range(K) if w[q] != 0)
+        ca = 0.0 if controller.atd is None else sum(w[q] * np.asarray(controller.atd[q](s)) for q in range(K) if w[q] != 0)
+        return np.asarray(cb, complex), np.asarray(ca, complex) * np.ones_like(s)
+    c = _as_lti(controller, "controller")
+    return np.asarray(c(s), complex), np.zeros_like(s)
+
+
+def closed_loop_response(model, controller, wind_speed, omega, output="tower_base_my"):
+    """T_{y,w}(jω) from rotor-effective wind (m/s) to ``output`` (SI) in closed loop.
+
+    With β = K·[Ω_g, ẋ_top], K = [−C_β, C_atd], and P the linearisation at ``wind_speed``:
+    T = P_yw + P_yβ·K·P_mw / (1 − K·P_mβ). With the ATD absent this is
+    [P_yw + C(P_yw P_Ωβ − P_yβ P_Ωw)]/(1 + C P_Ωβ), the workbench's closed-loop formula.
+    omega in rad/s; returns a complex array shaped like omega.
+    """
+    from .simulate import turbine_plant
+
+    w = np.asarray(omega, dtype=float)
+    plant = turbine_plant(model)
+    sys = plant.linearize(wind_speed)
+    s = 1j * w
+    names = list(plant.output_names)
+    iy, iO, iv = names.index(output), names.index("gen_speed"), names.index("tower_top_vel")
+    G = np.asarray(sys(s))  # (ny, nu, nw), inputs wind, pitch_cmd, gen_torque
+    cb, ca = _local_response(controller, model, wind_speed, s)
+    k_o, k_v = -cb, ca
+    loop = k_o * G[iO, 1] + k_v * G[iv, 1]
+    beta_per_w = (k_o * G[iO, 0] + k_v * G[iv, 0]) / (1.0 - loop)
+    return G[iy, 0] + G[iy, 1] * beta_per_w
+
+
+@dataclass(frozen=True)
+class LinearPrediction:
+    """Linear prediction at one wind speed: omega (rad/s), psd of the output (SI² per rad/s,
+    = |T|²S_W), del_ (DEL, Dirlik by default, 1 Hz, range) and sd (√∫S dω)."""
+
+    omega: np.ndarray
+    psd: np.ndarray
+    del_: float
+    sd: float
+
+
+def prediction_grid(duration: float = 600.0, omega_max: float = 30.0, n: int = 3000) -> np.ndarray:
+    """Log-spaced ω grid (rad/s) from 2π/duration (the longest period a record resolves) to omega_max."""
+    return np.geomspace(2 * np.pi / positive_scalar(duration, "duration"), positive_scalar(omega_max, "omega_max"), int(n))
+
+
+def linear_prediction(model, controller, wind_speed, *, output="tower_base_my", m=4.0, omega=None,
+                      turbulence_class="B", method="dirlik") -> LinearPrediction:
+    """|T_{y,w}|²·S_W and its DEL by a spectral method (Dirlik by default) at one wind speed.
+
+    S_W is :func:`specdesign.wind.rotor_effective_spectrum` (NTM class ``turbulence_class``).
+    omega defaults to :func:`prediction_grid` (600 s, 30 rad/s).
+    """
+    from . import spectral, wind
+    from .simulate import turbine_plant
+
+    w = prediction_grid() if omega is None else np.asarray(omega, dtype=float)
+    radius = _rotor_radius(model)
+    sw = wind.rotor_effective_spectrum(w, wind_speed, radius, turbulence_class=turbulence_class)
+    t = closed_loop_response(model, controller, wind_speed, w, output)
+    psd = np.abs(t) ** 2 * sw
+    turbine_plant(model)  # validates the model early
+    return LinearPrediction(omega=w, psd=psd, del_=float(spectral.del_spectral(w, psd, m, method=method)),
+                            sd=float(np.sqrt(np.trapezoid(psd, w))))
+
+
+def _rotor_radius(model):
+    if model is None or not hasattr(model, "rotor_radius"):
+        from . import turbine
+
+        return turbine.iea15mw().rotor_radius
+    return model.rotor_radius
+
+
+# ----------------------------------------------------------------------------- statistics
+def _pool(name, x, m, axis=-1):
+    if name == "tower_del":
+        return np.mean(x**m, axis=axis) ** (1.0 / m)
+    if name == "mean_power":
+        return np.mean(x, axis=axis)
+    return np.sqrt(np.mean(x**2, axis=axis))
+
+
+@dataclass(frozen=True)
+class PairedChange:
+    """Relative change (%) designed vs baseline per wind speed, with its standard error.
+
+    change : (W,) 100·(X_des/X_base − 1) of the seed-pooled indicator; se : (W,) standard
+    error over paired seeds; method : "jackknife" or "bootstrap"; n_seeds : S.
+    """
+
+    indicator: str
+    wind_speeds: np.ndarray
+    change: np.ndarray
+    se: np.ndarray
+    method: str
+    n_seeds: int
+
+
+def paired_change(designed, baseline, indicator="tower_del", *, m=4.0, wind_speeds=None, method="jackknife",
+                  n_boot=2000, seed=0) -> PairedChange:
+    """Paired-seed relative change of an indicator, with jackknife (default) or bootstrap SE.
+
+    designed, baseline : (W, S) per-run values on the same seeds (seed j of both columns saw
+    the same wind). Seeds are pooled per :mod:`specdesign.validate` (DEL by damage, SDs by
+    variance). Jackknife: θ_(i) from all seeds but i, SE = √((S−1)/S Σ(θ_(i) − θ̄)²).
+    Bootstrap: resample seed indices (the same for both controllers) ``n_boot`` times with
+    ``np.random.default_rng(seed)``; SE = SD of the replicates.
+    """
+    a = np.atleast_2d(np.asarray(designed, dtype=float))
+    b = np.atleast_2d(np.asarray(baseline, dtype=float))
+    if a.shape != b.shape:
+        raise ValueError(f"designed {a.shape} and baseline {b.shape} must have the same (W, S) shape: paired seeds")
+    if indicator not in _INDICATORS:
+        raise ValueError(f"indicator={indicator!r} must be one of {_INDICATORS}")
+    W, S = a.shape
+    vs = np.arange(W, dtype=float) if wind_speeds is None else np.asarray(wind_speeds, dtype=float)
+
+    def theta(ia, ib):
+        return 100.0 * (_pool(indicator, ia, m) / _pool(indicator, ib, m) - 1.0)
+
+    est = theta(a, b)
+    if S < 2:
+        se = np.full(W, np.nan)
+    elif method == "jackknife":
+        reps = np.stack([theta(np.delete(a, i, axis=1), np.delete(b, i, axis=1)) for i in range(S)], axis=-1)
+        se = np.sqrt((S - 1) / S * np.sum((reps - reps.mean(axis=-1, keepdims=True)) ** 2, axis=-1))
+    elif method == "bootstrap":
+        rng = np.random.default_rng(seed)
+        idx = rng.integers(0, S, size=(int(n_boot), S))
+        reps = np.stack([theta(a[:, i], b[:, i]) for i in idx], axis=-1)
+        se = reps.std(axis=-1, ddof=1)
+    else:
+        raise ValueError(f"method={method!r} must be 'jackknife' or 'bootstrap'")
+    return PairedChange(indicator=indicator, wind_speeds=vs, change=est, se=se, method=method, n_seeds=S)
+
+
+# ----------------------------------------------------------------------------- campaign
+@dataclass(frozen=True)
+class Campaign:
+    """Results of controllers × wind speeds × seeds (paired: every controller saw the same seeds).
+
+    controllers : names, in order. wind_speeds : (W,) m/s. seeds : (S,). duration, dt : record
+    length and sample spacing (s). m : Wöhler exponent.
+    values : dict indicator → (C, W, S) per-run values (see :class:`Indicators` for units).
+    predicted_del : (C, W) linear prediction of the tower-base DEL (Dirlik on |T|²S_W, N·m);
+        NaN for controllers without a linear form (callables).
+    omega : (nω,) Welch grid (rad/s). welch : dict output → (C, W, nω) seed-averaged Welch PSD
+    per rad/s. predicted_psd : dict output → (C, W, nω) |T|²S_W on the same grid.
+    series : dict controller → SimulationResult when run with ``keep_series=True``, else {}.
+    """
+
+    controllers: tuple
+    wind_speeds: np.ndarray
+    seeds: np.ndarray
+    duration: float
+    dt: float
+    m: float
+    values: dict = field(repr=False)
+    predicted_del: np.ndarray = field(repr=False)
+    omega: np.ndarray = field(repr=False)
+    welch: dict = field(repr=False)
+    predicted_psd: dict = field(repr=False)
+    series: dict = field(default_factory=dict, repr=False)
+
+    def index(self, controller: str) -> int:
+        if controller not in self.controllers:
+            raise ValueError(f"controller {controller!r} not in the campaign {self.controllers}")
+        return self.controllers.index(controller)
+
+    def change(self, designed, baseline, indicator="tower_del", **kw) -> PairedChange:
+        """:func:`paired_change` of ``indicator`` between two controllers of the campaign."""
+        i, j = self.index(designed), self.index(baseline)
+        return paired_change(self.values[indicator][i], self.values[indicator][j], indicator, m=self.m,
+                             wind_speeds=self.wind_speeds, **kw)
+
+
+_SPECTRA = ("gen_speed", "tower_base_my")
+
+
+def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
+                    turbulence_class, keep_series, nperseg):
+    """One wind speed, every controller, the same seeds: indicators, spectra, predictions."""
+    from . import wind as wmod
+    from .simulate import simulate, wind_series
+
+    radius = _rotor_radius(model)
+    wdt = record_dt
+    wind = wind_series(radius, [v], seeds, transient + duration + wdt, wdt, turbulence_class)
+    out = {"values": {}, "pred": [], "welch": {k: [] for k in _SPECTRA}, "ppsd": {k: [] for k in _SPECTRA}, "series": {}}
+    omega = None
+    for name, c in controllers.items():
+        r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
+                     record_dt=record_dt, transient=transient)
+        ind = indicators(r.outputs, r.dt, m)
+        for k, val in ind.as_dict().items():
+            out["values"].setdefault(k, []).append(val[0])
+        for k in _SPECTRA:
+            omega, p = welch_psd(r[k][0], r.dt, nperseg)
+            out["welch"][k].append(p.mean(axis=0))
+        if predict and _has_linear_form(c):
+            pr = linear_prediction(model, c, v, m=m, omega=prediction_grid(duration), turbulence_class=turbulence_class)
+            out["pred"].append(pr.del_)
+            sw = wmod.rotor_effective_spectrum(omega, v, radius, turbulence_class=turbulence_class)
+            pos = omega > 0  # an integrating controller makes T singular at ω = 0: leave DC out
+            for k in _SPECTRA:
+                pp = np.full(omega.size, np.nan)
+                pp[pos] = np.abs(closed_loop_response(model, c, v, omega[pos], k)) ** 2 * sw[pos]
+                out["ppsd"][k].append(pp)
+        else:
+            out["pred"].append(np.nan)
+            for k in _SPECTRA:
+                out["ppsd"][k].append(np.full(omega.size, np.nan))
+        if keep_series:
+            out["series"][name] = r
+    out["omega"] = omega
+    return out
+
+
+def _has_linear_form(c) -> bool:
+    from .simulate import ScheduledController, _is_lti_like
+
+    return isinstance(c, ScheduledController) or _is_lti_like(c)
+
+
+def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0, dt=0.02, record_dt=0.1,
+                 transient=60.0, m=4.0, predict=True, turbulence_class="B", keep_series=False,
+                 executor=None, progress=None, nperseg=None) -> Campaign:
+    """Run every controller at every wind speed on the same seeds and post-process.
+
+    controllers : dict name → controller (LTI, Controller, ScheduledController or callable;
+        see :mod:`specdesign.simulate`). wind_speeds (m/s), seeds (ints): every controller
+        sees the same wind series per (wind speed, seed) (:func:`specdesign.simulate.seed_for`).
+    model : TurbineModel (default ``turbine.iea15mw()``). duration, dt, record_dt, transient:
+        as in :func:`specdesign.simulate.simulate` (s). m : Wöhler exponent of the DEL.
+    predict : compute the linear predictions (|T|²S_W, Dirlik DEL) for LTI-like controllers.
+    keep_series : keep every run's time series in ``Campaign.series`` (memory: C·W·S·n·8 bytes
+        per output).
+    executor : optional ``concurrent.futures.Executor`` (a dask.distributed Client qualifies);
+        wind speeds are submitted as separate tasks. Default: run locally, the compiled
+        simulator already using every core.
+    progress : show a tqdm bar over wind speeds; None → only when stderr is a terminal.
+    """
+    if not isinstance(controllers, dict) or not controllers:
+        raise TypeError("controllers must be a non-empty dict {name: controller}")
+    if model is None:
+        from . import turbine
+
+        model = turbine.iea15mw()
+    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    seeds = np.atleast_1d(np.asarray(seeds, dtype=np.int64))
+    if seeds.ndim != 1 or seeds.size < 1 or len(set(seeds.tolist())) != seeds.size:
+        raise ValueError(f"seeds must be distinct integers, got {seeds!r}")
+    args = [(model, controllers, float(v), seeds, duration, dt, record_dt, transient, m, predict, turbulence_class,
+             keep_series, nperseg) for v in vs]
+    show = (sys.stderr.isatty()) if progress is None else bool(progress)
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=len(args), desc="validation", unit="wind speed", disable=not show)
+    try:
+        if executor is None:
+            points = []
+            for a in args:
+                points.append(_campaign_point(*a))
+                bar.update()
+        else:
+            futs = [executor.submit(_campaign_point, *a) for a in args]
+            points = []
+            for f in futs:
+                points.append(f.result())
+                bar.update()
+    finally:
+        bar.close()
+    names = tuple(controllers)
+    values = {k: np.stack([np.stack(p["values"][k]) for p in points], axis=1) for k in _INDICATORS}
+    series = {}
+    if keep_series:
+        from .simulate import SimulationResult
+
+        for name in names:
+            rs = [p["series"][name] for p in points]
+            outs = {k: np.concatenate([r.outputs[k] for r in rs], axis=0) for k in rs[0].outputs}
+            series[name] = SimulationResult(time=rs[0].time, wind_speeds=vs, seeds=seeds, outputs=outs, dt=rs[0].dt,
+                                            sim_dt=rs[0].sim_dt, controller=name)
+    return Campaign(
+        controllers=names, wind_speeds=vs, seeds=seeds, duration=float(duration), dt=float(record_dt), m=float(m),
+        values=values,
+        predicted_del=np.array([p["pred"] for p in points]).T,
+        omega=points[0]["omega"],
+        welch={k: np.stack([np.stack(p["welch"][k]) for p in points], axis=1) for k in _SPECTRA},
+        predicted_psd={k: np.stack([np.stack(p["ppsd"][k]) for p in points], axis=1) for k in _SPECTRA},
+        series=series,
+    )
+
+
+# ----------------------------------------------------------------------------- tables
+@dataclass(frozen=True)
+class Table:
+    """A plain table: ``columns`` (header strings) and ``rows`` (label, values), values as
+    floats (NaN shown empty). ``fmt`` formats the values; ``title`` and ``note`` are text."""
+
+    title: str
+    columns: tuple
+    rows: tuple
+    fmt: str = "{:.2f} %"
+    note: str = ""
+
+    def _cell(self, v):
+        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else self.fmt.format(v)
+
+    def to_markdown(self) -> str:
+        head = "| " + " | ".join(self.columns) + " |"
+        sep = "|" + "|".join("---" for _ in self.columns) + "|"
+        body = ["| " + " | ".join([label] + [self._cell(float(v)) for v in vals]) + " |" for label, vals in self.rows]
+        text = [f"**{self.title}**", "", head, sep, *body]
+        if self.note:
+            text += ["", self.note]
+        return "\n".join(text) + "\n"
+
+    _repr_markdown_ = to_markdown
+
+    def to_csv(self, path) -> Path:
+        """Write the table (values as plain numbers, NaN empty) to ``path``; returns the path."""
+        path = Path(path)
+        with open(path, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(self.columns)
+            for label, vals in self.rows:
+                w.writerow([label] + ["" if math.isnan(float(v)) else repr(float(v)) for v in vals])
+        return path
+
+    def values(self) -> np.ndarray:
+        """(n_rows, n_columns − 1) float array of the table body."""
+        return np.array([[float(v) for v in vals] for _, vals in self.rows])
+
+
+def _speed_columns(vs):
+    return tuple(["Indicator"] + [f"{v:g} m/s" for v in vs] + ["Mean"])
+
+
+def table2(campaign: Campaign, designed: str, baseline: str, *, k=WEIBULL_K, scale=WEIBULL_A) -> Table:
+    """The paper's Table 2: relative change (%) of each indicator, designed vs baseline, per
+    wind speed, and the Weibull-weighted mean (weights: :func:`weibull_weights`)."""
+    w = weibull_weights(campaign.wind_speeds, k, scale)
+    rows = []
+    for ind in ("gen_speed_sd", "mean_power", "tower_del", "pitch_sd", "pitch_rate_sd"):
+        ch = campaign.change(designed, baseline, ind).change
+        rows.append((_LABELS[ind], tuple(ch) + (float(w @ ch),)))
+    return Table(
+        title=f"Table 2: change of the indicators, {designed} vs {baseline}",
+        columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
+        note=f"Relative change 100·(X_{designed}/X_{baseline} − 1) over {campaign.seeds.size} paired seeds of "
+             f"{campaign.duration:g} s; DEL with m = {campaign.m:g}, 1 Hz. Mean: weighted by the Weibull pdf "
+             f"(k = {k}, A = {scale} m/s) at the operating points, normalised.",
+    )
+
+
+@dataclass(frozen=True)
+class Acceptance:
+    """Linear prediction vs rainflow of the tower-base DEL reduction, per wind speed (%).
+
+    predicted : 100·(1 − DEL_pred,des/DEL_pred,base) from Dirlik on |T|²S_W.
+    rainflow : 100·(1 − DEL_rf,des/DEL_rf,base), seeds pooled by damage, paired.
+    deviation : rainflow − predicted (percentage points); se : its standard error over paired
+    seeds (the prediction has no sampling error). n_seeds : S. method : SE method.
+    """
+
+    wind_speeds: np.ndarray
+    predicted: np.ndarray
+    rainflow: np.ndarray
+    deviation: np.ndarray
+    se: np.ndarray
+    n_seeds: int
+    method: str
+
+    def passes(self, tolerance_pp: float = 1.0) -> np.ndarray:
+        """True where |deviation| ≤ tolerance (percentage points)."""
+        return np.abs(self.deviation) <= tolerance_pp
+
+
+def acceptance(campaign: Campaign, designed: str, baseline: str, *, method="jackknife") -> Acceptance:
+    """Per wind speed: linear-prediction vs rainflow reduction of the tower-base DEL, their
+    deviation (pp) and its standard error over paired seeds."""
+    i, j = campaign.index(designed), campaign.index(baseline)
+    pred = 100.0 * (1.0 - campaign.predicted_del[i] / campaign.predicted_del[j])
+    ch = campaign.change(designed, baseline, "tower_del", method=method)
+    rf = -ch.change
+    return Acceptance(wind_speeds=campaign.wind_speeds, predicted=pred, rainflow=rf, deviation=rf - pred, se=ch.se,
+                      n_seeds=ch.n_seeds, method=method)
+
+
+def table3(campaign: Campaign, designed: str, baseline: str, *, promised=None, method="jackknife") -> Table:
+    """The paper's Table 3: tower-base DEL reduction promised by the specification (optional
+    dict wind speed → %), linear prediction, rainflow evaluation, |deviation| and its SE.
+    Mean column: plain mean of the |deviation| (as in the paper)."""
+    acc = acceptance(campaign, designed, baseline, method=method)
+    nan = float("nan")
+    rows = []
+    if promised is not None:
+        prom = {float(k): float(v) for k, v in promised.items()}
+        rows.append(("Specification", tuple(prom.get(float(v), nan) for v in acc.wind_speeds) + (nan,)))
+    dev = np.abs(acc.deviation)
+    rows += [
+        ("Linear prediction", tuple(acc.predicted) + (nan,)),
+        ("Rainflow evaluation", tuple(acc.rainflow) + (nan,)),
+        ("Estimation deviation", tuple(dev) + (float(np.mean(dev)),)),
+        (f"Standard error ({method}, paired seeds)", tuple(acc.se) + (nan,)),
+    ]
+    return Table(
+        title=f"Table 3: tower-base fatigue (DEL) reduction, {designed} vs {baseline}",
+        columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
+        note=f"{acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with m = {campaign.m:g} at 1 Hz; "
+             "linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
+    )
+
+
+# ----------------------------------------------------------------------------- configuration
+def load_controller(spec: dict, base: Path, model):
+    """A controller from a config entry (see ``docs/validation.md`` for the schema)."""
+    import control
+
+    from .simulate import rosco_scheduled, scheduled
+
+    kind = spec.get("kind", "file")
+    if kind == "rosco":
+        return rosco_scheduled(model, spec.get("wind_speeds"))
+    if kind != "file" or "file" not in spec:
+        raise ValueError(f"controller entry {spec!r}: kind must be 'rosco' or 'file' (with a 'file' key)")
+    path = (base / spec["file"]).resolve()
+    if not path.is_file():
+        raise FileNotFoundError(f"controller file {path} does not exist")
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not valid JSON ({e})") from None
+
+    def tf(d, where):
+        if not isinstance(d, dict) or "num" not in d or "den" not in d:
+            if isinstance(d, dict) and d.get("type") == "Controller" or "elements" in (d or {}):
+                from loopshaping.controller import Controller
+
+                return Controller.from_dict(d).tf()
+            raise ValueError(f"{path}: {where} must hold 'num' and 'den' coefficient lists (descending powers of s)")
+        return control.tf(np.asarray(d["num"], float), np.asarray(d["den"], float))
+
+    if "wind_speeds" in data:
+        vs = [float(v) for v in data["wind_speeds"]]
+        pitch = data.get("pitch")
+        if not isinstance(pitch, list) or len(pitch) != len(vs):
+            raise ValueError(f"{path}: 'pitch' must list one controller per wind speed ({len(vs)})")
+        atd = data.get("atd")
+        if atd is not None and (not isinstance(atd, list) or len(atd) != len(vs)):
+            raise ValueError(f"{path}: 'atd' must list one controller per wind speed ({len(vs)})")
+        return scheduled(model, {v: tf(p, f"pitch[{i}]") for i, (v, p) in enumerate(zip(vs, pitch))},
+                         None if atd is None else {v: tf(a, f"atd[{i}]") for i, (v, a) in enumerate(zip(vs, atd))},
+                         name=spec.get("name", path.stem))
+    if "pitch" in data:
+        c = tf(data["pitch"], "pitch")
+        if data.get("atd") is not None:
+            from .simulate import ScheduledController
+
+            return ScheduledController(np.zeros(1), (c,), (tf(data["atd"], "atd"),), name=spec.get("name", path.stem))
+        return c
+    return tf(data, "the file")
+
+
+def _read_config(path: Path) -> dict:
+    text = path.read_bytes()
+    if path.suffix.lower() == ".toml":
+        import tomllib
+
+        try:
+            return tomllib.loads(text.decode())
+        except tomllib.TOMLDecodeError as e:
+            raise ValueError(f"{path}: invalid TOML ({e})") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: invalid JSON ({e}); use a .toml or .json file") from None
+
+
+def run_config(path, out=None) -> Campaign:
+    """Run the campaign described by a TOML/JSON file and write tables and figures.
+
+    Writes into ``out`` (default: the file's ``output`` key, else ``validation_output`` beside
+    the file): ``table2.md/.csv``, ``table3.md/.csv``, ``indicators.csv``, ``fig8_<v>mps.png``,
+    ``fig9_<v>mps.png``, ``fig10.png``. Schema: ``docs/validation.md``.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"config file {path} does not exist")
+    cfg = _read_config(path)
+    allowed = {"turbine", "wind_speeds", "seeds", "duration", "dt", "record_dt", "transient", "wohler_exponent",
+               "turbulence_class", "controllers", "baseline", "designed", "promised", "output"}
+    unknown = set(cfg) - allowed
+    if unknown:
+        raise ValueError(f"{path}: unknown keys {sorted(unknown)}; allowed: {sorted(allowed)}")
+    for key in ("wind_speeds", "seeds", "controllers"):
+        if key not in cfg:
+            raise ValueError(f"{path}: missing required key {key!r}")
+    if cfg.get("turbine", "iea15mw") != "iea15mw":
+        raise ValueError(f"{path}: turbine={cfg['turbine']!r}; only 'iea15mw' is embedded")
+    from . import turbine
+
+    model = turbine.iea15mw()
+    seeds = cfg["seeds"]
+    if isinstance(seeds, int):
+        seeds = list(range(1, seeds + 1))
+    base = path.parent
+    ctrls = {name: load_controller(spec, base, model) for name, spec in cfg["controllers"].items()}
+    camp = run_campaign(
+        ctrls, cfg["wind_speeds"], seeds, model=model, duration=cfg.get("duration", 600.0), dt=cfg.get("dt", 0.02),
+        record_dt=cfg.get("record_dt", 0.1), transient=cfg.get("transient", 60.0), m=cfg.get("wohler_exponent", 4.0),
+        turbulence_class=cfg.get("turbulence_class", "B"), keep_series=True,
+    )
+    out = Path(out if out is not None else base / cfg.get("output", "validation_output"))
+    out.mkdir(parents=True, exist_ok=True)
+    _write_indicators(camp, out / "indicators.csv")
+    names = list(ctrls)
+    baseline = cfg.get("baseline", names[0])
+    designed = cfg.get("designed", names[-1])
+    if len(names) >= 2:
+        t2, t3 = table2(camp, designed, baseline), table3(camp, designed, baseline, promised=cfg.get("promised"))
+        for t, stem in ((t2, "table2"), (t3, "table3")):
+            (out / f"{stem}.md").write_text(t.to_markdown())
+            t.to_csv(out / f"{stem}.csv")
+    _write_figures(camp, out, designed, baseline if len(names) >= 2 else None)
+    return camp
+
+
+def _write_indicators(camp: Campaign, path: Path):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["controller", "wind_speed_m_s", "seed", "tower_del_Nm", "gen_speed_sd_rad_s", "mean_power_W",
+                    "pitch_sd_rad", "pitch_rate_sd_rad_s"])
+        for c, name in enumerate(camp.controllers):
+            for i, v in enumerate(camp.wind_speeds):
+                for s, seed in enumerate(camp.seeds):
+                    w.writerow([name, v, int(seed)] + [repr(float(camp.values[k][c, i, s])) for k in _INDICATORS])
+
+
+def _write_figures(camp: Campaign, out: Path, designed, baseline):
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from .plots import validation as pv
+
+    for v in camp.wind_speeds:
+        fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+        pv.plot_spectra(camp, v, "gen_speed", ax=axes[0])
+        pv.plot_spectra(camp, v, "tower_base_my", ax=axes[1])
+        fig.tight_layout()
+        fig.savefig(out / f"fig8_{v:g}mps.png", dpi=120)
+        plt.close(fig)
+        if camp.series:
+            axes = pv.plot_time_series(camp.series, v, seed_index=0)
+            axes[0].figure.savefig(out / f"fig9_{v:g}mps.png", dpi=120)
+            plt.close(axes[0].figure)
+    if baseline is not None:
+        ax = pv.plot_reductions(acceptance(camp, designed, baseline))
+        ax.figure.savefig(out / "fig10.png", dpi=120)
+        plt.close(ax.figure)
