@@ -148,7 +148,8 @@ def _controller(C, omega, name):
     if isinstance(C, control.LTI):
         if C.ninputs != 1 or C.noutputs != 1:
             raise ValueError(f"{name} must be SISO")
-        return np.asarray(C(1j * omega, squeeze=False))[0, 0, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.asarray(C(1j * omega, squeeze=False))[0, 0, :]
     c = np.asarray(C, dtype=complex)
     if c.shape != omega.shape:
         raise ValueError(f"{name} as a frequency response must have shape {omega.shape} to match omega, got {c.shape}")
@@ -161,9 +162,14 @@ def t_output_wind(P, C, omega, output, atd_controller=None, atd_measurement="tow
     P: named plant LTI or a mapping {(output, input): response}; C: pitch controller (LTI or its
     complex response on omega), sign β = −C·Ω_g; atd_controller likewise on
     ``atd_measurement``. omega in rad/s. Returns a complex array (output units per m/s).
+    Where C is infinite (an integrator evaluated at ω = 0; |C| > 1e15 counts as infinite,
+    since a state-space evaluation returns a huge finite number there) the limit C → ∞ is
+    returned, (P_{y,w}P_{Ω,β} − P_{y,β}P_{Ω,w})/P_{Ω,β}.
     """
     w = as_omega(omega, "omega")
     c = _controller(C, w, "C")
+    infinite = ~np.isfinite(c) | (np.abs(np.nan_to_num(c, nan=np.inf)) > 1e15)
+    c = np.where(infinite, 0.0, c)
     p_yw, p_yb = _response(P, w, output, "wind"), _response(P, w, output, "pitch_cmd")
     p_ow, p_ob = _response(P, w, "gen_speed", "wind"), _response(P, w, "gen_speed", "pitch_cmd")
     num = p_yw + c * (p_yw * p_ob - p_yb * p_ow)
@@ -173,7 +179,10 @@ def t_output_wind(P, C, omega, output, atd_controller=None, atd_measurement="tow
         p_zw, p_zb = _response(P, w, atd_measurement, "wind"), _response(P, w, atd_measurement, "pitch_cmd")
         num = num + k * (p_yw * p_zb - p_yb * p_zw)
         den = den + k * p_zb
-    return num / den
+    out = num / den
+    if infinite.any():
+        out[infinite] = ((p_yw * p_ob - p_yb * p_ow) / p_ob)[infinite]
+    return out
 
 
 def t_gen_speed_wind(P, C, omega, **atd):

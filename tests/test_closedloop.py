@@ -1,0 +1,149 @@
+"""Closed-loop formulas against python-control's interconnect, spectra and DEL."""
+import warnings
+
+import control
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.special import gamma
+
+from specdesign import closedloop as cl
+from specdesign.turbine import OUTPUT_NAMES, iea15mw, rosco_baseline
+from specdesign.wind import rotor_effective_spectrum
+
+OMEGA = np.logspace(-3, 1.3, 300)
+
+
+@pytest.fixture(scope="module")
+def setup():
+    model = iea15mw()
+    P = model.linearize(19.0)
+    C = rosco_baseline(model, 19.0)
+    # an ATD controller with dynamics: band-passed tower-top velocity, negative gain (β = −K·z)
+    K = control.tf([-0.04, 0], [1, 0.2]) * control.tf([1], [0.1, 1])
+    return model, P, C, K
+
+
+def _rel(a, b):
+    """Largest relative error; responses below 1e-6 of their peak count relative to that floor
+    (tower_top_acc falls as ω² towards 0, where both routes lose digits to cancellation)."""
+    return np.max(np.abs(a - b) / np.maximum(np.abs(b), 1e-6 * np.abs(b).max()))
+
+
+def test_eq4_eq5_match_interconnect(setup):
+    _, P, C, _ = setup
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", cl.ClosedLoopUnstableWarning)
+        T = cl.closed_loop(P, C)
+    assert T.input_labels == ["wind"]
+    assert T.output_labels == list(OUTPUT_NAMES) + ["pitch_cmd"]
+    assert _rel(cl.t_gen_speed_wind(P, C, OMEGA), cl.frequency_response(T, OMEGA, "gen_speed")) < 1e-9
+    assert _rel(cl.t_tower_wind(P, C, OMEGA), cl.frequency_response(T, OMEGA, "tower_base_my")) < 1e-9
+    for y in OUTPUT_NAMES:
+        if y == "power":
+            continue  # identically ∝ gen_speed above rated
+        assert _rel(cl.t_output_wind(P, C, OMEGA, y), cl.frequency_response(T, OMEGA, y)) < 1e-9, y
+
+
+def test_eq4_written_out(setup):
+    # T_Ω,w = P_Ω,w/(1 + C·P_Ω,β) with every factor evaluated independently by control
+    _, P, C, _ = setup
+    s = 1j * OMEGA
+    pw = P["gen_speed", "wind"](s)
+    pb = P["gen_speed", "pitch_cmd"](s)
+    assert _rel(cl.t_gen_speed_wind(P, C, OMEGA), pw / (1 + C(s) * pb)) < 1e-12
+
+
+def test_atd_formula_matches_interconnect(setup):
+    _, P, C, K = setup
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", cl.ClosedLoopUnstableWarning)
+        T = cl.closed_loop(P, C, atd_controller=K)
+    for y in ("gen_speed", "tower_base_my", "tower_top_vel", "pitch"):
+        got = cl.t_output_wind(P, C, OMEGA, y, atd_controller=K)
+        assert _rel(got, cl.frequency_response(T, OMEGA, y)) < 1e-9, y
+    # pitch command: T_β,w = −(C P_Ω,w + K P_z,w)/(1 + C P_Ω,β + K P_z,β)
+    s = 1j * OMEGA
+    num = C(s) * P["gen_speed", "wind"](s) + K(s) * P["tower_top_vel", "wind"](s)
+    den = 1 + C(s) * P["gen_speed", "pitch_cmd"](s) + K(s) * P["tower_top_vel", "pitch_cmd"](s)
+    assert _rel(cl.frequency_response(T, OMEGA, "pitch_cmd"), -num / den) < 1e-9
+    # acceleration feedback is another measurement, same algebra
+    Ka = control.tf([-0.02], [1, 0.2])
+    Ta = cl.closed_loop(P, C, atd_controller=Ka, atd_measurement="tower_top_acc")
+    got = cl.t_tower_wind(P, C, OMEGA, atd_controller=Ka, atd_measurement="tower_top_acc")
+    assert _rel(got, cl.frequency_response(Ta, OMEGA, "tower_base_my")) < 1e-9
+
+
+def test_atd_damps_the_tower_peak(setup):
+    _, P, C, K = setup
+    base = np.abs(cl.t_tower_wind(P, C, OMEGA))
+    atd = np.abs(cl.t_tower_wind(P, C, OMEGA, atd_controller=K))
+    band = (OMEGA > 0.9) & (OMEGA < 1.2)
+    assert atd[band].max() < 0.9 * base[band].max()
+
+
+def test_mapping_plant_and_array_controller(setup):
+    _, P, C, _ = setup
+    keys = [(y, u) for y in ("gen_speed", "tower_base_my") for u in ("wind", "pitch_cmd")]
+    resp = {k: P[k[0], k[1]](1j * OMEGA) for k in keys}
+    got = cl.t_tower_wind(resp, C(1j * OMEGA), OMEGA)
+    assert _rel(got, cl.t_tower_wind(P, C, OMEGA)) < 1e-12
+    with pytest.raises(ValueError, match="C as a frequency response"):
+        cl.t_tower_wind(resp, np.ones(3), OMEGA)
+
+
+def test_integral_action_and_open_loop_limit(setup):
+    _, P, C, _ = setup
+    T = cl.closed_loop(P, C)
+    assert abs(cl.frequency_response(T, [1e-6, 1e-5], "gen_speed")[0]) < 1e-4 * abs(control.dcgain(P["gen_speed", "wind"]))
+    # C → 0: the closed loop is the open loop
+    zero = control.tf([1e-300], [1])
+    assert _rel(cl.t_tower_wind(P, zero, OMEGA), P["tower_base_my", "wind"](1j * OMEGA)) < 1e-9
+
+
+def test_instability_is_reported(setup):
+    _, P, C, K = setup
+    with pytest.warns(cl.ClosedLoopUnstableWarning, match="poles") as rec:
+        cl.closed_loop(P, C, atd_controller=-25 * K)  # wrong sign, large gain: tower mode unstable
+    assert "closed loop" in str(rec[0].message)
+    unstable = control.ss([[0.5]], [[1]], [[1]], [[0]])
+    with pytest.warns(cl.ClosedLoopUnstableWarning, match="0.5"):
+        assert cl.check_stability(unstable, "toy") is False
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert cl.check_stability(cl.closed_loop(P, C, warn=False)) is True
+
+
+def test_output_psd_and_del(setup):
+    model, P, C, _ = setup
+    T = cl.closed_loop(P, C)
+    w = np.linspace(0.0, 10.0, 4001)
+    s_w = rotor_effective_spectrum(w, 19.0, model.rotor_radius)
+    s_y = cl.output_psd(T, w, s_w, "tower_base_my")
+    assert_allclose(s_y, np.abs(cl.t_tower_wind(P, C, w)) ** 2 * s_w, rtol=1e-9)
+    # narrow-band DEL written out: D/s = ν0 (2√(2 m0))^m Γ(1 + m/2), DEL = (D/s / 1 Hz)^(1/m)
+    m = 4.0
+    m0 = np.trapezoid(s_y, w)
+    m2 = np.trapezoid(w**2 * s_y, w)
+    nu0 = np.sqrt(m2 / m0) / (2 * np.pi)
+    del_nb = (nu0 * (2 * np.sqrt(2 * m0)) ** m * gamma(1 + m / 2)) ** (1 / m)
+    assert_allclose(cl.closed_loop_del(T, w, s_w, m, method="narrowband"), del_nb, rtol=1e-6)
+    # Dirlik is below the conservative narrow-band figure for a broad-band load
+    assert cl.closed_loop_del(T, w, s_w, m) < del_nb
+
+
+def test_bad_inputs(setup):
+    _, P, C, _ = setup
+    anonymous = control.ss(P.A, P.B, P.C, P.D)
+    with pytest.raises(ValueError, match="plant lacks"):
+        cl.closed_loop(anonymous, C)
+    with pytest.raises(TypeError, match="pitch_controller"):
+        cl.closed_loop(P, "PI")
+    with pytest.raises(ValueError, match="SISO"):
+        cl.closed_loop(P, control.ss(P.A, P.B, P.C, P.D))
+    with pytest.raises(ValueError, match="sys lacks"):
+        cl.frequency_response(P, OMEGA, "rotor_thrust")
+    with pytest.raises(ValueError, match="wind_psd"):
+        cl.output_psd(P, OMEGA, np.ones(3), "gen_speed")
+    with pytest.raises(ValueError, match="m="):
+        cl.closed_loop_del(P, OMEGA, np.ones(OMEGA.size), -1)
