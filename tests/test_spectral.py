@@ -176,6 +176,8 @@ def test_analytic_sensitivity_is_the_small_reduction_limit():
         # a 1e-6 reduction, scaled to 1 %: the finite difference converges to the derivative
         fd = sp.sensitivity(w, s, 4.0, reduction=1e-6, method=method) * (0.01 / 1e-6)
         assert_allclose(an, fd, rtol=1e-5, atol=1e-6 * np.abs(an).max())
+        # Euler: D is homogeneous of degree m/2 in S, so Σ_k S_k ∂D/∂S_k = (m/2) D exactly
+        assert an.sum() == pytest.approx(4.0 / 2, rel=1e-10)
         # and the paper's 1 % step differs from it only at second order
         one = sp.sensitivity(w, s, 4.0, method=method)
         assert np.abs(one - an).max() < 0.01 * np.abs(an).max()
