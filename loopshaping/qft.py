@@ -345,6 +345,10 @@ class Spec:
             with np.errstate(divide="ignore"):
                 w = up / low
         else:
+            if not (_is_lti(self.weight) or callable(self.weight)):
+                raw = np.asarray(self.weight)
+                if np.isrealobj(raw) and np.any(raw < 0):
+                    raise ValueError(f"weight of spec {self.name!r} must be ≥ 0 (linear magnitude, not dB)")
             w = np.abs(self._value(self.weight, omegas, n_cases, "weight", design)).astype(float)
         w = np.broadcast_to(w, (len(omegas), w.shape[1] if w.shape[1] != 1 else n_cases)).copy()
         if np.any(np.isnan(w)) or np.any(w < 0):
