@@ -102,6 +102,11 @@ class SpectralStats:
     def _from_array(cls, mom):
         return cls(*(mom[..., j] for j in range(len(_ORDERS))))
 
+    def damage_rate(self, m, method: str = "dirlik") -> np.ndarray:
+        """Damage per second for N = S^(-m) (S the range), from the stored moments; see :func:`damage_rate`."""
+        mom = np.stack([self.m0, self.m075, self.m1, self.m15, self.m2, self.m4], axis=-1)
+        return _damage_from_moments(mom, positive_scalar(m, "m"), method)
+
     @property
     def nu0(self):
         """Mean up-crossing rate of the mean level, Hz: √(m2/m0)/(2π)."""

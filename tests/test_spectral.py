@@ -79,9 +79,11 @@ def test_stacked_equals_one_by_one():
     w = random_psd(rng)[0]
     stack = np.array(spectra).reshape(2, 3, -1)
     r = np.linspace(0, 5, 7)
+    st = sp.spectral_stats(w, stack)
     for method in sp.METHODS:
         d = sp.damage_rate(w, stack, 4.0, method)
         assert d.shape == (2, 3)
+        assert_allclose(st.damage_rate(4.0, method), d, rtol=1e-14)  # moments once, any method
         assert_allclose(d.ravel(), [sp.damage_rate(w, s, 4.0, method) for s in spectra], rtol=1e-13)
     dd = sp.sensitivity(w, stack, 10.0)
     assert dd.shape == (2, 3, w.size)
