@@ -116,6 +116,20 @@ def test_rainflow_periodic_closes_the_residue_and_is_rotation_invariant():
     assert pkg == Counter({k: float(v) for k, v in ref.items()})
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.integers(-4, 4).map(float), min_size=3, max_size=40), st.integers(0, 39))
+def test_rainflow_periodic_property(x, k):
+    # full cycles only, the same multiset for every rotation, and every range within the record's span
+    c = rainflow(x, residue="periodic")
+    assert np.all(c.counts == 1.0)
+    assert np.all(c.ranges <= max(x) - min(x))
+    ck = rainflow(np.roll(x, k % len(x)), residue="periodic")
+    assert Counter(zip(ck.ranges.tolist(), ck.means.tolist())) == Counter(zip(c.ranges.tolist(), c.means.tolist()))
+    # the largest cycle of a closed record spans the whole record
+    if max(x) > min(x):
+        assert c.ranges.max() == max(x) - min(x)
+
+
 def test_rainflow_rejects_bad_input():
     with pytest.raises(ValueError, match="x"):
         rainflow([0.0, np.nan, 1.0])
