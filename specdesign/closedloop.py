@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,6 +37,8 @@ __all__ = [
     "t_tower_wind",
     "output_psd",
     "closed_loop_del",
+    "LoopMaps",
+    "loop_maps",
 ]
 
 
@@ -217,3 +220,37 @@ def closed_loop_del(sys, omega, wind_psd, m, output="tower_base_my", method="dir
     m = positive_scalar(m, "m")
     w = as_omega(omega, "omega")
     return float(del_spectral(w, output_psd(sys, w, wind_psd, output, input), m, method))
+
+
+@dataclass(frozen=True)
+class LoopMaps:
+    """Open- and closed-loop wind maps on one grid (the paper's Fig. 1), complex arrays.
+
+    omega (rad/s); gen_open / gen_closed: P_{Ω,w} and T_{Ω,w} ((rad/s) per (m/s));
+    tower_open / tower_closed: P_{MyT,w} and T_{MyT,w} (N·m per m/s); controller: C_β(jω)
+    (rad per rad/s); loop: L = C_β·P_{Ω,β} (-).
+    """
+
+    omega: np.ndarray
+    gen_open: np.ndarray
+    gen_closed: np.ndarray
+    tower_open: np.ndarray
+    tower_closed: np.ndarray
+    controller: np.ndarray
+    loop: np.ndarray
+
+
+def loop_maps(plant, pitch_controller, omega, atd_controller=None, atd_measurement="tower_top_vel") -> LoopMaps:
+    """Evaluate :class:`LoopMaps` for ``plant`` (named LTI) and controllers on ``omega`` (rad/s)."""
+    w = as_omega(omega, "omega")
+    c = _controller(pitch_controller, w, "pitch_controller")
+    atd = dict(atd_controller=atd_controller, atd_measurement=atd_measurement)
+    return LoopMaps(
+        omega=w,
+        gen_open=frequency_response(plant, w, "gen_speed"),
+        gen_closed=t_gen_speed_wind(plant, pitch_controller, w, **atd),
+        tower_open=frequency_response(plant, w, "tower_base_my"),
+        tower_closed=t_tower_wind(plant, pitch_controller, w, **atd),
+        controller=c,
+        loop=c * frequency_response(plant, w, "gen_speed", "pitch_cmd"),
+    )

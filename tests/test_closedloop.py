@@ -147,3 +147,28 @@ def test_bad_inputs(setup):
         cl.output_psd(P, OMEGA, np.ones(3), "gen_speed")
     with pytest.raises(ValueError, match="m="):
         cl.closed_loop_del(P, OMEGA, np.ones(OMEGA.size), -1)
+
+
+def test_loop_maps_and_figures(setup):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from specdesign.plots.turbine import plot_fatigue_origin, plot_open_vs_baseline
+
+    _, P, C, _ = setup
+    maps = cl.loop_maps(P, C, OMEGA)
+    s = 1j * OMEGA
+    assert_allclose(maps.gen_open, P["gen_speed", "wind"](s), rtol=1e-9)
+    assert_allclose(maps.loop, C(s) * P["gen_speed", "pitch_cmd"](s), rtol=1e-9)
+    assert _rel(maps.tower_closed, cl.t_tower_wind(P, C, OMEGA)) < 1e-12
+    ax = plot_open_vs_baseline(maps)
+    assert len(ax) == 3 and all(a.get_ylabel() for a in ax) and "rad/s" in ax[2].get_xlabel()
+    assert len(ax[0].get_lines()) == 2
+    psd = np.abs(maps.tower_closed) ** 2
+    ax = plot_fatigue_origin(OMEGA, maps.tower_closed, psd, np.ones_like(OMEGA), m=4)
+    assert ax[2].get_legend() is not None
+    with pytest.raises(ValueError, match="psd"):
+        plot_fatigue_origin(OMEGA, maps.tower_closed, psd[:-1], np.ones_like(OMEGA))
+    plt.close("all")
