@@ -1,0 +1,304 @@
+"""Controllers as ordered lists of elements, as in loop shaping on a Nichols chart.
+
+Every element is normalised to unit DC gain except ``gain`` itself (and the pure
+integrator/differentiator), so the overall gain is the product of the ``gain`` elements and
+moving a pole or zero does not change the low-frequency gain:
+
+============== ============================= ====================================
+kind           parameters                    factor
+============== ============================= ====================================
+gain           k (≠ 0, may be negative)      k
+integrator     order n ≥ 1                   1/s^n
+differentiator order n ≥ 1                   s^n
+real_pole      omega (rad/s, ≠ 0; < 0: RHP)  1/(s/ω + 1)
+real_zero      omega (rad/s, ≠ 0; < 0: RHP)  s/ω + 1
+complex_pole   omega > 0 (rad/s), |zeta| < 1 1/((s/ω)² + 2ζ s/ω + 1)
+complex_zero   omega > 0 (rad/s), |zeta| < 1 (s/ω)² + 2ζ s/ω + 1
+lead_lag       zero, pole > 0 (rad/s)        (s/zero + 1)/(s/pole + 1)
+notch          omega > 0, zeta_zero ≥ 0,     (s² + 2ζ_z ω s + ω²)/(s² + 2ζ_p ω s + ω²)
+               zeta_pole > 0
+============== ============================= ====================================
+
+Controllers are immutable: ``add``, ``replace``, ``remove`` and ``set`` return new ones.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+_PARAMS = {
+    "gain": ("k",),
+    "integrator": ("order",),
+    "differentiator": ("order",),
+    "real_pole": ("omega",),
+    "real_zero": ("omega",),
+    "complex_pole": ("omega", "zeta"),
+    "complex_zero": ("omega", "zeta"),
+    "lead_lag": ("zero", "pole"),
+    "notch": ("omega", "zeta_zero", "zeta_pole"),
+}
+KINDS = tuple(_PARAMS)
+_JSON_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Element:
+    """One factor of a controller; ``params`` by name (see the module table; ω in rad/s)."""
+
+    kind: str
+    params: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.kind not in _PARAMS:
+            raise ValueError(f"element kind={self.kind!r} is not one of {KINDS}")
+        want = set(_PARAMS[self.kind])
+        if set(self.params) != want:
+            raise TypeError(f"element {self.kind!r} takes parameters {_PARAMS[self.kind]}; got {sorted(self.params)}")
+        p = {}
+        for k in _PARAMS[self.kind]:
+            v = self.params[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+                raise ValueError(f"{self.kind}: parameter {k}={v!r} must be a finite number")
+            p[k] = int(v) if k == "order" else float(v)
+        k = self.kind
+        if k == "gain" and p["k"] == 0:
+            raise ValueError("gain: k must be non-zero (a zero controller has no loop to shape)")
+        if k in ("integrator", "differentiator") and (p["order"] < 1 or p["order"] != self.params["order"]):
+            raise ValueError(f"{k}: order must be an integer ≥ 1")
+        if k in ("real_pole", "real_zero") and p["omega"] == 0:
+            raise ValueError(f"{k}: omega must be ≠ 0 rad/s; use an integrator/differentiator for s = 0")
+        if k in ("complex_pole", "complex_zero"):
+            if p["omega"] <= 0 or not abs(p["zeta"]) < 1:
+                raise ValueError(f"{k}: needs omega > 0 rad/s and |zeta| < 1 (else use two real elements)")
+        if k == "lead_lag" and (p["zero"] <= 0 or p["pole"] <= 0):
+            raise ValueError("lead_lag: zero and pole must be > 0 rad/s")
+        if k == "notch" and (p["omega"] <= 0 or p["zeta_zero"] < 0 or p["zeta_pole"] <= 0):
+            raise ValueError("notch: needs omega > 0 rad/s, zeta_zero ≥ 0 and zeta_pole > 0")
+        object.__setattr__(self, "params", p)
+
+    def polys(self):
+        """(numerator, denominator) coefficient arrays in s, highest power first."""
+        p, k = self.params, self.kind
+        if k == "gain":
+            return np.array([p["k"]]), np.array([1.0])
+        if k == "integrator":
+            return np.array([1.0]), np.r_[1.0, np.zeros(p["order"])]
+        if k == "differentiator":
+            return np.r_[1.0, np.zeros(p["order"])], np.array([1.0])
+        if k in ("real_pole", "real_zero"):
+            f = np.array([1 / p["omega"], 1.0])
+            return (f, np.array([1.0])) if k == "real_zero" else (np.array([1.0]), f)
+        if k in ("complex_pole", "complex_zero"):
+            w = p["omega"]
+            f = np.array([1 / w**2, 2 * p["zeta"] / w, 1.0])
+            return (f, np.array([1.0])) if k == "complex_zero" else (np.array([1.0]), f)
+        if k == "lead_lag":
+            return np.array([1 / p["zero"], 1.0]), np.array([1 / p["pole"], 1.0])
+        w = p["omega"]
+        return np.array([1.0, 2 * p["zeta_zero"] * w, w * w]), np.array([1.0, 2 * p["zeta_pole"] * w, w * w])
+
+    def response(self, omegas) -> np.ndarray:
+        """Complex response at s = jω (ω in rad/s)."""
+        num, den = self.polys()
+        s = 1j * np.asarray(omegas, float)
+        return np.polyval(num, s) / np.polyval(den, s)
+
+    def __str__(self):
+        return f"{self.kind}(" + ", ".join(f"{k}={v:.6g}" for k, v in self.params.items()) + ")"
+
+
+# Factories, for readable controller definitions.
+def gain(k) -> Element:
+    return Element("gain", {"k": k})
+
+
+def integrator(order=1) -> Element:
+    return Element("integrator", {"order": order})
+
+
+def differentiator(order=1) -> Element:
+    return Element("differentiator", {"order": order})
+
+
+def real_pole(omega) -> Element:
+    """1/(s/ω + 1), ω in rad/s (negative: right-half-plane pole)."""
+    return Element("real_pole", {"omega": omega})
+
+
+def real_zero(omega) -> Element:
+    """s/ω + 1, ω in rad/s (negative: right-half-plane zero)."""
+    return Element("real_zero", {"omega": omega})
+
+
+def complex_pole(omega, zeta) -> Element:
+    """1/((s/ω)² + 2ζ s/ω + 1), ω in rad/s."""
+    return Element("complex_pole", {"omega": omega, "zeta": zeta})
+
+
+def complex_zero(omega, zeta) -> Element:
+    """(s/ω)² + 2ζ s/ω + 1, ω in rad/s."""
+    return Element("complex_zero", {"omega": omega, "zeta": zeta})
+
+
+def lead_lag(zero, pole) -> Element:
+    """(s/zero + 1)/(s/pole + 1): a lead when zero < pole, a lag otherwise (rad/s)."""
+    return Element("lead_lag", {"zero": zero, "pole": pole})
+
+
+def lead_from_phase(phase_deg, omega) -> Element:
+    """Lead (phase_deg > 0) or lag (< 0) with |phase| at most ±90° peaking at ω (rad/s)."""
+    if not 0 < abs(phase_deg) < 90:
+        raise ValueError(f"phase_deg={phase_deg} must be within (−90, 90) degrees and non-zero")
+    sin = math.sin(math.radians(abs(phase_deg)))
+    alpha = (1 + sin) / (1 - sin)
+    lo, hi = omega / math.sqrt(alpha), omega * math.sqrt(alpha)
+    return lead_lag(lo, hi) if phase_deg > 0 else lead_lag(hi, lo)
+
+
+def notch(omega, zeta_zero, zeta_pole) -> Element:
+    """(s² + 2ζ_z ω s + ω²)/(s² + 2ζ_p ω s + ω²): depth ζ_z/ζ_p at ω (rad/s)."""
+    return Element("notch", {"omega": omega, "zeta_zero": zeta_zero, "zeta_pole": zeta_pole})
+
+
+@dataclass(frozen=True)
+class Controller:
+    """An ordered tuple of :class:`Element`; the transfer function is their product."""
+
+    elements: tuple = ()
+
+    def __post_init__(self):
+        els = tuple(self.elements)
+        for i, e in enumerate(els):
+            if not isinstance(e, Element):
+                raise TypeError(f"elements[{i}] is a {type(e).__name__}, not a loopshaping.controller.Element")
+        object.__setattr__(self, "elements", els)
+
+    # -- editing (new objects)
+    def add(self, element: Element, index: int | None = None) -> Controller:
+        """A new controller with ``element`` inserted at ``index`` (default: appended)."""
+        els = list(self.elements)
+        els.insert(len(els) if index is None else index, element)
+        return Controller(tuple(els))
+
+    def replace(self, index: int, element: Element) -> Controller:
+        self._check_index(index)
+        els = list(self.elements)
+        els[index] = element
+        return Controller(tuple(els))
+
+    def remove(self, index: int) -> Controller:
+        self._check_index(index)
+        els = list(self.elements)
+        del els[index]
+        return Controller(tuple(els))
+
+    def set(self, index: int, **params) -> Controller:
+        """A new controller with some parameters of element ``index`` changed."""
+        self._check_index(index)
+        e = self.elements[index]
+        return self.replace(index, Element(e.kind, {**e.params, **params}))
+
+    def _check_index(self, index):
+        if not -len(self.elements) <= index < len(self.elements):
+            raise IndexError(f"index={index} out of range for a controller of {len(self.elements)} elements")
+
+    # -- evaluation
+    def polys(self):
+        """(numerator, denominator) in s, highest power first."""
+        num, den = np.array([1.0]), np.array([1.0])
+        for e in self.elements:
+            n, d = e.polys()
+            num, den = np.polymul(num, n), np.polymul(den, d)
+        return num, den
+
+    def tf(self):
+        """The python-control TransferFunction."""
+        import control as ct
+
+        num, den = self.polys()
+        return ct.tf(num, den)
+
+    def response(self, omegas) -> np.ndarray:
+        """Complex response at s = jω, ω in rad/s (evaluated factor by factor)."""
+        out = np.ones(np.shape(omegas), complex)
+        for e in self.elements:
+            out = out * e.response(omegas)
+        return out
+
+    @property
+    def is_proper(self) -> bool:
+        num, den = self.polys()
+        return len(np.trim_zeros(num, "f")) <= len(np.trim_zeros(den, "f"))
+
+    # -- conversion
+    @classmethod
+    def from_zpk(cls, zeros, poles, k) -> Controller:
+        """From zeros, poles (complex ones in conjugate pairs) and the gain of k·Π(s−z)/Π(s−p)."""
+        elements, scale = [], float(k)
+        for roots, is_zero in ((np.asarray(zeros, complex), True), (np.asarray(poles, complex), False)):
+            els, f = _elements_from_roots(roots, is_zero)
+            elements += els
+            scale = scale * f if is_zero else scale / f
+        if scale == 0:
+            raise ValueError("k must be non-zero")
+        return cls((gain(scale), *elements))
+
+    @classmethod
+    def from_tf(cls, sys) -> Controller:
+        """From a SISO python-control transfer function (factored into elements)."""
+        import control as ct
+
+        sys = ct.tf(sys)
+        if sys.ninputs != 1 or sys.noutputs != 1:
+            raise ValueError("sys must be SISO")
+        num, den = np.trim_zeros(sys.num[0][0], "f"), np.trim_zeros(sys.den[0][0], "f")
+        return cls.from_zpk(np.roots(num), np.roots(den), num[0] / den[0])
+
+    def to_dict(self) -> dict:
+        return {"version": _JSON_VERSION, "elements": [{"kind": e.kind, "params": dict(e.params)} for e in self.elements]}
+
+    @classmethod
+    def from_dict(cls, data) -> Controller:
+        if not isinstance(data, dict) or "elements" not in data:
+            raise ValueError("data must be a dict with an 'elements' list (from Controller.to_dict)")
+        if data.get("version", _JSON_VERSION) != _JSON_VERSION:
+            raise ValueError(f"unsupported controller format version {data.get('version')}")
+        return cls(tuple(Element(e["kind"], dict(e["params"])) for e in data["elements"]))
+
+    def to_json(self, **kwargs) -> str:
+        """JSON text; floats are written with repr precision, so the round trip is exact."""
+        return json.dumps(self.to_dict(), **kwargs)
+
+    @classmethod
+    def from_json(cls, text) -> Controller:
+        return cls.from_dict(json.loads(text))
+
+    def __str__(self):
+        return " · ".join(str(e) for e in self.elements) or "1"
+
+
+def _elements_from_roots(roots, is_zero):
+    """Elements for a set of roots and the factor f with Π(s − r) = f·Π(normalised factors)."""
+    els, f = [], 1.0
+    tol = 1e-9 * max(1.0, float(np.max(np.abs(roots), initial=0)))
+    origin = np.abs(roots) <= tol
+    if origin.sum():
+        els.append(differentiator(int(origin.sum())) if is_zero else integrator(int(origin.sum())))
+    rest = roots[~origin]
+    real = rest[np.abs(rest.imag) <= 1e-9 * np.abs(rest)]
+    cplx = rest[rest.imag > 1e-9 * np.abs(rest)]
+    if len(real) + 2 * len(cplx) != len(rest):
+        raise ValueError("complex roots must come in conjugate pairs")
+    for r in np.sort(real.real):
+        w = -r  # s − r = (−r)(s/ω + 1) with ω = −r
+        els.append(real_zero(w) if is_zero else real_pole(w))
+        f *= w
+    for r in sorted(cplx, key=abs):
+        wn = abs(r)
+        zeta = -r.real / wn  # (s − r)(s − r̄) = ωn²((s/ωn)² + 2ζ s/ωn + 1)
+        els.append(complex_zero(wn, zeta) if is_zero else complex_pole(wn, zeta))
+        f *= wn * wn
+    return els, f
