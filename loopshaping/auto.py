@@ -1,0 +1,182 @@
+"""Automatic loop shaping with convex optimisation (cvxpy, imported lazily).
+
+The controller poles are fixed; the numerator coefficients are the variables, so G(jω) and
+every A + B·G, C + D·G are affine in them at each design frequency. Each spec row (design
+frequency × case) |A + B·G| ≤ W·|C + D·G| is a second-order cone on the left and a
+non-convex "stay outside a disc" on the right. The right side is replaced by its tangent
+lower bound W·Re(conj(z_t)·(C + D·G))/|z_t| at the current iterate z_t (convex-concave
+procedure): each convex subproblem is an inner approximation, so once feasible every later
+iterate is feasible and the objective (the largest controller gain over the high-frequency
+grid) never increases. Slack variables with a growing penalty let the iteration start from
+an infeasible loop; slack left at the end means infeasible, and the binding design
+frequency and spec are reported.
+
+The bounds only hold at the design frequencies and do not imply closed-loop stability: run
+:func:`loopshaping.check.check` on the result.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .controller import Controller
+from .qft import Bounds, evaluate
+
+
+class InfeasibleError(ValueError):
+    """No controller with the given structure meets the bounds.
+
+    ``omega`` (rad/s) and ``spec`` name the most violated design frequency and spec;
+    ``violation_db`` is by how much the best loop found misses it.
+    """
+
+    def __init__(self, message, omega, spec, violation_db):
+        super().__init__(message)
+        self.omega, self.spec, self.violation_db = omega, spec, violation_db
+
+
+def _rows(bounds, basis):
+    """Stack every (spec, frequency, case) row: a, b (row·x), c, d (row·x), W, ω, spec name."""
+    a, b, c, d, W, om, name = [], [], [], [], [], [], []
+    for part in bounds.parts:
+        fi = np.searchsorted(bounds.omegas, part.omegas)
+        for k, f in enumerate(fi):
+            n = part.A.shape[1]
+            a.append(part.A[k])
+            b.append(part.B[k][:, None] * basis[f][None, :])
+            c.append(part.C[k])
+            d.append(part.D[k][:, None] * basis[f][None, :])
+            W.append(part.W[k])
+            om.append(np.full(n, part.omegas[k]))
+            name += [part.spec.name] * n
+    return (np.concatenate(a), np.vstack(b), np.concatenate(c), np.vstack(d), np.concatenate(W),
+            np.concatenate(om), np.array(name))
+
+
+def _fixed_poles(poles, omegas):
+    if poles is None:
+        return np.array([-10.0 * omegas.max()] * 2, complex)
+    if isinstance(poles, Controller):
+        return np.roots(poles.polys()[1]).astype(complex)
+    p = np.atleast_1d(np.asarray(poles, complex))
+    if p.size and not np.all(np.isfinite(p)):
+        raise ValueError("poles must be finite")
+    return p
+
+
+def shape(bounds: Bounds, poles=None, *, n_zeros=None, initial=None, hf_omegas=None, margin_db=0.0, max_iter=40,
+          tol=1e-5, solver=None) -> Controller:
+    """Shape G = N(s)/D(s) with fixed poles so that L0 = P0·G meets ``bounds``.
+
+    Parameters
+    ----------
+    bounds : :class:`~loopshaping.qft.Bounds` (its specs' exact inequalities are used, not
+        the phase grid).
+    poles : fixed controller poles (complex, conjugate pairs; 0 for integrators), or a
+        :class:`Controller` whose poles are kept. Default: a double real pole at
+        10 × the highest design frequency.
+    n_zeros : numerator degree, ≤ number of poles (proper); default = number of poles.
+    initial : Controller or LTI giving the first linearisation point (least-squares fitted
+        onto the structure); default: a constant gain that lifts the nominal loop 3 dB above
+        the highest lower bound at the lowest design frequency.
+    hf_omegas : rad/s grid where the largest controller gain is minimised; default 30 points
+        from 2 × to 1000 × the highest design frequency.
+    margin_db : every weight is tightened by this many dB, a cushion for the response
+        between design frequencies.
+    Returns a :class:`Controller`; raises :class:`InfeasibleError` (with the binding design
+    frequency and spec) when slack remains after ``max_iter`` iterations.
+    """
+    try:
+        import cvxpy as cp
+    except ImportError as e:  # pragma: no cover - cvxpy is a declared dependency
+        raise ImportError("loopshaping.auto.shape needs cvxpy") from e
+    if not isinstance(bounds, Bounds):
+        raise TypeError(f"bounds must be a loopshaping.qft.Bounds; got {type(bounds).__name__}")
+    w = bounds.omegas
+    p = _fixed_poles(poles, w)
+    m = len(p) if n_zeros is None else int(n_zeros)
+    if not 0 <= m <= len(p):
+        raise ValueError(f"n_zeros={n_zeros} must be between 0 and the number of poles ({len(p)}) for a proper controller")
+    den = np.real_if_close(np.poly(p)) if p.size else np.array([1.0])
+    if np.iscomplexobj(den):
+        raise ValueError("poles must come in complex-conjugate pairs")
+    if hf_omegas is None:
+        # A grid, not one point: a lone frequency would be "minimised" by a notch on it.
+        hf_omegas = np.logspace(np.log10(2 * w.max()), np.log10(1000 * w.max()), 30)
+    hf = np.atleast_1d(np.asarray(hf_omegas, float))
+    w_s = float(np.exp(np.mean(np.log(w))))  # numerator basis (s/w_s)^i keeps columns comparable
+
+    def basis_at(om):
+        s = 1j * np.asarray(om, float)
+        return (s[:, None] / w_s) ** np.arange(m + 1)[None, :] / np.polyval(den, s)[:, None]
+
+    basis = basis_at(w)
+    col = np.max(np.abs(basis), axis=0)
+    basis, hf_basis = basis / col, basis_at(hf) / col
+    a, b, c, d, W, om, names = _rows(bounds, basis)
+    W = W * 10 ** (-float(margin_db) / 20)
+
+    # Starting point.
+    if initial is None:
+        part0 = bounds.lower_bound_db()[0]
+        lb = np.max(part0[np.isfinite(part0)], initial=0.0)
+        p0 = _nominal(bounds)[0]
+        target = np.full(len(w), 10 ** ((lb + 3) / 20) / abs(p0))
+    else:
+        target = initial.response(w) if isinstance(initial, Controller) else evaluate(initial, w, "initial")
+    A_ls = np.vstack([basis.real, basis.imag])
+    x_t = np.linalg.lstsq(A_ls, np.r_[target.real, target.imag], rcond=None)[0]
+
+    x = cp.Variable(m + 1)
+    slack = cp.Variable(len(a), nonneg=True)
+    t = cp.Variable()
+    tau = 10.0
+    prev = np.inf
+    for _ in range(max_iter):
+        z_t = c + d @ x_t
+        mod = np.maximum(np.abs(z_t), 1e-300)
+        norm = np.where(W * mod > 0, W * mod, 1.0)
+        lhs_re = cp.multiply(1 / norm, a.real + b.real @ x)
+        lhs_im = cp.multiply(1 / norm, a.imag + b.imag @ x)
+        lin = np.conj(z_t)[:, None] * d
+        rhs = (W / (mod * norm)) * np.real(np.conj(z_t) * c) + cp.multiply(W / (mod * norm), lin.real @ x)
+        g_hf = np.abs(hf_basis @ x_t).max() or 1.0
+        cons = [cp.norm(cp.vstack([lhs_re, lhs_im]), 2, axis=0) <= rhs + slack,
+                cp.norm(cp.vstack([hf_basis.real @ x, hf_basis.imag @ x]), 2, axis=0) <= t]
+        prob = cp.Problem(cp.Minimize(t / g_hf + tau * cp.sum(slack)), cons)
+        try:
+            prob.solve(solver=solver)
+        except cp.SolverError:
+            x.value = None
+        if x.value is None:
+            if np.isfinite(prev):
+                break  # a large penalty made the subproblem ill-conditioned: judge the last iterate
+            raise RuntimeError(f"the convex subproblem failed ({prob.status}); try another solver=")
+        x_t = x.value
+        obj = float(np.abs(hf_basis @ x_t).max())
+        if slack.value.max() < 1e-8 and abs(prev - obj) <= tol * max(obj, 1e-300):
+            break
+        prev = obj
+        tau = min(tau * 5, 1e5)
+
+    with np.errstate(divide="ignore"):
+        viol = 20 * np.log10(np.abs(a + b @ x_t)) - 20 * np.log10(W * np.abs(c + d @ x_t))
+    viol = np.nan_to_num(viol, nan=0.0, neginf=-np.inf)
+    worst = int(np.argmax(viol))
+    if viol[worst] > 1e-6:
+        raise InfeasibleError(
+            f"no controller with poles {np.round(p, 6).tolist()} and {m} zeros meets the bounds: spec "
+            f"{names[worst]!r} is missed by {viol[worst]:.3g} dB at ω = {om[worst]:.4g} rad/s",
+            float(om[worst]), str(names[worst]), float(viol[worst]))
+    coef = x_t / col / w_s ** np.arange(m + 1)  # ascending powers of s
+    scale = np.max(np.abs(x_t))
+    keep = np.flatnonzero(np.abs(x_t) > 1e-10 * scale)
+    num = coef[: keep.max() + 1][::-1]
+    return Controller.from_zpk(np.roots(num), p, num[0] / den[0])
+
+
+def _nominal(bounds):
+    """Nominal plant P0 at the design frequencies, from the parts of the bounds."""
+    p0 = np.full(len(bounds.omegas), np.nan + 0j)
+    for part in bounds.parts:
+        p0[np.searchsorted(bounds.omegas, part.omegas)] = part.p0
+    return p0
