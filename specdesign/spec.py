@@ -159,6 +159,7 @@ class Specification:
             raise TypeError(f"baseline must be a python-control LTI system (wind → output), got {type(self.baseline).__name__}")
         if self.baseline.ninputs != 1 or self.baseline.noutputs != 1:
             raise ValueError(f"baseline must be SISO (one wind input, one output), got {self.baseline.noutputs}x{self.baseline.ninputs}")
+        _check_proper_stable(self.baseline, "baseline")
         object.__setattr__(self, "elements", tuple(self.elements))
         for i, e in enumerate(self.elements):
             if not isinstance(e, _ELEMENTS):
@@ -193,6 +194,17 @@ class Specification:
         return replace(self, elements=tuple(elements))
 
 
+def _check_proper_stable(sys, name):
+    if isinstance(sys, ct.TransferFunction):
+        num, den = sys.num[0][0], sys.den[0][0]
+        if len(np.trim_zeros(num, "f")) > len(np.trim_zeros(den, "f")):
+            raise ValueError(f"{name} is improper (numerator degree > denominator degree); a specification must be a proper transfer function")
+    poles = ct.poles(sys)
+    if sys.isctime() and np.any(poles.real >= 0):
+        bad = poles[poles.real >= 0]
+        raise ValueError(f"{name} is not stable (poles {np.round(bad, 4)} in the closed right half-plane); a specification must be a stable closed-loop map")
+
+
 def _siso_response(sys, omega):
     resp = ct.frequency_response(sys, omega)
     return np.asarray(resp.complex, dtype=complex).reshape(-1)
@@ -207,7 +219,8 @@ class Baseline:
 
     omega (rad/s), t_response = T_{y,w}(jω), s_wind = S_W(ω) (one-sided, (m/s)²/(rad/s)),
     psd = |T|² S_W, damage_rate (1/s, S-N with S_ref = 1 in the output's units),
-    sensitivity = ΔD%(ω) for a ``reduction`` of S_y at each grid point, m, method.
+    sensitivity = ΔD%(ω) per 1 % reduction of S_y at each grid point (computed with a finite
+    step ``reduction``), m (Wöhler exponent, range-based S-N), method (damage method name).
     """
 
     omega: np.ndarray
@@ -241,7 +254,8 @@ def baseline_from_response(omega, t_response, s_wind, m=4.0, *, method="dirlik",
     d0 = float(spectral.damage_rate(omega, psd, m, method=method))
     if not d0 > 0:
         raise ValueError("the baseline output spectrum carries no damage (all-zero PSD); check the output and the wind spectrum")
-    sens = spectral.sensitivity(omega, psd, m, reduction=reduction, method=method)
+    # Eq. (10) reads ΔD% as "per 1 % reduction"; a different finite step is rescaled to it.
+    sens = spectral.sensitivity(omega, psd, m, reduction=reduction, method=method) * (0.01 / reduction)
     return Baseline(omega, t_response, s_wind, psd, d0, np.asarray(sens), float(m), method, float(reduction), system, output, float(wind_speed))
 
 
