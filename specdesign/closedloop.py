@@ -151,7 +151,9 @@ def _controller(C, omega, name):
     if isinstance(C, control.LTI):
         if C.ninputs != 1 or C.noutputs != 1:
             raise ValueError(f"{name} must be SISO")
-        with np.errstate(divide="ignore", invalid="ignore"):
+        # An integrator evaluated at ω = 0 divides by zero; t_output_wind takes the limit there.
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
             return np.asarray(C(1j * omega, squeeze=False))[0, 0, :]
     c = np.asarray(C, dtype=complex)
     if c.shape != omega.shape:
