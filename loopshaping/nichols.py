@@ -91,13 +91,15 @@ def draw(bounds: Bounds | None, loop=None, ax=None, omega=None, m_contours_db=No
         lower, upper = bounds.edges()
         ph = bounds.phases_deg
         for i, w in enumerate(design):
-            for k in range(lower.shape[-1]):
-                lab = f"ω = {w:.4g} rad/s" if k == 0 else None
-                if np.any(np.isfinite(lower[i, :, k])):
-                    ax.plot(ph, lower[i, :, k], "-", color=colours[i], lw=1.5, label=lab)
+            # One artist per frequency and style (curves joined by NaN breaks): fast redraws.
+            lab = f"ω = {w:.4g} rad/s"
+            for edge, style in ((lower, "-"), (upper, "--")):
+                curves = edge[i].T[np.any(np.isfinite(edge[i].T), axis=1)]
+                if curves.size:
+                    xs = np.concatenate([np.r_[ph, np.nan] for _ in curves])
+                    ys = np.concatenate([np.r_[c, np.nan] for c in curves])
+                    ax.plot(xs, ys, style, color=colours[i], lw=1.5, label=lab)
                     lab = None
-                if np.any(np.isfinite(upper[i, :, k])):
-                    ax.plot(ph, upper[i, :, k], "--", color=colours[i], lw=1.5, label=lab)
             if bounds.empty[i]:
                 ax.plot([], [], " ", label=f"ω = {w:.4g} rad/s: EMPTY bound")
     for m in () if m_contours_db is None else np.atleast_1d(m_contours_db):

@@ -72,7 +72,8 @@ def evaluate(obj, omegas, name="system") -> np.ndarray:
         if isinstance(obj, ct.TransferFunction):
             num, den = obj.num[0][0], obj.den[0][0]
             s = 1j * omegas
-            return np.polyval(num, s) / np.polyval(den, s)
+            with np.errstate(divide="ignore", invalid="ignore"):  # a pole on jω is reported by callers
+                return np.polyval(num, s) / np.polyval(den, s)
         return np.asarray(obj(1j * omegas), complex).reshape(omegas.shape)
     if callable(obj):
         out = np.asarray(obj(omegas), complex)

@@ -108,3 +108,36 @@ def test_bad_elements_name_the_parameter():
         lc.Controller((3.0,))
     with pytest.raises(ValueError, match="elements"):
         lc.Controller.from_json("{}")
+
+
+def test_interactive_designer_numbers_and_widget():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from loopshaping import qft
+    from loopshaping.interactive import Designer
+
+    P = [ct.tf([k], [1, 31, 30]) for k in (1.0, 5.0, 10.0)]
+    w = np.array([0.1, 5.0, 100.0])
+    tmpl = qft.Template.from_systems(P, w)
+    b = qft.bounds(tmpl, "stability", 1.2)
+    d = Designer(b, tmpl, lc.Controller((lc.gain(379), lc.real_zero(42), lc.complex_pole(247, 0.5))))
+    fig = d.draw(live=True)
+    st = d.set_param(0, k=100.0)
+    G = 100 * (s / 42 + 1) / (s**2 / 247**2 + s / 247 + 1)
+    L = np.stack([resp(p * G, d.omega) for p in P], 1)
+    np.testing.assert_allclose(st.worst_T_db, 20 * np.log10(np.abs(L / (1 + L)).max(1)), atol=1e-9)
+    np.testing.assert_allclose(st.magnitude_db, 20 * np.log10(np.abs(L[:, 0])), atol=1e-9)
+    L0 = resp(P[0] * G, w)
+    want = b.is_allowed(w, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
+    np.testing.assert_array_equal(st.design_allowed, want)
+    np.testing.assert_allclose(d._artists["loop"].get_ydata(), st.magnitude_db)
+    d.add("real_pole", omega=2000.0)
+    assert d.controller.elements[-1] == lc.real_pole(2000.0)
+    d.remove(3)
+    assert len(d.controller.elements) == 3
+    ui = d.widget()
+    assert type(ui).__name__ == "VBox"
+    plt.close(fig)
