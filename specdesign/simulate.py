@@ -42,6 +42,8 @@ import numpy as np
 from numba import njit, prange
 
 from ._checks import positive_scalar
+from .turbine import outputs as _turbine_outputs
+from .turbine import rhs as _turbine_rhs
 
 __all__ = [
     "KernelPlant",
@@ -308,26 +310,47 @@ def _wind_at(w, wdt, t):
     return w[i] * (1.0 - f) + w[i + 1] * f
 
 
+_KIND_TURBINE, _KIND_LINEAR = 0, 1
+
+
 @njit(cache=True)
-def _rk4(rhs, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
+def _krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
+    # The built-in kernels are called directly (a function passed as an argument would
+    # defeat numba's on-disk cache); other kernels get rebound copies, see _compiled_for.
+    if kind == _KIND_TURBINE:
+        _turbine_rhs(x, wind, pitch_cmd, gen_torque, p, dx)
+    else:
+        _lin_rhs(x, wind, pitch_cmd, gen_torque, p, dx)
+
+
+@njit(cache=True)
+def _kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
+    if kind == _KIND_TURBINE:
+        _turbine_outputs(x, wind, pitch_cmd, gen_torque, p, y)
+    else:
+        _lin_outputs(x, wind, pitch_cmd, gen_torque, p, y)
+
+
+@njit(cache=True)
+def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
     n = x.size
-    rhs(x, _wind_at(w, wdt, t), beta_cmd, torque, p, k1)
+    _krhs(kind, x, _wind_at(w, wdt, t), beta_cmd, torque, p, k1)
     for i in range(n):
         xt[i] = x[i] + 0.5 * dt * k1[i]
     wm = _wind_at(w, wdt, t + 0.5 * dt)
-    rhs(xt, wm, beta_cmd, torque, p, k2)
+    _krhs(kind, xt, wm, beta_cmd, torque, p, k2)
     for i in range(n):
         xt[i] = x[i] + 0.5 * dt * k2[i]
-    rhs(xt, wm, beta_cmd, torque, p, k3)
+    _krhs(kind, xt, wm, beta_cmd, torque, p, k3)
     for i in range(n):
         xt[i] = x[i] + dt * k3[i]
-    rhs(xt, _wind_at(w, wdt, t + dt), beta_cmd, torque, p, k4)
+    _krhs(kind, xt, _wind_at(w, wdt, t + dt), beta_cmd, torque, p, k4)
     for i in range(n):
         x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
 
 
 @njit(cache=True)
-def _run_one(rhs, outfn, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
+def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
              beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr):
     nx = x.size
     nc = Ad.shape[1]
@@ -345,7 +368,7 @@ def _run_one(rhs, outfn, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sc
     j = 0
     for k in range(nsteps):
         t = k * dt
-        outfn(x, _wind_at(w, wdt, t), bcmd, torque, p, y)
+        _kout(kind, x, _wind_at(w, wdt, t), bcmd, torque, p, y)
         if k % rec_every == 0:
             for i in range(ny):
                 Yr[i, j] = y[i]
@@ -378,24 +401,27 @@ def _run_one(rhs, outfn, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sc
             u = (1.0 - f) * uk[q] + f * uk[q + 1]
         bcmd = beta0 + u
         bf += a_filt * (bcmd - bf)
-        _rk4(rhs, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
+        _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
 
 
 @njit(cache=True, parallel=True)
-def _run_batch(rhs, outfn, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
+def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
                beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y):
     """All runs, one per prange iteration; the controller bank is shared by the batch."""
     K = sched_pitch.size
     for r in prange(X0.shape[0]):
         x = X0[r].copy()
-        _run_one(rhs, outfn, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
+        _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
                  beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r])
 
 
-@njit(cache=True, parallel=True)
-def _step_all(rhs, outfn, P, X, W, wdt, t, dt, bcmd, torque, Y):
-    """One RK4 step of every run with a given pitch command, then the outputs at t + dt."""
-    for r in prange(X.shape[0]):
+@njit(cache=True)
+def _step_all(kind, P, X, W, wdt, t, dt, bcmd, torque, Y):
+    """One RK4 step of every run with a given pitch command, then the outputs at t + dt.
+
+    Serial: on the callable path the Python controller dominates, and a parallel launch per
+    step would cost more than it saves."""
+    for r in range(X.shape[0]):
         nx = X.shape[1]
         k1 = np.empty(nx)
         k2 = np.empty(nx)
@@ -403,16 +429,53 @@ def _step_all(rhs, outfn, P, X, W, wdt, t, dt, bcmd, torque, Y):
         k4 = np.empty(nx)
         xt = np.empty(nx)
         x = X[r]
-        _rk4(rhs, x, W[r], wdt, t, dt, bcmd[r], torque[r], P[r], k1, k2, k3, k4, xt)
+        _rk4(kind, x, W[r], wdt, t, dt, bcmd[r], torque[r], P[r], k1, k2, k3, k4, xt)
         y = Y[r]
-        outfn(x, _wind_at(W[r], wdt, t + dt), bcmd[r], torque[r], P[r], y)
+        _kout(kind, x, _wind_at(W[r], wdt, t + dt), bcmd[r], torque[r], P[r], y)
 
 
-@njit(cache=True, parallel=True)
-def _outputs_all(outfn, P, X, W, wdt, t, bcmd, torque, Y):
-    for r in prange(X.shape[0]):
+@njit(cache=True)
+def _outputs_all(kind, P, X, W, wdt, t, bcmd, torque, Y):
+    for r in range(X.shape[0]):
         y = Y[r]
-        outfn(X[r], _wind_at(W[r], wdt, t), bcmd[r], torque[r], P[r], y)
+        _kout(kind, X[r], _wind_at(W[r], wdt, t), bcmd[r], torque[r], P[r], y)
+
+
+_REBOUND = {}
+
+
+def _compiled_for(rhs, outfn):
+    """(kind, run_batch, step_all, outputs_all) for a kernel pair.
+
+    The turbine and linear kernels use the cached module functions. Any other pair gets
+    copies of the same loop code whose global names ``_krhs``/``_kout`` point at that
+    pair: one source for every kernel, compiled once per process for user kernels.
+    """
+    import types
+
+    if rhs is _lin_rhs:
+        return _KIND_LINEAR, _run_batch, _step_all, _outputs_all
+    if rhs is _turbine_rhs and outfn is _turbine_outputs:
+        return _KIND_TURBINE, _run_batch, _step_all, _outputs_all
+    key = (rhs, outfn)
+    if key not in _REBOUND:
+        g = dict(_run_one.py_func.__globals__)
+
+        def krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
+            rhs(x, wind, pitch_cmd, gen_torque, p, dx)
+
+        def kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
+            outfn(x, wind, pitch_cmd, gen_torque, p, y)
+
+        g["_krhs"], g["_kout"] = njit(krhs), njit(kout)
+
+        def copy(f, **kw):
+            return njit(**kw)(types.FunctionType(f.py_func.__code__, g, f.py_func.__name__))
+
+        g["_rk4"] = copy(_rk4)
+        g["_run_one"] = copy(_run_one)
+        _REBOUND[key] = (0, copy(_run_batch, parallel=True), copy(_step_all), copy(_outputs_all))
+    return _REBOUND[key]
 
 
 # ----------------------------------------------------------------------------- results
@@ -560,13 +623,14 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         P = np.ascontiguousarray(np.broadcast_to(plant.params, (R, plant.params.size)))
         X0 = np.repeat(np.stack([np.asarray(t[0], float) for t in trims]), S, axis=0)
     X0 = np.ascontiguousarray(X0)
+    kind, run_batch, step_all, outputs_all = _compiled_for(rhs, outfn)
     n_rec = (nsteps + rec_every - 1) // rec_every
     Y = np.empty((R, ny + 1, n_rec))
     omega_ref = np.full(R, plant.rated_speed)
 
     if callable(controller) and not _is_lti_like(controller) and not isinstance(controller, ScheduledController):
         label = getattr(controller, "__name__", "callable")
-        _run_callable(controller, rhs, outfn, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y, plant.output_names)
+        _run_callable(controller, step_all, outputs_all, kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y, plant.output_names)
     else:
         label = getattr(controller, "name", "controller")
         sched_pitch, mats, fw = _bank(controller, dt)
@@ -580,8 +644,8 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
             n = A.shape[0]
             Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :] = A, B, C, D
         a_filt = 1.0 - math.exp(-fw * dt)
-        _run_batch(rhs, outfn, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
-                   beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y)
+        run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
+                  beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y)
 
     skip = int(round(transient / record_dt))
     t_rec = np.arange(n_rec) * record_dt
@@ -603,12 +667,12 @@ def _is_lti_like(c) -> bool:
     return isinstance(c, control.LTI) or (hasattr(c, "tf") and callable(getattr(c, "tf")))
 
 
-def _run_callable(fn, rhs, outfn, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names):
+def _run_callable(fn, step_all, outputs_all, kind, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names):
     X = X0.copy()
     R = X.shape[0]
     bcmd = beta0.copy()
     y = np.empty((R, ny))
-    _outputs_all(outfn, P, X, Wr, wdt, 0.0, bcmd, torque, y)
+    outputs_all(kind, P, X, Wr, wdt, 0.0, bcmd, torque, y)
     j = 0
     for k in range(nsteps):
         t = k * dt
@@ -620,4 +684,4 @@ def _run_callable(fn, rhs, outfn, P, X0, Wr, wdt, dt, nsteps, rec_every, torque,
             Y[:, ny, j] = bcmd  # the command held during the previous step, as in the compiled loop
             j += 1
         bcmd = cmd
-        _step_all(rhs, outfn, P, X, Wr, wdt, t, dt, bcmd, torque, y)
+        step_all(kind, P, X, Wr, wdt, t, dt, bcmd, torque, y)
