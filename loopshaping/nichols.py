@@ -106,7 +106,7 @@ def draw(bounds: Bounds | None, loop=None, ax=None, omega=None, m_contours_db=No
         ph, mag = m_contour(float(m))
         ax.plot(ph, mag, ":", color="0.5", lw=0.8)
         j = np.nanargmin(np.abs(ph + 180 + 40))
-        ax.annotate(f"{m:g} dB", (ph[j], mag[j]), color="0.4", fontsize=7)
+        ax.annotate(f"M = {m:.3g} dB", (ph[j], mag[j]), color="0.4", fontsize=7)
     if loop is not None:
         if omega is None:
             lo = design.min() / 100 if design.size else 1e-2

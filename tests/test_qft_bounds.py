@@ -328,3 +328,20 @@ def test_bad_input_names_the_argument(template):
         qft.intersect(b, other)
     with pytest.raises(ValueError, match="not design frequencies"):
         b.is_allowed(3.0, -180, 0)
+
+
+def test_noise_bound_with_sensor_dynamics_matches_oracle(template):
+    H = 1 / (s / 50 + 1)
+    b = qft.bounds(template, "noise", 30.0, sensor=H)
+    Hw = qft.evaluate(H, OMEGAS)
+    for i in range(len(OMEGAS)):
+        fn = lambda P, G, i=i: np.abs(G * Hw[i] / (1 + P * G * Hw[i]))  # noqa: E731
+        ok = make_ok(template.responses[i], template.nominal_response[i], fn, 30.0)
+        phases_idx = np.arange(0, 361, 15)
+        phases = b.phases_deg[phases_idx]
+        want = [drop_slivers(t[np.abs(t) < 58], ok, ph)
+                for t, ph in zip(oracle_transitions(ok, phases, np.arange(-60, 60.0001, 0.1)), phases)]
+        got = [drop_slivers(g, ok, ph) for g, ph in zip(exact_transitions(b, i, phases_idx, 58), phases)]
+        for g, o in zip(got, want):
+            assert len(g) == len(o)
+            np.testing.assert_allclose(g, o, atol=0.01)
