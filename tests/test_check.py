@@ -101,3 +101,17 @@ def test_bad_input(setup):
         check(G_PUBLISHED, tmpl, arr, DENSE)
     with pytest.raises(TypeError, match="specs"):
         check(G_PUBLISHED, tmpl, [], DENSE)
+
+
+def test_general_form_reproduces_a_classic_spec(setup):
+    tmpl, _ = setup
+    P = list(tmpl.systems)
+    # |P·G/(1+P·G)| written as (A + B·G)/(C + D·G) with per-case LTI lists.
+    general = qft.Spec("general", 1.2, name="T as general", kind_args=dict(A=0.0, B=P, C=1.0, D=P))
+    res = check(G_PUBLISHED, tmpl, [qft.Spec("stability", 1.2), general], DENSE)
+    np.testing.assert_allclose(res.margins_db[1], res.margins_db[0], rtol=1e-12)
+    # The same at the design frequencies, with arrays (n_omega, n_cases) as the wind side builds them.
+    Pw = tmpl.responses
+    bg = qft.bounds(tmpl, "general", 1.2, A=np.zeros_like(Pw), B=Pw, C=np.ones_like(Pw), D=Pw)
+    bs = qft.bounds(tmpl, "stability", 1.2)
+    np.testing.assert_allclose(bg.forbidden_db, bs.forbidden_db, atol=1e-9)
