@@ -8,11 +8,12 @@ torque are held over a step (the controller is discrete, sampled at the simulati
 
 Controller convention (as everywhere in the workbench)::
 
-    β_cmd = β₀ − C_β·(Ω_g − Ω_rated) + C_atd·ẋ_top
+    β_cmd = β₀ − C_β·(Ω_g − Ω_rated) − C_atd·ẋ_top
 
 with C_β the pitch controller on the generator speed (β = −C·Ω_g in deviations) and an
 optional active-tower-damping controller C_atd on the tower-top fore-aft velocity (m/s),
-summed into the pitch command. β₀ is the trim pitch at the run's mean wind speed.
+summed into the pitch command with the same negative-feedback sign as in
+:mod:`specdesign.closedloop`. β₀ is the trim pitch at the run's mean wind speed.
 
 Gain scheduling (``ScheduledController``): K local controllers, each designed at a
 scheduling pitch β_k, all run in parallel on the same measurements; their outputs are
@@ -209,7 +210,7 @@ class ScheduledController:
 
     schedule_pitch : (K,) increasing scheduling pitches β_k (rad), one per local controller.
     pitch : K continuous SISO controllers C_β,k on the generator speed (β = −C·Ω_g).
-    atd : K continuous SISO controllers on tower-top velocity (β += C_atd·ẋ_top), or None.
+    atd : K continuous SISO controllers on tower-top velocity (β −= C_atd·ẋ_top), or None.
     filter_omega : corner (rad/s) of the first-order low-pass on the pitch command that
         gives the scheduling variable.
     name : label used in tables and figures.
@@ -374,8 +375,9 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
                 Yr[i, j] = y[i]
             Yr[ny, j] = bcmd
             j += 1
+        # Both loops feed back with a minus sign: β = −C_β·ΔΩ_g − C_atd·ẋ_top.
         e = -(y[i_speed] - omega_ref)
-        v = y[i_vel]
+        v = -y[i_vel]
         for q in range(K):
             s = Dd[q, 0] * e + Dd[q, 1] * v
             for i in range(nc):

@@ -206,7 +206,8 @@ def _local_response(controller, model, wind_speed, s):
 def closed_loop_response(model, controller, wind_speed, omega, output="tower_base_my"):
     """T_{y,w}(jω) from rotor-effective wind (m/s) to ``output`` (SI) in closed loop.
 
-    With β = K·[Ω_g, ẋ_top], K = [−C_β, C_atd], and P the linearisation at ``wind_speed``:
+    With β = K·[Ω_g, ẋ_top], K = [−C_β, −C_atd] (the sign convention of
+    :mod:`specdesign.closedloop` and the simulator), and P the linearisation at ``wind_speed``:
     T = P_yw + P_yβ·K·P_mw / (1 − K·P_mβ). With the ATD absent this is
     [P_yw + C(P_yw P_Ωβ − P_yβ P_Ωw)]/(1 + C P_Ωβ), the workbench's closed-loop formula.
     omega in rad/s; returns a complex array shaped like omega.
@@ -221,7 +222,7 @@ def closed_loop_response(model, controller, wind_speed, omega, output="tower_bas
     iy, iO, iv = names.index(output), names.index("gen_speed"), names.index("tower_top_vel")
     G = np.asarray(sys(s))  # (ny, nu, nw), inputs wind, pitch_cmd, gen_torque
     cb, ca = _local_response(controller, model, wind_speed, s)
-    k_o, k_v = -cb, ca
+    k_o, k_v = -cb, -ca
     loop = k_o * G[iO, 1] + k_v * G[iv, 1]
     beta_per_w = (k_o * G[iO, 0] + k_v * G[iv, 0]) / (1.0 - loop)
     return G[iy, 0] + G[iy, 1] * beta_per_w
@@ -634,13 +635,14 @@ def load_controller(spec: dict, base: Path, model):
         raise ValueError(f"{path}: not valid JSON ({e})") from None
 
     def tf(d, where):
-        if not isinstance(d, dict) or "num" not in d or "den" not in d:
-            if isinstance(d, dict) and d.get("type") == "Controller" or "elements" in (d or {}):
-                from loopshaping.controller import Controller
+        if isinstance(d, dict) and "num" in d and "den" in d:
+            return control.tf(np.asarray(d["num"], float), np.asarray(d["den"], float))
+        if isinstance(d, dict) and "elements" in d:
+            from loopshaping.controller import Controller
 
-                return Controller.from_dict(d).tf()
-            raise ValueError(f"{path}: {where} must hold 'num' and 'den' coefficient lists (descending powers of s)")
-        return control.tf(np.asarray(d["num"], float), np.asarray(d["den"], float))
+            return Controller.from_dict(d).tf()
+        raise ValueError(f"{path}: {where} must hold 'num' and 'den' coefficient lists (descending powers of s) "
+                         "or a loopshaping Controller ('elements', from Controller.to_dict)")
 
     if "wind_speeds" in data:
         vs = [float(v) for v in data["wind_speeds"]]
