@@ -204,13 +204,21 @@ class Designer:
         add_btn, rm_btn = ipw.Button(description="add element"), ipw.Button(description="remove selected")
         json_box = ipw.Textarea(value=self.controller.to_json(), layout=ipw.Layout(width="100%"), disabled=True)
 
+        busy = [False]
+
         def refresh(select=None):
+            # Relabel the list without letting the selection (and the slider being dragged) jump.
+            keep = elements.value if select is None else select
+            busy[0] = True
             elements.options = self._element_options()
-            if select is not None and elements.options:
-                elements.value = min(select, len(elements.options) - 1)
+            if elements.options:
+                elements.value = min(keep or 0, len(elements.options) - 1)
+            busy[0] = False
             json_box.value = self.controller.to_json()
 
         def build_sliders(change=None):
+            if busy[0]:
+                return
             idx = elements.value
             if idx is None or idx >= len(self.controller.elements):
                 sliders.children = ()

@@ -140,4 +140,13 @@ def test_interactive_designer_numbers_and_widget():
     assert len(d.controller.elements) == 3
     ui = d.widget()
     assert type(ui).__name__ == "VBox"
+    select, row, sliders, _ = ui.children[0].children
+    select.value = 1
+    slider = sliders.children[0]
+    slider.value = 30.0  # drag the zero
+    assert d.controller.elements[1] == lc.real_zero(30.0)
+    assert select.value == 1 and sliders.children[0] is slider  # the dragged slider survives
+    row.children[0].value = "notch"
+    row.children[1].click()
+    assert d.controller.elements[-1].kind == "notch" and select.value == 3
     plt.close(fig)
