@@ -115,3 +115,13 @@ def test_general_form_reproduces_a_classic_spec(setup):
     bg = qft.bounds(tmpl, "general", 1.2, A=np.zeros_like(Pw), B=Pw, C=np.ones_like(Pw), D=Pw)
     bs = qft.bounds(tmpl, "stability", 1.2)
     np.testing.assert_allclose(bg.forbidden_db, bs.forbidden_db, atol=1e-9)
+
+
+def test_tracking_spec_on_the_dense_grid(setup):
+    tmpl, _ = setup
+    up, low = 1.5 / (s / 5 + 1), 1 / (s / 2 + 1) ** 2
+    res = check(G_PUBLISHED, tmpl, [qft.Spec("tracking", None, kind_args=dict(upper=up, lower=low))], DENSE)
+    L = np.stack([np.squeeze(ct.frequency_response(P * G_PUBLISHED, DENSE).complex) for P in tmpl.systems], 1)
+    T = np.abs(L / (1 + L))
+    ratio = np.abs(np.squeeze(ct.frequency_response(up / low, DENSE).complex))
+    np.testing.assert_allclose(res.margins_db[0], 20 * np.log10(ratio) - 20 * np.log10(T.max(1) / T.min(1)), atol=1e-9)

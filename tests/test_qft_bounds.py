@@ -9,6 +9,8 @@ from __future__ import annotations
 import control as ct
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from loopshaping import qft
 
@@ -345,3 +347,31 @@ def test_noise_bound_with_sensor_dynamics_matches_oracle(template):
         for g, o in zip(got, want):
             assert len(g) == len(o)
             np.testing.assert_allclose(g, o, atol=0.01)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(-50, 50), st.floats(0, 30)), min_size=1, max_size=12))
+def test_interval_union_matches_a_sequential_merge(pairs):
+    lo = np.array([p[0] for p in pairs])
+    hi = lo + np.array([p[1] for p in pairs])
+    got_lo, got_hi = qft._merge(lo[None], hi[None])
+    got = [(a, b) for a, b in zip(got_lo[0], got_hi[0]) if not np.isnan(a)]
+    want = []
+    for a, b in sorted((a, b) for a, b in zip(lo, hi) if b > a):
+        if want and a <= want[-1][1]:
+            want[-1] = (want[-1][0], max(want[-1][1], b))
+        else:
+            want.append((a, b))
+    assert got == want
+
+
+def test_bounds_do_not_depend_on_the_block_size(monkeypatch):
+    rng = np.random.default_rng(5)
+    w = np.array([0.5, 20.0, 80.0])
+    k, a, b = rng.uniform(1, 10, 300), rng.uniform(1, 5, 300), rng.uniform(20, 30, 300)
+    tmpl = qft.Template.from_responses(w, k / ((1j * w[:, None] + a) * (1j * w[:, None] + b)))
+    ref = qft.bounds(tmpl, "stability", 1.2)
+    monkeypatch.setattr(qft, "_BLOCK", 700)  # a couple of phases per block
+    small = qft.bounds(tmpl, "stability", 1.2)
+    np.testing.assert_array_equal(small.forbidden_db, ref.forbidden_db)
+    assert ref.non_connected.any()  # the sort-and-merge path was exercised
