@@ -5,6 +5,7 @@
 - :mod:`loopshaping.nichols`: Nichols charts with bounds and loops.
 - :mod:`loopshaping.auto`: automatic loop shaping (cvxpy).
 - :mod:`loopshaping.check`: dense-grid specification check and robust stability.
+- :mod:`loopshaping.interactive`: the Jupyter loop-shaping designer (ipywidgets, ipympl).
 - :mod:`loopshaping.hinf`: H∞ synthesis with well-posedness checks, order reduction.
 
 This package knows nothing about wind turbines and never imports :mod:`specdesign`.
