@@ -279,8 +279,27 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO") -> ScheduledC
     return scheduled(model, {float(v): turbine.rosco_baseline(model, float(v)) for v in wind_speeds}, name=name)
 
 
+_BANKS: dict = {}
+
+
 def _bank(controller, dt):
-    """Discrete arrays of one controller (K local 2-input controllers) and its filter corner."""
+    """Discrete arrays of one controller (K local 2-input controllers) and its filter corner.
+
+    Memoised per (controller object, dt): a campaign simulates the same controllers at
+    every wind speed, and discretising a 14-point ROSCO schedule costs more than a run.
+    """
+    key = (id(controller), float(dt))
+    hit = _BANKS.get(key)
+    if hit is not None and hit[0] is controller:
+        return hit[1]
+    out = _make_bank(controller, dt)
+    if len(_BANKS) > 64:
+        _BANKS.clear()
+    _BANKS[key] = (controller, out)
+    return out
+
+
+def _make_bank(controller, dt):
     if not isinstance(controller, ScheduledController):
         controller = ScheduledController(np.zeros(1), (_as_lti(controller, "controller"),), None, name="controller")
     mats = []

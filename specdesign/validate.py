@@ -438,7 +438,9 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
         per output).
     executor : optional ``concurrent.futures.Executor`` (a dask.distributed Client qualifies);
         wind speeds are submitted as separate tasks. Default: run locally, the compiled
-        simulator already using every core.
+        simulator already using every core. For a local process pool use a "spawn" context,
+        ``ProcessPoolExecutor(mp_context=multiprocessing.get_context("spawn"))``: numba's
+        OpenMP threads make fork() unsafe.
     progress : show a tqdm bar over wind speeds; None → only when stderr is a terminal.
     """
     if not isinstance(controllers, dict) or not controllers:

@@ -245,3 +245,18 @@ def test_run_config_writes_tables_and_figures(tmp_path, model):
     (tmp_path / "badfile.json").write_text(json.dumps({**cfg, "controllers": {"X": {"file": "missing.json"}}}))
     with pytest.raises(FileNotFoundError, match="missing.json"):
         va.run_config(tmp_path / "badfile.json")
+
+
+def test_campaign_with_a_process_pool_equals_the_local_run(model):
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    ctrls = {"PI": turbine.rosco_baseline(model, 19.0)}
+    kw = dict(model=model, duration=40.0, transient=5.0, progress=False)
+    local = va.run_campaign(ctrls, [17.0, 19.0], [1, 2], **kw)
+    # spawn, not fork: numba's OpenMP threads in this process make fork() unsafe
+    with ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn")) as ex:
+        pooled = va.run_campaign(ctrls, [17.0, 19.0], [1, 2], executor=ex, **kw)
+    for k in local.values:
+        assert_allclose(pooled.values[k], local.values[k], rtol=1e-12)
+    assert_allclose(pooled.predicted_del, local.predicted_del, rtol=1e-12)
