@@ -13,8 +13,6 @@ from __future__ import annotations
 import sys
 import time
 
-import numpy as np
-
 from specdesign import simulate as sm
 from specdesign import turbine
 from specdesign import validate as va

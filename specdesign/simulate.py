@@ -541,7 +541,7 @@ def seed_for(wind_speed: float, seed: int) -> int:
     return int(seed) * 1000 + int(round(10.0 * float(wind_speed)))
 
 
-def wind_series(plant_radius, wind_speeds, seeds, duration, dt, turbulence_class="B"):
+def wind_series(rotor_radius, wind_speeds, seeds, duration, dt, turbulence_class="B"):
     """Rotor-effective wind (W, S, n) in m/s: mean plus :func:`specdesign.wind.synthesize` of
     :func:`specdesign.wind.rotor_effective_spectrum` at each mean speed, seeds from :func:`seed_for`."""
     from . import wind as wmod
@@ -549,7 +549,7 @@ def wind_series(plant_radius, wind_speeds, seeds, duration, dt, turbulence_class
     out = []
     for v in wind_speeds:
         def spec(om, v=v):
-            return wmod.rotor_effective_spectrum(om, v, plant_radius, turbulence_class=turbulence_class)
+            return wmod.rotor_effective_spectrum(om, v, rotor_radius, turbulence_class=turbulence_class)
 
         s = wmod.synthesize(spec, duration, dt, [seed_for(v, s) for s in seeds])
         out.append(v + np.asarray(s, dtype=float))
@@ -570,6 +570,10 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
     seeds : integer seeds (S of them) for the turbulent wind; or give ``wind`` instead.
     wind : optional (W, S, n_w) rotor-effective wind in m/s sampled every ``wind_dt`` s,
         covering ``transient + duration``.
+    wind_dt : spacing of the wind samples, s (default ``record_dt`` when synthesised; keep it
+        a multiple of ``dt`` so the interpolated wind is smooth within each RK4 step).
+    turbulence_class : IEC NTM class of the synthesised wind. wind_rotor_radius : rotor radius
+        for the rotor-effective spectrum, m (default: the IEA 15 MW's).
     duration : recorded length of each run, s. transient : simulated before the record
         starts (discarded), s. dt : integration and controller step, s. record_dt : sample
         spacing of the recorded outputs, s (a multiple of ``dt``).
@@ -598,7 +602,7 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         if seeds is None:
             raise ValueError("give either seeds (turbulent wind is synthesised) or wind (W, S, n) in m/s")
         seeds = np.atleast_1d(np.asarray(seeds, dtype=np.int64))
-        wind_dt = dt if wind_dt is None else positive_scalar(wind_dt, "wind_dt")
+        wind_dt = record_dt if wind_dt is None else positive_scalar(wind_dt, "wind_dt")
         radius = wind_rotor_radius
         if radius is None:
             from . import turbine

@@ -252,14 +252,12 @@ def linear_prediction(model, controller, wind_speed, *, output="tower_base_my", 
     omega defaults to :func:`prediction_grid` (600 s, 30 rad/s).
     """
     from . import spectral, wind
-    from .simulate import turbine_plant
 
     w = prediction_grid() if omega is None else np.asarray(omega, dtype=float)
     radius = _rotor_radius(model)
     sw = wind.rotor_effective_spectrum(w, wind_speed, radius, turbulence_class=turbulence_class)
     t = closed_loop_response(model, controller, wind_speed, w, output)
     psd = np.abs(t) ** 2 * sw
-    turbine_plant(model)  # validates the model early
     return LinearPrediction(omega=w, psd=psd, del_=float(spectral.del_spectral(w, psd, m, method=method)),
                             sd=float(np.sqrt(np.trapezoid(psd, w))))
 
