@@ -235,7 +235,15 @@ def test_run_config_writes_tables_and_figures(tmp_path, model):
     for f in ("table2.md", "table2.csv", "table3.md", "table3.csv", "indicators.csv", "fig8_19mps.png", "fig9_19mps.png", "fig10.png"):
         assert (tmp_path / "out" / f).is_file(), f
     assert "Specification" in (tmp_path / "out" / "table3.md").read_text()
-    # TOML works the same way, and bad configs name the file and the key
+    # the command line with a TOML file: same schema, output folder from --out
+    from specdesign.__main__ import main
+
+    (tmp_path / "c.toml").write_text('wind_speeds = [19.0]\nseeds = [4]\nduration = 30.0\ntransient = 5.0\n'
+                                     '[controllers.PI]\nfile = "pi.json"\n')
+    assert main(["validate", str(tmp_path / "c.toml"), "--out", str(tmp_path / "cli")]) == 0
+    rows = (tmp_path / "cli" / "indicators.csv").read_text().splitlines()
+    assert len(rows) == 2 and rows[1].startswith("PI,19.0,4,")
+    # bad configs name the file and the key
     (tmp_path / "bad.toml").write_text('wind_speeds = [19.0]\nseeds = 2\ncolour = "red"\n[controllers.PI]\nfile = "pi.json"\n')
     with pytest.raises(ValueError, match=r"bad\.toml.*colour"):
         va.run_config(tmp_path / "bad.toml")
