@@ -272,8 +272,12 @@ class HinfDesign:
     ``predicted_del_reduction`` (Dirlik on the reduced controller's closed loop, %);
     ``speed_excess_db`` max over the grid of 20·log10(|T_Ω,w|/|W_Ω|) (≤ 0 means met);
     ``tower_excess_db`` the same for MyT at ``tower_mode`` (rad/s);
+    ``discrete_controller`` K sampled at ``dt`` (Tustin prewarped at the tower mode) or None;
     ``pitch_std``/``pitch_std_baseline`` pitch-command standard deviation (rad) from the
-    linear model; ``omega`` the grid; ``notes``.
+    linear model; ``omega`` the grid; ``check`` the :func:`loopshaping.check.check` of the
+    reduced pitch controller against both specifications in QFT's general form (specs
+    "tower" and "speed", margins in dB, stability, gain/phase margins; None with ATD, whose
+    1×2 loop that SISO check does not cover); ``notes``.
     """
 
     pitch_controller: ct.StateSpace
@@ -292,7 +296,28 @@ class HinfDesign:
     pitch_std: float
     pitch_std_baseline: float
     omega: np.ndarray
+    check: object
+    discrete_controller: object
     notes: tuple
+
+
+def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
+    """Re-check a SISO pitch controller with :mod:`loopshaping.check`: the tower spec in
+    the general form |(A + B·C)/(1 + D·C)| ≤ |W_MyT| with A = P_{MyT,w},
+    B = P_{MyT,w}P_{Ω,β} − P_{MyT,β}P_{Ω,w}, D = P_{Ω,β}; the speed spec with A = P_{Ω,w}, B = 0."""
+    from loopshaping import check, qft
+
+    def resp(o, i):
+        sub = plant[o, i]
+        return lambda w: np.asarray(ct.frequency_response(sub, np.asarray(w, float)).complex).reshape(-1, 1)
+
+    p_mw, p_mb = resp("tower_base_my", "wind"), resp("tower_base_my", "pitch_cmd")
+    p_ow, p_ob = resp("gen_speed", "wind"), resp("gen_speed", "pitch_cmd")
+    tower = qft.Spec("general", weight=_siso_tf(w_tower, "w_tower"), name="tower", kind_args=dict(
+        A=p_mw, B=lambda w: p_mw(w) * p_ob(w) - p_mb(w) * p_ow(w), C=1.0, D=p_ob))
+    speed = qft.Spec("general", weight=_siso_tf(w_speed, "w_speed"), name="speed",
+                     kind_args=dict(A=p_ow, B=0.0, C=1.0, D=p_ob))
+    return check.check(pitch_controller, [plant["gen_speed", "pitch_cmd"]], [tower, speed], omega)
 
 
 def closed_loop(plant, controller, measurements=("gen_speed",)):
@@ -346,6 +371,7 @@ def design_hinf(
     omega=None,
     suboptimality=0.05,
     reduction_method="balanced",
+    dt=None,
     **plant_options,
 ):
     """Design, reduce and assess an H∞ pitch (and optional ATD) controller at one wind speed.
@@ -375,6 +401,9 @@ def design_hinf(
         Passed to :func:`loopshaping.hinf.synthesize`.
     reduction_method : str
         Passed to :func:`loopshaping.hinf.reduce`.
+    dt : float, optional
+        Sample time (s): also return ``discrete_controller``, the reduced K by Tustin
+        prewarped at the tower mode (exact there).
     **plant_options
         ``noise``, ``noise_band``, ``rolloff``, ``shift`` for :func:`generalized_plant`.
     """
@@ -431,5 +460,7 @@ def design_hinf(
         predicted_del_reduction=100.0 * (1.0 - del1 / del0),
         speed_excess_db=speed_excess, tower_excess_db=tower_excess, tower_mode=wt_mode,
         pitch_std=std(t_pitch), pitch_std_baseline=std(t_pitch0), omega=omega,
+        check=_qft_check(plant, parts[0], w_tower, w_speed, omega) if len(parts) == 1 else None,
+        discrete_controller=None if dt is None else _hinf.discretize(K, dt, prewarp_frequency=wt_mode),
         notes=gp.notes + res.notes,
     )

@@ -142,12 +142,37 @@ def test_acceptance_at_19_mps(design, model, plant, specs):
     assert reduction >= promise > 0
 
 
+def test_loopshaping_check_agrees(design):
+    # The QFT-side checker (another module, polynomial closed-loop poles) sees the same.
+    res = design.check
+    if design.controller.ninputs == 2:
+        assert res is None
+        return
+    assert res.stable.all() and res.phase_margin_deg[0] > 30 and res.gain_margin_db[0] > 6
+    speed = res.margins_db[res.names.index("speed")]
+    tower = res.margins_db[res.names.index("tower")]
+    assert speed.min() >= -1.0
+    assert speed.min() == pytest.approx(-design.speed_excess_db, abs=1e-6)
+    near_mode = np.abs(np.log(res.omegas / design.tower_mode)) < 0.2
+    assert tower[near_mode].min() >= 0.0
+
+
 def test_sign_convention_matches_rosco(design, model):
     # β = −C·Ω_g: at low frequency C_β has integral action with ROSCO's sign.
     w = np.array([1e-3, 2e-3])
     c = _resp(design.pitch_controller, w)[0, 0]
     c0 = _resp(ct.ss(turbine.rosco_baseline(model, V)), w)[0, 0]
     assert np.all(np.real(c / c0) > 0)
+
+
+def test_discrete_controller_exact_at_the_tower_mode(model):
+    d = hinf.design_hinf(model, V, order=8, dt=0.05)
+    assert d.discrete_controller.dt == 0.05
+    wm = d.tower_mode
+    kd = np.asarray(d.discrete_controller(np.exp(1j * wm * 0.05))).ravel()[0]
+    kc = np.asarray(d.controller(1j * wm)).ravel()[0]
+    assert kd == pytest.approx(kc, rel=1e-8)
+    assert hinf.design_hinf(model, V, order=8).discrete_controller is None
 
 
 def test_reduction_report_is_consistent(design):
