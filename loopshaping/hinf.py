@@ -226,7 +226,7 @@ def _hinf_norm(sys):
     i = int(np.argmax(g))
     best = g[i]
     for _ in range(3):
-        # Zoom twice on the grid peak (±1 grid step, 200 points) to pin it down.
+        # Zoom three times on the grid peak (±1 grid step, 201 points) to pin it down.
         lo_w, hi_w = w[max(i - 1, 0)], w[min(i + 1, len(w) - 1)]
         w = np.linspace(lo_w, hi_w, 201)
         g = _sigma_max(sys, w)
@@ -683,10 +683,14 @@ def mixed_sensitivity(
                 warnings.warn(note, WellPosednessWarning, stacklevel=2)
         weights[name] = W
     P = _augment(G, weights["w_s"], weights["w_ks"], weights["w_t"])
-    result = synthesize(
-        P, ny, nu, regularize=regularize, epsilon=epsilon, suboptimality=suboptimality,
-        gamma_tol=gamma_tol, rank_tol=rank_tol, axis_tol=axis_tol,
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", WellPosednessWarning)
+        result = synthesize(
+            P, ny, nu, regularize=regularize, epsilon=epsilon, suboptimality=suboptimality,
+            gamma_tol=gamma_tol, rank_tol=rank_tol, axis_tol=axis_tol,
+        )
+    for w in caught:  # re-issue at the caller of mixed_sensitivity, not inside this module
+        warnings.warn(w.message, w.category, stacklevel=2)
     if notes:
         result = HinfResult(
             controller=result.controller, gamma=result.gamma, closed_loop=result.closed_loop,

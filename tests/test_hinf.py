@@ -58,6 +58,27 @@ def test_mixed_sensitivity_matches_mixsyn_gamma(weights):
     assert isinstance(K, ct.StateSpace)
 
 
+def test_mimo_mixed_sensitivity_matches_mixsyn_and_grid():
+    G2 = ct.tf([[[1.0], [0.5]], [[0.2], [2.0]]], [[[1.0, 1.0], [1.0, 2.0]], [[1.0, 1.0], [1.0, 3.0]]])
+    ws = (s / 2 + 1) / (s + 1e-2)
+    wks = ct.tf([0.1, 0.05], [0.01, 1])
+    _, _, (gamma_pc, _) = _quiet_mixsyn(G2, ws, wks)
+    res = hinf.mixed_sensitivity(G2, w_s=ws, w_ks=wks, suboptimality=0.02)
+    assert res.controller.ninputs == 2 and res.controller.noutputs == 2
+    assert res.gamma_bound / 1.02 == pytest.approx(gamma_pc, rel=0.01)
+    # σ_max of [W_S S; W_KS K S] from G(jω), K(jω) only.
+    w = np.logspace(-4, 4, 4000)
+    Gj, Kj = _freq(ct.ss(G2), w), _freq(res.controller, w)
+    wsj, wksj = _freq(ct.ss(ws), w)[0, 0], _freq(ct.ss(wks), w)[0, 0]
+    peak = 0.0
+    for i in range(len(w)):
+        S = np.linalg.inv(np.eye(2) + Gj[:, :, i] @ Kj[:, :, i])
+        M = np.vstack([wsj[i] * S, wksj[i] * Kj[:, :, i] @ S])
+        peak = max(peak, np.linalg.svd(M, compute_uv=False)[0])
+    assert peak <= res.gamma * (1 + 1e-6)
+    assert peak >= res.gamma * (1 - 1e-2)
+
+
 def test_gamma_is_the_closed_loop_norm_on_a_dense_grid():
     res = hinf.mixed_sensitivity(G, w_s=W_S, w_ks=ct.tf(0.1, 1), w_t=W_T, suboptimality=0.05)
     mag = _weighted_siso_stack(G, res.controller, (W_S, ct.tf(0.1, 1), W_T), OMEGA)
@@ -171,10 +192,11 @@ def test_ill_posed_rank_deficient_d12_raises_within_a_second():
 
 def test_ill_posed_regularized_on_request():
     ws, wt = (s / 1.5 + 10) / (s + 1e-3), ct.tf([1 / 20, 1], [1 / 2000, 1])
-    with pytest.warns(hinf.WellPosednessWarning, match="D12"):
+    with pytest.warns(hinf.WellPosednessWarning, match="D12") as rec:
         res = hinf.mixed_sensitivity(G, w_s=ws, w_t=wt, regularize=True, epsilon=1e-2,
                                      suboptimality=0.05)
     assert any("D12" in n for n in res.notes)
+    assert all(r.filename == __file__ for r in rec)  # warned at the caller's line
     # Regularisation only adds a (small) output, so the [W_S S; W_T T] stack is ≤ γ.
     mag = _weighted_siso_stack(G, res.controller, (ws, None, wt), OMEGA)
     assert mag.max() <= res.gamma * (1 + 1e-6)
