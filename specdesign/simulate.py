@@ -65,7 +65,7 @@ SCHEDULE_FILTER_OMEGA = 0.1
 
 
 # ----------------------------------------------------------------------------- plant
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class KernelPlant:
     """A plant given by a compiled kernel pair, as :mod:`specdesign.turbine` defines it.
 
@@ -204,7 +204,7 @@ def discretize(controller, dt):
             np.array([float(np.squeeze(d.D))]))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class ScheduledController:
     """Local pitch (and optional ATD) controllers blended by output on filtered pitch.
 
@@ -500,7 +500,7 @@ def _compiled_for(rhs, outfn):
 
 
 # ----------------------------------------------------------------------------- results
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class SimulationResult:
     """Time series of a batch of runs, shaped (n_wind_speeds, n_seeds, n_samples).
 

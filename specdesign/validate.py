@@ -108,7 +108,7 @@ def welch_psd(x, dt, nperseg: int | None = None, axis: int = -1):
 
 
 # ----------------------------------------------------------------------------- indicators
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class Indicators:
     """Per-run indicators, each an array shaped like the runs (e.g. (W, S)).
 
@@ -228,7 +228,7 @@ def closed_loop_response(model, controller, wind_speed, omega, output="tower_bas
     return G[iy, 0] + G[iy, 1] * beta_per_w
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class LinearPrediction:
     """Linear prediction at one wind speed: omega (rad/s), psd of the output (SI² per rad/s,
     = |T|²S_W), del_ (DEL, Dirlik by default, 1 Hz, range) and sd (√∫S dω)."""
@@ -279,7 +279,7 @@ def _pool(name, x, m, axis=-1):
     return np.sqrt(np.mean(x**2, axis=axis))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class PairedChange:
     """Relative change (%) designed vs baseline per wind speed, with its standard error.
 
@@ -334,7 +334,7 @@ def paired_change(designed, baseline, indicator="tower_del", *, m=4.0, wind_spee
 
 
 # ----------------------------------------------------------------------------- campaign
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class Campaign:
     """Results of controllers × wind speeds × seeds (paired: every controller saw the same seeds).
 
@@ -345,7 +345,8 @@ class Campaign:
         NaN for controllers without a linear form (callables).
     omega : (nω,) Welch grid (rad/s). welch : dict output → (C, W, nω) seed-averaged Welch PSD
     per rad/s. predicted_psd : dict output → (C, W, nω) |T|²S_W on the same grid.
-    series : dict controller → SimulationResult when run with ``keep_series=True``, else {}.
+    series : dict controller → SimulationResult (W, k, n) of the first k seeds kept
+        (``keep_series``), else {}.
     """
 
     controllers: tuple
@@ -380,8 +381,9 @@ def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, trans
                     turbulence_class, keep_series, nperseg):
     """One wind speed, every controller, the same seeds: indicators, spectra, predictions."""
     from . import wind as wmod
-    from .simulate import simulate, wind_series
+    from .simulate import SimulationResult, simulate, wind_series
 
+    n_keep = len(seeds) if keep_series is True else int(keep_series)
     radius = _rotor_radius(model)
     wdt = record_dt
     wind = wind_series(radius, [v], seeds, transient + duration + wdt, wdt, turbulence_class)
@@ -409,8 +411,10 @@ def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, trans
             out["pred"].append(np.nan)
             for k in _SPECTRA:
                 out["ppsd"][k].append(np.full(omega.size, np.nan))
-        if keep_series:
-            out["series"][name] = r
+        if n_keep:
+            outs = {k: a[:, :n_keep] for k, a in r.outputs.items()}
+            out["series"][name] = SimulationResult(time=r.time, wind_speeds=r.wind_speeds, seeds=seeds[:n_keep],
+                                                   outputs=outs, dt=r.dt, sim_dt=r.sim_dt, controller=name)
     out["omega"] = omega
     return out
 
@@ -432,8 +436,9 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
     model : TurbineModel (default ``turbine.iea15mw()``). duration, dt, record_dt, transient:
         as in :func:`specdesign.simulate.simulate` (s). m : Wöhler exponent of the DEL.
     predict : compute the linear predictions (|T|²S_W, Dirlik DEL) for LTI-like controllers.
-    keep_series : keep every run's time series in ``Campaign.series`` (memory: C·W·S·n·8 bytes
-        per output).
+    keep_series : keep time series in ``Campaign.series``: True for every seed, an int k for
+        the first k seeds (enough for Fig. 9), False for none (memory: C·W·k·n·8 bytes per
+        output).
     executor : optional ``concurrent.futures.Executor`` (a dask.distributed Client qualifies);
         wind speeds are submitted as separate tasks. Default: run locally, the compiled
         simulator already using every core. For a local process pool use a "spawn" context,
@@ -480,7 +485,7 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
         for name in names:
             rs = [p["series"][name] for p in points]
             outs = {k: np.concatenate([r.outputs[k] for r in rs], axis=0) for k in rs[0].outputs}
-            series[name] = SimulationResult(time=rs[0].time, wind_speeds=vs, seeds=seeds, outputs=outs, dt=rs[0].dt,
+            series[name] = SimulationResult(time=rs[0].time, wind_speeds=vs, seeds=rs[0].seeds, outputs=outs, dt=rs[0].dt,
                                             sim_dt=rs[0].sim_dt, controller=name)
     return Campaign(
         controllers=names, wind_speeds=vs, seeds=seeds, duration=float(duration), dt=float(record_dt), m=float(m),
@@ -555,7 +560,7 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k=WEIBULL_K, sca
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class Acceptance:
     """Linear prediction vs rainflow of the tower-base DEL reduction, per wind speed (%).
 
@@ -712,7 +717,7 @@ def run_config(path, out=None) -> Campaign:
     camp = run_campaign(
         ctrls, cfg["wind_speeds"], seeds, model=model, duration=cfg.get("duration", 600.0), dt=cfg.get("dt", 0.02),
         record_dt=cfg.get("record_dt", 0.1), transient=cfg.get("transient", 60.0), m=cfg.get("wohler_exponent", 4.0),
-        turbulence_class=cfg.get("turbulence_class", "B"), keep_series=True,
+        turbulence_class=cfg.get("turbulence_class", "B"), keep_series=1,
     )
     out = Path(out if out is not None else base / cfg.get("output", "validation_output"))
     out.mkdir(parents=True, exist_ok=True)

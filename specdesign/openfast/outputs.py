@@ -65,7 +65,7 @@ def to_si(unit: str) -> tuple[str, float]:
     return u, 1.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class OpenFASTOutput:
     """Channels of one OpenFAST output file, in SI.
 
