@@ -4,6 +4,7 @@ import subprocess
 import sys
 import textwrap
 import warnings
+from pathlib import Path
 
 import control as ct
 import numpy as np
@@ -181,8 +182,9 @@ def test_ill_posed_rank_deficient_d12_raises_within_a_second():
     # A strictly proper plant with only w_s and w_t: D12 = 0. SLICOT's sb10ad iterates on
     # it without end (python-control's mixsyn hangs), so run it in a subprocess: a hang is
     # a failure, not a stuck test run.
+    root = Path(__file__).resolve().parents[1]  # import this checkout's loopshaping
     out = subprocess.run([sys.executable, "-c", ILL_POSED], capture_output=True, text=True,
-                         timeout=60)
+                         timeout=60, cwd=root)
     assert out.returncode == 0, out.stderr
     first, message = out.stdout.split("\n", 1)
     assert first.startswith("VALUEERROR"), out.stdout
