@@ -8,9 +8,12 @@ The design loop, one module a step:
 - :mod:`specdesign.spectral`: spectral moments, Dirlik & co., DEL, damage sensitivity ΔD%(ω).
 - :mod:`specdesign.fatigue`: rainflow counting, S-N curves, Palmgren-Miner, DEL from time series.
 - :mod:`specdesign.spec`: notch-shaped specifications W_y(s) that promise a fatigue reduction.
+- :mod:`specdesign.qft`: QFT design of the pitch and tower-damping controllers against the specs.
+- :mod:`specdesign.hinf`: H∞ design with the fatigue-based specifications as weights.
 - :mod:`specdesign.simulate`: batched nonlinear time-domain simulation.
 - :mod:`specdesign.validate`: rainflow validation, indicators, the paper's tables.
 - :mod:`specdesign.openfast`: OpenFAST file adapters (.lin, .out/.outb).
+- :mod:`specdesign.demo`: the 19 m/s design loop behind ``python -m specdesign demo``.
 
 Generic control design (QFT, loop shaping, H∞) lives in the sibling package :mod:`loopshaping`.
 Units are SI throughout; frequencies in rad/s; PSDs one-sided per rad/s.
