@@ -268,3 +268,11 @@ def test_campaign_with_a_process_pool_equals_the_local_run(model):
     for k in local.values:
         assert_allclose(pooled.values[k], local.values[k], rtol=1e-12)
     assert_allclose(pooled.predicted_del, local.predicted_del, rtol=1e-12)
+
+
+def test_progress_bar_on_request_only(model, capsys):
+    ctrls = {"PI": turbine.rosco_baseline(model, 19.0)}
+    va.run_campaign(ctrls, [19.0], [1], model=model, duration=20.0, transient=5.0, progress=True, predict=False)
+    assert "validation" in capsys.readouterr().err
+    va.run_campaign(ctrls, [19.0], [1], model=model, duration=20.0, transient=5.0, progress=False, predict=False)
+    assert "validation" not in capsys.readouterr().err
