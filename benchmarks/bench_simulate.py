@@ -58,7 +58,7 @@ def main(quick=False):
           f"{transient:g} s transient + 600 s recorded per run; compile time excluded")
     print(f"{'case':58s} {'time (s)':>9s} {'target':>8s} {'ratio':>7s}")
     print(f"{'wind synthesis, 6 speeds × 4 seeds':58s} {t_wind:9.2f}")
-    print(f"{'48 runs, scheduled ROSCO (14 local PI) + ROSCO+ATD, sim only':58s} {t_sim:9.2f} {3.0:8.1f} {t_sim / 3.0:7.2f}")
+    print(f"{f'48 runs, scheduled ROSCO ({len(rosco.pitch)} local PI) + ROSCO+ATD, sim only':58s} {t_sim:9.2f} {3.0:8.1f} {t_sim / 3.0:7.2f}")
     print(f"{'24 runs, one LTI controller (no scheduling), sim only':58s} {t_one:9.2f}")
     print(f"{'48-run campaign: wind + sim + rainflow + Welch + linear pred':58s} {t_camp:9.2f} {3.0:8.1f} {t_camp / 3.0:7.2f}")
     print(f"{'simulated seconds per wall second (48 runs, sim only)':58s} {sim_s / t_sim:9.0f}")

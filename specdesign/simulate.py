@@ -182,8 +182,8 @@ def _as_lti(c, name):
 def discretize(controller, dt):
     """Tustin discretisation of a SISO continuous controller at step ``dt`` (s).
 
-    Returns ``(A, B, C, D)`` float arrays of shapes (n, n), (n,), (n,), scalar D (a 1-tuple
-    array) of the discrete state-space form x⁺ = A x + B u, y = C x + D u.
+    Returns ``(A, B, C, D)`` float arrays of shapes (n, n), (n,), (n,) and (1,) of the
+    discrete state-space form x⁺ = A x + B u, y = C x + D u.
     Raises ValueError for an improper controller (more zeros than poles).
     """
     import control
@@ -275,7 +275,7 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO") -> ScheduledC
         model = turbine.iea15mw()
     if wind_speeds is None:
         lo, hi = getattr(model, "wind_range", (11.0, 25.0))
-        wind_speeds = np.arange(math.ceil(lo) + 1.0, hi + 0.5, 1.0)
+        wind_speeds = np.arange(math.ceil(lo), hi + 0.5, 1.0)
     return scheduled(model, {float(v): turbine.rosco_baseline(model, float(v)) for v in wind_speeds}, name=name)
 
 
@@ -286,7 +286,7 @@ def _bank(controller, dt):
     """Discrete arrays of one controller (K local 2-input controllers) and its filter corner.
 
     Memoised per (controller object, dt): a campaign simulates the same controllers at
-    every wind speed, and discretising a 14-point ROSCO schedule costs more than a run.
+    every wind speed, and discretising a 15-point ROSCO schedule costs more than a run.
     """
     key = (id(controller), float(dt))
     hit = _BANKS.get(key)
