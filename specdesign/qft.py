@@ -540,10 +540,29 @@ def _callable(fn, key):
 def design_qft(model, wind_speed, target_reduction=25.0, *, speed_relax_db=(3.0, 4.5, 6.0, 8.0), **kwargs) -> QFTDesign:
     """QFT design of C_β and C_atd at ``wind_speed`` (m/s) against the fatigue-based specs.
 
-    ``speed_relax_db``: a relaxation of the generator-speed spec in dB, or an increasing
-    sequence of them tried in turn (default 3, 4.5, 6, 8 dB): the design with the smallest
-    relaxation that meets every spec is returned (or the last attempt, with a warning).
-    Other keywords: see :func:`_design_single` (the parameters documented there).
+    Parameters
+    ----------
+    model : :class:`specdesign.turbine.TurbineModel` (e.g. ``turbine.iea15mw()``).
+    wind_speed : operating point, m/s (above rated, inside ``model.wind_range``).
+    target_reduction : predicted tower-base DEL reduction (1 Hz, m = 4) vs ROSCO to reach, %.
+    spec_reduction : damage reduction (%) the notch-shaped tower specification promises
+        (:func:`specdesign.spec.shape_to_target`, notches above ``keep_below`` rad/s).
+    template_offsets : wind-speed offsets (m/s) of the neighbouring operating points.
+    design_omegas : QFT design frequencies, rad/s (default :data:`DEFAULT_DESIGN_OMEGAS`).
+    dense_omegas : grid of the final check, rad/s (default 600 points, 0.005-20 rad/s).
+    speed_relax_db : relaxation of the generator-speed spec in dB (≥ 0), or an increasing
+        sequence tried in turn (default 3, 4.5, 6, 8 dB): the design with the smallest
+        relaxation that meets every spec is returned (else the last attempt, with a warning).
+    tower_relax_db, tower_relax_omega : the tower spec is relaxed by this many dB above about
+        this frequency (rad/s), where ΔD% is negligible (0 to disable).
+    max_sensitivity : bound on |1/(1+L)| for both loops and at the actuator (> 1).
+    min_decay : required closed-loop decay rate, 1/s (poles left of −min_decay).
+    keep_below : protected band of the notch specification, rad/s (power regulation).
+    refine : rounds adding the dense check's failing frequencies to the design set.
+    maxfev : function evaluations per tuning round.
+
+    Returns a :class:`QFTDesign`; ``success`` is False (with a message, and a RuntimeWarning)
+    when the target, a bound, the dense check or stability is not met.
     """
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
     if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
@@ -563,29 +582,7 @@ def design_qft(model, wind_speed, target_reduction=25.0, *, speed_relax_db=(3.0,
 def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=15.0, template_offsets=(-1.0, -0.5, 0.5, 1.0),
                    design_omegas=None, dense_omegas=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
                    max_sensitivity=1.9, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
-    """QFT design of C_β and C_atd at ``wind_speed`` (m/s) against the fatigue-based specs.
-
-    Parameters
-    ----------
-    model : :class:`specdesign.turbine.TurbineModel` (e.g. ``turbine.iea15mw()``).
-    wind_speed : operating point, m/s (above rated, inside ``model.wind_range``).
-    target_reduction : predicted tower-base DEL reduction (1 Hz, m = 4) vs ROSCO to reach, %.
-    spec_reduction : damage reduction (%) the notch-shaped tower specification promises
-        (:func:`specdesign.spec.shape_to_target`, notches above ``keep_below`` rad/s).
-    template_offsets : wind-speed offsets (m/s) of the neighbouring operating points.
-    design_omegas : QFT design frequencies, rad/s (default :data:`DEFAULT_DESIGN_OMEGAS`).
-    dense_omegas : grid of the final check, rad/s (default 600 points, 0.005-20 rad/s).
-    speed_relax_db : relaxation of the generator-speed spec (dB ≥ 0).
-    tower_relax_db, tower_relax_omega : the tower spec is relaxed by this many dB above about
-        this frequency (rad/s), where ΔD% is negligible (0 to disable).
-    max_sensitivity : bound on |1/(1+L)| for both loops and at the actuator (> 1).
-    min_decay : required closed-loop decay rate, 1/s (poles left of −min_decay).
-    refine : rounds adding the dense check's failing frequencies to the design set.
-    maxfev : function evaluations per tuning round.
-
-    Returns a :class:`QFTDesign`; ``success`` is False (with a message) when the target, a
-    bound, the dense check or stability is not met — the best design found is returned.
-    """
+    """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
     from loopshaping import qft as lqft
 
     from . import spec as sp
