@@ -81,6 +81,9 @@ class HinfResult:
         Everything that was changed to make the problem well posed.
     rcond : numpy.ndarray
         SLICOT's reciprocal condition estimates (control, measurement, X- and Y-Riccati).
+    decay_rate : float
+        α of an α-shifted synthesis (0 for none). With α > 0, ``gamma_bound`` is the γ of
+        the shifted problem (not a bound on ``gamma``, which is measured on the jω axis).
     """
 
     controller: ct.StateSpace
@@ -90,6 +93,7 @@ class HinfResult:
     generalized_plant: ct.StateSpace
     notes: tuple = ()
     rcond: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))
+    decay_rate: float = 0.0
 
     def __iter__(self):
         # The public contract is "returns controller, γ": keep tuple unpacking working.
@@ -412,6 +416,8 @@ def synthesize(
     gamma_tol=1e-4,
     rank_tol=1e-9,
     axis_tol=1e-9,
+    decay_rate=0.0,
+    decay_states=None,
 ):
     """γ-optimal H∞ controller for a general plant, closed by ``u = K·y``.
 
@@ -435,6 +441,21 @@ def synthesize(
         Relative width of the final γ bracket of the bisection.
     rank_tol, axis_tol : float
         Tolerances of :func:`check_well_posed`.
+    decay_rate : float
+        α ≥ 0 (1/s). With α > 0 the synthesis is α-shifted: it is done on the plant with
+        A → A + α·I and the controller is shifted back (A_K → A_K − α·I), so every pole of
+        the closed loop F_l(P, K) satisfies Re p < −α (ζ ≥ α/|p| for an oscillatory pair).
+        The price: the γ-optimality then holds on the line Re s = −α, not on the jω axis;
+        ``gamma`` is recomputed on the jω axis. Modes the controller cannot move (weight
+        poles) slower than α make the shifted problem ill posed (ValueError): lower α or
+        use ``decay_states``.
+    decay_states : array of bool, optional
+        Shift only these states of ``generalized_plant`` (default: all). Use it to leave
+        input and output weights, which sit in series outside the feedback loop and which
+        no controller can move, unshifted: the bound Re p < −α then holds for the poles of
+        the loop formed by the shifted states and the controller, and the unshifted
+        weights keep their own poles. The caller is responsible for the unshifted states
+        being such series weights; the returned ``closed_loop`` lets you check.
 
     Returns
     -------
@@ -459,13 +480,50 @@ def synthesize(
             "generalized_plant has no states: a static problem needs no H∞ synthesis "
             "(use a static gain), and SLICOT does not accept it"
         )
+    if not (np.isfinite(decay_rate) and decay_rate >= 0):
+        raise ValueError(f"decay_rate={decay_rate!r} must be a number ≥ 0 (1/s)")
+    if decay_states is None:
+        mask = np.ones(P.nstates, dtype=bool)
+    else:
+        mask = np.asarray(decay_states, dtype=bool).reshape(-1)
+        if mask.size != P.nstates:
+            raise ValueError(
+                f"decay_states has {mask.size} entries, the generalized plant {P.nstates} states"
+            )
     notes = []
     if regularize:
         P, notes = _regularized(P, n_meas, n_ctrl, epsilon, rank_tol)
         for note in notes:
             warnings.warn(note, WellPosednessWarning, stacklevel=2)
-    check_well_posed(P, n_meas, n_ctrl, rank_tol=rank_tol, axis_tol=axis_tol)
-    return _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, tuple(notes))
+    if decay_rate == 0:
+        check_well_posed(P, n_meas, n_ctrl, rank_tol=rank_tol, axis_tol=axis_tol)
+        return _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, tuple(notes))
+    alpha = float(decay_rate)
+    shift = alpha * np.diag(mask.astype(float))
+    P_alpha = ct.ss(np.asarray(P.A, dtype=float) + shift, P.B, P.C, P.D)
+    try:
+        check_well_posed(P_alpha, n_meas, n_ctrl, rank_tol=rank_tol, axis_tol=axis_tol)
+    except ValueError as e:
+        raise ValueError(
+            f"with decay_rate={alpha:g} (synthesis on A + α·I): {e} A mode slower than α that "
+            "the controller cannot move (typically a weight pole) makes the shifted problem ill "
+            "posed: lower decay_rate, speed up that weight pole, or leave the weights out of "
+            "the shift with decay_states."
+        ) from None
+    notes = tuple(notes) + (
+        f"α-shifted synthesis: decay_rate {alpha:g} 1/s ({int(mask.sum())} of {P.nstates} "
+        "states shifted); γ recomputed on the jω axis",
+    )
+    res = _solve(P_alpha, n_meas, n_ctrl, suboptimality, gamma_tol, notes)
+    Ka = res.controller
+    K = ct.ss(np.asarray(Ka.A, dtype=float) - alpha * np.eye(Ka.nstates), Ka.B, Ka.C, Ka.D)
+    cl = _lower_lft(_partition(P, n_meas, n_ctrl), K)
+    if cl.nstates and np.max(np.linalg.eigvals(cl.A).real) >= 0:  # pragma: no cover
+        raise RuntimeError("α-shifted synthesis returned a destabilising controller")
+    return HinfResult(
+        controller=K, gamma=_hinf_norm(cl), closed_loop=cl, gamma_bound=res.gamma_bound,
+        generalized_plant=P, notes=notes, rcond=res.rcond, decay_rate=alpha,
+    )
 
 
 def _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, notes):
@@ -627,6 +685,7 @@ def mixed_sensitivity(
     gamma_tol=1e-4,
     rank_tol=1e-9,
     axis_tol=1e-9,
+    decay_rate=0.0,
 ):
     """Mixed-sensitivity H∞ design: minimise ‖[W_S·S; W_KS·K·S; W_T·T]‖∞.
 
@@ -651,6 +710,11 @@ def mixed_sensitivity(
         Distance (rad/s) by which weight poles on the imaginary axis are moved left.
     suboptimality, gamma_tol, rank_tol, axis_tol
         As in :func:`synthesize`.
+    decay_rate : float
+        α ≥ 0 (1/s): α-shifted synthesis (see :func:`synthesize`) with only the plant's
+        states shifted, so every pole of the feedback loop of G and K has Re < −α; the
+        weights (in series, outside the loop) keep their own poles, so integrators in W_S
+        are allowed.
 
     Returns
     -------
@@ -683,11 +747,13 @@ def mixed_sensitivity(
                 warnings.warn(note, WellPosednessWarning, stacklevel=2)
         weights[name] = W
     P = _augment(G, weights["w_s"], weights["w_ks"], weights["w_t"])
+    decay_states = np.arange(P.nstates) < G.nstates  # _augment puts the plant's states first
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", WellPosednessWarning)
         result = synthesize(
             P, ny, nu, regularize=regularize, epsilon=epsilon, suboptimality=suboptimality,
             gamma_tol=gamma_tol, rank_tol=rank_tol, axis_tol=axis_tol,
+            decay_rate=decay_rate, decay_states=decay_states,
         )
     for w in caught:  # re-issue at the caller of mixed_sensitivity, not inside this module
         warnings.warn(w.message, w.category, stacklevel=2)
@@ -696,6 +762,7 @@ def mixed_sensitivity(
             controller=result.controller, gamma=result.gamma, closed_loop=result.closed_loop,
             gamma_bound=result.gamma_bound, generalized_plant=result.generalized_plant,
             notes=tuple(notes) + result.notes, rcond=result.rcond,
+            decay_rate=result.decay_rate,
         )
     return result
 

@@ -149,6 +149,49 @@ def test_synthesize_general_plant_against_lft_oracle(d22):
                                                       suboptimality=0.02).gamma, rel=1e-6)
 
 
+@pytest.mark.parametrize("alpha", [0.3, 1.0])
+@pytest.mark.parametrize("d22", [0.0, 0.4])
+def test_decay_rate_bounds_every_closed_loop_pole(alpha, d22):
+    # The unstable 2-state plant: without a shift its closed loop has a pole at ≈ −0.1.
+    P = _general_plant(d22)
+    res = hinf.synthesize(P, 1, 1, decay_rate=alpha, suboptimality=0.02)
+    assert res.decay_rate == alpha and any("α-shifted" in n for n in res.notes)
+    # Closed loop rebuilt independently by interconnection of P and the returned K.
+    Pn = ct.ss(P.A, P.B, P.C, P.D, inputs=["w1", "w2", "u"], outputs=["z1", "z2", "y"])
+    K = res.controller
+    Kn = ct.ss(K.A, K.B, K.C, K.D, inputs=["y"], outputs=["u"])
+    cl = ct.interconnect([Pn, Kn], inplist=["w1", "w2"], outlist=["z1", "z2"])
+    assert np.max(cl.poles().real) < -alpha
+    assert np.max(res.closed_loop.poles().real) < -alpha
+    # γ is the jω-axis norm of the returned closed loop, and no better than unshifted.
+    mag = _lft_freq(P, K, np.logspace(-4, 5, 6000))
+    assert mag.max() == pytest.approx(res.gamma, rel=2e-3)
+    assert res.gamma >= hinf.synthesize(P, 1, 1, suboptimality=0.02).gamma * (1 - 1e-6)
+
+
+def test_decay_rate_in_mixed_sensitivity_keeps_integral_weights():
+    # Only the plant's states are shifted: W_S with a (shifted) integrator stays allowed, and
+    # the loop G–K has every pole left of −α; the weights keep their own poles.
+    alpha = 0.5
+    res = hinf.mixed_sensitivity(G, w_s=W_S, w_ks=W_KS, decay_rate=alpha)
+    L = ct.feedback(ct.ss(G) * res.controller)
+    assert np.max(L.poles().real) < -alpha
+    assert res.gamma == pytest.approx(_weighted_siso_stack(G, res.controller, (W_S, W_KS, None),
+                                                           OMEGA).max(), rel=1e-3)
+
+
+def test_decay_rate_slower_weight_mode_is_refused():
+    # Shifting the whole plant (weights included) past a weight's pole at −1e-3 leaves a mode
+    # the controller cannot move: refused at once, naming the remedy.
+    P = hinf.mixed_sensitivity(G, w_s=W_S, w_ks=W_KS).generalized_plant
+    with pytest.raises(ValueError, match="decay_rate=0.1.*decay_states"):
+        hinf.synthesize(P, 1, 1, decay_rate=0.1)
+    with pytest.raises(ValueError, match="decay_rate"):
+        hinf.synthesize(P, 1, 1, decay_rate=-1.0)
+    with pytest.raises(ValueError, match="decay_states"):
+        hinf.synthesize(P, 1, 1, decay_rate=0.1, decay_states=[True])
+
+
 def test_integrator_in_weight_is_shifted_with_a_note():
     w_s_int = (s / 1.5 + 10) / s
     with pytest.warns(hinf.WellPosednessWarning, match="w_s"):
