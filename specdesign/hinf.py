@@ -29,6 +29,7 @@ from loopshaping import hinf as _hinf
 __all__ = [
     "GeneralizedPlant",
     "HinfDesign",
+    "assessment_grid",
     "closed_loop",
     "design_hinf",
     "generalized_plant",
@@ -39,6 +40,15 @@ __all__ = [
 #: 0.01 m/s on the tower-top velocity keeps the ATD gain moderate: with 1e-3 the 1×2 design
 #: was 3 % better at full order but needed 11 states after balanced truncation instead of 8.
 DEFAULT_NOISE = {"gen_speed": 1e-3, "tower_top_vel": 1e-2, "tower_top_acc": 1e-2}
+
+#: Damping floor (ratio) of the specifications' zeros in the weights, see :func:`inverse_weight`.
+DEFAULT_MIN_DAMPING = 0.05
+#: α (1/s) of the α-shifted synthesis in :func:`design_hinf`.
+DEFAULT_DECAY_RATE = 0.02
+#: ω_i (rad/s) of the integrator built into the plant for an α-shifted synthesis.
+DEFAULT_INTEGRAL_CORNER = 0.1
+#: Half-width of the tower-mode band (relative) over which ``tower_excess_db`` is the maximum.
+TOWER_BAND = 0.1
 
 
 def _siso_tf(sys, name):
@@ -80,7 +90,7 @@ def _cascade(zeros, poles, gain):
     return sys
 
 
-def inverse_weight(specification, *, rolloff=10.0, shift=1e-3, name="specification"):
+def inverse_weight(specification, *, rolloff=10.0, shift=1e-3, min_damping=0.0, name="specification"):
     """A stable, proper, minimum-phase W⁻¹ with |W⁻¹(jω)| = 1/|W(jω)| below ``rolloff``.
 
     Zeros of W in the right half-plane are reflected (same magnitude on the jω axis), zeros
@@ -94,6 +104,12 @@ def inverse_weight(specification, *, rolloff=10.0, shift=1e-3, name="specificati
         W(s), stable and proper (output units per m/s of wind).
     rolloff, shift : float
         rad/s.
+    min_damping : float
+        Zeros of W with damping ratio below this (a narrow dip of the specification, such
+        as the one ROSCO's T_{Ω,w} has at the tower mode) are given this damping at the same
+        |z|: W⁻¹ then caps its resonant peak there (relaxes the weight in that narrow band)
+        instead of asking the synthesis to track a 40 dB spike, which it does by copying the
+        dip into a lightly damped closed-loop pole pair. 0 keeps every zero.
 
     Returns
     -------
@@ -128,6 +144,19 @@ def inverse_weight(specification, *, rolloff=10.0, shift=1e-3, name="specificati
         )
     z = np.where(rhp, -zeros.conj(), zeros)
     z = np.where(axis, z - shift, z)
+    if not (np.isfinite(min_damping) and 0 <= min_damping < 1):
+        raise ValueError(f"min_damping={min_damping!r} must be in [0, 1)")
+    osc = np.abs(z.imag) > 1e-9 * np.maximum(1.0, np.abs(z))
+    light = osc & (-z.real < min_damping * np.abs(z))
+    if light.any():
+        mag = np.abs(z[light])
+        z = z.copy()
+        z[light] = mag * (-min_damping + 1j * np.sign(z[light].imag) * np.sqrt(1 - min_damping**2))
+        notes.append(
+            f"{name}: {light.sum()} lightly damped zero(s) near "
+            f"{', '.join(f'{w:.3g}' for w in np.unique(np.round(mag, 4)))} rad/s given damping "
+            f"{min_damping:g} (the weight is capped there; the check uses the true specification)"
+        )
     if r:
         notes.append(f"{name}: relative degree {r} rolled off by poles at −{rolloff:g} rad/s")
     gain = rolloff**r * den[0] / num[0]
@@ -141,7 +170,11 @@ class GeneralizedPlant:
 
     ``system``: inputs ``['wind', 'noise_<meas>'..., 'pitch_cmd']``, outputs
     ``['z_tower', 'z_speed', 'z_pitch', 'y_<meas>'...]``; ``n_meas``, ``n_ctrl`` (= 1);
-    ``measurements`` (names); ``inverse_weights`` {'tower', 'speed', 'pitch'} → LTI; ``notes``.
+    ``measurements`` (names); ``inverse_weights`` {'tower', 'speed', 'pitch'} → LTI; ``notes``;
+    ``input_filter`` F(s) = (1 + s/ω_i)/s when built with ``integral_corner`` (the control
+    input is then ``pitch_u`` and the turbine's controller is F·K), else None;
+    ``n_plant_states``: the first states of ``system`` are the turbine's (and F's), the rest
+    are weights in series.
     """
 
     system: ct.StateSpace
@@ -150,6 +183,8 @@ class GeneralizedPlant:
     measurements: tuple
     inverse_weights: dict
     notes: tuple
+    input_filter: object = None
+    n_plant_states: int = 0
 
 
 def _named(sys, inp, out, name):
@@ -168,6 +203,8 @@ def generalized_plant(
     noise_band=(1e-3, 1.0),
     rolloff=10.0,
     shift=1e-3,
+    min_damping=0.0,
+    integral_corner=None,
 ):
     """The generalized plant at one operating point (see the module docstring).
 
@@ -192,8 +229,13 @@ def generalized_plant(
         with integral action a measurement offset at DC would pass to Ω_g and meet the
         speed weight's near-infinite low-frequency gain, so the noise is kept out of DC
         (a > 0 keeps its zero off the imaginary axis).
-    rolloff, shift : float
-        Passed to :func:`inverse_weight` (rad/s).
+    rolloff, shift, min_damping : float
+        Passed to :func:`inverse_weight` (rad/s; damping ratio).
+    integral_corner : float, optional
+        ω_i (rad/s): put F(s) = (1 + s/ω_i)/s in front of the pitch input, so the control
+        input becomes ``pitch_u`` and the controller F·K has exact integral action (needed by
+        an α-shifted synthesis, which would otherwise move the controller's integrator to −α).
+        The pitch weight stays on ``pitch_cmd``.
     """
     if not isinstance(plant, ct.StateSpace):
         raise TypeError(f"plant must be a named control.StateSpace, got {type(plant).__name__}")
@@ -221,8 +263,9 @@ def generalized_plant(
     a, b = noise_band
     if not (0 < a < b):
         raise ValueError(f"noise_band={noise_band!r} must be (a, b) rad/s with 0 < a < b")
-    wt_inv, n1 = inverse_weight(w_tower, rolloff=rolloff, shift=shift, name="w_tower")
-    ws_inv, n2 = inverse_weight(w_speed, rolloff=rolloff, shift=shift, name="w_speed")
+    kw = dict(rolloff=rolloff, shift=shift, min_damping=min_damping)
+    wt_inv, n1 = inverse_weight(w_tower, name="w_tower", **kw)
+    ws_inv, n2 = inverse_weight(w_speed, name="w_speed", **kw)
     if w_pitch is None:
         w_pitch = 0.1 * ct.tf([1 / 0.5, 1], [1 / 20.0, 1])
     elif isinstance(w_pitch, (int, float)):
@@ -234,6 +277,21 @@ def generalized_plant(
         plant.A, np.asarray(plant.B)[:, [i_w, i_u]], plant.C, np.asarray(plant.D)[:, [i_w, i_u]],
         inputs=["wind", "pitch_cmd"], outputs=list(plant.output_labels), name="plant",
     )
+    input_filter, control = None, "pitch_cmd"
+    if integral_corner is not None:
+        if not (np.isfinite(integral_corner) and integral_corner > 0):
+            raise ValueError(f"integral_corner={integral_corner!r} must be a positive frequency in rad/s")
+        # pitch_cmd = F(s)·u with F = (1 + s/ω_i)/s: the integrator is part of the plant (and of
+        # its states, so an α-shift moves it and the controller keeps exact integral action).
+        f = ct.ss(ct.tf([1.0 / integral_corner, 1.0], [1.0, 0.0]))
+        input_filter = ct.ss(f.A, f.B, f.C, f.D, inputs=["pitch_u"], outputs=["pitch_cmd"], name="F_int")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            Pn = ct.interconnect([Pn, input_filter], inplist=["wind", "pitch_u"], outlist=list(plant.output_labels) + ["pitch_cmd"],
+                                 inputs=["wind", "pitch_u"], outputs=list(plant.output_labels) + ["pitch_cmd"], name="plant")
+        Pn = ct.ss(Pn.A, Pn.B, Pn.C, Pn.D, inputs=["wind", "pitch_u"],
+                   outputs=list(plant.output_labels) + ["pitch_cmd"], name="plant")
+        control = "pitch_u"
     systems = [
         Pn,
         _named(wt_inv, "tower_base_my", "z_tower", "W_tower_inv"),
@@ -245,7 +303,7 @@ def generalized_plant(
         systems.append(_named(nf, f"noise_{mname}", f"n_{mname}", f"N_{mname}"))
         systems.append(ct.summing_junction(inputs=[mname, f"n_{mname}"], output=f"y_{mname}",
                                            name=f"sum_{mname}"))
-    inputs = ["wind"] + [f"noise_{x}" for x in measurements] + ["pitch_cmd"]
+    inputs = ["wind"] + [f"noise_{x}" for x in measurements] + [control]
     outputs = ["z_tower", "z_speed", "z_pitch"] + [f"y_{x}" for x in measurements]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # unused plant outputs
@@ -254,7 +312,7 @@ def generalized_plant(
     return GeneralizedPlant(
         system=ct.ss(sys), n_meas=len(measurements), n_ctrl=1, measurements=measurements,
         inverse_weights={"tower": wt_inv, "speed": ws_inv, "pitch": ct.ss(wp)},
-        notes=n1 + n2,
+        notes=n1 + n2, input_filter=input_filter, n_plant_states=Pn.nstates,
     )
 
 
@@ -299,6 +357,12 @@ class HinfDesign:
     check: object
     discrete_controller: object
     notes: tuple
+    zeta_min: float
+    zeta_min_frequency: float
+    peak_sensitivity: float
+    max_pole_real: float
+    decay_rate: float
+    tower_band_excess_db: float
 
 
 def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
@@ -347,6 +411,71 @@ def closed_loop(plant, controller, measurements=("gen_speed",)):
                                inputs=["wind"], outputs=outs + ["pitch_cmd"], name="hinf_closed_loop")
 
 
+def _roots(sys):
+    """Poles and zeros of a SISO LTI (or of every channel of a MIMO one), complex array."""
+    sys = ct.ss(sys)
+    out = [np.asarray(sys.poles(), dtype=complex)]
+    for i in range(sys.noutputs):
+        for j in range(sys.ninputs):
+            sub = sys[i, j]
+            if sub.nstates:
+                out.append(np.asarray(ct.tf(sub).zeros(), dtype=complex))
+    return np.concatenate(out) if out else np.zeros(0, complex)
+
+
+def assessment_grid(omega, roots=(), *, zeta_max=0.3, rel_width=0.05, rel_step=1e-4):
+    """A frequency grid (rad/s) that cannot step over a narrow resonance or dip.
+
+    ``omega`` refined around every lightly damped root: for each pole or zero p of
+    ``roots`` with damping ratio ζ = −Re p/|p| < ``zeta_max`` (either sign, so unstable and
+    right-half-plane roots count too) and |Im p| inside [omega[0], omega[-1]], the grid gets
+    |Im p| and |p| exactly and geometric points with relative spacing ``rel_step`` over
+    |Im p|·(1 ± ``rel_width``). A second-order peak of damping ζ has a relative half-power
+    width 2ζ, so with the defaults every peak with ζ ≳ 5·10⁻⁵ gets ≥ 1 point inside its
+    half-power band, and the exact |Im p| points bound the rest.
+
+    Parameters
+    ----------
+    omega : array
+        Base grid, rad/s, increasing and positive.
+    roots : array of complex, or iterable of arrays / LTI systems
+        Poles and zeros to refine around; LTI systems contribute their poles and the zeros of
+        each channel.
+    zeta_max, rel_width, rel_step : float
+        Damping threshold and refinement half-width and step, relative to the frequency.
+
+    Returns
+    -------
+    numpy.ndarray
+        Sorted unique grid in rad/s containing ``omega``.
+    """
+    omega = np.asarray(omega, dtype=float).reshape(-1)
+    if omega.size < 2 or np.any(omega <= 0) or np.any(np.diff(omega) <= 0):
+        raise ValueError("omega must be an increasing grid of positive frequencies in rad/s")
+    for k, v in (("zeta_max", zeta_max), ("rel_width", rel_width), ("rel_step", rel_step)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{k}={v!r} must be positive")
+    if isinstance(roots, ct.LTI):
+        roots = [roots]
+    parts = []
+    for r in ([roots] if isinstance(roots, np.ndarray) else roots):
+        parts.append(_roots(r) if isinstance(r, ct.LTI) else np.atleast_1d(np.asarray(r, complex)))
+    p = np.concatenate(parts) if parts else np.zeros(0, complex)
+    p = p[np.isfinite(p) & (np.abs(p) > 0)]
+    light = p[(np.abs(p.imag) > 0) & (-p.real < zeta_max * np.abs(p))]
+    lo, hi = omega[0], omega[-1]
+    extra = []
+    n = int(np.ceil(np.log((1 + rel_width) / (1 - rel_width)) / np.log1p(rel_step))) + 1
+    for w0 in np.unique(np.round(np.abs(light.imag), 12)):
+        if not lo <= w0 <= hi:
+            continue
+        extra.append(np.geomspace(w0 * (1 - rel_width), w0 * (1 + rel_width), n))
+        extra.append([w0])
+    extra.append(np.abs(light))
+    grid = np.unique(np.concatenate([omega] + [np.asarray(e, float) for e in extra]))
+    return grid[(grid >= lo) & (grid <= hi)]
+
+
 def _tower_mode(plant):
     """Frequency (rad/s) of the least-damped complex open-loop pole pair: the tower mode."""
     p = np.asarray(plant.poles())
@@ -372,9 +501,17 @@ def design_hinf(
     suboptimality=0.05,
     reduction_method="balanced",
     dt=None,
+    min_damping=DEFAULT_MIN_DAMPING,
+    decay_rate=DEFAULT_DECAY_RATE,
+    integral_corner=None,
     **plant_options,
 ):
     """Design, reduce and assess an H∞ pitch (and optional ATD) controller at one wind speed.
+
+    Every frequency-domain number is computed on :func:`assessment_grid`: ``omega`` refined
+    around the lightly damped poles of the closed loop (full and reduced controller), and the
+    poles and zeros of ROSCO's closed loop and of both specifications, so a narrow peak
+    cannot fall between grid points.
 
     Parameters
     ----------
@@ -396,7 +533,8 @@ def design_hinf(
     m : float
         Wöhler exponent of the tower-base DEL (S-N curve on ranges).
     omega : array, optional
-        Assessment grid in rad/s (default :func:`specdesign.spec.default_omega`).
+        Base grid in rad/s (default :func:`specdesign.spec.default_omega`), refined by
+        :func:`assessment_grid` for the assessment.
     suboptimality : float
         Passed to :func:`loopshaping.hinf.synthesize`.
     reduction_method : str
@@ -404,15 +542,27 @@ def design_hinf(
     dt : float, optional
         Sample time (s): also return ``discrete_controller``, the reduced K by Tustin
         prewarped at the tower mode (exact there).
+    min_damping : float
+        Damping floor for the specifications' zeros in the weights (:func:`inverse_weight`).
+        The default caps W_Ω⁻¹ at ROSCO's narrow dip of T_{Ω,w} at the tower mode (ζ ≈ 0.01);
+        without it (0) the synthesis copies the dip into a closed-loop pole pair of ζ ≈ 0.003.
+    decay_rate : float
+        α (1/s) of an α-shifted synthesis (:func:`loopshaping.hinf.synthesize`) on the
+        turbine's states and the integrator F (weights, in series, unshifted): every pole of
+        the loop with the full-order controller has Re < −α (reduction may move them; the
+        reduced loop's poles are reported in ``zeta_min`` and ``max_pole_real``).
+    integral_corner : float, optional
+        ω_i (rad/s) of the integrator F(s) = (1 + s/ω_i)/s built into the plant
+        (:func:`generalized_plant`). Default: 0.1 rad/s when ``decay_rate`` > 0 (without it
+        the shift would move the controller's integral action to −α), none otherwise.
     **plant_options
         ``noise``, ``noise_band``, ``rolloff``, ``shift`` for :func:`generalized_plant`.
     """
-    from . import closedloop, spec, spectral, turbine
+    from . import closedloop, spec, spectral, turbine, wind
 
     v = float(wind_speed)
     plant = model.linearize(v)
     base = spec.baseline_analysis(model, v, m=m, omega=omega)
-    omega = base.omega
     if w_tower is None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -422,13 +572,27 @@ def design_hinf(
         w_tower = shaped.specification
     if w_speed is None:
         w_speed = spec.speed_specification(model, v)
-    wt_resp = ct.frequency_response(_siso_tf(w_tower, "w_tower"), omega)
-    wt_resp = np.asarray(wt_resp.complex).reshape(-1)
+    Wt, Ws = _siso_tf(w_tower, "w_tower"), _siso_tf(w_speed, "w_speed")
+    wt_resp = np.asarray(ct.frequency_response(Wt, base.omega).complex).reshape(-1)
     promise = spec.evaluate(wt_resp / base.t_response, base)
 
-    gp = generalized_plant(plant, w_tower, w_speed, w_pitch, measurements, **plant_options)
-    res = _hinf.synthesize(gp.system, gp.n_meas, gp.n_ctrl, suboptimality=suboptimality)
-    red = _hinf.reduce(res.controller, order, method=reduction_method)
+    if integral_corner is None and decay_rate > 0:
+        integral_corner = DEFAULT_INTEGRAL_CORNER
+    gp = generalized_plant(plant, w_tower, w_speed, w_pitch, measurements, min_damping=min_damping,
+                           integral_corner=integral_corner, **plant_options)
+    n_p = gp.n_plant_states
+    A_gp = np.asarray(gp.system.A)
+    if not (np.allclose(A_gp[:plant.nstates, :plant.nstates], plant.A)
+            and not np.any(A_gp[:n_p, n_p:])):  # pragma: no cover - interconnect's state order
+        raise RuntimeError("generalized plant does not start with the turbine's states, "
+                           "followed by weights in series: the α-shift would be wrong")
+    res = _hinf.synthesize(gp.system, gp.n_meas, gp.n_ctrl, suboptimality=suboptimality,
+                           decay_rate=decay_rate, decay_states=np.arange(gp.system.nstates) < n_p)
+    K_full = res.controller
+    if gp.input_filter is not None:
+        f = gp.input_filter
+        K_full = ct.series(ct.ss(K_full.A, K_full.B, K_full.C, K_full.D), ct.ss(f.A, f.B, f.C, f.D))
+    red = _hinf.reduce(K_full, order, method=reduction_method)
     K = red.controller
     cl = closed_loop(plant, K, measurements)
     if not closedloop.check_stability(cl, "H∞ closed loop (reduced controller)"):
@@ -436,25 +600,41 @@ def design_hinf(
             f"the {order}-state reduced controller does not stabilise the turbine at {v:g} m/s "
             f"(reduction error {red.error_hinf:.3g}); raise order"
         )
+    rosco = turbine.rosco_baseline(model, v)
+    cl0 = closedloop.closed_loop(plant, rosco, warn=False)
+    cl_full = closed_loop(plant, K_full, measurements)
+    omega = assessment_grid(base.omega, [
+        cl.poles(), cl_full.poles(), cl0["gen_speed", "wind"], cl0["tower_base_my", "wind"], Wt, Ws,
+    ])
     # β = −C·y: the workbench's controllers are −K, one SISO part per measurement.
     parts = [ct.minreal(ct.ss(K.A, K.B[:, [i]], -K.C, -K.D[:, [i]]), verbose=False)
              for i in range(len(measurements))]
     t_tower = closedloop.frequency_response(cl, omega, "tower_base_my")
     t_speed = closedloop.frequency_response(cl, omega, "gen_speed")
     t_pitch = closedloop.frequency_response(cl, omega, "pitch_cmd")
-    ws_resp = np.asarray(ct.frequency_response(_siso_tf(w_speed, "w_speed"), omega).complex).reshape(-1)
+    ws_resp = np.asarray(ct.frequency_response(Ws, omega).complex).reshape(-1)
+    wt_resp = np.asarray(ct.frequency_response(Wt, omega).complex).reshape(-1)
     speed_excess = float(np.max(20 * np.log10(np.abs(t_speed) / np.abs(ws_resp))))
     wt_mode = _tower_mode(plant)
+    band = np.abs(omega / wt_mode - 1) <= TOWER_BAND
+    tower_band_excess = float(np.max(20 * np.log10(np.abs(t_tower[band]) / np.abs(wt_resp[band]))))
     at_mode = np.abs(closedloop.frequency_response(cl, [wt_mode, 2 * wt_mode], "tower_base_my"))[0]
-    w_at_mode = np.abs(np.asarray(_siso_tf(w_tower, "w_tower")(1j * wt_mode)))
-    tower_excess = float(20 * np.log10(at_mode / w_at_mode))
-    del0 = float(spectral.del_spectral(omega, base.psd, m))
-    del1 = float(spectral.del_spectral(omega, np.abs(t_tower) ** 2 * base.s_wind, m))
-    cl0 = closedloop.closed_loop(plant, turbine.rosco_baseline(model, v), warn=False)
+    tower_excess = float(20 * np.log10(at_mode / np.abs(np.asarray(Wt(1j * wt_mode)))))
+    s_wind = wind.rotor_effective_spectrum(omega, v, model.rotor_radius)
+    t_tower0 = closedloop.frequency_response(cl0, omega, "tower_base_my")
+    del0 = float(spectral.del_spectral(omega, np.abs(t_tower0) ** 2 * s_wind, m))
+    del1 = float(spectral.del_spectral(omega, np.abs(t_tower) ** 2 * s_wind, m))
     t_pitch0 = closedloop.frequency_response(cl0, omega, "pitch_cmd")
-    std = lambda t: float(np.sqrt(np.trapezoid(np.abs(t) ** 2 * base.s_wind, omega)))  # noqa: E731
+    std = lambda t: float(np.sqrt(np.trapezoid(np.abs(t) ** 2 * s_wind, omega)))  # noqa: E731
+    # Loop at the actuator, L_u = Σ C_i·P_{y_i,β}; its peak sensitivity max |1/(1 + L_u)|.
+    Kj = np.asarray(ct.frequency_response(K, omega).complex).reshape(1, len(measurements), -1)[0]
+    L_u = -sum(Kj[i] * closedloop.frequency_response(plant, omega, y, "pitch_cmd")
+               for i, y in enumerate(measurements))
+    p = np.asarray(cl.poles())
+    osc = p[np.abs(p.imag) > 1e-6]
+    zeta = -osc.real / np.abs(osc)
     return HinfDesign(
-        pitch_controller=parts[0], atd_controller=parts[1] if len(parts) > 1 else None, controller=K, full_controller=res.controller,
+        pitch_controller=parts[0], atd_controller=parts[1] if len(parts) > 1 else None, controller=K, full_controller=K_full,
         gamma=res.gamma, reduction=red, w_tower=w_tower, w_speed=w_speed,
         promised_del_reduction=float(promise.exact_del),
         predicted_del_reduction=100.0 * (1.0 - del1 / del0),
@@ -463,4 +643,10 @@ def design_hinf(
         check=_qft_check(plant, parts[0], w_tower, w_speed, omega) if len(parts) == 1 else None,
         discrete_controller=None if dt is None else _hinf.discretize(K, dt, prewarp_frequency=wt_mode),
         notes=gp.notes + res.notes,
+        zeta_min=float(zeta.min()) if zeta.size else 1.0,
+        zeta_min_frequency=float(np.abs(osc[np.argmin(zeta)])) if zeta.size else float("nan"),
+        peak_sensitivity=float(np.max(np.abs(1.0 / (1.0 + L_u)))),
+        max_pole_real=float(p.real.max()),
+        decay_rate=float(decay_rate),
+        tower_band_excess_db=tower_band_excess,
     )
