@@ -312,7 +312,9 @@ def generalized_plant(
     return GeneralizedPlant(
         system=ct.ss(sys), n_meas=len(measurements), n_ctrl=1, measurements=measurements,
         inverse_weights={"tower": wt_inv, "speed": ws_inv, "pitch": ct.ss(wp)},
-        notes=n1 + n2, input_filter=input_filter, n_plant_states=Pn.nstates,
+        notes=n1 + n2 + (() if input_filter is None else (
+            f"integrator (1 + s/{integral_corner:g})/s built into the plant: the controller is F·K",)),
+        input_filter=input_filter, n_plant_states=Pn.nstates,
     )
 
 
@@ -329,10 +331,16 @@ class HinfDesign:
     ``promised_del_reduction`` (the specification's exact Dirlik promise, %) and
     ``predicted_del_reduction`` (Dirlik on the reduced controller's closed loop, %);
     ``speed_excess_db`` max over the grid of 20·log10(|T_Ω,w|/|W_Ω|) (≤ 0 means met);
-    ``tower_excess_db`` the same for MyT at ``tower_mode`` (rad/s);
+    ``tower_excess_db`` the same for MyT at ``tower_mode`` (rad/s) and
+    ``tower_band_excess_db`` its max over ``tower_mode``·(1 ± :data:`TOWER_BAND`);
+    ``zeta_min`` the least damping ratio of the reduced loop's oscillatory poles, at
+    ``zeta_min_frequency`` (|p|, rad/s), ``max_pole_real`` its largest Re p (1/s);
+    ``peak_sensitivity`` max |1/(1 + L_u)| at the actuator, L_u = Σ C_i·P_{y_i,β};
+    ``decay_rate`` the α of the synthesis;
     ``discrete_controller`` K sampled at ``dt`` (Tustin prewarped at the tower mode) or None;
     ``pitch_std``/``pitch_std_baseline`` pitch-command standard deviation (rad) from the
-    linear model; ``omega`` the grid; ``check`` the :func:`loopshaping.check.check` of the
+    linear model; ``omega`` the assessment grid (:func:`assessment_grid`) on which every
+    frequency-domain number here is computed, DELs included; ``check`` the :func:`loopshaping.check.check` of the
     reduced pitch controller against both specifications in QFT's general form (specs
     "tower" and "speed", margins in dB, stability, gain/phase margins; None with ATD, whose
     1×2 loop that SISO check does not cover); ``notes``.
