@@ -12,14 +12,20 @@ an infeasible loop; slack left at the end means infeasible, and the binding desi
 frequency and spec are reported.
 
 The bounds only hold at the design frequencies and do not imply closed-loop stability: run
-:func:`loopshaping.check.check` on the result.
+:func:`loopshaping.check.check` on the result. :func:`refine` does both in a loop: shape,
+check on a dense grid over every case, add the frequencies where the check fails to the
+design set (bounds recomputed there from the plant cases and the specs) and shape again.
 """
 from __future__ import annotations
 
+import warnings
+from dataclasses import dataclass
+
 import numpy as np
 
+
 from .controller import Controller
-from .qft import Bounds, evaluate
+from .qft import Bounds, Spec, Template, _check_grid, evaluate
 
 
 class InfeasibleError(ValueError):
@@ -180,3 +186,121 @@ def _nominal(bounds):
     for part in bounds.parts:
         p0[np.searchsorted(bounds.omegas, part.omegas)] = part.p0
     return p0
+
+
+@dataclass(frozen=True, eq=False)
+class RefineResult:
+    """Outcome of :func:`refine`.
+
+    Attributes
+    ----------
+    controller : the last shaped :class:`Controller`.
+    bounds : the :class:`~loopshaping.qft.Bounds` it was shaped against (the final design set).
+    template : the plant cases at the final design frequencies (rad/s).
+    check : :class:`~loopshaping.check.CheckResult` of ``controller`` on the dense grid.
+    added : (k,) frequencies added to the design set, rad/s, in the order they were added.
+    rounds : shaping calls made.
+    """
+
+    controller: Controller
+    bounds: Bounds
+    template: Template
+    check: object
+    added: np.ndarray
+    rounds: int
+
+    @property
+    def passed(self) -> bool:
+        """Every spec met on the dense grid for every case and every closed loop stable."""
+        return bool(self.check.passed)
+
+
+def refine(template: Template, specs, omega_dense, poles=None, *, max_rounds=6, margin_db=0.01, phases_deg=None,
+           **shape_kwargs) -> RefineResult:
+    """:func:`shape`, check on a dense grid, add the failing frequencies, shape again.
+
+    Each round shapes against the exact bounds of ``specs`` at the current design frequencies
+    (first the template's), runs :func:`loopshaping.check.check` on ``omega_dense`` over every
+    case and, if a spec fails, adds the worst frequency of every violated range of the grid
+    to the design set (bounds recomputed there from the plant cases), starting the next shape
+    from the last controller. Stops when the check passes, after ``max_rounds`` shapes, or
+    when nothing new can be added (a failure left only at design frequencies, or closed-loop
+    instability, which bounds at more frequencies do not cure): look at ``result.passed``.
+
+    Parameters
+    ----------
+    template : :class:`~loopshaping.qft.Template` built from systems (the cases are
+        re-evaluated at the added frequencies); a disk radius must be the same at every
+        design frequency.
+    specs : :class:`~loopshaping.qft.Bounds` (its specs are used), a
+        :class:`~loopshaping.qft.Spec` or a list of them; weights and general-form
+        coefficients must be numbers, LTI or callables of ω.
+    omega_dense : strictly increasing grid of the check, rad/s.
+    poles, shape_kwargs : as :func:`shape` (``n_zeros``, ``initial``, ``hf_omegas``,
+        ``max_iter``, ``tol``, ``solver``).
+    margin_db : :func:`shape`'s cushion, default 0.01 dB, so that solver tolerance cannot
+        leave a bound violated by a hair at a design frequency.
+    phases_deg : phase grid of the returned bounds (charts only; the shaper uses the exact
+        inequalities).
+    Raises :class:`InfeasibleError` when a shaping round is infeasible.
+    """
+    from . import qft
+    from .check import check
+
+    if not isinstance(template, Template):
+        raise TypeError(f"template must be a loopshaping.qft.Template; got {type(template).__name__}")
+    if template.systems is None:
+        raise ValueError("template has no systems (built from responses): refine re-evaluates the plant cases "
+                         "at new frequencies; build it with Template.from_systems")
+    disk = template.disk_radius
+    if disk is not None:
+        if not np.allclose(disk, disk[0], rtol=1e-12, atol=0):
+            raise ValueError("template.disk_radius varies with frequency: refine cannot evaluate it at new "
+                             "frequencies; expand the disk into cases or use a constant radius")
+        disk = float(disk[0])
+    if isinstance(specs, Bounds):
+        specs = list(specs.specs)
+    elif isinstance(specs, Spec):
+        specs = [specs]
+    else:
+        specs = list(specs)
+    if not specs or not all(isinstance(sp, Spec) for sp in specs):
+        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
+    w_dense = _check_grid(omega_dense, "omega_dense")
+    if int(max_rounds) < 1:
+        raise ValueError(f"max_rounds={max_rounds} must be ≥ 1")
+    if poles is None:
+        # shape's default depends on the design frequencies: fix it once for every round
+        poles = _fixed_poles(None, template.omegas)
+    systems, nominal = template.systems, template.nominal
+    omegas = template.omegas
+    added = []
+    initial = shape_kwargs.pop("initial", None)
+    for rounds in range(1, int(max_rounds) + 1):
+        tmpl = Template.from_systems(systems, omegas, nominal, disk)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", qft.BoundsWarning)
+            # a spec may leave some design frequencies unconstrained (band, infinite weight)
+            parts = [qft.bounds(tmpl, sp, phases_deg=phases_deg) for sp in specs if np.any(sp.in_band(omegas))]
+            b = qft.intersect(*parts)
+        G = shape(b, poles, initial=initial, margin_db=margin_db, **shape_kwargs)
+        res = check(G, tmpl, specs, w_dense)
+        if res.passed or rounds == int(max_rounds):
+            break
+        new = []
+        for name, ok in zip(res.names, res.spec_passed):
+            if ok:
+                continue
+            i = res.names.index(name)
+            m = np.nan_to_num(res.margins_db[i], nan=np.inf)
+            for lo, hi in res.violated_ranges(name):
+                sel = (w_dense >= lo) & (w_dense <= hi)
+                new.append(w_dense[sel][np.argmin(m[sel])])
+        new = np.setdiff1d(np.unique(new), omegas)
+        new = new[~np.isclose(new[:, None], omegas[None, :], rtol=1e-9, atol=0).any(axis=1)] if new.size else new
+        if not new.size:
+            break
+        added.extend(new.tolist())
+        omegas = np.unique(np.r_[omegas, new])
+        initial = G
+    return RefineResult(G, b, tmpl, res, np.array(added, float), rounds)

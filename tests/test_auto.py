@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from loopshaping import qft
-from loopshaping.auto import InfeasibleError, shape
+from loopshaping.auto import InfeasibleError, refine, shape
 from loopshaping.check import check
 from loopshaping.controller import Controller
 
@@ -75,3 +75,61 @@ def test_bad_input(problem):
         shape("bounds")
     with pytest.raises(ValueError, match="conjugate"):
         shape(b, poles=[-1 + 1j])
+
+
+# ----------------------------------------------------------------------------- refine
+def _manual_specs():
+    return [qft.Spec("stability", 1.2), qft.Spec("sensitivity", W_SENS, band=(0, 10)),
+            qft.Spec("input_disturbance", 0.01, band=(0, 10))]
+
+
+@pytest.mark.parametrize("start", ["published", "default"])
+def test_refine_repairs_the_loop_between_the_manual_design_frequencies(start):
+    # Only the manual's four design frequencies: the shaped loop meets the bounds there but
+    # bulges through the stability (margin) spec around 15-85 rad/s; refine adds the worst
+    # frequencies of the failing ranges until the dense check passes.
+    cases, nom = manual_cases()
+    tmpl = qft.Template.from_systems(cases, OMEGAS, nominal=nom)
+    specs = _manual_specs()
+    dense = np.logspace(-2, 3, 1000)
+    published = Controller.from_tf(G_PUBLISHED)
+    kw = (dict(poles=published, n_zeros=1, initial=published) if start == "published"
+          else dict(poles=[-247 * np.exp(1j * np.pi / 3), -247 * np.exp(-1j * np.pi / 3)]))
+    b = qft.intersect(*[qft.bounds(tmpl, sp) for sp in specs])
+    plain = check(shape(b, margin_db=0.01, **kw), tmpl, specs, dense)
+    assert not plain.passed and plain.worst("stability")[1] < -10
+    res = refine(tmpl, specs, dense, **kw)
+    assert res.passed, res.check.summary()
+    assert res.check.stable.all()
+    assert res.rounds >= 2 and res.added.size >= 1
+    assert np.all((res.added > 10) & (res.added < 100))
+    assert set(OMEGAS) <= set(res.template.omegas) and set(res.added) <= set(res.template.omegas)
+    np.testing.assert_array_equal(res.bounds.omegas, res.template.omegas)
+    L0 = res.template.nominal_response * res.controller.response(res.template.omegas)
+    assert res.bounds.is_allowed(res.template.omegas, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0))).all()
+    num, den = res.controller.polys()
+    assert len(np.trim_zeros(num, "f")) <= len(np.trim_zeros(den, "f"))
+
+
+def test_refine_stops_after_max_rounds_and_reports_failure():
+    cases, nom = manual_cases()
+    tmpl = qft.Template.from_systems(cases, OMEGAS, nominal=nom)
+    res = refine(tmpl, _manual_specs(), np.logspace(-2, 3, 1000), poles=[-247 * np.exp(1j * np.pi / 3),
+                                                                        -247 * np.exp(-1j * np.pi / 3)], max_rounds=1)
+    assert res.rounds == 1 and res.added.size == 0 and not res.passed
+
+
+def test_refine_bad_input():
+    cases, nom = manual_cases()
+    tmpl = qft.Template.from_systems(cases, OMEGAS, nominal=nom)
+    dense = np.logspace(-2, 3, 50)
+    with pytest.raises(ValueError, match="systems"):
+        refine(qft.Template.from_responses(OMEGAS, tmpl.responses), _manual_specs(), dense)
+    with pytest.raises(ValueError, match="disk_radius"):
+        refine(qft.Template.from_systems(cases, OMEGAS, nom, disk_radius=[0.1, 0.1, 0.2, 0.3]), _manual_specs(), dense)
+    with pytest.raises(TypeError, match="Spec"):
+        refine(tmpl, ["stability"], dense)
+    with pytest.raises(TypeError, match="Template"):
+        refine("template", _manual_specs(), dense)
+    with pytest.raises(ValueError, match="max_rounds"):
+        refine(tmpl, _manual_specs(), dense, max_rounds=0)
