@@ -19,7 +19,7 @@ Sign convention of the workbench: β = −C_β·Ω_g − C_atd·v_tt. SLICOT clo
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import control as ct
 import numpy as np
@@ -29,11 +29,13 @@ from loopshaping import hinf as _hinf
 __all__ = [
     "GeneralizedPlant",
     "HinfDesign",
+    "QFT_SPEED_RELAX_DB",
     "assessment_grid",
     "closed_loop",
     "design_hinf",
     "generalized_plant",
     "inverse_weight",
+    "qft_specifications",
 ]
 
 #: Default measurement-noise levels (units of the measurement: rad/s, m/s, m/s²).
@@ -343,7 +345,15 @@ class HinfDesign:
     frequency-domain number here is computed, DELs included; ``check`` the :func:`loopshaping.check.check` of the
     reduced pitch controller against both specifications in QFT's general form (specs
     "tower" and "speed", margins in dB, stability, gain/phase margins; None with ATD, whose
-    1×2 loop that SISO check does not cover); ``notes``.
+    1×2 loop that SISO check does not cover); ``notes``;
+    ``specs`` which specifications were the weights ("qft", "qft_design", "rosco", "custom")
+    and ``speed_relax_db`` the relaxation of ROSCO's T_{Ω,w} in the speed spec (dB; nan for
+    custom specs); ``notch_spec`` the unrelaxed notch specification (ROSCO × notches of
+    :func:`specdesign.spec.shape_to_target`; ``w_tower`` for custom specs),
+    ``notch_promised_del_reduction`` its promise (%), ``tower_notch_excess_db`` the tower
+    excess against it at ``tower_mode`` (stricter than ``tower_excess_db`` when ``w_tower``
+    is relaxed); ``speed_excess_baseline_db`` max 20·log10(|T_Ω,w|/|T^ROSCO_Ω,w|), the speed
+    excess over ROSCO's unrelaxed response (what a relaxed speed spec gives away).
     """
 
     pitch_controller: ct.StateSpace
@@ -371,6 +381,12 @@ class HinfDesign:
     max_pole_real: float
     decay_rate: float
     tower_band_excess_db: float
+    specs: str = "custom"
+    speed_relax_db: float = float("nan")
+    notch_spec: object = None
+    notch_promised_del_reduction: float = float("nan")
+    tower_notch_excess_db: float = float("nan")
+    speed_excess_baseline_db: float = float("nan")
 
 
 def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
@@ -494,16 +510,66 @@ def _tower_mode(plant):
     return float(np.abs(p[np.argmin(zeta)]))
 
 
+def qft_specifications(model, wind_speed, *, speed_relax_db=4.5, spec_reduction=15.0, tower_relax_db=6.0,
+                       tower_relax_omega=1.3, keep_below=0.6, m=4.0, omega=None):
+    """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
+
+    Tower load: W_MyT = T^ROSCO_{MyT,w} × the notches of :func:`specdesign.spec.shape_to_target`
+    (``spec_reduction`` % damage, notches above ``keep_below`` rad/s) × two leads
+    (1 + s/ω_r)/(1 + s/(ω_r·10^(tower_relax_db/40))), ω_r = ``tower_relax_omega`` (rad/s): the
+    spec is relaxed by ``tower_relax_db`` at high frequency, where ΔD% is negligible (the
+    leads already lift it by ≈ 1.9 dB at the tower mode, 1.06 rad/s, with the defaults).
+    Generator speed: W_Ω = T^ROSCO_{Ω,w}·10^(speed_relax_db/20), ROSCO's dip at the tower
+    mode (a ζ = 0.01 zero pair) kept.
+
+    Returns
+    -------
+    (Specification, Specification, Specification)
+        ``(tower_spec, speed_spec, notch_spec)``: the two specs QFT is given and the
+        unrelaxed notch spec whose promise :func:`specdesign.spec.shape_to_target` reports.
+    """
+    from . import spec
+
+    for k, v in (("speed_relax_db", speed_relax_db), ("tower_relax_db", tower_relax_db)):
+        if not (np.isfinite(v) and v >= 0):
+            raise ValueError(f"{k}={v!r} must be a finite relaxation ≥ 0 dB")
+    if not (np.isfinite(tower_relax_omega) and tower_relax_omega > 0):
+        raise ValueError(f"tower_relax_omega={tower_relax_omega!r} must be a positive frequency in rad/s")
+    v = float(wind_speed)
+    base = spec.baseline_analysis(model, v, m=m, omega=omega)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        shaped = spec.shape_to_target(base, spec_reduction, keep_below=keep_below)
+    if not shaped.success:
+        raise ValueError(f"no tower specification at {v:g} m/s: {shaped.message}")
+    relax = ()
+    if tower_relax_db > 0:
+        half = tower_relax_db / 2
+        relax = (spec.LeadLag(tower_relax_omega, tower_relax_omega * 10 ** (half / 20)),) * 2
+    tower = spec.Specification(base.system, tuple(shaped.notches) + relax, name="W_tower_base_my")
+    speed = spec.speed_specification(model, v, margin_db=float(speed_relax_db))
+    return tower, speed, shaped.specification
+
+
+#: Relaxations (dB) of the generator-speed spec tried in turn by ``design_hinf(specs="qft")``:
+#: the ladder of :func:`specdesign.qft.design_qft`.
+QFT_SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
+
+
 def design_hinf(
     model,
     wind_speed,
     *,
+    specs="qft",
     target_reduction=15.0,
-    measurements=("gen_speed",),
+    measurements=("gen_speed", "tower_top_vel"),
     order=8,
     w_tower=None,
     w_speed=None,
     w_pitch=None,
+    speed_relax_db=QFT_SPEED_RELAX_DB,
+    tower_relax_db=6.0,
+    tower_relax_omega=1.3,
     m=4.0,
     omega=None,
     suboptimality=0.05,
@@ -527,17 +593,32 @@ def design_hinf(
         E.g. :func:`specdesign.turbine.iea15mw`.
     wind_speed : float
         m/s, above rated.
+    specs : "qft", "rosco" or specdesign.qft.QFTDesign
+        Which specifications are the weights (``w_tower``/``w_speed``, when given, override).
+        ``"qft"`` (default): those of :func:`specdesign.qft.design_qft`
+        (:func:`qft_specifications`): the notch spec relaxed by ``tower_relax_db`` above
+        ≈ ``tower_relax_omega`` and ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``; given a
+        sequence (default :data:`QFT_SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
+        in turn and the smallest whose reduced design meets both specs on the refined grid
+        (speed everywhere, tower over the tower-mode band) is kept, as QFT does.
+        A ``QFTDesign``: its own ``tower_spec`` and ``speed_spec``, for a comparison on
+        exactly the specs that design met. ``"rosco"``: the unrelaxed notch spec and ROSCO's
+        T_{Ω,w} (this function's default before; its ζ = 0.01 dip at the tower mode is then
+        a spec no well-damped loop can follow, docs/hinf.md).
     target_reduction : float
-        % of tower-base damage the automatic specification (:func:`specdesign.spec.shape_to_target`)
-        must promise when ``w_tower`` is not given.
+        % of tower-base damage the automatic notch specification
+        (:func:`specdesign.spec.shape_to_target`) must promise (QFT's ``spec_reduction``).
     measurements : tuple of str
-        ``("gen_speed",)`` or ``("gen_speed", "tower_top_vel")`` (1×2 controller with ATD).
+        ``("gen_speed", "tower_top_vel")`` (default: 1×2 controller, pitch + active tower
+        damping) or ``("gen_speed",)`` (pitch only).
     order : int
         States of the reduced controller.
     w_tower, w_speed : Specification or SISO LTI, optional
-        Defaults: the automatic notch specification and the baseline T_{Ω,w}.
+        Explicit specifications (override ``specs``).
     w_pitch : optional
         Pitch-activity weight, see :func:`generalized_plant`.
+    speed_relax_db, tower_relax_db, tower_relax_omega : float (dB, dB, rad/s)
+        See ``specs="qft"``.
     m : float
         Wöhler exponent of the tower-base DEL (S-N curve on ranges).
     omega : array, optional
@@ -551,9 +632,10 @@ def design_hinf(
         Sample time (s): also return ``discrete_controller``, the reduced K by Tustin
         prewarped at the tower mode (exact there).
     min_damping : float
-        Damping floor for the specifications' zeros in the weights (:func:`inverse_weight`).
-        The default caps W_Ω⁻¹ at ROSCO's narrow dip of T_{Ω,w} at the tower mode (ζ ≈ 0.01);
-        without it (0) the synthesis copies the dip into a closed-loop pole pair of ζ ≈ 0.003.
+        Damping floor for the specifications' zeros in the weights (:func:`inverse_weight`):
+        it caps W_Ω⁻¹ at ROSCO's narrow dip of T_{Ω,w} at the tower mode (ζ ≈ 0.01); the
+        assessment uses the true specification, dip included.
+        Without it (0) the synthesis copies the dip into a closed-loop pole pair of ζ ≈ 0.003.
     decay_rate : float
         α (1/s) of an α-shifted synthesis (:func:`loopshaping.hinf.synthesize`) on the
         turbine's states and the integrator F (weights, in series, unshifted): every pole of
@@ -566,23 +648,82 @@ def design_hinf(
     **plant_options
         ``noise``, ``noise_band``, ``rolloff``, ``shift`` for :func:`generalized_plant`.
     """
-    from . import closedloop, spec, spectral, turbine, wind
+    from . import qft as _qft
+    from . import spec
 
     v = float(wind_speed)
-    plant = model.linearize(v)
     base = spec.baseline_analysis(model, v, m=m, omega=omega)
-    if w_tower is None:
+    notch_spec, ladder, label = None, [None], "custom"
+    if isinstance(specs, _qft.QFTDesign):
+        label = "qft_design"
+        w_tower = specs.tower_spec if w_tower is None else w_tower
+        w_speed = specs.speed_spec if w_speed is None else w_speed
+        notch_spec = specs.shaping.specification
+        ladder = [float(specs.options.get("speed_relax_db", np.nan))]
+    elif isinstance(specs, str) and specs in ("qft", "rosco"):
+        label = specs
+        if specs == "qft":
+            ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
+            if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
+                raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
+            ladder = [float(x) for x in ladder] if w_speed is None else [float(ladder[0])]
+        else:
+            ladder = [0.0]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             shaped = spec.shape_to_target(base, target_reduction)
         if not shaped.success:
             raise ValueError(f"no tower specification at {v:g} m/s: {shaped.message}")
-        w_tower = shaped.specification
-    if w_speed is None:
-        w_speed = spec.speed_specification(model, v)
+        notch_spec = shaped.specification
+    else:
+        raise ValueError(f"specs={specs!r} must be 'qft', 'rosco' or a specdesign.qft.QFTDesign")
+    if w_tower is not None and w_speed is not None and label in ("qft", "rosco"):
+        label, ladder, notch_spec = "custom", [None], None
+    design = None
+    for k, relax in enumerate(ladder):
+        wt, ws = w_tower, w_speed
+        if label == "qft":
+            t_q, s_q, _ = qft_specifications(model, v, speed_relax_db=relax, spec_reduction=target_reduction,
+                                             tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
+                                             m=m, omega=omega)
+            wt = t_q if wt is None else wt
+            ws = s_q if ws is None else ws
+        elif label == "rosco":
+            wt = notch_spec if wt is None else wt
+            ws = spec.speed_specification(model, v) if ws is None else ws
+        last = k == len(ladder) - 1
+        try:
+            design = _design_once(model, v, base, wt, ws, notch_spec, label, relax, measurements=measurements,
+                                  order=order, w_pitch=w_pitch, m=m, suboptimality=suboptimality,
+                                  reduction_method=reduction_method, dt=dt, min_damping=min_damping,
+                                  decay_rate=decay_rate, integral_corner=integral_corner, **plant_options)
+        except RuntimeError:
+            if last:
+                raise
+            continue
+        if last or (design.speed_excess_db <= 0 and design.tower_band_excess_db <= 0):
+            break
+    if label == "qft" and len(ladder) > 1:
+        met = design.speed_excess_db <= 0 and design.tower_band_excess_db <= 0
+        design = replace(design, notes=design.notes + (
+            f"specs='qft': speed spec relaxed by {design.speed_relax_db:g} dB, the smallest of {tuple(ladder)} "
+            "with both specs met on the refined grid" if met else
+            f"specs='qft': no relaxation of {tuple(ladder)} met both specs; the last is returned",))
+    return design
+
+
+def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, measurements, order, w_pitch, m,
+                 suboptimality, reduction_method, dt, min_damping, decay_rate, integral_corner, **plant_options):
+    """One synthesis, reduction and assessment of :func:`design_hinf` on fixed specifications."""
+    from . import closedloop, spec, spectral, turbine, wind
+
+    plant = model.linearize(v)
     Wt, Ws = _siso_tf(w_tower, "w_tower"), _siso_tf(w_speed, "w_speed")
     wt_resp = np.asarray(ct.frequency_response(Wt, base.omega).complex).reshape(-1)
     promise = spec.evaluate(wt_resp / base.t_response, base)
+    Wn = Wt if notch_spec is None else _siso_tf(notch_spec, "notch_spec")
+    wn_resp = np.asarray(ct.frequency_response(Wn, base.omega).complex).reshape(-1)
+    notch_promise = spec.evaluate(wn_resp / base.t_response, base)
 
     if integral_corner is None and decay_rate > 0:
         integral_corner = DEFAULT_INTEGRAL_CORNER
@@ -612,7 +753,7 @@ def design_hinf(
     cl0 = closedloop.closed_loop(plant, rosco, warn=False)
     cl_full = closed_loop(plant, K_full, measurements)
     omega = assessment_grid(base.omega, [
-        cl.poles(), cl_full.poles(), cl0["gen_speed", "wind"], cl0["tower_base_my", "wind"], Wt, Ws,
+        cl.poles(), cl_full.poles(), cl0["gen_speed", "wind"], cl0["tower_base_my", "wind"], Wt, Ws, Wn,
     ])
     # β = −C·y: the workbench's controllers are −K, one SISO part per measurement.
     parts = [ct.minreal(ct.ss(K.A, K.B[:, [i]], -K.C, -K.D[:, [i]]), verbose=False)
@@ -628,6 +769,9 @@ def design_hinf(
     tower_band_excess = float(np.max(20 * np.log10(np.abs(t_tower[band]) / np.abs(wt_resp[band]))))
     at_mode = np.abs(closedloop.frequency_response(cl, [wt_mode, 2 * wt_mode], "tower_base_my"))[0]
     tower_excess = float(20 * np.log10(at_mode / np.abs(np.asarray(Wt(1j * wt_mode)))))
+    notch_excess = float(20 * np.log10(at_mode / np.abs(np.asarray(Wn(1j * wt_mode)))))
+    t_speed0 = closedloop.frequency_response(cl0, omega, "gen_speed")
+    speed_excess0 = float(np.max(20 * np.log10(np.abs(t_speed) / np.abs(t_speed0))))
     s_wind = wind.rotor_effective_spectrum(omega, v, model.rotor_radius)
     t_tower0 = closedloop.frequency_response(cl0, omega, "tower_base_my")
     del0 = float(spectral.del_spectral(omega, np.abs(t_tower0) ** 2 * s_wind, m))
@@ -657,4 +801,8 @@ def design_hinf(
         max_pole_real=float(p.real.max()),
         decay_rate=float(decay_rate),
         tower_band_excess_db=tower_band_excess,
+        specs=label, speed_relax_db=float("nan") if relax is None else float(relax),
+        notch_spec=notch_spec if notch_spec is not None else w_tower,
+        notch_promised_del_reduction=float(notch_promise.exact_del),
+        tower_notch_excess_db=notch_excess, speed_excess_baseline_db=speed_excess0,
     )

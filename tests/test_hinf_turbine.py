@@ -5,7 +5,9 @@ within 1 dB, tower-load spec met at the tower mode, predicted tower-base DEL red
 least the specification's promise, on a grid that cannot miss narrow peaks
 (:func:`specdesign.hinf.assessment_grid`). Every number is recomputed here by the explicit
 closed-loop formula of specdesign.closedloop (not the interconnection design_hinf uses).
-The full acceptance is not met today: see the strict xfail and docs/hinf.md.
+The default design (QFT's specifications, pitch + ATD, 1×2) meets it, the tower spec at the
+mode against both QFT's relaxed spec and the unrelaxed notch spec whose 3.98 % DEL promise
+is quoted; the pitch-only design does not (strict xfail, docs/hinf.md).
 """
 import control as ct
 import numpy as np
@@ -182,7 +184,7 @@ def test_design_grid_misses_no_peak(design, plant):
 
 
 def test_stability_damping_states_and_del(design, model, plant, specs):
-    base, w_tower, w_speed = specs
+    base, w_tower, _ = specs
     d = design
     assert d.controller.nstates <= 8
     n = d.controller.ninputs
@@ -195,7 +197,7 @@ def test_stability_damping_states_and_del(design, model, plant, specs):
     assert np.min(-osc.real / np.abs(osc)) == pytest.approx(d.zeta_min) and d.zeta_min >= 0.05
     assert hinf.closed_loop(plant, d.full_controller, meas).poles().real.max() < -d.decay_rate
     assert d.decay_rate == hinf.DEFAULT_DECAY_RATE > 0
-    assert d.peak_sensitivity < 1.2
+    assert d.peak_sensitivity < 1.3
     np.testing.assert_allclose(_resp(d.pitch_controller, d.omega)[0, 0],
                                -_resp(d.controller, d.omega)[0, 0], rtol=1e-6)
     # Predicted DEL reduction ≥ the specification's promise, on the design's (refined) grid.
@@ -206,10 +208,12 @@ def test_stability_damping_states_and_del(design, model, plant, specs):
     del0 = spectral.del_spectral(d.omega, np.abs(t0) ** 2 * s_w, 4.0)
     del1 = spectral.del_spectral(d.omega, np.abs(t_my) ** 2 * s_w, 4.0)
     reduction = 100 * (1 - del1 / del0)
-    promise = spec.evaluate(w_tower, base).exact_del
+    promise = spec.evaluate(w_tower, base).exact_del  # the 15 %-damage notch spec: 3.98 % DEL
     assert d.predicted_del_reduction == pytest.approx(reduction, abs=1e-6)
-    assert d.promised_del_reduction == pytest.approx(promise, abs=1e-6)
-    assert reduction >= promise > 0
+    assert d.notch_promised_del_reduction == pytest.approx(promise, abs=1e-6)
+    # the relaxed spec the design was given promises less (an increase, −2.7 %)
+    assert d.promised_del_reduction == pytest.approx(spec.evaluate(d.w_tower, base).exact_del, abs=1e-6)
+    assert reduction >= promise > 3.9 and d.promised_del_reduction < 0
 
 
 def hinf_wind(model, omega):
@@ -218,36 +222,95 @@ def hinf_wind(model, omega):
     return wind.rotor_effective_spectrum(omega, V, model.rotor_radius)
 
 
-def test_spec_numbers_on_the_refined_grid(design, plant, specs):
-    _, w_tower, w_speed = specs
+def test_spec_numbers_on_the_refined_grid(design, model, plant, specs):
+    _, w_notch, w_rosco = specs
     d = design
+    assert d.specs == "qft"
     _, t_om = _explicit(d, plant, d.omega)
-    excess = 20 * np.log10(np.abs(t_om) / w_speed.magnitude(d.omega))
+    excess = 20 * np.log10(np.abs(t_om) / d.w_speed.magnitude(d.omega))
     assert d.speed_excess_db == pytest.approx(excess.max(), abs=1e-6)
+    # the speed spec is ROSCO's T_Ω,w (dip included) raised by the relaxation
+    np.testing.assert_allclose(d.w_speed.magnitude(d.omega),
+                               w_rosco.magnitude(d.omega) * 10 ** (d.speed_relax_db / 20), rtol=1e-9)
+    assert d.speed_excess_baseline_db == pytest.approx(
+        np.max(20 * np.log10(np.abs(t_om) / w_rosco.magnitude(d.omega))), abs=1e-6)
     wm = d.tower_mode
     assert 0.9 < wm < 1.2
     wpair = np.array([wm, 2 * wm])
     t_mode, _ = _explicit(d, plant, wpair)
     assert d.tower_excess_db == pytest.approx(
-        20 * np.log10(abs(t_mode[0]) / w_tower.magnitude(wpair)[0]), abs=1e-6)
-    # Measured at 19 m/s (docs/hinf.md): what each structure achieves today.
+        20 * np.log10(abs(t_mode[0]) / d.w_tower.magnitude(wpair)[0]), abs=1e-6)
+    assert d.tower_notch_excess_db == pytest.approx(
+        20 * np.log10(abs(t_mode[0]) / w_notch.magnitude(wpair)[0]), abs=1e-6)
+    np.testing.assert_allclose(d.notch_spec.magnitude(d.omega), w_notch.magnitude(d.omega), rtol=1e-9)
+    # Measured at 19 m/s (docs/hinf.md): what each structure achieves on QFT's specs.
     if d.controller.ninputs == 1:
-        assert d.speed_excess_db < 1.1 and d.tower_excess_db < 2.5
+        assert d.speed_relax_db == 3.0  # the first rung of QFT's ladder already meets both
+        assert d.speed_excess_db < -1.5 and -0.2 < d.tower_excess_db < 0 and d.tower_band_excess_db < 0
+        assert d.tower_notch_excess_db > 1.5  # but not the unrelaxed notch spec at the mode
     else:
-        assert d.speed_excess_db < 3.5 and d.tower_excess_db < -2.0 and d.tower_band_excess_db < 0
+        assert d.speed_relax_db == 4.5  # QFT's ladder picks 4.5 dB at 19 m/s too (docs/qft_turbine.md)
+        assert d.speed_excess_db < -1.0 and d.tower_excess_db < -6.0 and d.tower_notch_excess_db < -4.0
+        assert d.tower_band_excess_db < -4.0 and d.speed_excess_baseline_db < 3.5
+        assert d.predicted_del_reduction > 35.0
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "issue 6 acceptance not met on the refined grid: pitch-only, P_{Ω,β} has a lightly damped "
-    "right-half-plane zero pair at 0.0095 ± 1.081j, so a damped loop exceeds the tower spec at "
-    "the mode (+1.9 dB) and the speed spec ends at +1.02 dB; with ATD the tower spec is met but "
-    "ROSCO's ζ = 0.01 dip of T_Ω,w at 1.081 rad/s is exceeded by 2.9 dB (docs/hinf.md)"))
-def test_acceptance_at_19_mps(design):
+def test_acceptance_at_19_mps(design, request):
     d = design
-    assert d.controller.nstates <= 8 and d.zeta_min >= 0.05
+    if d.controller.ninputs == 1:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=(
+            "pitch-only: P_{Ω,β} has a lightly damped right-half-plane zero pair at 0.0095 ± 1.081j; "
+            "the damped loop meets QFT's relaxed tower spec at the mode (−0.08 dB) only because its "
+            "relaxation lifts the spec by 1.9 dB there: +1.85 dB over the notch spec (docs/hinf.md)")))
+    # issue 6, on the refined grid: ≤ 8 states, damped, robust, speed spec within 1 dB, the
+    # tower spec at the mode (the relaxed one given to the design and the notch spec whose
+    # promise is quoted), predicted DEL reduction ≥ both promises.
+    assert d.controller.nstates <= 8 and d.zeta_min >= 0.05 and d.peak_sensitivity <= 2.0
+    assert d.max_pole_real < 0
     assert d.speed_excess_db <= 1.0
-    assert d.tower_excess_db <= 0.0
-    assert d.predicted_del_reduction >= d.promised_del_reduction
+    assert d.tower_excess_db <= 0.0 and d.tower_notch_excess_db <= 0.0
+    assert d.predicted_del_reduction >= d.notch_promised_del_reduction >= d.promised_del_reduction
+
+
+def test_qft_specs_are_design_qfts(model):
+    # specs="qft" builds exactly the specs design_qft gives its bounds (a QFT run cut short
+    # here: only its specs are used), and specs=<QFTDesign> takes them as they are.
+    import warnings
+
+    from specdesign import qft
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        q = qft.design_qft(model, V, speed_relax_db=4.5, maxfev=1, refine=0)
+    tower, speed, notch = hinf.qft_specifications(model, V, speed_relax_db=4.5)
+    w = np.logspace(-2, 1, 300)
+    for a, b in ((tower, q.tower_spec), (speed, q.speed_spec), (notch, q.shaping.specification)):
+        np.testing.assert_allclose(a.response(w), b.response(w), rtol=1e-9)
+    d = hinf.design_hinf(model, V, specs=q)
+    assert d.specs == "qft_design" and d.speed_relax_db == 4.5
+    assert d.w_tower is q.tower_spec and d.w_speed is q.speed_spec
+    assert d.notch_promised_del_reduction == pytest.approx(q.shaping.promise.exact_del, abs=1e-6)
+    # the first rung (3 dB) leaves the 1×2 design 0.15 dB over the speed spec, inside
+    # ROSCO's dip at 1.08 rad/s: the ladder moves on to 4.5 dB
+    d3 = hinf.design_hinf(model, V, speed_relax_db=3.0)
+    assert 0 < d3.speed_excess_db < 0.5
+    with pytest.raises(ValueError, match="specs"):
+        hinf.design_hinf(model, V, specs="hinf")
+
+
+def test_rosco_specs_ask_for_the_dip(model):
+    # specs="rosco" (the default before): ROSCO's own T_Ω,w unrelaxed, with its ζ = 0.01 dip
+    # at 1.081 rad/s. The damped 1×2 loop meets the tower spec but exceeds the speed spec by
+    # ≈ 2.9 dB, by more than 1 dB only inside the dip.
+    d = hinf.design_hinf(model, V, specs="rosco")
+    assert d.specs == "rosco" and d.speed_relax_db == 0.0
+    assert 2.5 < d.speed_excess_db < 3.5 and d.tower_excess_db < -3.0 and d.zeta_min > 0.1
+    from specdesign import closedloop
+
+    cl = hinf.closed_loop(model.linearize(V), d.controller, ("gen_speed", "tower_top_vel"))
+    r = 20 * np.log10(np.abs(closedloop.frequency_response(cl, d.omega, "gen_speed")) / d.w_speed.magnitude(d.omega))
+    over = d.omega[r > 1.0]
+    assert over.min() > 1.06 and over.max() < 1.10
 
 
 def test_loopshaping_check_agrees(design):
@@ -268,7 +331,7 @@ def test_loopshaping_check_agrees(design):
 def test_undamped_default_of_before_is_still_available(model):
     # min_damping=0, decay_rate=0 is the design this module used to make: ζ ≈ 0.003 at
     # 1.08 rad/s and a +6.9 dB narrow-band speed excess that a 400-point grid missed.
-    d = hinf.design_hinf(model, V, min_damping=0.0, decay_rate=0.0)
+    d = hinf.design_hinf(model, V, specs="rosco", measurements=("gen_speed",), min_damping=0.0, decay_rate=0.0)
     assert d.zeta_min < 0.005 and abs(d.zeta_min_frequency - 1.08) < 0.01
     assert d.speed_excess_db > 5.0
 
