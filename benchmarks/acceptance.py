@@ -42,7 +42,7 @@ def main(argv=None):
     designs = design_schedule(model, args.speeds)
     t_design = time.perf_counter() - t0
     seeds = np.arange(args.seeds)
-    acc_rows, t2s, t3s = [], [], []
+    acc_rows, t2s = [], []
     for d in designs:
         v = d.wind_speed
         ctrls = {

@@ -25,7 +25,7 @@ import numpy as np
 
 
 from .controller import Controller
-from .qft import Bounds, Spec, Template, _check_grid, evaluate
+from .qft import Bounds, Template, _check_grid, as_specs, evaluate
 
 
 class InfeasibleError(ValueError):
@@ -258,14 +258,7 @@ def refine(template: Template, specs, omega_dense, poles=None, *, max_rounds=6, 
             raise ValueError("template.disk_radius varies with frequency: refine cannot evaluate it at new "
                              "frequencies; expand the disk into cases or use a constant radius")
         disk = float(disk[0])
-    if isinstance(specs, Bounds):
-        specs = list(specs.specs)
-    elif isinstance(specs, Spec):
-        specs = [specs]
-    else:
-        specs = list(specs)
-    if not specs or not all(isinstance(sp, Spec) for sp in specs):
-        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
+    specs = as_specs(specs)
     w_dense = _check_grid(omega_dense, "omega_dense")
     if int(max_rounds) < 1:
         raise ValueError(f"max_rounds={max_rounds} must be ≥ 1")

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .controller import Controller
-from .qft import Bounds, Spec, Template, _check_grid, _is_lti, evaluate
+from .qft import Template, _check_grid, _is_lti, as_specs, evaluate
 
 
 @dataclass(frozen=True, eq=False)
@@ -171,14 +171,7 @@ def check(controller_or_tf, template_or_plants, specs, omega_dense) -> CheckResu
         plants = list(template_or_plants)
     if not plants:
         raise ValueError("template_or_plants is empty")
-    if isinstance(specs, Bounds):
-        specs = list(specs.specs)
-    elif isinstance(specs, Spec):
-        specs = [specs]
-    else:
-        specs = list(specs)
-    if not specs or not all(isinstance(sp, Spec) for sp in specs):
-        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
+    specs = as_specs(specs)
     G = (controller_or_tf.response(w) if isinstance(controller_or_tf, Controller)
          else evaluate(controller_or_tf, w, "controller_or_tf"))[:, None]
     P = np.stack([evaluate(p, w, f"plant {i}") for i, p in enumerate(plants)], axis=1)

@@ -809,3 +809,16 @@ def intersect(*bounds_list) -> Bounds:
         hi_all.append(hi)
     lo, hi = _merge(np.concatenate(lo_all, -1), np.concatenate(hi_all, -1))
     return Bounds(omegas, phases, np.stack([lo, hi], -1), parts)
+
+
+def as_specs(specs) -> list:
+    """A Bounds (its specs), one Spec, or an iterable of Spec → non-empty list of Spec."""
+    if isinstance(specs, Bounds):
+        specs = list(specs.specs)
+    elif isinstance(specs, Spec):
+        specs = [specs]
+    else:
+        specs = list(specs)
+    if not specs or not all(isinstance(sp, Spec) for sp in specs):
+        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
+    return specs

@@ -234,7 +234,7 @@ def _damage_from_moments(mom, m, method):
     """Damage rate for a moment array (..., 6) in _ORDERS; handles degenerate spectra."""
     f = _check_method(method)
     re = np.real(mom)
-    m0, m2, m4 = re[..., 0], re[..., 4], re[..., 5]
+    m0, m2 = re[..., 0], re[..., 4]
     alive = (m0 > 0) & (m2 > 0)
     safe = np.where(alive[..., None], mom, 1.0)
     mo = tuple(safe[..., j] for j in range(len(_ORDERS)))

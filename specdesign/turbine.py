@@ -454,32 +454,22 @@ class TurbineModel:
         hx = np.array([1e-6, 1e-5, 1e-6, 1e-7, 1e-7])
         hu = np.array([1e-5, 1e-7, 1.0])
         n, m, ny = 5, 3, len(OUTPUT_NAMES)
-        A = np.empty((n, n))
-        B = np.empty((n, m))
-        C = np.empty((ny, n))
-        D = np.empty((ny, m))
         p = self._params
-        fp, fm, yp, ym = np.empty(n), np.empty(n), np.empty(ny), np.empty(ny)
-        for k in range(n):
-            xp, xm = x0.copy(), x0.copy()
-            xp[k] += hx[k]
-            xm[k] -= hx[k]
-            rhs(xp, u0[0], u0[1], u0[2], p, fp)
-            rhs(xm, u0[0], u0[1], u0[2], p, fm)
-            outputs(xp, u0[0], u0[1], u0[2], p, yp)
-            outputs(xm, u0[0], u0[1], u0[2], p, ym)
-            A[:, k] = (fp - fm) / (2 * hx[k])
-            C[:, k] = (yp - ym) / (2 * hx[k])
-        for k in range(m):
-            up, um = u0.copy(), u0.copy()
-            up[k] += hu[k]
-            um[k] -= hu[k]
-            rhs(x0, up[0], up[1], up[2], p, fp)
-            rhs(x0, um[0], um[1], um[2], p, fm)
-            outputs(x0, up[0], up[1], up[2], p, yp)
-            outputs(x0, um[0], um[1], um[2], p, ym)
-            B[:, k] = (fp - fm) / (2 * hu[k])
-            D[:, k] = (yp - ym) / (2 * hu[k])
+        f, y = np.empty(n), np.empty(ny)
+
+        def evaluate(z):  # (dx/dt, y) at z = (x, u), as one vector
+            rhs(z[:n], z[n], z[n + 1], z[n + 2], p, f)
+            outputs(z[:n], z[n], z[n + 1], z[n + 2], p, y)
+            return np.concatenate([f, y])
+
+        z0, hz = np.concatenate([x0, u0]), np.concatenate([hx, hu])
+        J = np.empty((n + ny, n + m))
+        for k in range(n + m):
+            zp, zm = z0.copy(), z0.copy()
+            zp[k] += hz[k]
+            zm[k] -= hz[k]
+            J[:, k] = (evaluate(zp) - evaluate(zm)) / (2 * hz[k])
+        A, B, C, D = J[:n, :n], J[:n, n:], J[n:, :n], J[n:, n:]
         return A, B, C, D
 
     def rated_wind_speed(self) -> float:

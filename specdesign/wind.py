@@ -11,7 +11,6 @@ All spectra are one-sided and per rad/s (∫₀^∞ S(ω) dω = variance, (m/s)�
 """
 from __future__ import annotations
 
-from collections.abc import Callable
 
 import numpy as np
 

@@ -13,7 +13,7 @@ import control as ct
 import numpy as np
 import pytest
 
-from specdesign import closedloop, qft, spectral, turbine, wind
+from specdesign import closedloop, qft, turbine, wind
 
 
 @pytest.fixture(scope="module")
