@@ -509,14 +509,17 @@ class Table:
     rows: tuple
     fmt: str = "{:.2f} %"
     note: str = ""
+    row_fmt: tuple = ()  # (label, fmt) pairs overriding ``fmt`` for those rows (e.g. pp)
 
-    def _cell(self, v):
-        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else self.fmt.format(v)
+    def _cell(self, v, fmt=None):
+        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else (fmt or self.fmt).format(v)
 
     def to_markdown(self) -> str:
         head = "| " + " | ".join(self.columns) + " |"
         sep = "|" + "|".join("---" for _ in self.columns) + "|"
-        body = ["| " + " | ".join([label] + [self._cell(float(v)) for v in vals]) + " |" for label, vals in self.rows]
+        fmts = dict(self.row_fmt)
+        body = ["| " + " | ".join([label] + [self._cell(float(v), fmts.get(label)) for v in vals]) + " |"
+                for label, vals in self.rows]
         text = [f"**{self.title}**", "", head, sep, *body]
         if self.note:
             text += ["", self.note]
@@ -611,11 +614,13 @@ def table3(campaign: Campaign, designed: str, baseline: str, *, promised=None, m
         ("Estimation deviation", tuple(dev) + (float(np.mean(dev)),)),
         (f"Standard error ({method}, paired seeds)", tuple(acc.se) + (nan,)),
     ]
+    pp = (("Estimation deviation", "{:.2f} pp"), (f"Standard error ({method}, paired seeds)", "{:.2f} pp"))
     return Table(
         title=f"Table 3: tower-base fatigue (DEL) reduction, {designed} vs {baseline}",
         columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
         note=f"{acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with m = {campaign.m:g} at 1 Hz; "
              "linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
+        row_fmt=pp,
     )
 
 

@@ -276,3 +276,13 @@ def test_progress_bar_on_request_only(model, capsys):
     assert "validation" in capsys.readouterr().err
     va.run_campaign(ctrls, [19.0], [1], model=model, duration=20.0, transient=5.0, progress=False, predict=False)
     assert "validation" not in capsys.readouterr().err
+
+
+def test_table_row_formats_mark_percentage_points():
+    from specdesign.validate import Table
+
+    t = Table("t", ("Indicator", "19 m/s"), (("Reduction", (25.0,)), ("Deviation", (1.5,))),
+              row_fmt=(("Deviation", "{:.2f} pp"),))
+    md = t.to_markdown()
+    assert "| Reduction | 25.00 % |" in md
+    assert "| Deviation | 1.50 pp |" in md
