@@ -9,6 +9,7 @@ Writes ``summary.md``, the tables (Markdown and CSV) and the figures into ``out`
 """
 from __future__ import annotations
 
+import json
 import time
 from pathlib import Path
 
@@ -110,6 +111,17 @@ def run_demo(out="specdesign_output", *, fast=False, wind_speed=19.0, spec_reduc
     axes[0].figure.savefig(out / "4_time_series.png", dpi=120)
     plt.close(axes[0].figure)
 
+    # the designed controllers and a campaign file, so `python -m specdesign validate` can rerun
+    # or extend the validation (more seeds, other wind speeds) without redesigning
+    (out / "controller_qft.json").write_text(json.dumps(
+        {"pitch": _tf_dict(design.pitch_controller), "atd": _tf_dict(design.atd_controller)}, indent=1))
+    (out / "validate.toml").write_text(
+        f"# python -m specdesign validate {out / 'validate.toml'}  (schema: docs/validation.md)\n"
+        f'turbine = "iea15mw"\nwind_speeds = [{v:g}]\nseeds = {list(range(n_seeds))}\nduration = {duration:g}\n'
+        'baseline = "ROSCO"\ndesigned = "QFT"\noutput = "validation"\n\n'
+        f'[controllers.ROSCO]\nkind = "rosco"\nwind_speeds = [{v:g}]\n\n[controllers.QFT]\nfile = "controller_qft.json"\n\n'
+        f'[promised]\n"{v:g}" = {p.exact_del:.4f}\n')
+
     elapsed = time.perf_counter() - t_start
     summary = {
         "wind_speed": v,
@@ -138,11 +150,18 @@ def run_demo(out="specdesign_output", *, fast=False, wind_speed=19.0, spec_reduc
         t3.to_markdown(),
         "Figures: 1_sensitivity.png, 2_specification.png, 3_nichols.png, 3_bode.png, 4_spectra.png, 4_time_series.png",
         "",
+        "Controllers: controller_qft.json; rerun or extend the validation with "
+        "`python -m specdesign validate validate.toml` (edit seeds or wind speeds there).",
+        "",
         f"Run time: {elapsed:.0f} s.",
     ]
     (out / "summary.md").write_text("\n".join(lines) + "\n")
     _say(f"done in {elapsed:.0f} s: {out.resolve()}/summary.md")
     return summary
+
+
+def _tf_dict(tf):
+    return {"num": np.asarray(tf.num[0][0], float).tolist(), "den": np.asarray(tf.den[0][0], float).tolist()}
 
 
 def _tf_text(tf):
