@@ -15,13 +15,24 @@ optional active-tower-damping controller C_atd on the tower-top fore-aft velocit
 summed into the pitch command with the same negative-feedback sign as in
 :mod:`specdesign.closedloop`. β₀ is the trim pitch at the run's mean wind speed.
 
-Gain scheduling (``ScheduledController``): K local controllers, each designed at a
-scheduling pitch β_k, all run in parallel on the same measurements; their outputs are
-blended with piecewise-linear weights in a low-pass-filtered pitch command β_f (output
-blending, as in the seed paper). For ROSCO's PI, whose local controllers share the filter
-and differ only in their gains, output blending equals ROSCO's interpolated gains applied
-to a common integral of the error (ROSCO integrates K_i(β)·e instead; the two coincide at
-a fixed operating point and differ only while β_f moves).
+Gain scheduling (``ScheduledController``) has two forms, both scheduled on β_f, the pitch
+command low-pass filtered (first order, ``filter_omega``), with piecewise-linear weights
+between K scheduling pitches β_k, clamped at the ends:
+
+* ``form="output"`` (general designed controllers, :func:`scheduled`): the K local
+  controllers run in parallel on the same measurements and their *outputs* are blended
+  (as in the seed paper). For PI locals with different K_i this computes
+  K_i(β_f)·∫e, not ∫K_i(β_f)·e: the two differ by a coupling term K_i′(β_f)·β̇_f·∫e while
+  β_f moves (see ``docs/nonlinearity.md``).
+* ``form="gains"`` (ROSCO's own scheduling, the default of :func:`rosco_scheduled`): one PI
+  whose gains are interpolated in β_f and applied to one filtered error with ONE
+  integrator of K_i(β_f)·e_f, u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_rated − Ω_g).
+  Discrete at the simulation step as the LTI path is (Tustin): F by Tustin, the integral
+  by the trapezoid rule with the gain of the current step, I_k = I_{k−1} +
+  K_i(β_f,k)·dt/2·(e_f,k + e_f,k−1). With frozen gains it is exactly the LTI
+  (K_p + K_i/s)·F simulated on the ordinary path.
+
+An ATD controller, if present, is output-blended in both forms.
 
 Three controller kinds are accepted wherever a controller is asked for: a python-control
 LTI system (SISO, proper; discretised by Tustin at the simulation step), a
@@ -204,16 +215,28 @@ def discretize(controller, dt):
             np.array([float(np.squeeze(d.D))]))
 
 
+_FORMS = ("output", "gains")
+
+
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class ScheduledController:
-    """Local pitch (and optional ATD) controllers blended by output on filtered pitch.
+    """Local pitch (and optional ATD) controllers scheduled on filtered pitch.
 
     schedule_pitch : (K,) increasing scheduling pitches β_k (rad), one per local controller.
-    pitch : K continuous SISO controllers C_β,k on the generator speed (β = −C·Ω_g).
-    atd : K continuous SISO controllers on tower-top velocity (β −= C_atd·ẋ_top), or None.
+    pitch : K continuous SISO controllers C_β,k on the generator speed (β = −C·Ω_g): the
+        local controllers (in ``form="gains"``, the frozen-gain PIs (K_p,k + K_i,k/s)·F).
+    atd : K continuous SISO controllers on tower-top velocity (β −= C_atd·ẋ_top), or None;
+        output-blended in both forms.
     filter_omega : corner (rad/s) of the first-order low-pass on the pitch command that
-        gives the scheduling variable.
+        gives the scheduling variable β_f.
     name : label used in tables and figures.
+    form : ``"output"`` blends the local controllers' outputs; ``"gains"`` runs ROSCO's form,
+        u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt with e_f = error_filter·(Ω_rated − Ω_g), the gains
+        interpolated linearly in β_f (see the module docstring). Build it with
+        :meth:`gain_scheduled_pi`.
+    kp, ki : (K,) PI gains at the scheduling pitches (``form="gains"`` only; in the workbench's
+        convention C = (K_p + K_i/s)·F, i.e. ROSCO's negative gains), rad/(rad/s) and rad/rad.
+    error_filter : SISO LTI filter F on the speed error (``form="gains"`` only).
     """
 
     schedule_pitch: np.ndarray
@@ -221,6 +244,10 @@ class ScheduledController:
     atd: tuple | None = None
     filter_omega: float = SCHEDULE_FILTER_OMEGA
     name: str = "controller"
+    form: str = "output"
+    kp: np.ndarray | None = field(default=None, repr=False)
+    ki: np.ndarray | None = field(default=None, repr=False)
+    error_filter: object = field(default=None, repr=False)
 
     def __post_init__(self):
         b = np.atleast_1d(np.asarray(self.schedule_pitch, dtype=float))
@@ -232,10 +259,57 @@ class ScheduledController:
         if self.atd is not None and len(self.atd) != b.size:
             raise ValueError(f"atd needs one controller per scheduling pitch ({b.size}), got {len(self.atd)}")
         positive_scalar(self.filter_omega, "filter_omega")
+        if self.form not in _FORMS:
+            raise ValueError(f"form must be one of {_FORMS}, got {self.form!r}")
+        if self.form == "output":
+            if self.kp is not None or self.ki is not None or self.error_filter is not None:
+                raise ValueError("kp, ki and error_filter are for form='gains' only")
+            return
+        gains = []
+        for g, nm in ((self.kp, "kp"), (self.ki, "ki")):
+            a = np.atleast_1d(np.asarray(g, dtype=float)) if g is not None else None
+            if a is None or a.shape != b.shape or not np.all(np.isfinite(a)):
+                raise ValueError(f"form='gains' needs {nm} as {b.size} finite gains, one per scheduling pitch, got {g!r}")
+            gains.append(a)
+        object.__setattr__(self, "kp", gains[0])
+        object.__setattr__(self, "ki", gains[1])
+        f = _as_lti(self.error_filter, "error_filter")
+        object.__setattr__(self, "error_filter", f)
+        # The local controllers must be the frozen-gain PIs, or the linear prediction (which
+        # blends them) would describe another controller than the one simulated.
+        jw = 1j * np.array([0.03, 0.3, 1.0, 3.0])
+        fj = np.asarray(f(jw), complex)
+        for k in range(b.size):
+            ref = (gains[0][k] + gains[1][k] / jw) * fj
+            got = np.asarray(_as_lti(self.pitch[k], f"pitch[{k}]")(jw), complex)
+            if not np.allclose(got, ref, rtol=1e-8, atol=0):
+                raise ValueError(f"pitch[{k}] is not (kp[{k}] + ki[{k}]/s)·error_filter; build form='gains' "
+                                 "with ScheduledController.gain_scheduled_pi")
 
     def local(self, k: int):
         """(C_β, C_atd or None) of the k-th local controller."""
         return self.pitch[k], (None if self.atd is None else self.atd[k])
+
+    @classmethod
+    def gain_scheduled_pi(cls, schedule_pitch, kp, ki, error_filter, *, atd=None,
+                          filter_omega=SCHEDULE_FILTER_OMEGA, name="PI") -> "ScheduledController":
+        """ROSCO-form gain-scheduled PI: u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_ref − Ω_g).
+
+        schedule_pitch (rad), kp, ki : (K,) gains at the scheduling pitches, in the
+        workbench's convention C = (K_p + K_i/s)·F (ROSCO's negative gains).
+        error_filter : SISO LTI F on the speed error (e.g. :func:`specdesign.turbine.speed_filter`).
+        atd : K ATD controllers (output-blended) or None.
+        """
+        import control
+
+        f = _as_lti(error_filter, "error_filter")
+        kp = np.atleast_1d(np.asarray(kp, dtype=float))
+        ki = np.atleast_1d(np.asarray(ki, dtype=float))
+        if kp.shape != ki.shape or kp.ndim != 1:
+            raise ValueError(f"kp and ki must be 1-D arrays of the same length, got shapes {kp.shape} and {ki.shape}")
+        pitch = tuple(control.tf([a, c], [1.0, 0.0]) * f for a, c in zip(kp, ki))
+        return cls(schedule_pitch, pitch, None if atd is None else tuple(atd), filter_omega, name,
+                   form="gains", kp=kp, ki=ki, error_filter=f)
 
 
 def scheduled(model, pitch, atd=None, *, filter_omega=SCHEDULE_FILTER_OMEGA, name="designed") -> ScheduledController:
@@ -263,11 +337,15 @@ def scheduled(model, pitch, atd=None, *, filter_omega=SCHEDULE_FILTER_OMEGA, nam
     )
 
 
-def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO") -> ScheduledController:
+def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains") -> ScheduledController:
     """The ROSCO baseline PI (tower damping off) with its gain schedule on filtered pitch.
 
-    Local controllers are ``turbine.rosco_baseline(model, v)`` at ``wind_speeds`` (m/s;
-    default every 1 m/s over the model's above-rated range), blended by output.
+    ``form="gains"`` (default) is ROSCO's own scheduling: K_p and K_i of
+    ``turbine.rosco_baseline(model, v)`` at ``wind_speeds`` (m/s; default every 1 m/s over the
+    model's above-rated range), placed at each speed's trim pitch, interpolated linearly in
+    the filtered pitch command, applied to one error filtered by ``turbine.speed_filter()``
+    with one integrator of K_i(β_f)·e_f. ``form="output"`` blends the outputs of the local
+    PIs instead (the general scheme of :func:`scheduled`; kept for comparison).
     """
     from . import turbine
 
@@ -276,7 +354,29 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO") -> ScheduledC
     if wind_speeds is None:
         lo, hi = getattr(model, "wind_range", (11.0, 25.0))
         wind_speeds = np.arange(math.ceil(lo), hi + 0.5, 1.0)
-    return scheduled(model, {float(v): turbine.rosco_baseline(model, float(v)) for v in wind_speeds}, name=name)
+    vs = [float(v) for v in np.atleast_1d(np.asarray(wind_speeds, dtype=float))]
+    if form == "output":
+        return scheduled(model, {v: turbine.rosco_baseline(model, v) for v in vs}, name=name)
+    if form != "gains":
+        raise ValueError(f"form must be one of {_FORMS}, got {form!r}")
+    # The gains of turbine.rosco_baseline: pole placement on the straight-line fits of A, B_β.
+    sched = turbine.rosco_gain_schedule(model)
+    pa, pb = np.polyfit(sched.v, sched.A, 1), np.polyfit(sched.v, sched.B_beta, 1)
+    v = np.array(sorted(set(vs)))
+    a, bb = np.polyval(pa, v), np.polyval(pb, v)
+    kp = (2 * sched.zeta_pc * sched.omega_pc + a) / bb
+    ki = sched.omega_pc**2 / bb
+    plant = turbine_plant(model)
+    beta = np.array([plant.trim(s)[1] for s in v])
+    order = np.argsort(beta)
+    sc = ScheduledController.gain_scheduled_pi(beta[order], kp[order], ki[order], turbine.speed_filter(), name=name)
+    # Same controller as rosco_baseline at each speed (checked against its transfer function).
+    jw = 1j * np.array([0.05, 0.5, 2.0])
+    for k, s in enumerate(v[order]):
+        ref = np.asarray(turbine.rosco_baseline(model, float(s))(jw), complex)
+        if not np.allclose(np.asarray(sc.pitch[k](jw), complex), ref, rtol=1e-9, atol=0):
+            raise RuntimeError(f"rosco_scheduled's gains at {s:g} m/s differ from turbine.rosco_baseline")
+    return sc
 
 
 _BANKS: dict = {}
@@ -300,23 +400,31 @@ def _bank(controller, dt):
 
 
 def _make_bank(controller, dt):
+    """(schedule_pitch, per-local (A, B, C, D) of the output-blended part, filter corner,
+    scheduled-PI arrays (kp, ki, Af, Bf, Cf, Df) or None).
+
+    In ``form="gains"`` the local pitch controllers are not in the blended bank (only the ATD
+    locals are); the PI runs as one filter, one integrator and interpolated gains."""
     if not isinstance(controller, ScheduledController):
         controller = ScheduledController(np.zeros(1), (_as_lti(controller, "controller"),), None, name="controller")
+    gains = controller.form == "gains"
+    none = (np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1))
     mats = []
     for k in range(controller.schedule_pitch.size):
         cb, ca = controller.local(k)
-        Ab, Bb, Cb, Db = discretize(cb, dt)
-        if ca is None:
-            Aa, Ba, Ca, Da = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1)
-        else:
-            Aa, Ba, Ca, Da = discretize(ca, dt)
+        Ab, Bb, Cb, Db = none if gains else discretize(cb, dt)
+        Aa, Ba, Ca, Da = none if ca is None else discretize(ca, dt)
         nb, na = Ab.shape[0], Aa.shape[0]
         A = np.zeros((nb + na, nb + na))
         A[:nb, :nb], A[nb:, nb:] = Ab, Aa
         B = np.zeros((nb + na, 2))
         B[:nb, 0], B[nb:, 1] = Bb, Ba
         mats.append((A, B, np.concatenate([Cb, Ca]), np.array([Db[0], Da[0]])))
-    return controller.schedule_pitch, mats, controller.filter_omega
+    pi = None
+    if gains:
+        Af, Bf, Cf, Df = discretize(controller.error_filter, dt)
+        pi = (controller.kp, controller.ki, Af, Bf, Cf, Df)
+    return controller.schedule_pitch, mats, controller.filter_omega, pi
 
 
 # ----------------------------------------------------------------------------- compiled loop
@@ -371,9 +479,10 @@ def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
 
 @njit(cache=True)
 def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr):
+             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df):
     nx = x.size
     nc = Ad.shape[1]
+    nf = Af.shape[0]
     k1 = np.empty(nx)
     k2 = np.empty(nx)
     k3 = np.empty(nx)
@@ -383,6 +492,10 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
     xc = np.zeros((K, nc))
     xn = np.empty(nc)
     uk = np.empty(K)
+    xf = np.zeros(nf)
+    xfn = np.empty(nf)
+    integ = 0.0
+    ef_prev = 0.0
     bcmd = beta0
     bf = beta0
     j = 0
@@ -409,17 +522,44 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
                 xn[i] = a
             for i in range(nc):
                 xc[q, i] = xn[i]
-        # Output blending: piecewise-linear weights in the filtered pitch, clamped at the ends.
+        # Piecewise-linear weights in the filtered pitch, clamped at the ends: (1 − f) on q, f on q + 1.
+        q = 0
+        f = 0.0
         if K == 1 or bf <= sched_pitch[0]:
-            u = uk[0]
-        elif bf >= sched_pitch[K - 1]:
-            u = uk[K - 1]
-        else:
             q = 0
+        elif bf >= sched_pitch[K - 1]:
+            q = K - 1
+        else:
             while sched_pitch[q + 1] < bf:
                 q += 1
             f = (bf - sched_pitch[q]) / (sched_pitch[q + 1] - sched_pitch[q])
+        # Output blending (of the ATD locals only, in the scheduled-PI form).
+        if f == 0.0:
+            u = uk[q]
+        else:
             u = (1.0 - f) * uk[q] + f * uk[q + 1]
+        if pi_on:
+            # ROSCO's form: one filtered error, gains interpolated in β_f, one integrator of
+            # K_i(β_f)·e_f (trapezoid = Tustin of 1/s, so frozen gains give the LTI exactly).
+            ef = Df[0] * e
+            for i in range(nf):
+                ef += Cf[i] * xf[i]
+            for i in range(nf):
+                a = Bf[i] * e
+                for m in range(nf):
+                    a += Af[i, m] * xf[m]
+                xfn[i] = a
+            for i in range(nf):
+                xf[i] = xfn[i]
+            if f == 0.0:
+                kpv = kp[q]
+                kiv = ki[q]
+            else:
+                kpv = (1.0 - f) * kp[q] + f * kp[q + 1]
+                kiv = (1.0 - f) * ki[q] + f * ki[q + 1]
+            integ += kiv * 0.5 * dt * (ef + ef_prev)
+            ef_prev = ef
+            u += kpv * ef + integ
         bcmd = beta0 + u
         bf += a_filt * (bcmd - bf)
         _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
@@ -427,13 +567,13 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
 
 @njit(cache=True, parallel=True)
 def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
-               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y):
+               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df):
     """All runs, one per prange iteration; the controller bank is shared by the batch."""
     K = sched_pitch.size
     for r in prange(X0.shape[0]):
         x = X0[r].copy()
         _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-                 beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r])
+                 beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf, Cf, Df)
 
 
 @njit(cache=True)
@@ -658,7 +798,7 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         _run_callable(controller, step_all, outputs_all, kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y, plant.output_names)
     else:
         label = getattr(controller, "name", "controller")
-        sched_pitch, mats, fw = _bank(controller, dt)
+        sched_pitch, mats, fw, pi = _bank(controller, dt)
         K = sched_pitch.size
         nc = max(1, max(m[0].shape[0] for m in mats))
         Ad = np.zeros((K, nc, nc))
@@ -669,8 +809,14 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
             n = A.shape[0]
             Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :] = A, B, C, D
         a_filt = 1.0 - math.exp(-fw * dt)
+        if pi is None:
+            pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
+            Af, Bf, Cf, Df = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1)
+        else:
+            pi_on, (kp, ki, Af, Bf, Cf, Df) = True, pi
         run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
-                  beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y)
+                  beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on,
+                  *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df)))
 
     skip = int(round(transient / record_dt))
     t_rec = np.arange(n_rec) * record_dt

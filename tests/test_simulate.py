@@ -1,6 +1,7 @@
 """Batched simulator: integration accuracy (analytic oracle, step-size convergence on the
 turbine), batching, controller paths against independent implementations, scheduling by
-output blending, and nonlinear vs linear agreement at small turbulence."""
+output blending and by ROSCO's scheduled gains, and nonlinear vs linear agreement at small
+turbulence."""
 import math
 
 import control
@@ -142,6 +143,84 @@ def test_identical_local_controllers_blend_to_the_single_controller():
     assert_allclose(bank["gen_speed"], one["gen_speed"], rtol=0, atol=1e-12)
 
 
+class ScheduledPI:
+    """Independent callable of ROSCO's gain scheduling: e_f = F·(Ω_ref − Ω) (scipy bilinear),
+    u = Kp(β_f)·e_f + I, I += Ki(β_f)·dt/2·(e_f + e_f,prev), gains by np.interp in β_f."""
+
+    def __init__(self, sched, kp, ki, filt, beta0, omega_ref, dt, filter_omega, n, atd=None):
+        f = control.ss(filt)
+        self.F = cont2discrete((f.A, f.B, f.C, f.D), dt, method="bilinear")[:4]
+        self.xf = np.zeros((n, self.F[0].shape[0]))
+        self.atd = None
+        if atd is not None:
+            self.atd = [cont2discrete((control.ss(c).A, control.ss(c).B, control.ss(c).C, control.ss(c).D), dt, method="bilinear")[:4] for c in atd]
+            self.xa = [np.zeros((n, m[0].shape[0])) for m in self.atd]
+        self.sched, self.kp, self.ki = (np.asarray(a, float) for a in (sched, kp, ki))
+        self.beta0, self.ref, self.dt = beta0, omega_ref, dt
+        self.a = 1 - math.exp(-filter_omega * dt)
+        self.bf = np.full(n, beta0, dtype=float)
+        self.integ = np.zeros(n)
+        self.eprev = np.zeros(n)
+
+    def __call__(self, t, y):
+        A, B, C, D = self.F
+        e = -(y["gen_speed"] - self.ref)
+        ef = self.xf @ C.ravel() + D.item() * e
+        self.xf = self.xf @ A.T + np.outer(e, B.ravel())
+        kp, ki = np.interp(self.bf, self.sched, self.kp), np.interp(self.bf, self.sched, self.ki)
+        self.integ = self.integ + ki * 0.5 * self.dt * (ef + self.eprev)
+        self.eprev = ef
+        u = kp * ef + self.integ
+        if self.atd is not None:
+            v = -y["tower_top_vel"]
+            K = len(self.atd)
+            w = np.array([np.interp(self.bf, self.sched, np.eye(K)[q]) for q in range(K)])
+            for q, (Aa, Ba, Ca, Da) in enumerate(self.atd):
+                u = u + w[q] * (self.xa[q] @ Ca.ravel() + Da.item() * v)
+                self.xa[q] = self.xa[q] @ Aa.T + np.outer(v, Ba.ravel())
+        cmd = self.beta0 + u
+        self.bf = self.bf + self.a * (cmd - self.bf)
+        return cmd
+
+
+def test_scheduled_gains_equal_independent_python_pi():
+    # ROSCO's form on the oscillator: the ramping wind drives the filtered pitch across the
+    # scheduling points, so the gains (and the integrand K_i(β_f)·e_f) really move.
+    t = np.arange(0, 80.05, 0.05)
+    wind = (1.0 + 0.02 * t + 0.1 * np.sin(0.9 * t))[None, None, :]
+    sched, kp, ki = [1.2, 1.8, 2.4], [-0.2, -0.6, -1.2], [-0.1, -0.4, -0.5]
+    filt = control.tf([4.0], [1.0, 2.4, 4.0])
+    atd = [control.tf([0.05 * g], [1.0, 0.5]) for g in (1.0, 2.0, 3.0)]
+    kw = dict(wind_dt=0.05, duration=60.0, dt=0.025, record_dt=0.1, transient=10.0)
+    for a in (None, atd):
+        sc = sm.ScheduledController.gain_scheduled_pi(np.array(sched), kp, ki, filt, atd=a, filter_omega=0.3)
+        assert sc.form == "gains"
+        fast = sm.simulate(osc_plant(), sc, [1.0], wind=wind, **kw)
+        slow = sm.simulate(osc_plant(), ScheduledPI(sched, kp, ki, filt, 0.0, 0.0, 0.025, 0.3, 1, atd=a), [1.0], wind=wind, **kw)
+        pc = fast["pitch_cmd"][0, 0]
+        assert pc.min() < 1.8 < pc.max()  # crosses a scheduling point
+        assert_allclose(fast["pitch_cmd"], slow["pitch_cmd"], rtol=0, atol=1e-10)
+        assert_allclose(fast["gen_speed"], slow["gen_speed"], rtol=0, atol=1e-10)
+    # ... and it is not output blending: the two forms differ while β_f moves
+    blended = sm.simulate(osc_plant(), sm.ScheduledController(np.array(sched), sc.pitch, filter_omega=0.3), [1.0], wind=wind, **kw)
+    gains = sm.simulate(osc_plant(), sm.ScheduledController.gain_scheduled_pi(np.array(sched), kp, ki, filt, filter_omega=0.3), [1.0], wind=wind, **kw)
+    assert np.max(np.abs(blended["pitch_cmd"] - gains["pitch_cmd"])) > 1e-3
+
+
+def test_scheduled_gains_with_equal_gains_equal_the_lti_pi():
+    # Frozen gains (the same PI at every scheduling point): exactly the LTI (Kp + Ki/s)·F.
+    rng = np.random.default_rng(5)
+    wind = 1 + 0.3 * rng.standard_normal((1, 2, 401))
+    filt = control.tf([4.0], [1.0, 2.4, 4.0])
+    kw = dict(wind_dt=0.05, duration=15.0, dt=0.01, record_dt=0.05, transient=0.0)
+    lti = sm.simulate(osc_plant(), control.tf([-0.5, -0.2], [1, 0]) * filt, [1.0], wind=wind, **kw)
+    sc = sm.ScheduledController.gain_scheduled_pi(np.array([-1.0, 0.0, 2.0]), [-0.5] * 3, [-0.2] * 3, filt)
+    bank = sm.simulate(osc_plant(), sc, [1.0], wind=wind, **kw)
+    assert np.std(lti["gen_speed"]) > 0.01
+    assert_allclose(bank["gen_speed"], lti["gen_speed"], rtol=0, atol=1e-12)
+    assert_allclose(bank["pitch_cmd"], lti["pitch_cmd"], rtol=0, atol=1e-12)
+
+
 def test_linear_kernel_reproduces_a_linear_plant_exactly():
     # The oscillator is linear, so its linear twin must give the same trajectories.
     rng = np.random.default_rng(4)
@@ -229,6 +308,49 @@ def test_nonlinear_and_linear_agree_at_small_turbulence(model):
     assert 1.6 < errs[0] / errs[1] < 2.4
 
 
+def _rosco_oracle(model, v, dt, n):
+    """ScheduledPI with ROSCO's gains computed here from turbine.rosco_gain_schedule (pole
+    placement on the line fits of A and B_β), at the trim pitch of every 1 m/s from 11 to 25."""
+    g = turbine.rosco_gain_schedule(model)
+    vs = np.arange(11.0, 25.5, 1.0)
+    a, b = np.polyval(np.polyfit(g.v, g.A, 1), vs), np.polyval(np.polyfit(g.v, g.B_beta, 1), vs)
+    kp, ki = (2 * g.zeta_pc * g.omega_pc + a) / b, g.omega_pc**2 / b
+    beta = [model.trim(s).pitch for s in vs]
+    wn, z = 1.0081, 0.7
+    filt = control.tf([wn**2], [1, 2 * z * wn, wn**2])
+    return ScheduledPI(beta, kp, ki, filt, model.trim(v).pitch, model.rated_rotor_speed, dt, sm.SCHEDULE_FILTER_OMEGA, n)
+
+
+def test_rosco_scheduled_is_rosco_gain_scheduling_on_the_turbine(model):
+    """rosco_scheduled (compiled, ROSCO's form by default) = an independent Python ROSCO
+    gain-scheduled PI on the nonlinear turbine, with the filtered pitch crossing several
+    scheduling points; the output-blended form (kept for comparison) is another controller."""
+    sc = sm.rosco_scheduled(model)
+    assert sc.form == "gains" and sc.schedule_pitch.size == 15
+    kw = dict(seeds=[1, 2], duration=150.0, dt=0.02, record_dt=0.1, transient=20.0)
+    fast = sm.simulate(model, sc, [19.0], **kw)
+    slow = sm.simulate(model, _rosco_oracle(model, 19.0, 0.02, 2), [19.0], **kw)
+    bf = fast["pitch_cmd"][0]
+    assert np.sum((sc.schedule_pitch > bf.min()) & (sc.schedule_pitch < bf.max())) >= 2
+    assert_allclose(fast["pitch_cmd"], slow["pitch_cmd"], rtol=0, atol=1e-10)
+    assert_allclose(fast["gen_speed"], slow["gen_speed"], rtol=0, atol=1e-10)
+    assert_allclose(fast["tower_base_my"], slow["tower_base_my"], rtol=0, atol=1e-10 * np.std(slow["tower_base_my"]))
+    blended = sm.simulate(model, sm.rosco_scheduled(model, form="output"), [19.0], **kw)
+    assert np.max(np.abs(blended["pitch_cmd"] - fast["pitch_cmd"])) > 1e-4
+
+
+@pytest.mark.parametrize("linear", [False, True])
+def test_rosco_scheduled_with_frozen_gains_equals_rosco_baseline_lti(model, linear):
+    """One scheduling point (frozen gains): rosco_scheduled = turbine.rosco_baseline(model, v)
+    simulated as an LTI, on the nonlinear turbine and on its linearisation."""
+    kw = dict(seeds=[4, 5], duration=100.0, dt=0.02, record_dt=0.1, transient=20.0, linear=linear)
+    for v in (15.0, 21.0):
+        one = sm.simulate(model, sm.rosco_scheduled(model, [v]), [v], **kw)
+        lti = sm.simulate(model, turbine.rosco_baseline(model, v), [v], **kw)
+        for key in ("pitch_cmd", "gen_speed", "tower_base_my"):
+            assert_allclose(one[key], lti[key], rtol=0, atol=1e-10 * np.std(lti[key]))
+
+
 def test_seeds_give_paired_reproducible_wind(model):
     a = sm.wind_series(120.97, [15.0, 19.0], [1, 2], 50.0, 0.1)
     b = sm.wind_series(120.97, [19.0], [2], 50.0, 0.1)
@@ -260,5 +382,11 @@ def test_bad_arguments():
         sm.simulate(osc_plant(), c, [1.0], duration=5.0)
     with pytest.raises(ValueError, match="schedule_pitch"):
         sm.ScheduledController(np.array([0.2, 0.1]), (c, c))
+    with pytest.raises(ValueError, match="form"):
+        sm.ScheduledController(np.array([0.1]), (c,), form="blend")
+    with pytest.raises(ValueError, match="kp"):
+        sm.ScheduledController(np.array([0.1, 0.2]), (c, c), form="gains", kp=[1.0], ki=[1.0, 1.0], error_filter=c)
+    with pytest.raises(ValueError, match="pitch\\[0\\] is not"):  # locals must be the frozen-gain PIs
+        sm.ScheduledController(np.array([0.1]), (c,), form="gains", kp=[1.0], ki=[1.0], error_filter=c)
     with pytest.raises(ValueError, match="shape"):
         sm.simulate(osc_plant(), lambda t, y: np.zeros(3), [1.0], wind=wind, wind_dt=0.1, duration=5.0, transient=0, record_dt=0.1, dt=0.1)
