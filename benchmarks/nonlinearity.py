@@ -514,7 +514,7 @@ def main(argv=None):
         from specdesign.simulate import rosco_scheduled
 
         ds = {s: designs_for(model, s) for s in sched_speeds}
-        sch = {"ROSCO": rosco_scheduled(model),
+        sch = {"ROSCO": rosco_scheduled(model, form="output"),
                "QFT": scheduled(model, {s: d[0] for s, d in ds.items()}, atd={s: d[1] for s, d in ds.items()}, name="QFT")}
         hp = pred_red(prediction(model, sch, v))
         hl = run(model, sch, v, wind, linear=True)
