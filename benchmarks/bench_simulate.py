@@ -10,6 +10,7 @@ Run: python benchmarks/bench_simulate.py [--quick]
 """
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 
@@ -35,7 +36,7 @@ def main(quick=False):
     import control
 
     atd = control.tf([-0.014187, -0.014187 * 4.357], [1, 0.3276])
-    designed = sm.ScheduledController(rosco.schedule_pitch, rosco.pitch, tuple(atd for _ in rosco.pitch), name="ATD")
+    designed = dataclasses.replace(rosco, atd=tuple(atd for _ in rosco.pitch), name="ATD")  # same ROSCO form + ATD
     ctrls = {"ROSCO": rosco, "ATD": designed}
     dt, rdt, transient = 0.02, 0.1, 60.0
 

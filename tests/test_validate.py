@@ -1,6 +1,7 @@
 """Post-processing: Weibull weights (paper's Table 2 means), Welch scaling, indicators vs
 closed forms, paired-seed statistics, the closed-loop prediction vs python-control, a small
 campaign with its tables, OpenFAST outputs through the same path, and the config runner."""
+import dataclasses
 import json
 import math
 
@@ -134,7 +135,7 @@ def test_closed_loop_response_matches_interconnect(model):
 @pytest.fixture(scope="module")
 def campaign(model):
     base = sm.rosco_scheduled(model, [15.0, 17.0, 19.0, 21.0])
-    des = sm.ScheduledController(base.schedule_pitch, base.pitch, tuple(ATD for _ in base.pitch), name="ATD")
+    des = dataclasses.replace(base, atd=tuple(ATD for _ in base.pitch), name="ATD")  # like for like: ROSCO's form + ATD
     return va.run_campaign({"ROSCO": base, "ATD": des}, [16.0, 19.0], [1, 2, 3], model=model, duration=200.0,
                            transient=30.0, keep_series=True, progress=False)
 
