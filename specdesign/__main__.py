@@ -15,14 +15,19 @@ def main(argv: list[str] | None = None) -> int:
     val.add_argument("config", help="TOML or JSON campaign file")
     val.add_argument("--out", default=None, help="output folder (default: from the config file)")
     args = parser.parse_args(argv)
-    if args.command == "demo":
-        from specdesign.demo import run_demo
+    try:
+        if args.command == "demo":
+            from specdesign.demo import run_demo
 
-        run_demo(out=args.out, fast=args.fast)
-    else:
-        from specdesign.validate import run_config
+            run_demo(out=args.out, fast=args.fast)
+        else:
+            from specdesign.validate import run_config
 
-        run_config(args.config, out=args.out)
+            run_config(args.config, out=args.out)
+    except (ValueError, TypeError, FileNotFoundError) as e:
+        # bad input from the user: the message names it; a traceback would only hide it
+        print(f"specdesign {args.command}: error: {e}", file=sys.stderr)
+        return 2
     return 0
 
 
