@@ -32,6 +32,7 @@ __all__ = [
     "closed_loop",
     "check_stability",
     "frequency_response",
+    "siso_response",
     "t_output_wind",
     "t_gen_speed_wind",
     "t_tower_wind",
@@ -143,21 +144,32 @@ def _response(P, omega, output, input):
     return frequency_response(P, omega, output, input)
 
 
-def _controller(C, omega, name):
+def siso_response(sys, omega, name="controller"):
+    """Complex response at s = jω (omega in rad/s) of one SISO element of a loop.
+
+    ``sys``: a SISO python-control LTI, a real scalar gain, None (an open loop: 0), or a
+    complex array already evaluated on ``omega``. An integrator at ω = 0 gives inf without a
+    warning: callers such as :func:`t_output_wind` take the limit there.
+    """
     import control
 
-    if C is None:
-        return np.zeros(omega.shape, complex)
-    if isinstance(C, control.LTI):
-        if C.ninputs != 1 or C.noutputs != 1:
-            raise ValueError(f"{name} must be SISO")
-        # An integrator evaluated at ω = 0 divides by zero; t_output_wind takes the limit there.
-        with warnings.catch_warnings():
+    w = np.asarray(omega, dtype=float)
+    if sys is None:
+        return np.zeros(w.shape, complex)
+    if isinstance(sys, (int, float)):
+        return np.full(w.shape, complex(sys))
+    if isinstance(sys, control.LTI):
+        if sys.ninputs != 1 or sys.noutputs != 1:
+            raise ValueError(f"{name} must be SISO, got {sys.noutputs}x{sys.ninputs}")
+        with warnings.catch_warnings(), np.errstate(divide="ignore", invalid="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
-            return np.asarray(C(1j * omega, squeeze=False))[0, 0, :]
-    c = np.asarray(C, dtype=complex)
-    if c.shape != omega.shape:
-        raise ValueError(f"{name} as a frequency response must have shape {omega.shape} to match omega, got {c.shape}")
+            if isinstance(sys, control.TransferFunction):
+                s = 1j * w
+                return np.polyval(sys.num[0][0], s) / np.polyval(sys.den[0][0], s)
+            return np.asarray(sys(1j * w, squeeze=False))[0, 0, :].reshape(w.shape)
+    c = np.asarray(sys, dtype=complex)
+    if c.shape != w.shape:
+        raise ValueError(f"{name} as a frequency response must have shape {w.shape} to match omega, got {c.shape}")
     return c
 
 
@@ -172,7 +184,7 @@ def t_output_wind(P, C, omega, output, atd_controller=None, atd_measurement="tow
     returned, (P_{y,w}P_{Ω,β} − P_{y,β}P_{Ω,w})/P_{Ω,β}.
     """
     w = as_omega(omega, "omega")
-    c = _controller(C, w, "C")
+    c = siso_response(C, w, "C")
     infinite = ~np.isfinite(c) | (np.abs(np.nan_to_num(c, nan=np.inf)) > 1e15)
     c = np.where(infinite, 0.0, c)
     p_yw, p_yb = _response(P, w, output, "wind"), _response(P, w, output, "pitch_cmd")
@@ -180,7 +192,7 @@ def t_output_wind(P, C, omega, output, atd_controller=None, atd_measurement="tow
     num = p_yw + c * (p_yw * p_ob - p_yb * p_ow)
     den = 1 + c * p_ob
     if atd_controller is not None:
-        k = _controller(atd_controller, w, "atd_controller")
+        k = siso_response(atd_controller, w, "atd_controller")
         p_zw, p_zb = _response(P, w, atd_measurement, "wind"), _response(P, w, atd_measurement, "pitch_cmd")
         num = num + k * (p_yw * p_zb - p_yb * p_zw)
         den = den + k * p_zb
@@ -245,7 +257,7 @@ class LoopMaps:
 def loop_maps(plant, pitch_controller, omega, atd_controller=None, atd_measurement="tower_top_vel") -> LoopMaps:
     """Evaluate :class:`LoopMaps` for ``plant`` (named LTI) and controllers on ``omega`` (rad/s)."""
     w = as_omega(omega, "omega")
-    c = _controller(pitch_controller, w, "pitch_controller")
+    c = siso_response(pitch_controller, w, "pitch_controller")
     atd = dict(atd_controller=atd_controller, atd_measurement=atd_measurement)
     return LoopMaps(
         omega=w,

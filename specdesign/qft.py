@@ -70,6 +70,7 @@ import control as ct
 import numpy as np
 
 from ._checks import positive_scalar
+from .closedloop import _named_siso, _require, check_stability, closed_loop, frequency_response, siso_response
 
 __all__ = [
     "QFTDesign",
@@ -94,25 +95,8 @@ _DC_SAFETY_DB = 0.005
 
 
 # ----------------------------------------------------------------------------- plant algebra
-def _siso_response(sys, omega):
-    """Complex response of a SISO LTI (or a scalar, or None → 0) at jω."""
-    if sys is None:
-        return np.zeros(np.shape(omega), complex)
-    if isinstance(sys, (int, float)):
-        return np.full(np.shape(omega), complex(sys))
-    if not isinstance(sys, ct.LTI):
-        raise TypeError(f"controller must be a python-control LTI system, got {type(sys).__name__}")
-    if sys.ninputs != 1 or sys.noutputs != 1:
-        raise ValueError("controller must be SISO")
-    if isinstance(sys, ct.TransferFunction):
-        s = 1j * np.asarray(omega, float)
-        return np.polyval(sys.num[0][0], s) / np.polyval(sys.den[0][0], s)
-    return np.asarray(sys(1j * np.asarray(omega, float)), complex).reshape(np.shape(omega))
-
-
 def _plant_responses(plants, omega, outputs=_OUTPUTS):
     """{(output, input): (n_omega, n_cases) complex} for a list of named plant LTIs."""
-    from .closedloop import frequency_response
 
     return {
         (o, i): np.stack([frequency_response(P, omega, o, i) for P in plants], axis=1)
@@ -158,7 +142,7 @@ def general_form(plant, omega, output="tower_base_my", measurement="gen_speed", 
     outs = tuple(dict.fromkeys((output, measurement) + ((closed_measurement,) if closed_controller is not None else ())))
     R = _plant_responses(plants, w, outs)
     if closed_controller is not None:
-        R = _close_one(R, _siso_response(closed_controller, w)[:, None], closed_measurement, outs)
+        R = _close_one(R, siso_response(closed_controller, w)[:, None], closed_measurement, outs)
     A, B, C, D = _coefficients(R, output, measurement)
     if single:
         return A[:, 0], B[:, 0], C[:, 0], D[:, 0]
@@ -171,7 +155,6 @@ def partial_loop(plant, controller, measurement="tower_top_vel"):
     Returns a named StateSpace with inputs ``wind`` and ``pitch_cmd`` (now the free input u)
     and the plant's outputs: the "plant" the other controller sees in sequential closure.
     """
-    from .closedloop import _named_siso, _require
 
     if not isinstance(plant, ct.LTI):
         raise TypeError(f"plant must be a named python-control LTI system, got {type(plant).__name__}")
@@ -377,7 +360,7 @@ class _Problem:
             if np.any(np.asarray(p.D) != 0):
                 raise ValueError("the plant has a direct feedthrough pitch → measurement; not supported")
             self.pss.append((np.asarray(p.A), np.asarray(p.B), np.asarray(p.C)))
-        c0 = _siso_response(self.rosco[nominal], self.wf)[:, None]
+        c0 = siso_response(self.rosco[nominal], self.wf)[:, None]
         T0 = {y: self._t(self.Rf, c0, 0.0, y)[:, nominal] for y in ("tower_base_my", "gen_speed", "pitch")}
         from . import spectral
 
@@ -400,7 +383,7 @@ class _Problem:
     def weights(self, omega):
         """(W_Ω, W_MyT), each (n_omega, n_cases) magnitudes at ω (rad/s)."""
         R = _plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"))
-        c = np.stack([_siso_response(r, omega) for r in self.rosco], axis=1)
+        c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
         w_speed = np.abs(self._t(R, c, 0.0, "gen_speed")) * self.speed_gain
         w_tower = np.abs(self._t(R, c, 0.0, "tower_base_my")) * np.abs(self.tower_shaping(omega))[:, None]
         return w_speed, w_tower
@@ -505,7 +488,6 @@ def _tune(prob, x0, target, min_decay, maxfev):
 def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01)):
     """|p|·spread for lightly damped (ζ < zeta_max) poles and zeros of every case's ROSCO
     closed-loop maps wind → gen_speed and wind → tower_base_my, inside 0.005-20 rad/s."""
-    from .closedloop import closed_loop
 
     if not enabled:
         return np.zeros(0)
@@ -650,7 +632,6 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
         atd_bounds = lqft.intersect(*[lqft.bounds(atd_t, s_) for s_ in atd_specs])
     bounds_met = _bounds_met(pitch_bounds, cb, pitch_t, prob.wd) and _bounds_met(atd_bounds, ca, atd_t, prob.wd)
 
-    from .closedloop import check_stability, closed_loop
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -659,7 +640,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
     all_stable = bool(np.all(stable))
     red, dred, gs, ps, rate = prob.performance(x)
     Rdense = _plant_responses(prob.plants, wdense, ("gen_speed", "tower_top_vel"))
-    cdn, kdn = _siso_response(cb, wdense)[:, None], _siso_response(ca, wdense)[:, None]
+    cdn, kdn = siso_response(cb, wdense)[:, None], siso_response(ca, wdense)[:, None]
     peak_in = float(np.max(1 / np.abs(1 + cdn * Rdense[("gen_speed", "pitch_cmd")] + kdn * Rdense[("tower_top_vel", "pitch_cmd")])))
     nomp = pitch_t.nominal
     problems = []
@@ -704,7 +685,7 @@ def _checks(prob, cb, ca, wdense):
     def data(omegas):
         w = np.asarray(omegas, float)
         R = _plant_responses(plants, w, ("gen_speed", "tower_base_my", "tower_top_vel"))
-        c, k = _siso_response(cb, w)[:, None], _siso_response(ca, w)[:, None]
+        c, k = siso_response(cb, w)[:, None], siso_response(ca, w)[:, None]
         W_speed, W_tower = prob.weights(w)
         Rp = _close_one(R, k, "tower_top_vel", ("gen_speed", "tower_base_my"))  # ATD closed: C_β's plant
         Ra = _close_one(R, c, "gen_speed", ("tower_top_vel", "tower_base_my", "gen_speed"))  # pitch closed: ATD's plant
@@ -754,7 +735,7 @@ def _checks(prob, cb, ca, wdense):
 
 
 def _bounds_met(bounds, controller, template, omegas):
-    L0 = template.nominal_response * _siso_response(controller, template.omegas)
+    L0 = template.nominal_response * siso_response(controller, template.omegas)
     ok = bounds.is_allowed(template.omegas, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
     return bool(np.all(ok))
 

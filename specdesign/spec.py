@@ -24,6 +24,7 @@ import numpy as np
 
 from . import spectral
 from ._checks import as_omega, as_psd, positive_scalar
+from .closedloop import siso_response
 
 __all__ = [
     "Notch",
@@ -175,7 +176,7 @@ class Specification:
     def response(self, omega) -> np.ndarray:
         """W_y(jω) on the grid ω (rad/s), complex."""
         omega = np.asarray(omega, dtype=float)
-        return _siso_response(self.baseline, omega) * self.shaping(omega)
+        return siso_response(self.baseline, omega, "baseline") * self.shaping(omega)
 
     def magnitude(self, omega) -> np.ndarray:
         return np.abs(self.response(omega))
@@ -203,11 +204,6 @@ def _check_proper_stable(sys, name):
     if sys.isctime() and np.any(poles.real >= 0):
         bad = poles[poles.real >= 0]
         raise ValueError(f"{name} is not stable (poles {np.round(bad, 4)} in the closed right half-plane); a specification must be a stable closed-loop map")
-
-
-def _siso_response(sys, omega):
-    resp = ct.frequency_response(sys, omega)
-    return np.asarray(resp.complex, dtype=complex).reshape(-1)
 
 
 # --------------------------------------------------------------------------------------

@@ -37,6 +37,7 @@ def plot_design_bode(design, model=None, omega=None, axes=None):
             ax.semilogx(w, db(design.speed_spec.response(w)), "C3", label="specification (relaxed ROSCO)")
         else:
             ax.semilogx(w, db(design.shaping.specification.response(w)), "C3", label="specification: ROSCO × notches")
+            ax.semilogx(w, db(design.tower_spec.response(w)), "C3--", label="spec used for the bounds (relaxed at high ω)")
         ax.semilogx(w, db(closedloop.frequency_response(design.closed_loop, w, out)), "C1", lw=2, label="QFT: $C_\\beta$ + ATD")
         wd = design.design_omegas[(design.design_omegas >= w[0]) & (design.design_omegas <= w[-1])]
         ax.semilogx(wd, db(closedloop.frequency_response(design.closed_loop, wd, out)), "o", color="C4", ms=4,
