@@ -206,26 +206,23 @@ def _local_response(controller, model, wind_speed, s):
 def closed_loop_response(model, controller, wind_speed, omega, output="tower_base_my"):
     """T_{y,w}(jω) from rotor-effective wind (m/s) to ``output`` (SI) in closed loop.
 
-    With β = K·[Ω_g, ẋ_top], K = [−C_β, −C_atd] (the sign convention of
-    :mod:`specdesign.closedloop` and the simulator), and P the linearisation at ``wind_speed``:
-    T = P_yw + P_yβ·K·P_mw / (1 − K·P_mβ). With the ATD absent this is
-    [P_yw + C(P_yw P_Ωβ − P_yβ P_Ωw)]/(1 + C P_Ωβ), the workbench's closed-loop formula.
-    omega in rad/s; returns a complex array shaped like omega.
+    The controller (any kind the simulator runs; a scheduled one blended at the trim pitch of
+    ``wind_speed``) closes the linearisation at ``wind_speed`` through
+    :func:`specdesign.closedloop.t_output_wind`, with β = −C_β·Ω_g − C_atd·ẋ_top as in the
+    simulator. omega in rad/s, strictly increasing; returns a complex array shaped like omega.
     """
+    from .closedloop import t_output_wind
     from .simulate import turbine_plant
 
     w = np.asarray(omega, dtype=float)
     plant = turbine_plant(model)
-    sys = plant.linearize(wind_speed)
-    s = 1j * w
+    G = np.asarray(plant.linearize(wind_speed)(1j * w))  # (ny, nu, nw), inputs wind, pitch_cmd, gen_torque
     names = list(plant.output_names)
-    iy, iO, iv = names.index(output), names.index("gen_speed"), names.index("tower_top_vel")
-    G = np.asarray(sys(s))  # (ny, nu, nw), inputs wind, pitch_cmd, gen_torque
-    cb, ca = _local_response(controller, model, wind_speed, s)
-    k_o, k_v = -cb, -ca
-    loop = k_o * G[iO, 1] + k_v * G[iv, 1]
-    beta_per_w = (k_o * G[iO, 0] + k_v * G[iv, 0]) / (1.0 - loop)
-    return G[iy, 0] + G[iy, 1] * beta_per_w
+    # by position: a user KernelPlant's linearisation need not carry signal names
+    P = {(o, u): G[names.index(o), j] for o in {output, "gen_speed", "tower_top_vel"}
+         for j, u in enumerate(("wind", "pitch_cmd"))}
+    cb, ca = _local_response(controller, model, wind_speed, 1j * w)
+    return t_output_wind(P, cb, w, output, atd_controller=ca, atd_measurement="tower_top_vel")
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
