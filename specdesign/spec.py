@@ -297,11 +297,6 @@ class Promise:
         return self.predicted_damage - self.exact_damage
 
 
-def _damage_to_del(reduction_pct, m):
-    ratio = np.clip(1 - np.asarray(reduction_pct) / 100.0, 0.0, None)
-    return 100.0 * (1 - ratio ** (1.0 / m))
-
-
 def evaluate(spec_or_shaping, base: Baseline) -> Promise:
     """Promised fatigue reduction of a specification (or a shaping response) vs ``base``.
 
@@ -330,7 +325,7 @@ def _promise(base: Baseline, ratio: np.ndarray) -> Promise:
     predicted = float(spectral.predicted_change(base.omega, base.sensitivity, np.ones_like(ratio), ratio))
     d_new = float(spectral.damage_rate(base.omega, base.psd * ratio, base.m, method=base.method))
     exact = 100.0 * (1 - d_new / base.damage_rate)
-    return Promise(predicted, exact, float(_damage_to_del(predicted, base.m)), float(_damage_to_del(exact, base.m)))
+    return Promise(predicted, exact, float(spectral.del_reduction(predicted, base.m)), float(spectral.del_reduction(exact, base.m)))
 
 
 # --------------------------------------------------------------------------------------

@@ -33,6 +33,7 @@ __all__ = [
     "sensitivity",
     "predicted_change",
     "Change",
+    "del_reduction",
     "exact_change",
 ]
 
@@ -432,6 +433,14 @@ class Change:
     damage_after: np.ndarray
 
 
+def del_reduction(damage_reduction, m):
+    """DEL reduction (%) equivalent to a damage reduction (%) at Wöhler exponent ``m``:
+    100·(1 − (1 − ΔD/100)^(1/m)). A damage reduction of 100 % or more (possible for the
+    first-order Eq. 10 estimate, never for an exact one) means no damage left: 100 %."""
+    ratio = np.clip(1.0 - np.asarray(damage_reduction, dtype=float) / 100.0, 0.0, None)
+    return 100.0 * (1.0 - ratio ** (1.0 / positive_scalar(m, "m")))
+
+
 def exact_change(omega, psd_before, psd_after, m, method: str = "dirlik") -> Change:
     """Exact damage and DEL reduction (%) from ``psd_before`` to ``psd_after`` (both (..., n) per rad/s).
 
@@ -446,5 +455,5 @@ def exact_change(omega, psd_before, psd_after, m, method: str = "dirlik") -> Cha
     d1 = damage_rate(w, after, m, method)
     if np.any(d0 <= 0):
         raise ValueError("psd_before has zero damage (all-zero spectrum); a relative change is undefined")
-    ratio = d1 / d0
-    return Change(100.0 * (1.0 - ratio), 100.0 * (1.0 - ratio ** (1.0 / m)), d0, d1)
+    damage = 100.0 * (1.0 - d1 / d0)
+    return Change(damage, del_reduction(damage, m), d0, d1)

@@ -21,6 +21,7 @@ printed in the paper's Table 2 from its per-speed values (tested).
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 import sys
@@ -315,19 +316,24 @@ def paired_change(designed, baseline, indicator="tower_del", *, m=4.0, wind_spee
         return 100.0 * (_pool(indicator, ia, m) / _pool(indicator, ib, m) - 1.0)
 
     est = theta(a, b)
-    if S < 2:
-        se = np.full(W, np.nan)
-    elif method == "jackknife":
-        reps = np.stack([theta(np.delete(a, i, axis=1), np.delete(b, i, axis=1)) for i in range(S)], axis=-1)
-        se = np.sqrt((S - 1) / S * np.sum((reps - reps.mean(axis=-1, keepdims=True)) ** 2, axis=-1))
-    elif method == "bootstrap":
-        rng = np.random.default_rng(seed)
-        idx = rng.integers(0, S, size=(int(n_boot), S))
-        reps = np.stack([theta(a[:, i], b[:, i]) for i in idx], axis=-1)
-        se = reps.std(axis=-1, ddof=1)
-    else:
-        raise ValueError(f"method={method!r} must be 'jackknife' or 'bootstrap'")
+    se = _resampled_se(lambda idx: theta(a[:, idx], b[:, idx]), S, W, method, n_boot, seed)
     return PairedChange(indicator=indicator, wind_speeds=vs, change=est, se=se, method=method, n_seeds=S)
+
+
+def _resampled_se(theta, S, W, method, n_boot=2000, seed=0):
+    """SE over paired seeds of a statistic ``theta(seed_indices) → (W,)``: jackknife
+    (leave one seed out) or bootstrap (the same resampled seeds for every array)."""
+    if method not in ("jackknife", "bootstrap"):
+        raise ValueError(f"method={method!r} must be 'jackknife' or 'bootstrap'")
+    if S < 2:
+        return np.full(W, np.nan)
+    if method == "jackknife":
+        keep = np.arange(S)
+        reps = np.stack([theta(np.delete(keep, i)) for i in range(S)], axis=-1)
+        return np.sqrt((S - 1) / S * np.sum((reps - reps.mean(axis=-1, keepdims=True)) ** 2, axis=-1))
+    rng = np.random.default_rng(seed)
+    reps = np.stack([theta(i) for i in rng.integers(0, S, size=(int(n_boot), S))], axis=-1)
+    return reps.std(axis=-1, ddof=1)
 
 
 # ----------------------------------------------------------------------------- campaign
@@ -344,6 +350,10 @@ class Campaign:
     per rad/s. predicted_psd : dict output → (C, W, nω) |T|²S_W on the same grid.
     series : dict controller → SimulationResult (W, k, n) of the first k seeds kept
         (``keep_series``), else {}.
+    linear_values : like ``values`` from the same seeds run through the *linearised* model
+        (``run_campaign(linear_twin=True)``; NaN for controllers without a linear form), else
+        {}. It splits the prediction error into the spectral method's part and the plant's
+        nonlinearity (:func:`acceptance`).
     """
 
     controllers: tuple
@@ -358,6 +368,7 @@ class Campaign:
     welch: dict = field(repr=False)
     predicted_psd: dict = field(repr=False)
     series: dict = field(default_factory=dict, repr=False)
+    linear_values: dict = field(default_factory=dict, repr=False)
 
     def index(self, controller: str) -> int:
         if controller not in self.controllers:
@@ -375,7 +386,7 @@ _SPECTRA = ("gen_speed", "tower_base_my")
 
 
 def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
-                    turbulence_class, keep_series, nperseg):
+                    turbulence_class, keep_series, nperseg, linear_twin=False):
     """One wind speed, every controller, the same seeds: indicators, spectra, predictions."""
     from . import wind as wmod
     from .simulate import SimulationResult, simulate, wind_series
@@ -384,7 +395,8 @@ def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, trans
     radius = _rotor_radius(model)
     wdt = record_dt
     wind = wind_series(radius, [v], seeds, transient + duration + wdt, wdt, turbulence_class)
-    out = {"values": {}, "pred": [], "welch": {k: [] for k in _SPECTRA}, "ppsd": {k: [] for k in _SPECTRA}, "series": {}}
+    out = {"values": {}, "linear": {}, "pred": [], "welch": {k: [] for k in _SPECTRA}, "ppsd": {k: [] for k in _SPECTRA},
+           "series": {}}
     omega = None
     for name, c in controllers.items():
         r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
@@ -392,6 +404,15 @@ def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, trans
         ind = indicators(r.outputs, r.dt, m)
         for k, val in ind.as_dict().items():
             out["values"].setdefault(k, []).append(val[0])
+        if linear_twin:
+            if _has_linear_form(c):
+                rl = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
+                              record_dt=record_dt, transient=transient, linear=True)
+                lin = indicators(rl.outputs, rl.dt, m).as_dict()
+            else:
+                lin = {k: np.full((1, len(seeds)), np.nan) for k in _INDICATORS}
+            for k, val in lin.items():
+                out["linear"].setdefault(k, []).append(val[0])
         for k in _SPECTRA:
             omega, p = welch_psd(r[k][0], r.dt, nperseg)
             out["welch"][k].append(p.mean(axis=0))
@@ -424,7 +445,7 @@ def _has_linear_form(c) -> bool:
 
 def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0, dt=0.02, record_dt=0.1,
                  transient=60.0, m=4.0, predict=True, turbulence_class="B", keep_series=False,
-                 executor=None, progress=None, nperseg=None) -> Campaign:
+                 linear_twin=False, executor=None, progress=None, nperseg=None) -> Campaign:
     """Run every controller at every wind speed on the same seeds and post-process.
 
     controllers : dict name → controller (LTI, Controller, ScheduledController or callable;
@@ -436,6 +457,11 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
     keep_series : keep time series in ``Campaign.series``: True for every seed, an int k for
         the first k seeds (enough for Fig. 9), False for none (memory: C·W·k·n·8 bytes per
         output).
+    linear_twin : also run every LTI-like controller through the linearised model on the
+        same wind (twice the simulation time): ``Campaign.linear_values``, and
+        :func:`acceptance` then splits the deviation into the spectral method's part
+        (linear-model rainflow − prediction) and the plant nonlinearity's part (nonlinear −
+        linear-model rainflow).
     executor : optional ``concurrent.futures.Executor`` (a dask.distributed Client qualifies);
         wind speeds are submitted as separate tasks. Default: run locally, the compiled
         simulator already using every core. For a local process pool use a "spawn" context,
@@ -454,7 +480,7 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
     if seeds.ndim != 1 or seeds.size < 1 or len(set(seeds.tolist())) != seeds.size:
         raise ValueError(f"seeds must be distinct integers, got {seeds!r}")
     args = [(model, controllers, float(v), seeds, duration, dt, record_dt, transient, m, predict, turbulence_class,
-             keep_series, nperseg) for v in vs]
+             keep_series, nperseg, bool(linear_twin)) for v in vs]
     show = (sys.stderr.isatty()) if progress is None else bool(progress)
     from tqdm.auto import tqdm
 
@@ -492,7 +518,44 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
         welch={k: np.stack([np.stack(p["welch"][k]) for p in points], axis=1) for k in _SPECTRA},
         predicted_psd={k: np.stack([np.stack(p["ppsd"][k]) for p in points], axis=1) for k in _SPECTRA},
         series=series,
+        linear_values={k: np.stack([np.stack(p["linear"][k]) for p in points], axis=1) for k in _INDICATORS}
+        if linear_twin else {},
     )
+
+
+def concat_campaigns(campaigns) -> Campaign:
+    """One :class:`Campaign` from campaigns over different wind speeds (e.g. one per operating
+    point, each with that point's designed controllers under the same names). They must share
+    controller names, seeds, duration, sampling, m and Welch grid; wind speeds are stacked in
+    the given order."""
+    camps = list(campaigns)
+    if not camps or not all(isinstance(c, Campaign) for c in camps):
+        raise TypeError("campaigns must be a non-empty sequence of validate.Campaign")
+    c0 = camps[0]
+    for k, c in enumerate(camps[1:], 1):
+        same = (c.controllers == c0.controllers and np.array_equal(c.seeds, c0.seeds) and c.duration == c0.duration
+                and c.dt == c0.dt and c.m == c0.m and np.array_equal(c.omega, c0.omega)
+                and bool(c.linear_values) == bool(c0.linear_values) and bool(c.series) == bool(c0.series))
+        if not same:
+            raise ValueError(f"campaigns[{k}] differs from campaigns[0] in controllers, seeds, duration, dt, m, Welch "
+                             "grid, linear twin or kept series: run them with the same settings")
+    vs = np.concatenate([c.wind_speeds for c in camps])
+    if len(set(vs.tolist())) != vs.size:
+        raise ValueError(f"campaigns repeat a wind speed ({vs.tolist()} m/s)")
+
+    def cat(dicts, axis=1):
+        return {k: np.concatenate([d[k] for d in dicts], axis=axis) for k in dicts[0]} if dicts[0] else {}
+
+    series = {}
+    for name in c0.series:
+        rs = [c.series[name] for c in camps]
+        series[name] = dataclasses.replace(rs[0], wind_speeds=np.concatenate([r.wind_speeds for r in rs]),
+                                           outputs=cat([r.outputs for r in rs], axis=0))
+    return dataclasses.replace(
+        c0, wind_speeds=vs, values=cat([c.values for c in camps]),
+        predicted_del=np.concatenate([c.predicted_del for c in camps], axis=1),
+        welch=cat([c.welch for c in camps]), predicted_psd=cat([c.predicted_psd for c in camps]), series=series,
+        linear_values=cat([c.linear_values for c in camps]))
 
 
 # ----------------------------------------------------------------------------- tables
@@ -568,6 +631,12 @@ class Acceptance:
     rainflow : 100·(1 − DEL_rf,des/DEL_rf,base), seeds pooled by damage, paired.
     deviation : rainflow − predicted (percentage points); se : its standard error over paired
     seeds (the prediction has no sampling error). n_seeds : S. method : SE method.
+
+    With a linear twin (``run_campaign(linear_twin=True)``), the deviation splits exactly into
+    spectral_deviation = rainflow_linear − predicted (the spectral method against rainflow on
+    the linearised model, same seeds; SE se_spectral) and nonlinear_deviation = rainflow −
+    rainflow_linear (the plant's nonlinearity; SE se_nonlinear, small because both runs saw
+    the same wind). All NaN without a linear twin.
     """
 
     wind_speeds: np.ndarray
@@ -577,6 +646,11 @@ class Acceptance:
     se: np.ndarray
     n_seeds: int
     method: str
+    rainflow_linear: np.ndarray
+    spectral_deviation: np.ndarray
+    se_spectral: np.ndarray
+    nonlinear_deviation: np.ndarray
+    se_nonlinear: np.ndarray
 
     def passes(self, tolerance_pp: float = 1.0) -> np.ndarray:
         """True where |deviation| ≤ tolerance (percentage points)."""
@@ -585,13 +659,29 @@ class Acceptance:
 
 def acceptance(campaign: Campaign, designed: str, baseline: str, *, method="jackknife") -> Acceptance:
     """Per wind speed: linear-prediction vs rainflow reduction of the tower-base DEL, their
-    deviation (pp) and its standard error over paired seeds."""
+    deviation (pp) and its standard error over paired seeds; split into the spectral and the
+    nonlinear part when the campaign has a linear twin."""
     i, j = campaign.index(designed), campaign.index(baseline)
     pred = 100.0 * (1.0 - campaign.predicted_del[i] / campaign.predicted_del[j])
     ch = campaign.change(designed, baseline, "tower_del", method=method)
     rf = -ch.change
+    nan = np.full(rf.shape, np.nan)
+    rfl, dsp, sesp, dnl, senl = nan, nan, nan, nan, nan
+    if campaign.linear_values:
+        a, b = campaign.values["tower_del"][i], campaign.values["tower_del"][j]
+        al, bl = campaign.linear_values["tower_del"][i], campaign.linear_values["tower_del"][j]
+        lin = paired_change(al, bl, "tower_del", m=campaign.m, wind_speeds=campaign.wind_speeds, method=method)
+        rfl, sesp = -lin.change, lin.se
+        dsp, dnl = rfl - pred, rf - rfl
+
+        def gap(idx):  # nonlinear − linear rainflow reduction on the same resampled seeds
+            return 100.0 * (_pool("tower_del", al[:, idx], campaign.m) / _pool("tower_del", bl[:, idx], campaign.m)
+                            - _pool("tower_del", a[:, idx], campaign.m) / _pool("tower_del", b[:, idx], campaign.m))
+
+        senl = _resampled_se(gap, a.shape[1], a.shape[0], method)
     return Acceptance(wind_speeds=campaign.wind_speeds, predicted=pred, rainflow=rf, deviation=rf - pred, se=ch.se,
-                      n_seeds=ch.n_seeds, method=method)
+                      n_seeds=ch.n_seeds, method=method, rainflow_linear=rfl, spectral_deviation=dsp, se_spectral=sesp,
+                      nonlinear_deviation=dnl, se_nonlinear=senl)
 
 
 def table3(campaign: Campaign, designed: str, baseline: str, *, promised=None, method="jackknife") -> Table:
@@ -611,13 +701,25 @@ def table3(campaign: Campaign, designed: str, baseline: str, *, promised=None, m
         ("Estimation deviation", tuple(dev) + (float(np.mean(dev)),)),
         (f"Standard error ({method}, paired seeds)", tuple(acc.se) + (nan,)),
     ]
-    pp = (("Estimation deviation", "{:.2f} pp"), (f"Standard error ({method}, paired seeds)", "{:.2f} pp"))
+    pp = [("Estimation deviation", "{:.2f} pp"), (f"Standard error ({method}, paired seeds)", "{:.2f} pp")]
+    if campaign.linear_values:  # the split of the signed deviation: spectral method + plant nonlinearity
+        split = (
+            ("Rainflow evaluation, linearised model", acc.rainflow_linear, None),
+            ("Spectral-method part (linearised − prediction)", acc.spectral_deviation, "{:+.2f} pp"),
+            ("Spectral-method part: standard error", acc.se_spectral, "{:.2f} pp"),
+            ("Nonlinear part (rainflow − linearised)", acc.nonlinear_deviation, "{:+.2f} pp"),
+            ("Nonlinear part: standard error", acc.se_nonlinear, "{:.2f} pp"),
+        )
+        for name, vals, fmt in split:
+            rows.append((name, tuple(vals) + (nan,)))
+            if fmt:
+                pp.append((name, fmt))
     return Table(
         title=f"Table 3: tower-base fatigue (DEL) reduction, {designed} vs {baseline}",
         columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
         note=f"{acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with m = {campaign.m:g} at 1 Hz; "
              "linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
-        row_fmt=pp,
+        row_fmt=tuple(pp),
     )
 
 
@@ -699,7 +801,7 @@ def run_config(path, out=None) -> Campaign:
         raise FileNotFoundError(f"config file {path} does not exist")
     cfg = _read_config(path)
     allowed = {"turbine", "wind_speeds", "seeds", "duration", "dt", "record_dt", "transient", "wohler_exponent",
-               "turbulence_class", "controllers", "baseline", "designed", "promised", "output"}
+               "turbulence_class", "controllers", "baseline", "designed", "promised", "output", "linear_twin"}
     unknown = set(cfg) - allowed
     if unknown:
         raise ValueError(f"{path}: unknown keys {sorted(unknown)}; allowed: {sorted(allowed)}")
@@ -719,7 +821,7 @@ def run_config(path, out=None) -> Campaign:
     camp = run_campaign(
         ctrls, cfg["wind_speeds"], seeds, model=model, duration=cfg.get("duration", 600.0), dt=cfg.get("dt", 0.02),
         record_dt=cfg.get("record_dt", 0.1), transient=cfg.get("transient", 60.0), m=cfg.get("wohler_exponent", 4.0),
-        turbulence_class=cfg.get("turbulence_class", "B"), keep_series=1,
+        turbulence_class=cfg.get("turbulence_class", "B"), keep_series=1, linear_twin=bool(cfg.get("linear_twin", False)),
     )
     out = Path(out if out is not None else base / cfg.get("output", "validation_output"))
     out.mkdir(parents=True, exist_ok=True)

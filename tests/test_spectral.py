@@ -228,6 +228,15 @@ def test_predicted_change_is_eq10_sum():
     assert sp.predicted_change(w, dd, t2, w2) == pytest.approx(expect)
 
 
+def test_del_reduction_from_damage_reduction():
+    # loads × 0.9 ⇒ damage × 0.9^m: the DEL reduction is 10 % whatever m
+    for m in (3.0, 4.0, 10.0):
+        assert sp.del_reduction(100 * (1 - 0.9**m), m) == pytest.approx(10.0, rel=1e-12)
+    assert_allclose(sp.del_reduction([0.0, 100.0, 130.0], 4.0), [0.0, 100.0, 100.0])  # Eq. 10 can pass 100 %
+    with pytest.raises(ValueError, match="m"):
+        sp.del_reduction(10.0, -1.0)
+
+
 def test_exact_change_damage_and_del():
     w, s = random_psd(np.random.default_rng(3))
     ch = sp.exact_change(w, s, 0.81 * s, 4.0)  # all loads scale by 0.9: D by 0.9^4

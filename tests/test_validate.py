@@ -182,6 +182,76 @@ def test_tables_and_acceptance(campaign, tmp_path):
     assert float(rows[2].split(",")[1]) == pytest.approx(acc.predicted[0])
 
 
+def test_acceptance_without_a_linear_twin_has_no_split(campaign):
+    acc = va.acceptance(campaign, "ATD", "ROSCO")
+    assert campaign.linear_values == {}
+    assert np.all(np.isnan(acc.nonlinear_deviation)) and np.all(np.isnan(acc.spectral_deviation))
+    assert "linearised" not in va.table3(campaign, "ATD", "ROSCO").to_markdown()
+
+
+def test_linear_twin_splits_the_deviation(model):
+    """Same seeds through the linearised model: linear values equal an independent
+    ``simulate(linear=True)``; deviation = spectral part + nonlinear part exactly; the
+    nonlinear part's jackknife SE equals a hand leave-one-out loop and is smaller than the
+    rainflow SE (both runs saw the same wind); callables have no linear twin (NaN)."""
+    v, seeds, kw = 19.0, [1, 2, 3, 4, 5], dict(duration=200.0, transient=30.0)
+    rosco = turbine.rosco_baseline(model, v)
+    atd = sm.ScheduledController(np.zeros(1), (rosco,), (ATD,), name="ATD")
+    camp = va.run_campaign({"ROSCO": rosco, "ATD": atd}, [v], seeds, model=model, linear_twin=True, progress=False, **kw)
+    for c, ctrl in enumerate((rosco, atd)):
+        r = sm.simulate(model, ctrl, [v], seeds=seeds, linear=True, **kw)
+        assert_allclose(camp.linear_values["tower_del"][c], va.indicators(r.outputs, r.dt).tower_del, rtol=1e-10)
+        assert not np.allclose(camp.linear_values["tower_del"][c], camp.values["tower_del"][c], rtol=1e-3)
+    acc = va.acceptance(camp, "ATD", "ROSCO")
+    assert_allclose(acc.spectral_deviation + acc.nonlinear_deviation, acc.deviation, atol=1e-12)
+    lin = va.paired_change(camp.linear_values["tower_del"][1], camp.linear_values["tower_del"][0], m=4.0)
+    assert_allclose(acc.rainflow_linear, -lin.change) and assert_allclose(acc.se_spectral, lin.se)
+
+    def reduction(vals, keep):  # pooled by damage, m = 4
+        d = [np.mean(vals[c, 0, keep] ** 4) ** 0.25 for c in (1, 0)]
+        return 100 * (1 - d[0] / d[1])
+
+    nl, li = camp.values["tower_del"], camp.linear_values["tower_del"]
+    reps = np.array([reduction(nl, np.delete(np.arange(5), i)) - reduction(li, np.delete(np.arange(5), i))
+                     for i in range(5)])
+    assert acc.nonlinear_deviation[0] == pytest.approx(reduction(nl, np.arange(5)) - reduction(li, np.arange(5)), abs=1e-12)
+    assert acc.se_nonlinear[0] == pytest.approx(np.sqrt(4 / 5 * np.sum((reps - reps.mean()) ** 2)), rel=1e-10)
+    assert acc.se_nonlinear[0] < acc.se[0]
+    md = va.table3(camp, "ATD", "ROSCO").to_markdown()
+    assert "| Nonlinear part (rainflow − linearised) |" in md and " pp |" in md
+
+    pitch0 = model.trim(v).pitch
+
+    def hold(t, y):  # a callable controller (pitch held at the trim): no linear form, so no twin
+        return np.full(np.shape(y["gen_speed"]), pitch0)
+
+    camp2 = va.run_campaign({"ROSCO": rosco, "hold": hold}, [v], [1, 2], model=model, linear_twin=True,
+                            predict=False, progress=False, duration=20.0, transient=5.0)
+    assert np.all(np.isfinite(camp2.linear_values["tower_del"][0])) and np.all(np.isnan(camp2.linear_values["tower_del"][1]))
+
+
+def test_concat_campaigns_equals_one_multi_speed_campaign(model):
+    ctrls = {"PI": turbine.rosco_baseline(model, 19.0), "PI+ATD": sm.ScheduledController(
+        np.zeros(1), (turbine.rosco_baseline(model, 19.0),), (ATD,))}
+    kw = dict(model=model, duration=40.0, transient=5.0, progress=False, keep_series=1, linear_twin=True)
+    both = va.run_campaign(ctrls, [17.0, 19.0], [1, 2], **kw)
+    cat = va.concat_campaigns([va.run_campaign(ctrls, [v], [1, 2], **kw) for v in (17.0, 19.0)])
+    assert_allclose(cat.wind_speeds, both.wind_speeds)
+    for k in both.values:
+        assert_allclose(cat.values[k], both.values[k], rtol=1e-12)
+        assert_allclose(cat.linear_values[k], both.linear_values[k], rtol=1e-12)
+    assert_allclose(cat.predicted_del, both.predicted_del, rtol=1e-12)
+    assert_allclose(cat.welch["tower_base_my"], both.welch["tower_base_my"], rtol=1e-12)
+    assert_allclose(cat.series["PI"]["tower_base_my"], both.series["PI"]["tower_base_my"], rtol=1e-12)
+    with pytest.raises(ValueError, match="repeat a wind speed"):
+        va.concat_campaigns([cat, cat])
+    other = va.run_campaign(ctrls, [21.0], [1, 3], **kw)
+    with pytest.raises(ValueError, match=r"campaigns\[1\] differs"):
+        va.concat_campaigns([cat, other])
+    with pytest.raises(TypeError, match="Campaign"):
+        va.concat_campaigns([])
+
+
 def test_figures(campaign):
     import matplotlib.pyplot as plt
 
