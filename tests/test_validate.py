@@ -219,6 +219,13 @@ def test_linear_twin_splits_the_deviation(model):
     assert acc.se_nonlinear[0] < acc.se[0]
     md = va.table3(camp, "ATD", "ROSCO").to_markdown()
     assert "| Nonlinear part (rainflow − linearised) |" in md and " pp |" in md
+    import matplotlib.pyplot as plt
+
+    from specdesign.plots import validation as pv
+
+    labels = pv.plot_reductions(acc).get_legend_handles_labels()[1]
+    assert len(labels) == 3 and any("linearised" in lab for lab in labels)
+    plt.close("all")
 
     pitch0 = model.trim(v).pitch
 
