@@ -44,30 +44,18 @@ _OFF = 19
 
 
 @njit(cache=True)
-def _aero(p, omega, vrel, beta):
-    radius = p[tb.P_RADIUS]
-    area = np.pi * radius * radius
-    v = max(vrel, 0.1)
-    tsr = max(omega, 1e-6) * radius / v
-    n_cells = (int(p[tb.P_N_TSR]) - 1) * (int(p[tb.P_N_PITCH]) - 1) * 16
-    cp = tb._bicubic(p, tb._HEADER, tsr, beta)
-    ct = tb._bicubic(p, tb._HEADER + n_cells, tsr, beta)
-    q_dyn = 0.5 * p[tb.P_RHO] * area * v * v
-    return q_dyn * radius * cp / tsr, q_dyn * ct
-
-
-@njit(cache=True)
 def hybrid_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
-    omega, q, qd, beta, beta_rate = x[0], x[1], x[2], x[3], x[4]
+    # the model's own aerodynamics and mechanics: the hybrids differ from it only where intended
+    omega, qd, beta = x[0], x[2], x[3]
     o = int(p[_OFF])
     lin_q, lin_t, frz = p[o] > 0.5, p[o + 1] > 0.5, p[o + 2] > 0.5
     om0, v0, b0, q0, t0 = p[o + 4], p[o + 5], p[o + 6], p[o + 7], p[o + 8]
     if frz:
-        torque, thrust = _aero(p, omega, wind, beta)
+        torque, thrust = tb.aero_loads(p, omega, wind, beta)
         torque -= p[o + 10] * qd
         thrust -= p[o + 13] * qd
     else:
-        torque, thrust = _aero(p, omega, wind - qd, beta)
+        torque, thrust = tb.aero_loads(p, omega, wind - qd, beta)
     dom, dv, db = omega - om0, wind - qd - v0, beta - b0
     if p[o + 3] > 0.5:
         # Second-order Taylor expansion of both torque and thrust; mask picks the quadratic
@@ -88,31 +76,14 @@ def hybrid_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
         torque = q0 + p[o + 9] * dom + p[o + 10] * dv + p[o + 11] * db
     if lin_t:
         thrust = t0 + p[o + 12] * dom + p[o + 13] * dv + p[o + 14] * db
-    dx[0] = (torque - gen_torque) / p[tb.P_INERTIA]
-    dx[1] = qd
-    dx[2] = (thrust - p[tb.P_TWR_STIFF] * q - p[tb.P_TWR_DAMP] * qd) / p[tb.P_TWR_MASS]
-    rate_lim = p[tb.P_RATE_LIM]
-    rate = min(max(beta_rate, -rate_lim), rate_lim)
-    if (beta >= p[tb.P_PITCH_MAX] and rate > 0.0) or (beta <= p[tb.P_PITCH_MIN] and rate < 0.0):
-        rate = 0.0
-    wa = p[tb.P_ACT_OMEGA]
-    acc = wa * wa * (pitch_cmd - beta) - 2.0 * p[tb.P_ACT_ZETA] * wa * rate
-    if (beta_rate >= rate_lim and acc > 0.0) or (beta_rate <= -rate_lim and acc < 0.0):
-        acc = 0.0
-    dx[3] = rate
-    dx[4] = acc
+    tb.mechanics(x, torque, thrust, pitch_cmd, gen_torque, p, dx)
 
 
 @njit(cache=True)
 def hybrid_outputs(x, wind, pitch_cmd, gen_torque, p, y):
     dx = np.empty(5)
     hybrid_rhs(x, wind, pitch_cmd, gen_torque, p, dx)
-    y[0] = x[0]
-    y[1] = p[tb.P_MY_PER_M] * x[1]
-    y[2] = dx[2]
-    y[3] = x[2]
-    y[4] = x[3]
-    y[5] = p[tb.P_GEN_EFF] * gen_torque * x[0]
+    tb.outputs_from(x, dx, gen_torque, p, y)
 
 
 def aero_derivatives(model, v):
@@ -121,14 +92,14 @@ def aero_derivatives(model, v):
     p = model.kernel_params()
     x0 = np.array([op.rotor_speed, v, op.pitch])
     h = np.array([1e-5, 1e-4, 1e-6])
-    q0, t0 = _aero(p, *x0)
+    q0, t0 = tb.aero_loads(p, *x0)
     dq, dt_ = np.empty(3), np.empty(3)
     for k in range(3):
         a, b = x0.copy(), x0.copy()
         a[k] += h[k]
         b[k] -= h[k]
-        qa, ta = _aero(p, *a)
-        qb, tb_ = _aero(p, *b)
+        qa, ta = tb.aero_loads(p, *a)
+        qb, tb_ = tb.aero_loads(p, *b)
         dq[k], dt_[k] = (qa - qb) / (2 * h[k]), (ta - tb_) / (2 * h[k])
     return q0, t0, dq, dt_
 
@@ -147,7 +118,7 @@ def aero_hessians(model, v):
             x = x0.copy()
             x[i] += si * h[i]
             x[j] += sj * h[j]
-            acc += sg * np.array(_aero(p, *x))
+            acc += sg * np.array(tb.aero_loads(p, *x))
         acc /= 4 * h[i] * h[j]
         hq[n], ht[n] = acc
     return hq, ht

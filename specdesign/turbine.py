@@ -12,7 +12,11 @@ One compiled right-hand side serves the nonlinear simulator and the linearisatio
 linear model is by construction the Jacobian of what the simulator integrates.
 
 ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` and ``outputs(x, wind, pitch_cmd, gen_torque, p, y)``
-are module-level ``@numba.njit(cache=True)`` functions, callable from other ``@njit`` code:
+are module-level ``@numba.njit(cache=True)`` functions, callable from other ``@njit`` code.
+They are composed of ``aero_loads(p, omega, v_rel, beta)`` → (torque, thrust),
+``mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)`` and
+``outputs_from(x, dx, gen_torque, p, y)``, so a kernel that changes only the aerodynamics
+reuses the rest:
 
 - ``x`` (float64[5], read) and ``dx`` (float64[5], written) follow :data:`STATE_NAMES`:
 
@@ -58,6 +62,9 @@ __all__ = [
     "OUTPUT_NAMES",
     "rhs",
     "outputs",
+    "aero_loads",
+    "mechanics",
+    "outputs_from",
     "TurbineModel",
     "OperatingPoint",
     "RoscoSchedule",
@@ -108,33 +115,33 @@ def _bicubic(p, offset, tsr, pitch):
 
 
 @njit(cache=True)
-def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
-    """State derivative of the reduced IEA 15 MW model, written into ``dx``.
-
-    See the module docstring, section "Kernel interface", for the state vector, units and
-    the layout of the parameter array ``p`` (from :meth:`TurbineModel.kernel_params`).
-    """
-    omega = x[0]
-    q = x[1]
-    qd = x[2]
-    beta = x[3]
-    beta_rate = x[4]
+def aero_loads(p, omega, v_rel, beta):
+    """(aerodynamic torque N·m, thrust N) at rotor speed ``omega`` (rad/s), wind relative to
+    the tower top ``v_rel`` (m/s) and pitch ``beta`` (rad), from the compiled Cp/Ct interpolant."""
     radius = p[P_RADIUS]
     area = np.pi * radius * radius
-    # The rotor sees the wind relative to the moving tower top; kept positive so that a
-    # wild transient cannot divide by zero.
-    v_rel = max(wind - qd, 0.1)
-    tsr = max(omega, 1e-6) * radius / v_rel
+    # Kept positive so that a wild transient cannot divide by zero.
+    v = max(v_rel, 0.1)
+    tsr = max(omega, 1e-6) * radius / v
     n_cells = (int(p[P_N_TSR]) - 1) * (int(p[P_N_PITCH]) - 1) * 16
     cp = _bicubic(p, _HEADER, tsr, beta)
     ct = _bicubic(p, _HEADER + n_cells, tsr, beta)
-    q_dyn = 0.5 * p[P_RHO] * area * v_rel * v_rel
+    q_dyn = 0.5 * p[P_RHO] * area * v * v
     # Aerodynamic torque = P/Ω = q_dyn·R·Cp/λ, written without 1/Ω.
-    aero_torque = q_dyn * radius * cp / tsr
-    thrust = q_dyn * ct
+    return q_dyn * radius * cp / tsr, q_dyn * ct
+
+
+@njit(cache=True)
+def mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx):
+    """State derivative given the aerodynamic loads: rigid drivetrain, first tower fore-aft
+    mode, pitch actuator with rate and position limits (written into ``dx``). Shared by
+    :func:`rhs` and by kernels that replace only the aerodynamics."""
+    beta = x[3]
+    beta_rate = x[4]
+    qd = x[2]
     dx[0] = (aero_torque - gen_torque) / p[P_INERTIA]
     dx[1] = qd
-    dx[2] = (thrust - p[P_TWR_STIFF] * q - p[P_TWR_DAMP] * qd) / p[P_TWR_MASS]
+    dx[2] = (thrust - p[P_TWR_STIFF] * x[1] - p[P_TWR_DAMP] * qd) / p[P_TWR_MASS]
 
     rate_lim = p[P_RATE_LIM]
     rate = min(max(beta_rate, -rate_lim), rate_lim)
@@ -150,6 +157,29 @@ def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
 
 
 @njit(cache=True)
+def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
+    """State derivative of the reduced IEA 15 MW model, written into ``dx``.
+
+    See the module docstring, section "Kernel interface", for the state vector, units and
+    the layout of the parameter array ``p`` (from :meth:`TurbineModel.kernel_params`).
+    """
+    # The rotor sees the wind relative to the moving tower top.
+    aero_torque, thrust = aero_loads(p, x[0], wind - x[2], x[3])
+    mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)
+
+
+@njit(cache=True)
+def outputs_from(x, dx, gen_torque, p, y):
+    """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``."""
+    y[0] = x[0]
+    y[1] = p[P_MY_PER_M] * x[1]
+    y[2] = dx[2]
+    y[3] = x[2]
+    y[4] = x[3]
+    y[5] = p[P_GEN_EFF] * gen_torque * x[0]
+
+
+@njit(cache=True)
 def outputs(x, wind, pitch_cmd, gen_torque, p, y):
     """Outputs of the reduced model in the order of :data:`OUTPUT_NAMES`, written into ``y``.
 
@@ -158,12 +188,7 @@ def outputs(x, wind, pitch_cmd, gen_torque, p, y):
     """
     dx = np.empty(5)
     rhs(x, wind, pitch_cmd, gen_torque, p, dx)
-    y[0] = x[0]
-    y[1] = p[P_MY_PER_M] * x[1]
-    y[2] = dx[2]
-    y[3] = x[2]
-    y[4] = x[3]
-    y[5] = p[P_GEN_EFF] * gen_torque * x[0]
+    outputs_from(x, dx, gen_torque, p, y)
 
 
 # ----------------------------------------------------------------------------- data
