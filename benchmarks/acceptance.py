@@ -79,14 +79,7 @@ def main(argv=None):
         "linear_twin=True)`), which splits the deviation exactly into the spectral method's part (rainflow on the "
         "linearised model − prediction) and the plant nonlinearity's part (nonlinear − linearised rainflow).",
         "",
-        "| wind speed (m/s) | linear prediction DEL −% | rainflow DEL −% | deviation (pp) | SE (pp) | within 1 pp "
-        "| spectral part (pp) | nonlinear part (pp) |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for k, v in enumerate(acc.wind_speeds):
-        lines.append(f"| {v:g} | {acc.predicted[k]:.2f} | {acc.rainflow[k]:.2f} | {acc.deviation[k]:+.2f} | "
-                     f"{acc.se[k]:.2f} | {'yes' if acc.passes()[k] else 'no'} | {acc.spectral_deviation[k]:+.2f} ± "
-                     f"{acc.se_spectral[k]:.2f} | {acc.nonlinear_deviation[k]:+.2f} ± {acc.se_nonlinear[k]:.2f} |")
+    ] + split_table(acc, "spectral part (pp)")
     dev, sp = np.abs(acc.deviation), np.abs(acc.spectral_deviation)
     lines += ["", f"Mean |deviation| {dev.mean():.2f} pp, max {dev.max():.2f} pp on the nonlinear model; the spectral "
               f"part alone (linearised model, same seeds and loop) {sp.mean():.2f} pp, max {sp.max():.2f} pp. "
@@ -95,6 +88,19 @@ def main(argv=None):
               validate.table2(camp, "QFT", "ROSCO").to_markdown(), READING] + sched_lines
     Path(args.out).write_text("\n".join(lines) + "\n")
     print(f"mean |deviation| {dev.mean():.2f} pp, max {dev.max():.2f} pp; wrote {args.out} ({elapsed:.0f} s)")
+
+
+def split_table(acc, linear_part):
+    """Markdown rows: prediction, rainflow, signed deviation with its SE and the 1-pp verdict,
+    and the split into the linearised twin's part (column title ``linear_part``) and the
+    nonlinear part, per wind speed of ``acc`` (a :class:`validate.Acceptance`)."""
+    lines = ["| wind speed (m/s) | linear prediction DEL −% | rainflow DEL −% | deviation (pp) | SE (pp) | within 1 pp "
+             f"| {linear_part} | nonlinear part (pp) |", "|---|---|---|---|---|---|---|---|"]
+    for k, v in enumerate(acc.wind_speeds):
+        lines.append(f"| {v:g} | {acc.predicted[k]:.2f} | {acc.rainflow[k]:.2f} | {acc.deviation[k]:+.2f} | "
+                     f"{acc.se[k]:.2f} | {'yes' if acc.passes()[k] else 'no'} | {acc.spectral_deviation[k]:+.2f} ± "
+                     f"{acc.se_spectral[k]:.2f} | {acc.nonlinear_deviation[k]:+.2f} ± {acc.se_nonlinear[k]:.2f} |")
+    return lines
 
 
 def _scheduled_section(model, designs, seeds, duration):
@@ -112,16 +118,12 @@ def _scheduled_section(model, designs, seeds, duration):
              f"ROSCO with its own gain scheduling (`simulate.rosco_scheduled`) vs the designs blended in filtered pitch "
              f"(`simulate.scheduled`), {len(seeds)} paired seeds × {duration:g} s at every speed. The prediction is the "
              "design at its own trim; the linearised twin keeps the scheduling (pitch still moves the blend), so its "
-             "part also holds the effect of scheduling, not only the spectral method's.", "",
-             "| wind speed (m/s) | linear prediction DEL −% | rainflow DEL −% | deviation (pp) | SE (pp) | within 1 pp "
-             "| linearised-plant part (pp) | nonlinear part (pp) |", "|---|---|---|---|---|---|---|---|"]
+             "part also holds the effect of scheduling, not only the spectral method's.", ""]
+    lines += split_table(acc, "linearised-plant part (pp)")
     for k, v in enumerate(acc.wind_speeds):
         print(f"scheduled {v:5.1f} m/s: deviation {acc.deviation[k]:+5.2f} ± {acc.se[k]:.2f} pp = linearised "
               f"{acc.spectral_deviation[k]:+5.2f} + nonlinear {acc.nonlinear_deviation[k]:+5.2f} ± "
               f"{acc.se_nonlinear[k]:.2f} pp", flush=True)
-        lines.append(f"| {v:g} | {acc.predicted[k]:.2f} | {acc.rainflow[k]:.2f} | {acc.deviation[k]:+.2f} | "
-                     f"{acc.se[k]:.2f} | {'yes' if acc.passes()[k] else 'no'} | {acc.spectral_deviation[k]:+.2f} ± "
-                     f"{acc.se_spectral[k]:.2f} | {acc.nonlinear_deviation[k]:+.2f} ± {acc.se_nonlinear[k]:.2f} |")
     return lines
 
 
