@@ -67,6 +67,7 @@ __all__ = [
     "outputs_from",
     "TurbineModel",
     "OperatingPoint",
+    "AeroExpansion",
     "RoscoSchedule",
     "iea15mw",
     "rosco_baseline",
@@ -76,6 +77,11 @@ __all__ = [
 STATE_NAMES = ("rotor_speed", "tower_top_disp", "tower_top_vel", "pitch", "pitch_rate")
 INPUT_NAMES = ("wind", "pitch_cmd", "gen_torque")
 OUTPUT_NAMES = ("gen_speed", "tower_base_my", "tower_top_acc", "tower_top_vel", "pitch", "power")
+#: Extra inputs of ``linearize(..., load_inputs=True)``: disturbances added to the aerodynamic
+#: torque (N·m) and thrust (N).
+LOAD_INPUT_NAMES = ("aero_torque", "thrust")
+#: Arguments of the aerodynamic loads that :class:`AeroExpansion` expands in.
+AERO_VARIABLES = ("rotor_speed", "relative_wind", "pitch")
 
 # Header of the flat kernel parameter array.
 P_RHO, P_RADIUS, P_INERTIA = 0, 1, 2
@@ -295,6 +301,42 @@ class OperatingPoint:
         return np.array([self.wind_speed, self.pitch, self.gen_torque])
 
 
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
+class AeroExpansion:
+    """Taylor expansion of the aerodynamic loads about a trim, to third order.
+
+    The loads (aerodynamic torque N·m, thrust N) are functions of z = (rotor speed rad/s, wind
+    relative to the tower top m/s, pitch rad) (:data:`AERO_VARIABLES`). ``point`` (3,) is z at
+    the trim of ``wind_speed`` (m/s) and ``loads`` (2,) the loads there; ``gradient`` (2, 3),
+    ``hessian`` (2, 3, 3) and ``third`` (2, 3, 3, 3) are their first, second and third
+    partial derivatives in z (SI units of load per unit of each variable), by central
+    differences of the compiled interpolant with steps ``steps`` (3,).
+    """
+
+    wind_speed: float
+    point: np.ndarray
+    loads: np.ndarray
+    gradient: np.ndarray
+    hessian: np.ndarray
+    third: np.ndarray
+    steps: np.ndarray
+
+    def evaluate(self, dz, order: int = 3) -> np.ndarray:
+        """Load change (2, ...) predicted by the Taylor polynomial of ``order`` (1-3) for the
+        deviations ``dz`` (3, ...) from ``point`` (same units as :data:`AERO_VARIABLES`)."""
+        dz = np.asarray(dz, dtype=float)
+        if dz.ndim < 1 or dz.shape[0] != 3:
+            raise ValueError(f"dz must have shape (3, ...) ordered as {AERO_VARIABLES}, got {dz.shape}")
+        if order not in (1, 2, 3):
+            raise ValueError(f"order={order!r} must be 1, 2 or 3")
+        out = np.einsum("ki,i...->k...", self.gradient, dz)
+        if order >= 2:
+            out = out + 0.5 * np.einsum("kij,i...,j...->k...", self.hessian, dz, dz)
+        if order == 3:
+            out = out + np.einsum("kijl,i...,j...,l...->k...", self.third, dz, dz, dz) / 6.0
+        return out
+
+
 @dataclass(frozen=True)
 class TurbineModel:
     """Reduced-order turbine: rotor + rigid drivetrain + tower fore-aft mode + pitch actuator.
@@ -504,21 +546,90 @@ class TurbineModel:
         omega, torque = self.rated_rotor_speed, self.rated_generator_torque
         return float(brentq(lambda v: self._aero_torque(v, omega, self.pitch_min) - torque, 5.0, 20.0, xtol=1e-10))
 
-    def linearize(self, wind_speed):
+    def linearize(self, wind_speed, *, load_inputs: bool = False):
         """Linear model at the trim for ``wind_speed`` (m/s, 11-25): a ``control.StateSpace``
         with inputs ``wind`` (m/s), ``pitch_cmd`` (rad), ``gen_torque`` (N·m), outputs
         :data:`OUTPUT_NAMES` (SI) and states :data:`STATE_NAMES`, all deviations from the trim.
         Index it by name: ``sys['gen_speed', 'wind']``.
+
+        load_inputs : also take :data:`LOAD_INPUT_NAMES`, disturbances added to the
+            aerodynamic torque (N·m) and thrust (N): the inputs through which the higher-order
+            aerodynamic terms of :meth:`aero_expansion` act (:func:`specdesign.validate.volterra_response`).
         """
         import control
 
         op = self.trim(wind_speed)
         A, B, C, D = self.jacobians(op)
+        inputs = list(INPUT_NAMES)
+        if load_inputs:
+            BL, DL = self._load_jacobians(op)
+            B, D = np.hstack([B, BL]), np.hstack([D, DL])
+            inputs += list(LOAD_INPUT_NAMES)
         return control.ss(
             A, B, C, D,
-            inputs=list(INPUT_NAMES), outputs=list(OUTPUT_NAMES), states=list(STATE_NAMES),
+            inputs=inputs, outputs=list(OUTPUT_NAMES), states=list(STATE_NAMES),
             name=f"{self.name}@{op.wind_speed:g}mps".replace(".", "p"),
         )
+
+    def _load_jacobians(self, op: OperatingPoint):
+        """(B, D) columns of additive aerodynamic torque and thrust at ``op``: :func:`mechanics`
+        and :func:`outputs_from` are linear in the loads, so one difference of 1 N·m / 1 N is exact
+        up to round-off."""
+        p, x0 = self._params, np.array(op.x, dtype=float)
+        q0, t0 = self._aero_point(op)[1]
+        dx, y = np.empty(5), np.empty(len(OUTPUT_NAMES))
+
+        def evaluate(q, t):
+            mechanics(x0, q, t, op.pitch, op.gen_torque, p, dx)
+            outputs_from(x0, dx, op.gen_torque, p, y)
+            return np.concatenate([dx, y])
+
+        base = evaluate(q0, t0)
+        h = np.array([1.0e3, 1.0e3])  # N·m, N: exact for a linear map, well above round-off
+        cols = [(evaluate(q0 + h[0], t0) - base) / h[0], (evaluate(q0, t0 + h[1]) - base) / h[1]]
+        J = np.stack(cols, axis=1)
+        return J[:5], J[5:]
+
+    def _aero_point(self, op: OperatingPoint):
+        """(z0, loads0): the aerodynamic arguments (:data:`AERO_VARIABLES`) and loads (torque
+        N·m, thrust N) at the trim ``op`` (tower at rest, so the relative wind is the wind)."""
+        z0 = np.array([op.rotor_speed, op.wind_speed, op.pitch])
+        return z0, np.array(aero_loads(self._params, z0[0], z0[1], z0[2]))
+
+    def aero_expansion(self, wind_speed, *, steps=(2e-3, 2e-2, 2e-3)) -> AeroExpansion:
+        """Third-order Taylor expansion of (aerodynamic torque, thrust) about the trim of
+        ``wind_speed`` (m/s) in (rotor speed, relative wind, pitch): :class:`AeroExpansion`.
+
+        steps : central-difference steps (rad/s, m/s, rad), small against the excursions in
+        turbulence (≈ 0.05 rad/s, 1.5 m/s, 0.03 rad at class B) and large enough that
+        round-off stays ≤ 1e-6 of the third derivatives.
+        """
+        op = self.trim(wind_speed)
+        z0, loads0 = self._aero_point(op)
+        h = np.asarray(steps, dtype=float)
+        if h.shape != (3,) or not np.all(np.isfinite(h)) or np.any(h <= 0):
+            raise ValueError(f"steps={steps!r} must be three positive step sizes (rad/s, m/s, rad)")
+        p = self._params
+        E = np.diag(h)
+
+        def f(z):
+            return np.array(aero_loads(p, z[0], z[1], z[2]))
+
+        grad = np.stack([(f(z0 + E[i]) - f(z0 - E[i])) / (2 * h[i]) for i in range(3)], axis=-1)
+        hess = np.empty((2, 3, 3))
+        third = np.empty((2, 3, 3, 3))
+        signs = np.array([(a, b, c) for a in (1, -1) for b in (1, -1) for c in (1, -1)], dtype=float)
+        for i in range(3):
+            for j in range(3):
+                hess[:, i, j] = (f(z0 + E[i] + E[j]) - f(z0 + E[i] - E[j]) - f(z0 - E[i] + E[j])
+                                 + f(z0 - E[i] - E[j])) / (4 * h[i] * h[j])
+                for k in range(3):
+                    acc = sum(s.prod() * f(z0 + s[0] * E[i] + s[1] * E[j] + s[2] * E[k]) for s in signs)
+                    third[:, i, j, k] = acc / (8 * h[i] * h[j] * h[k])
+        for a in (z0, loads0, grad, hess, third, h):
+            a.flags.writeable = False
+        return AeroExpansion(wind_speed=op.wind_speed, point=z0, loads=loads0, gradient=grad, hessian=hess,
+                             third=third, steps=h)
 
 
 def iea15mw() -> TurbineModel:

@@ -53,4 +53,6 @@ def test_validate_config_written_by_the_demo_reproduces_its_validation(demo):
     table3 = out / "validation" / "table3.csv"
     assert _row(table3, "Linear prediction")[0] == pytest.approx(s["predicted_del_pct"], abs=1e-6)
     assert _row(table3, "Rainflow evaluation")[0] == pytest.approx(s["rainflow_del_pct"], abs=1e-6)
-    assert np.array_equal(camp.seeds, np.arange(3))
+    assert _row(table3, "Volterra prediction (order 3, rainflow, same seeds)")[0] == pytest.approx(
+        s["volterra_del_pct"], abs=1e-6)
+    assert np.array_equal(camp.seeds, np.arange(3)) and camp.volterra_order == 3

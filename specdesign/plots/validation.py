@@ -85,7 +85,8 @@ def plot_reductions(acc, *, ax=None):
     """Fig. 10: tower-base DEL reduction (%) vs mean wind speed (m/s): linear prediction and
     rainflow evaluation with ±1 standard error bars (paired seeds), plus rainflow on the
     linearised model when the campaign had a linear twin (the gap between the two rainflow
-    curves is the plant nonlinearity's part). ``acc`` is an
+    curves is the plant nonlinearity's part) and the Volterra prediction when the campaign had
+    one (``run_campaign(volterra=k)``). ``acc`` is an
     :class:`~specdesign.validate.Acceptance`. Returns the axes."""
     ax = _axes(ax)
     ax.plot(acc.wind_speeds, acc.predicted, "o--", label="linear prediction (Dirlik on |T|²S_W)")
@@ -94,6 +95,9 @@ def plot_reductions(acc, *, ax=None):
     if np.all(np.isfinite(acc.rainflow_linear)):
         ax.errorbar(acc.wind_speeds, acc.rainflow_linear, yerr=acc.se_spectral, fmt="^:", capsize=3,
                     label="rainflow, linearised model (same seeds, ±1 SE)")
+    if acc.volterra_order and np.all(np.isfinite(acc.volterra)):
+        ax.plot(acc.wind_speeds, acc.volterra, "d-.",
+                label=f"Volterra prediction, order {acc.volterra_order} (rainflow, same seeds)")
     ax.set_xlabel("mean wind speed (m/s)")
     ax.set_ylabel("tower-base DEL reduction (%)")
     ax.legend(fontsize="small")
