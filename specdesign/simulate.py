@@ -29,8 +29,11 @@ between K scheduling pitches β_k, clamped at the ends:
   integrator of K_i(β_f)·e_f, u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_rated − Ω_g).
   Discrete at the simulation step as the LTI path is (Tustin): F by Tustin, the integral
   by the trapezoid rule with the gain of the current step, I_k = I_{k−1} +
-  K_i(β_f,k)·dt/2·(e_f,k + e_f,k−1). With frozen gains it is exactly the LTI
-  (K_p + K_i/s)·F simulated on the ordinary path.
+  K_i(β_f,k)·dt/2·(e_f,k + e_f,k−1). With ``pitch_limits`` (``rosco_scheduled``: the
+  model's) the integrator, as absolute pitch β_0 + I, and the PI output are saturated at
+  them, as ROSCO's PI does (anti-windup near rated, where the pitch reaches its minimum).
+  Without limits, or while they are not reached, and with frozen gains it is exactly the
+  LTI (K_p + K_i/s)·F simulated on the ordinary path.
 
 An ATD controller, if present, is output-blended in both forms.
 
@@ -237,6 +240,9 @@ class ScheduledController:
     kp, ki : (K,) PI gains at the scheduling pitches (``form="gains"`` only; in the workbench's
         convention C = (K_p + K_i/s)·F, i.e. ROSCO's negative gains), rad/(rad/s) and rad/rad.
     error_filter : SISO LTI filter F on the speed error (``form="gains"`` only).
+    pitch_limits : (min, max) absolute pitch (rad) at which ``form="gains"`` saturates its
+        integrator (the trim pitch plus ∫K_i·e_f) and its PI output, as ROSCO's PI does
+        (anti-windup); None (default) for no saturation.
     """
 
     schedule_pitch: np.ndarray
@@ -248,6 +254,7 @@ class ScheduledController:
     kp: np.ndarray | None = field(default=None, repr=False)
     ki: np.ndarray | None = field(default=None, repr=False)
     error_filter: object = field(default=None, repr=False)
+    pitch_limits: tuple | None = None
 
     def __post_init__(self):
         b = np.atleast_1d(np.asarray(self.schedule_pitch, dtype=float))
@@ -262,9 +269,14 @@ class ScheduledController:
         if self.form not in _FORMS:
             raise ValueError(f"form must be one of {_FORMS}, got {self.form!r}")
         if self.form == "output":
-            if self.kp is not None or self.ki is not None or self.error_filter is not None:
-                raise ValueError("kp, ki and error_filter are for form='gains' only")
+            if self.kp is not None or self.ki is not None or self.error_filter is not None or self.pitch_limits is not None:
+                raise ValueError("kp, ki, error_filter and pitch_limits are for form='gains' only")
             return
+        if self.pitch_limits is not None:
+            lim = tuple(float(x) for x in self.pitch_limits)
+            if len(lim) != 2 or not lim[0] < lim[1] or any(math.isnan(x) for x in lim):
+                raise ValueError(f"pitch_limits must be (min, max) pitch in rad with min < max, got {self.pitch_limits!r}")
+            object.__setattr__(self, "pitch_limits", lim)
         gains = []
         for g, nm in ((self.kp, "kp"), (self.ki, "ki")):
             a = np.atleast_1d(np.asarray(g, dtype=float)) if g is not None else None
@@ -292,13 +304,15 @@ class ScheduledController:
 
     @classmethod
     def gain_scheduled_pi(cls, schedule_pitch, kp, ki, error_filter, *, atd=None,
-                          filter_omega=SCHEDULE_FILTER_OMEGA, name="PI") -> "ScheduledController":
+                          filter_omega=SCHEDULE_FILTER_OMEGA, name="PI", pitch_limits=None) -> "ScheduledController":
         """ROSCO-form gain-scheduled PI: u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_ref − Ω_g).
 
         schedule_pitch (rad), kp, ki : (K,) gains at the scheduling pitches, in the
         workbench's convention C = (K_p + K_i/s)·F (ROSCO's negative gains).
         error_filter : SISO LTI F on the speed error (e.g. :func:`specdesign.turbine.speed_filter`).
         atd : K ATD controllers (output-blended) or None.
+        pitch_limits : (min, max) pitch (rad) saturating the integrator and the PI output
+            (ROSCO's anti-windup), or None.
         """
         import control
 
@@ -309,7 +323,7 @@ class ScheduledController:
             raise ValueError(f"kp and ki must be 1-D arrays of the same length, got shapes {kp.shape} and {ki.shape}")
         pitch = tuple(control.tf([a, c], [1.0, 0.0]) * f for a, c in zip(kp, ki))
         return cls(schedule_pitch, pitch, None if atd is None else tuple(atd), filter_omega, name,
-                   form="gains", kp=kp, ki=ki, error_filter=f)
+                   form="gains", kp=kp, ki=ki, error_filter=f, pitch_limits=pitch_limits)
 
 
 def scheduled(model, pitch, atd=None, *, filter_omega=SCHEDULE_FILTER_OMEGA, name="designed") -> ScheduledController:
@@ -344,7 +358,8 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains")
     ``turbine.rosco_baseline(model, v)`` at ``wind_speeds`` (m/s; default every 1 m/s over the
     model's above-rated range), placed at each speed's trim pitch, interpolated linearly in
     the filtered pitch command, applied to one error filtered by ``turbine.speed_filter()``
-    with one integrator of K_i(β_f)·e_f. ``form="output"`` blends the outputs of the local
+    with one integrator of K_i(β_f)·e_f, integrator and output saturated at the model's pitch
+    limits as ROSCO's PI does (anti-windup). ``form="output"`` blends the outputs of the local
     PIs instead (the general scheme of :func:`scheduled`; kept for comparison).
     """
     from . import turbine
@@ -369,7 +384,8 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains")
     plant = turbine_plant(model)
     beta = np.array([plant.trim(s)[1] for s in v])
     order = np.argsort(beta)
-    sc = ScheduledController.gain_scheduled_pi(beta[order], kp[order], ki[order], turbine.speed_filter(), name=name)
+    sc = ScheduledController.gain_scheduled_pi(beta[order], kp[order], ki[order], turbine.speed_filter(), name=name,
+                                               pitch_limits=(model.pitch_min, model.pitch_max))
     # Same controller as rosco_baseline at each speed (checked against its transfer function).
     jw = 1j * np.array([0.05, 0.5, 2.0])
     for k, s in enumerate(v[order]):
@@ -401,7 +417,8 @@ def _bank(controller, dt):
 
 def _make_bank(controller, dt):
     """(schedule_pitch, per-local (A, B, C, D) of the output-blended part, filter corner,
-    scheduled-PI arrays (kp, ki, Af, Bf, Cf, Df) or None).
+    scheduled-PI arrays (kp, ki, Af, Bf, Cf, Df, limits) or None; limits (2,) in rad, ±inf
+    for none).
 
     In ``form="gains"`` the local pitch controllers are not in the blended bank (only the ATD
     locals are); the PI runs as one filter, one integrator and interpolated gains."""
@@ -423,7 +440,8 @@ def _make_bank(controller, dt):
     pi = None
     if gains:
         Af, Bf, Cf, Df = discretize(controller.error_filter, dt)
-        pi = (controller.kp, controller.ki, Af, Bf, Cf, Df)
+        lim = (-np.inf, np.inf) if controller.pitch_limits is None else controller.pitch_limits
+        pi = (controller.kp, controller.ki, Af, Bf, Cf, Df, np.array(lim, dtype=float))
     return controller.schedule_pitch, mats, controller.filter_omega, pi
 
 
@@ -479,7 +497,7 @@ def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
 
 @njit(cache=True)
 def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df):
+             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim):
     nx = x.size
     nc = Ad.shape[1]
     nf = Af.shape[0]
@@ -559,7 +577,12 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
                 kiv = (1.0 - f) * ki[q] + f * ki[q + 1]
             integ += kiv * 0.5 * dt * (ef + ef_prev)
             ef_prev = ef
-            u += kpv * ef + integ
+            # ROSCO saturates the integrator (the trim pitch + ∫) and the PI output at the
+            # pitch limits: anti-windup. With infinite limits this is the plain PI.
+            lo = lim[0] - beta0
+            hi = lim[1] - beta0
+            integ = min(max(integ, lo), hi)
+            u += min(max(kpv * ef + integ, lo), hi)
         bcmd = beta0 + u
         bf += a_filt * (bcmd - bf)
         _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
@@ -567,13 +590,13 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
 
 @njit(cache=True, parallel=True)
 def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
-               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df):
+               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim):
     """All runs, one per prange iteration; the controller bank is shared by the batch."""
     K = sched_pitch.size
     for r in prange(X0.shape[0]):
         x = X0[r].copy()
         _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-                 beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf, Cf, Df)
+                 beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf, Cf, Df, lim)
 
 
 @njit(cache=True)
@@ -811,12 +834,12 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         a_filt = 1.0 - math.exp(-fw * dt)
         if pi is None:
             pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
-            Af, Bf, Cf, Df = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1)
+            Af, Bf, Cf, Df, lim = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1), np.array([-np.inf, np.inf])
         else:
-            pi_on, (kp, ki, Af, Bf, Cf, Df) = True, pi
+            pi_on, (kp, ki, Af, Bf, Cf, Df, lim) = True, pi
         run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
                   beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on,
-                  *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df)))
+                  *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim)))
 
     skip = int(round(transient / record_dt))
     t_rec = np.arange(n_rec) * record_dt

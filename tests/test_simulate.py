@@ -2,6 +2,7 @@
 turbine), batching, controller paths against independent implementations, scheduling by
 output blending and by ROSCO's scheduled gains, and nonlinear vs linear agreement at small
 turbulence."""
+import dataclasses
 import math
 
 import control
@@ -145,9 +146,10 @@ def test_identical_local_controllers_blend_to_the_single_controller():
 
 class ScheduledPI:
     """Independent callable of ROSCO's gain scheduling: e_f = F·(Ω_ref − Ω) (scipy bilinear),
-    u = Kp(β_f)·e_f + I, I += Ki(β_f)·dt/2·(e_f + e_f,prev), gains by np.interp in β_f."""
+    u = Kp(β_f)·e_f + I, I += Ki(β_f)·dt/2·(e_f + e_f,prev), gains by np.interp in β_f;
+    with ``limits`` (rad) β0 + I and β0 + u are clipped to them (ROSCO's anti-windup)."""
 
-    def __init__(self, sched, kp, ki, filt, beta0, omega_ref, dt, filter_omega, n, atd=None):
+    def __init__(self, sched, kp, ki, filt, beta0, omega_ref, dt, filter_omega, n, atd=None, limits=None):
         f = control.ss(filt)
         self.F = cont2discrete((f.A, f.B, f.C, f.D), dt, method="bilinear")[:4]
         self.xf = np.zeros((n, self.F[0].shape[0]))
@@ -161,6 +163,7 @@ class ScheduledPI:
         self.bf = np.full(n, beta0, dtype=float)
         self.integ = np.zeros(n)
         self.eprev = np.zeros(n)
+        self.lo, self.hi = (-np.inf, np.inf) if limits is None else (limits[0] - beta0, limits[1] - beta0)
 
     def __call__(self, t, y):
         A, B, C, D = self.F
@@ -168,9 +171,9 @@ class ScheduledPI:
         ef = self.xf @ C.ravel() + D.item() * e
         self.xf = self.xf @ A.T + np.outer(e, B.ravel())
         kp, ki = np.interp(self.bf, self.sched, self.kp), np.interp(self.bf, self.sched, self.ki)
-        self.integ = self.integ + ki * 0.5 * self.dt * (ef + self.eprev)
+        self.integ = np.clip(self.integ + ki * 0.5 * self.dt * (ef + self.eprev), self.lo, self.hi)
         self.eprev = ef
-        u = kp * ef + self.integ
+        u = np.clip(kp * ef + self.integ, self.lo, self.hi)
         if self.atd is not None:
             v = -y["tower_top_vel"]
             K = len(self.atd)
@@ -308,7 +311,7 @@ def test_nonlinear_and_linear_agree_at_small_turbulence(model):
     assert 1.6 < errs[0] / errs[1] < 2.4
 
 
-def _rosco_oracle(model, v, dt, n):
+def _rosco_oracle(model, v, dt, n, limits=None):
     """ScheduledPI with ROSCO's gains computed here from turbine.rosco_gain_schedule (pole
     placement on the line fits of A and B_β), at the trim pitch of every 1 m/s from 11 to 25."""
     g = turbine.rosco_gain_schedule(model)
@@ -318,7 +321,8 @@ def _rosco_oracle(model, v, dt, n):
     beta = [model.trim(s).pitch for s in vs]
     wn, z = 1.0081, 0.7
     filt = control.tf([wn**2], [1, 2 * z * wn, wn**2])
-    return ScheduledPI(beta, kp, ki, filt, model.trim(v).pitch, model.rated_rotor_speed, dt, sm.SCHEDULE_FILTER_OMEGA, n)
+    return ScheduledPI(beta, kp, ki, filt, model.trim(v).pitch, model.rated_rotor_speed, dt, sm.SCHEDULE_FILTER_OMEGA, n,
+                       limits=limits)
 
 
 def test_rosco_scheduled_is_rosco_gain_scheduling_on_the_turbine(model):
@@ -337,6 +341,27 @@ def test_rosco_scheduled_is_rosco_gain_scheduling_on_the_turbine(model):
     assert_allclose(fast["tower_base_my"], slow["tower_base_my"], rtol=0, atol=1e-10 * np.std(slow["tower_base_my"]))
     blended = sm.simulate(model, sm.rosco_scheduled(model, form="output"), [19.0], **kw)
     assert np.max(np.abs(blended["pitch_cmd"] - fast["pitch_cmd"])) > 1e-4
+
+
+def test_rosco_scheduled_saturates_its_integrator_as_rosco_does(model):
+    """Near rated the pitch reaches its minimum: rosco_scheduled clips the integrator (as
+    absolute pitch) and the PI output at the model's pitch limits, equal to the independent
+    Python ROSCO with the same clipping; without limits the same PI winds up far below."""
+    sc = sm.rosco_scheduled(model)
+    assert sc.pitch_limits == (model.pitch_min, model.pitch_max)
+    v, kw = 12.5, dict(seeds=[1, 2], duration=300.0, dt=0.02, record_dt=0.1, transient=20.0)
+    fast = sm.simulate(model, sc, [v], **kw)
+    slow = sm.simulate(model, _rosco_oracle(model, v, 0.02, 2, limits=(model.pitch_min, model.pitch_max)), [v], **kw)
+    assert_allclose(fast["pitch_cmd"], slow["pitch_cmd"], rtol=0, atol=1e-10)
+    assert_allclose(fast["gen_speed"], slow["gen_speed"], rtol=0, atol=1e-10)
+    pc = fast["pitch_cmd"]
+    assert pc.min() >= model.pitch_min and np.mean(pc <= model.pitch_min + 1e-12) > 0.01  # saturated at times
+    free = sm.simulate(model, dataclasses.replace(sc, pitch_limits=None), [v], **kw)
+    assert free["pitch_cmd"].min() < model.pitch_min - np.radians(1.0)
+    with pytest.raises(ValueError, match="pitch_limits"):
+        dataclasses.replace(sc, pitch_limits=(0.5, 0.1))
+    with pytest.raises(ValueError, match="pitch_limits"):
+        sm.ScheduledController(sc.schedule_pitch, sc.pitch, pitch_limits=(0.0, 1.0))
 
 
 @pytest.mark.parametrize("linear", [False, True])
