@@ -387,9 +387,7 @@ def volterra_prediction(model, controller, wind_speed, *, seeds=range(1000, 1200
     from .fatigue import del_rainflow
     from .simulate import wind_series
 
-    seeds = np.atleast_1d(np.asarray(list(seeds) if not np.isscalar(seeds) else seeds, dtype=np.int64))
-    if seeds.ndim != 1 or seeds.size < 1 or len(set(seeds.tolist())) != seeds.size:
-        raise ValueError(f"seeds must be distinct integers, got {seeds!r}")
+    seeds = _distinct_seeds(seeds)
     duration, dt, m = positive_scalar(duration, "duration"), positive_scalar(dt, "dt"), positive_scalar(m, "m")
     dels, sq = [], []
     for lo in range(0, seeds.size, max(int(chunk), 1)):
@@ -399,8 +397,15 @@ def volterra_prediction(model, controller, wind_speed, *, seeds=range(1000, 1200
         dels += [del_rainflow(row, m, duration) for row in y]
         sq.append(y.var(axis=-1))
     dels = np.asarray(dels)
-    return VolterraPrediction(del_=float(np.mean(dels**m) ** (1 / m)), dels=dels, sd=float(np.sqrt(np.mean(np.concatenate(sq)))),
+    return VolterraPrediction(del_=float(_pool("tower_del", dels, m)), dels=dels, sd=float(np.sqrt(np.mean(np.concatenate(sq)))),
                               order=int(order), seeds=seeds, duration=duration)
+
+
+def _distinct_seeds(seeds) -> np.ndarray:
+    seeds = np.atleast_1d(np.asarray(seeds, dtype=np.int64))
+    if seeds.ndim != 1 or seeds.size < 1 or len(set(seeds.tolist())) != seeds.size:
+        raise ValueError(f"seeds must be distinct integers, got {seeds!r}")
+    return seeds
 
 
 def _rotor_radius(model):
@@ -648,9 +653,7 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
 
         model = turbine.iea15mw()
     vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
-    seeds = np.atleast_1d(np.asarray(seeds, dtype=np.int64))
-    if seeds.ndim != 1 or seeds.size < 1 or len(set(seeds.tolist())) != seeds.size:
-        raise ValueError(f"seeds must be distinct integers, got {seeds!r}")
+    seeds = _distinct_seeds(seeds)
     if volterra not in (0, 1, 2, 3) or isinstance(volterra, bool):
         raise ValueError(f"volterra={volterra!r} must be 0 (none) or an order 1, 2 or 3")
     if volterra and not hasattr(model, "aero_expansion"):
