@@ -376,11 +376,8 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains")
         raise ValueError(f"form must be one of {_FORMS}, got {form!r}")
     # The gains of turbine.rosco_baseline: pole placement on the straight-line fits of A, B_β.
     sched = turbine.rosco_gain_schedule(model)
-    pa, pb = np.polyfit(sched.v, sched.A, 1), np.polyfit(sched.v, sched.B_beta, 1)
     v = np.array(sorted(set(vs)))
-    a, bb = np.polyval(pa, v), np.polyval(pb, v)
-    kp = (2 * sched.zeta_pc * sched.omega_pc + a) / bb
-    ki = sched.omega_pc**2 / bb
+    kp, ki = sched.gains(v)
     plant = turbine_plant(model)
     beta = np.array([plant.trim(s)[1] for s in v])
     order = np.argsort(beta)
@@ -389,7 +386,7 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains")
     # Same controller as rosco_baseline at each speed (checked against its transfer function).
     jw = 1j * np.array([0.05, 0.5, 2.0])
     for k, s in enumerate(v[order]):
-        ref = np.asarray(turbine.rosco_baseline(model, float(s))(jw), complex)
+        ref = np.asarray(turbine.rosco_baseline(model, float(s), schedule=sched)(jw), complex)
         if not np.allclose(np.asarray(sc.pitch[k](jw), complex), ref, rtol=1e-9, atol=0):
             raise RuntimeError(f"rosco_scheduled's gains at {s:g} m/s differ from turbine.rosco_baseline")
     return sc

@@ -690,6 +690,14 @@ class RoscoSchedule:
     omega_pc: float
     zeta_pc: float
 
+    def gains(self, wind_speeds):
+        """(Kp, Ki) at ``wind_speeds`` (m/s; scalar or array) from the straight-line fits of A
+        and B_β over ``v``, by the same pole placement as ``Kp``, ``Ki`` (ROSCO's sign)."""
+        v = np.asarray(wind_speeds, dtype=float)
+        a = np.polyval(np.polyfit(self.v, self.A, 1), v)
+        b = np.polyval(np.polyfit(self.v, self.B_beta, 1), v)
+        return (2 * self.zeta_pc * self.omega_pc + a) / b, self.omega_pc**2 / b
+
 
 def _rotor_coefficients(model: TurbineModel, v: float):
     """(pitch_op, A, B_beta, B_wind) of the rotor equation at the trim, from the kernel's Jacobian."""
@@ -750,11 +758,7 @@ def rosco_baseline(model: TurbineModel, wind_speed, *, omega_pc: float = 0.2, ze
     v = model._check_wind(wind_speed)
     if schedule is None:
         schedule = rosco_gain_schedule(model, omega_pc=omega_pc, zeta_pc=zeta_pc)
-    pa = np.polyfit(schedule.v, schedule.A, 1)
-    pb = np.polyfit(schedule.v, schedule.B_beta, 1)
-    a, b = np.polyval(pa, v), np.polyval(pb, v)
-    kp = (2 * schedule.zeta_pc * schedule.omega_pc + a) / b
-    ki = schedule.omega_pc**2 / b
+    kp, ki = (float(g) for g in schedule.gains(v))
     pi = control.tf([kp, ki], [1.0, 0.0])
     c = pi * speed_filter()
     return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=f"ROSCO_PI@{v:g}mps".replace(".", "p"))
