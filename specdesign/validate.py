@@ -377,7 +377,7 @@ def volterra_prediction(model, controller, wind_speed, *, seeds=range(1000, 1200
                         order=3, m=4.0, output="tower_base_my", turbulence_class="B", chunk=50) -> VolterraPrediction:
     """DEL of ``output`` predicted by the Volterra series (:func:`volterra_response`) over
     synthetic periodic wind records: the nonlinear counterpart of :func:`linear_prediction`,
-    made before any time-domain simulation (FFT-fast: ≈ 0.05 s per 600 s record).
+    made before any time-domain simulation (FFT-fast: a few ms per record, `benchmarks/volterra.py`).
 
     seeds : wind seeds (records from :func:`specdesign.simulate.wind_series`, periodic over
         ``duration`` s, so no transient is needed); the DEL's sampling error falls as 1/√S,
