@@ -62,25 +62,23 @@ SEED0 = 1000
 # ----------------------------------------------------------------------------- cost patches
 @contextlib.contextmanager
 def extra_cost(term):
-    """Add ``term(problem, x)`` to the QFT tuner's cost while the block runs.
+    """Add ``term(problem, x)`` to the QFT tuner's objective while the block runs.
 
-    The original cost's barrier values (≥ 1e10: unstable or not evaluable) are passed through
-    untouched, so the extra term can never trade stability for anything.
+    Both the exploration's penalty cost and the polish use ``_Problem.objective``; the cost's
+    barrier values (≥ 1e10: unstable or not evaluable) come before the objective, so the extra
+    term can never trade stability for anything.
     """
-    orig = qft._Problem.cost
+    orig = qft._Problem.objective
 
-    def cost(self, x, target, min_decay, weight=1e3):
-        base = orig(self, x, target, min_decay, weight)
-        if base >= 1e10:
-            return base
+    def objective(self, x):
         extra = term(self, x)
-        return float(base + extra) if np.isfinite(extra) else 1e12
+        return float(orig(self, x) + extra) if np.isfinite(extra) else 1e12
 
-    qft._Problem.cost = cost
+    qft._Problem.objective = objective
     try:
         yield
     finally:
-        qft._Problem.cost = orig
+        qft._Problem.objective = orig
 
 
 def _tuner_rho(prob, x):

@@ -51,12 +51,16 @@ Fixed structures (6 states in all):
                            · ω_f²/(s² + 2ζ_f ω_f s + ω_f²),      k < 0
     C_atd(s) = k_a·(s/z_a + 1)/(s/p_a + 1),                        k_a < 0
 
-started from ROSCO's PI and filter (the complex pair cancelled) and a weak ATD, tuned by
-scipy's Powell method (deterministic) on: minimise (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)²
-subject, by exterior penalties, to a predicted tower-base DEL reduction ≥ ``target_reduction``
-(Dirlik on |T|²S_W, nominal case), every bound at every design frequency for every case with
-a 0.1 dB safety margin, and every closed loop (full interconnection, every case) with poles
-left of −``min_decay`` 1/s. The two loops' bounds are then computed exactly with
+started from ROSCO's PI and filter (the complex pair cancelled) and a weak ATD, tuned to:
+minimise (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)² subject to a predicted tower-base DEL
+reduction ≥ ``target_reduction`` (Dirlik on |T|²S_W, nominal case), every bound at every
+design frequency for every case with a safety margin (0.1 dB on the stability specs, 0.02 dB
+on the performance specs), and every closed loop (full interconnection, every case) with
+poles left of −``min_decay`` 1/s. scipy's Powell method explores on exterior penalties, SLSQP
+polishes the Powell end point and the start to KKT points of the constrained problem, and the
+best candidate is kept by a total order (feasible first, then the smaller objective): a
+polished optimum moves continuously with the data, so the design does not jump when the
+wind speed moves by round-off (Powell's end point alone did). The two loops' bounds are then computed exactly with
 :func:`loopshaping.qft.bounds` for the final controllers and the design is checked on a dense
 grid over all cases with :func:`loopshaping.check.check`; frequencies where the dense check
 fails are added to the design set and the tuning repeated (up to ``refine`` times).
@@ -439,6 +443,9 @@ class _Problem:
         """(DEL reduction %, damage reduction %, SD ratios gen speed, pitch, pitch rate) nominal."""
         from . import spectral
 
+        key = np.asarray(x, float).tobytes()
+        if getattr(self, "_perf_key", None) == key:  # the objective and the constraints ask for the same x
+            return self._perf
         nb, db, na, da = _polys(x)
         s = 1j * self.wf[:, None]
         c = np.polyval(nb, s) / np.polyval(db, s)
@@ -448,41 +455,105 @@ class _Problem:
         to = self._t(self.Rf, c, k, "gen_speed")[:, self.nom]
         d = float(spectral.damage_rate(self.wf, np.abs(tm) ** 2 * self.S, self.base.m, method=self.base.method))
         ratio = d / self.d0
-        return (100 * (1 - ratio ** (1 / self.base.m)), 100 * (1 - ratio), self._sd(to) / self.sd0["gen_speed"],
-                self._sd(tp) / self.sd0["pitch"], self._sd(tp * 1j * self.wf) / self.sd0["pitch_rate"])
+        self._perf_key, self._perf = key, (
+            100 * (1 - ratio ** (1 / self.base.m)), 100 * (1 - ratio), self._sd(to) / self.sd0["gen_speed"],
+            self._sd(tp) / self.sd0["pitch"], self._sd(tp * 1j * self.wf) / self.sd0["pitch_rate"])
+        return self._perf
+
+    def objective(self, x):
+        """The tuning objective: (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)², nominal case."""
+        _, _, gs, _, rate = self.performance(x)
+        return float(rate**2 + 0.1 * gs**2)
+
+    def _safety(self):
+        # the performance specs touch their weights at ω → 0 (integral action: every design
+        # reaches the same DC response), so only the margin specs get a full safety margin
+        return np.where(self.wd >= 0.05, _PERF_SAFETY_DB, _DC_SAFETY_DB)[None, :, None]
+
+    def constraints(self, x, target, min_decay):
+        """Every requirement as one vector that is ≥ 0 when met: bound margins (dB) less their
+        safety margin per spec, frequency and case; DEL reduction − target (pp); decay margin
+        −(max Re p + min_decay) per case (1/s)."""
+        g = self.margins(x)
+        return np.r_[(g[:2] - self._safety()).ravel(), (g[2:] - _SAFETY_DB).ravel(), self.performance(x)[0] - target,
+                     -(self.max_real(x) + min_decay)]
 
     def cost(self, x, target, min_decay, weight=1e3):
+        """Exterior-penalty cost of the exploration: objective + 10·(target − reduction)₊²
+        + weight·Σ(bound violation, dB)²; a barrier (≥ 1e10) for decay-rate violations."""
         try:
             g = self.margins(x)
-            red, _, gs, _, rate = self.performance(x)
+            red = self.performance(x)[0]
             mr = self.max_real(x)
         except (ValueError, np.linalg.LinAlgError, FloatingPointError):
             return 1e12
         if not (np.all(np.isfinite(g)) and np.isfinite(red) and np.all(np.isfinite(mr))):
             return 1e12
-        # the performance specs touch their weights at ω → 0 (integral action: every design
-        # reaches the same DC response), so only the margin specs get a safety margin
-        safety = np.where(self.wd >= 0.05, _PERF_SAFETY_DB, _DC_SAFETY_DB)[None, :, None]
-        viol = np.sum(np.minimum(g[:2] - safety, 0.0) ** 2) + np.sum(np.minimum(g[2:] - _SAFETY_DB, 0.0) ** 2)
+        viol = np.sum(np.minimum(g[:2] - self._safety(), 0.0) ** 2) + np.sum(np.minimum(g[2:] - _SAFETY_DB, 0.0) ** 2)
         excess = np.sum(np.maximum(mr + min_decay, 0.0))
         if excess > 0:  # a barrier: never trade stability for anything
             return float(1e10 * (1 + excess))
-        return float(rate**2 + 0.1 * gs**2 + 10 * max(target - red, 0.0) ** 2 + weight * viol)
+        return float(self.objective(x) + 10 * max(target - red, 0.0) ** 2 + weight * viol)
+
+
+#: Largest constraint violation a polished candidate may keep and still count as feasible
+#: (dB for bounds, pp for the DEL target, 1/s for the decay rate): SLSQP's own tolerance.
+_FEASIBLE_TOL = 1e-6
 
 
 def _tune(prob, x0, target, min_decay, maxfev):
+    """Tune from ``x0``: explore, polish, and keep the best candidate by a total order.
+
+    Returns (x, feasible): the chosen parameters and whether they meet every constraint.
+
+    Powell on the penalty cost explores (a derivative-free search that gets past the kinks of
+    the bounds from an infeasible start) but stops wherever its line searches happen to end,
+    so its end point moves with round-off. Each candidate is therefore polished by SLSQP on the
+    constrained problem (objective subject to :meth:`_Problem.constraints` ≥ 0) to a KKT point,
+    which moves continuously with the data. Candidates: the polished Powell end point, the
+    polished start, and the unpolished Powell end point. The order that picks one is total:
+    feasible (every constraint ≥ −1e-6) before infeasible; among feasible ones the smaller
+    objective; among infeasible ones the smaller penalty cost; ties by candidate order.
+    """
     from scipy.optimize import minimize
 
     lo, hi = _to_x_bounds()
+    box = list(zip(lo, hi))
     x = x0
     # exterior penalty method: the bound violations cost more and more (continuation)
     for weight in (1e3, 1e5, 1e7):
         with np.errstate(all="ignore"):
-            res = minimize(prob.cost, x, args=(target, min_decay, weight), method="Powell", bounds=list(zip(lo, hi)),
+            res = minimize(prob.cost, x, args=(target, min_decay, weight), method="Powell", bounds=box,
                            options={"maxfev": int(maxfev), "xtol": 1e-4, "ftol": 1e-8})
         if np.all(np.isfinite(res.x)) and res.fun <= prob.cost(x, target, min_decay, weight):
             x = np.clip(res.x, lo, hi)
-    return x
+
+    def polish(start):
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                r = minimize(prob.objective, start, method="SLSQP", bounds=box,
+                             constraints=[{"type": "ineq", "fun": prob.constraints, "args": (target, min_decay)}],
+                             options={"maxiter": 300, "ftol": 1e-10})
+            except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+                return None
+        return np.clip(r.x, lo, hi) if np.all(np.isfinite(r.x)) else None
+
+    candidates = [c for c in (polish(x), polish(np.asarray(x0, float)), x) if c is not None]
+
+    def key(c):
+        with np.errstate(all="ignore"):
+            try:
+                g = prob.constraints(c, target, min_decay)
+                if np.all(np.isfinite(g)) and g.min() >= -_FEASIBLE_TOL:
+                    return (0, prob.objective(c))
+                return (1, prob.cost(c, target, min_decay, 1e7))
+            except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+                return (2, 0.0)
+
+    keys = [key(c) for c in candidates]
+    best = min(range(len(candidates)), key=lambda i: (keys[i], i))
+    return candidates[best], keys[best][0] == 0
 
 
 def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01)):
@@ -613,11 +684,12 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
     x = _rosco_start(prob.rosco[nom])
     rounds = 0
     while True:
-        x = _tune(prob, x, t, min_decay, maxfev)
+        x, feasible = _tune(prob, x, t, min_decay, maxfev)
         cb, ca = _controllers(x, v)
         pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = _checks(prob, cb, ca, wdense)
         bad = [w for chk in (pitch_check, atd_check) for name in chk.names for w in [chk.worst(name)] if w[1] < 0]
-        if not bad or rounds >= refine:
+        # more design frequencies cannot rescue a design that already fails on the ones it has
+        if not bad or not feasible or rounds >= refine:
             break
         new = np.unique(np.r_[prob.wd, [w[0] for w in bad]])
         if new.size == prob.wd.size:

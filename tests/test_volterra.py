@@ -63,7 +63,8 @@ def test_aero_expansion_converges_with_its_order(model, expansion):
 def test_load_inputs_of_the_linearisation(model):
     base, sys = model.linearize(V), model.linearize(V, load_inputs=True)
     assert list(sys.input_labels) == list(base.input_labels) + ["aero_torque", "thrust"]
-    assert_allclose(sys.B[:, :3], base.B, rtol=0, atol=0) and assert_allclose(sys.D[:, :3], base.D, rtol=0, atol=0)
+    assert_allclose(sys.B[:, :3], base.B, rtol=0, atol=0)
+    assert_allclose(sys.D[:, :3], base.D, rtol=0, atol=0)
     b = np.zeros((5, 2))
     b[0, 0], b[2, 1] = 1 / model.drivetrain_inertia, 1 / model.tower_modal_mass
     assert_allclose(sys.B[:, 3:], b, rtol=1e-6, atol=1e-15)
@@ -159,7 +160,8 @@ def test_campaign_with_a_volterra_prediction(model):
 
     acc = va.acceptance(camp, "ATD", "ROSCO")
     vc = va.paired_change(camp.volterra_values["tower_del"][1], camp.volterra_values["tower_del"][0], m=4.0)
-    assert_allclose(acc.volterra, -vc.change) and acc.volterra_order == 3
+    assert_allclose(acc.volterra, -vc.change)
+    assert acc.volterra_order == 3
     assert_allclose(acc.volterra_deviation, acc.rainflow - acc.volterra, atol=1e-12)
 
     def reduction(vals, keep):
