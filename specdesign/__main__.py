@@ -6,7 +6,10 @@ import sys
 
 
 def main(argv: list[str] | None = None) -> int:
+    from specdesign import __version__
+
     parser = argparse.ArgumentParser(prog="specdesign", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"specdesign {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="run the 19 m/s design loop and write its tables and figures")
     demo.add_argument("--out", default="specdesign_output", help="output folder (default: %(default)s)")
