@@ -7,12 +7,25 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["as_omega", "as_psd", "as_signal", "positive_scalar"]
+__all__ = ["as_omega", "as_psd", "as_signal", "as_real", "positive_scalar"]
+
+
+def as_real(x, name: str) -> np.ndarray:
+    """``x`` as a float64 array; complex input is a TypeError (taking its real part silently
+    would drop the imaginary part of, e.g., a frequency response passed where |T|² belongs)."""
+    a = np.asarray(x)
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} is complex; pass real values (e.g. np.abs(T)**2 for a squared magnitude, "
+                        f"or np.real(...) if the imaginary part is meant to be dropped)")
+    try:
+        return np.asarray(a, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of real numbers, got {a.dtype}") from None
 
 
 def as_omega(omega, name: str = "omega", *, allow_zero: bool = True) -> np.ndarray:
     """Validate a frequency grid in rad/s: 1-D, finite, strictly increasing, non-negative."""
-    w = np.asarray(omega, dtype=float)
+    w = as_real(omega, name)
     if w.ndim != 1:
         raise ValueError(f"{name} must be a 1-D grid of frequencies in rad/s, got shape {w.shape}")
     if w.size < 2:
@@ -32,7 +45,7 @@ def as_omega(omega, name: str = "omega", *, allow_zero: bool = True) -> np.ndarr
 
 def as_psd(psd, n: int, name: str = "psd") -> np.ndarray:
     """Validate a one-sided PSD stack of shape (..., n): finite, non-negative."""
-    s = np.asarray(psd, dtype=float)
+    s = as_real(psd, name)
     if s.ndim == 0 or s.shape[-1] != n:
         raise ValueError(f"{name} must have shape (..., {n}) to match the frequency grid, got {s.shape}")
     if not np.all(np.isfinite(s)):
@@ -45,7 +58,7 @@ def as_psd(psd, n: int, name: str = "psd") -> np.ndarray:
 
 def as_signal(x, name: str = "x", *, min_samples: int = 2) -> np.ndarray:
     """Validate a 1-D, finite time series."""
-    a = np.asarray(x, dtype=float)
+    a = as_real(x, name)
     if a.ndim != 1:
         raise ValueError(f"{name} must be a 1-D time series, got shape {a.shape}")
     if a.size < min_samples:

@@ -317,7 +317,11 @@ def del_rainflow(x, m, duration, n_eq_rate: float = 1.0, *, ultimate=None, resid
     n_eq = positive_scalar(duration, "duration") * positive_scalar(n_eq_rate, "n_eq_rate")
     c = rainflow(x, residue=residue)
     s = c.ranges if ultimate is None else goodman_ranges(c.ranges, c.means, ultimate)
-    return float((np.sum(c.counts * s**m) / n_eq) ** (1.0 / m))
+    top = float(np.max(s)) if s.size else 0.0
+    if top == 0.0:
+        return 0.0
+    # DEL is homogeneous of degree 1 in the load: ranges relative to the largest never overflow
+    return top * float((np.sum(c.counts * (s / top) ** m) / n_eq) ** (1.0 / m))
 
 
 @dataclass(frozen=True)

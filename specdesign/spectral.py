@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import gamma
 
-from ._checks import as_omega, as_psd, positive_scalar
+from ._checks import as_omega, as_psd, as_real, positive_scalar
 
 __all__ = [
     "METHODS",
@@ -231,13 +231,21 @@ def _check_method(method):
     return _METHODS[method]
 
 
-def _damage_from_moments(mom, m, method):
-    """Damage rate for a moment array (..., 6) in _ORDERS; handles degenerate spectra."""
+def _damage_parts(mom, m, method):
+    """(d_n, s0) for a moment array (..., 6) in _ORDERS: damage rate = d_n · s0^(m/2).
+
+    Every moment scales with S, and every method is homogeneous of degree m/2 in the moments,
+    so the damage is evaluated on the moments divided by s0 = m0 (d_n: the damage of the
+    spectrum scaled to unit variance, finite for any m ≤ 100) and the load scale comes back
+    as s0^(m/2) only where the caller needs the damage itself; a DEL or a damage ratio never
+    forms it and so never overflows. Degenerate spectra (m0 = 0 or m2 = 0) give d_n = 0, s0 = 1.
+    """
     f = _check_method(method)
     re = np.real(mom)
     m0, m2 = re[..., 0], re[..., 4]
     alive = (m0 > 0) & (m2 > 0)
-    safe = np.where(alive[..., None], mom, 1.0)
+    s0 = np.where(alive, m0, 1.0)
+    safe = np.where(alive[..., None], mom / s0[..., None], 1.0)
     mo = tuple(safe[..., j] for j in range(len(_ORDERS)))
     with np.errstate(all="ignore"):
         d = f(mo, m)
@@ -247,7 +255,22 @@ def _damage_from_moments(mom, m, method):
             a2 = np.real(mo[4]) / np.sqrt(np.real(mo[0]) * np.real(mo[5]))
             narrow = ((1.0 - a2) < _NARROW) | ~np.isfinite(d)
             d = np.where(narrow, _nb(mo, m), d)
-    return np.where(alive, d, 0.0)
+    return np.where(alive, d, 0.0), s0
+
+
+def _damage_from_moments(mom, m, method):
+    """Damage rate for a moment array (..., 6) in _ORDERS; handles degenerate spectra.
+
+    Raises OverflowError where the damage itself is not representable in float64 (large
+    loads at a large Wöhler exponent): its DEL still is (:func:`del_spectral`).
+    """
+    dn, s0 = _damage_parts(mom, m, method)
+    with np.errstate(over="ignore"):
+        d = dn * s0 ** (0.5 * m)
+    if not np.all(np.isfinite(d)):
+        raise OverflowError(f"the damage rate at m={m:g} exceeds float64 (load scale √m0 up to {np.sqrt(np.max(s0)):.3g}); "
+                            "compute the DEL (del_spectral), or express the load in larger units")
+    return d
 
 
 def _prepare(omega, psd, m):
@@ -290,8 +313,10 @@ def del_spectral(omega, psd, m, method: str = "dirlik", n_eq_rate: float = 1.0) 
     second, does the damage of the spectrum. Same arguments as :func:`damage_rate`.
     """
     rate = positive_scalar(n_eq_rate, "n_eq_rate")
-    m = positive_scalar(m, "m")
-    return (damage_rate(omega, psd, m, method) / rate) ** (1.0 / m)
+    w, s, m = _prepare(omega, psd, m)
+    dn, s0 = _damage_parts(s @ _moment_matrix(w, _ORDERS), m, method)
+    # DEL is homogeneous of degree 1 in the load: √s0 carries the scale, never raised to m
+    return np.sqrt(s0) * (dn / rate) ** (1.0 / m)
 
 
 def dirlik_range_pdf(omega, psd, ranges) -> np.ndarray:
@@ -363,6 +388,10 @@ def sensitivity(omega, psd, m, reduction: float = 0.01, method: str = "dirlik", 
     w, s, m = _prepare(omega, psd, m)
     _check_method(method)
     a = _moment_matrix(w, _ORDERS)  # (n, 6)
+    # ΔD% is a ratio, invariant to the load scale: work on each spectrum scaled to unit
+    # variance so that no damage overflows at a large m
+    m0 = s @ a[:, 0]
+    s = s / np.where(m0 > 0, m0, 1.0)[..., None]
     mom0 = s @ a  # (..., 6)
     d0 = _damage_from_moments(mom0, m, method)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -408,9 +437,7 @@ def predicted_change(omega, sensitivity, t_mag2, w_mag2) -> np.ndarray:
         |T|² = 0 carry no spectrum and contribute nothing.
     """
     w = as_omega(omega)
-    dd = np.asarray(sensitivity, dtype=float)
-    t2 = np.asarray(t_mag2, dtype=float)
-    w2 = np.asarray(w_mag2, dtype=float)
+    dd, t2, w2 = (as_real(v, n) for v, n in ((sensitivity, "sensitivity"), (t_mag2, "t_mag2"), (w_mag2, "w_mag2")))
     for name, v in (("sensitivity", dd), ("t_mag2", t2), ("w_mag2", w2)):
         if v.ndim == 0 or v.shape[-1] != w.size:
             raise ValueError(f"{name} must have shape (..., {w.size}) to match omega, got {v.shape}")
@@ -451,9 +478,13 @@ def exact_change(omega, psd_before, psd_after, m, method: str = "dirlik") -> Cha
     before = as_psd(psd_before, w.size, "psd_before")
     after = as_psd(psd_after, w.size, "psd_after")
     m = positive_scalar(m, "m")
-    d0 = damage_rate(w, before, m, method)
-    d1 = damage_rate(w, after, m, method)
-    if np.any(d0 <= 0):
+    a = _moment_matrix(w, _ORDERS)
+    (n0, s0), (n1, s1) = (_damage_parts(x @ a, m, method) for x in (before, after))
+    if np.any(n0 <= 0):
         raise ValueError("psd_before has zero damage (all-zero spectrum); a relative change is undefined")
-    damage = 100.0 * (1.0 - d1 / d0)
-    return Change(damage, del_reduction(damage, m), d0, d1)
+    # the ratio from the unit-variance damages and the variance ratio: no overflow at large m
+    with np.errstate(divide="ignore"):
+        ratio = np.where(n1 > 0, np.exp(np.log(n1 / n0) + 0.5 * m * np.log(s1 / s0)), 0.0)
+    damage = 100.0 * (1.0 - ratio)
+    return Change(damage, del_reduction(damage, m), _damage_from_moments(before @ a, m, method),
+                  _damage_from_moments(after @ a, m, method))
