@@ -29,6 +29,9 @@ from ._checks import as_omega, as_psd, positive_scalar
 
 __all__ = [
     "ClosedLoopUnstableWarning",
+    "closed_loop_poles",
+    "unstable_poles",
+    "unstable_message",
     "closed_loop",
     "check_stability",
     "frequency_response",
@@ -268,3 +271,48 @@ def loop_maps(plant, pitch_controller, omega, atd_controller=None, atd_measureme
         controller=c,
         loop=c * frequency_response(plant, w, "gen_speed", "pitch_cmd"),
     )
+
+
+def closed_loop_poles(model, controller, wind_speed) -> np.ndarray:
+    """Poles (1/s) of the linearised turbine at ``wind_speed`` (m/s) closed by ``controller``.
+
+    ``model``: TurbineModel or :class:`specdesign.simulate.KernelPlant` with a linearisation;
+    ``controller``: anything :func:`specdesign.simulate.simulate` runs with a linear form (LTI,
+    Controller, ScheduledController: blended at the trim pitch of ``wind_speed``, as
+    :func:`specdesign.validate.closed_loop_response` blends it); β = −C_β·Ω_g − C_atd·ẋ_top.
+    """
+    import control
+
+    from .simulate import ScheduledController, _as_lti, turbine_plant
+
+    plant = turbine_plant(model)
+    G = control.ss(plant.linearize(wind_speed))
+    names = list(plant.output_names)
+    meas = G[[names.index("gen_speed"), names.index("tower_top_vel")], 1]  # pitch_cmd → (Ω_g, ẋ_top), by position
+    if isinstance(controller, ScheduledController):
+        b0 = plant.trim(wind_speed)[1]
+        K = controller.schedule_pitch.size
+        w = [float(np.interp(b0, controller.schedule_pitch, np.eye(K)[q])) for q in range(K)]
+        parts = [(w[q], controller.local(q)) for q in range(K) if w[q] != 0]
+        cb = sum((wq * control.ss(c) for wq, (c, _) in parts), control.ss([], [], [], [[0.0]]))
+        ca = sum((wq * control.ss(a) for wq, (_, a) in parts if a is not None), control.ss([], [], [], [[0.0]]))
+        # two blended locals integrate the same error: their difference is an uncontrollable
+        # mode at s = 0 of the parallel realisation, not of the loop
+        cb, ca = (control.minreal(x, verbose=False) if x.nstates else x for x in (cb, ca))
+    else:
+        cb, ca = control.ss(_as_lti(controller, "controller")), control.ss([], [], [], [[0.0]])
+    K2 = control.ss([], [], [], [[1.0, 1.0]]) * control.append(cb, ca)  # [C_β, C_atd]: 1×2
+    return np.asarray(control.feedback(meas, K2, sign=-1).poles())
+
+
+def unstable_poles(model, controller, wind_speed) -> np.ndarray:
+    """The closed-loop poles with Re ≥ 0 (1/s), sorted; empty when the loop is stable."""
+    p = closed_loop_poles(model, controller, wind_speed)
+    return np.sort_complex(p[p.real >= 0])
+
+
+def unstable_message(controller, wind_speed, poles) -> str:
+    """One line naming the controller, the wind speed and its unstable poles."""
+    name = getattr(controller, "name", None) or type(controller).__name__
+    listing = ", ".join(f"{z.real:.4g}{z.imag:+.4g}j" for z in poles)
+    return f"controller {name!r} destabilises the linearised turbine at {wind_speed:g} m/s (closed-loop poles {listing})"

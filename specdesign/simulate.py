@@ -61,6 +61,7 @@ from .turbine import outputs as _turbine_outputs
 from .turbine import rhs as _turbine_rhs
 
 __all__ = [
+    "SimulationDivergedError",
     "KernelPlant",
     "ScheduledController",
     "SimulationResult",
@@ -68,9 +69,26 @@ __all__ = [
     "scheduled",
     "rosco_scheduled",
     "discretize",
+    "split_integrator",
     "simulate",
     "linear_plant_params",
 ]
+
+#: Largest |λ|·dt accepted, λ the fastest eigenvalue of the linearised plant: RK4 is stable up
+#: to about 2.8 and resolves a mode to a fraction of a percent per step at 1 (dt ≤ 0.32 s on
+#: the IEA 15 MW, whose pitch actuator is at 3.14 rad/s); larger steps gave NaN or wrong DELs.
+MAX_STEP_EIGENVALUE = 1.0
+
+#: Largest difference (m/s) between the mean of a given wind record and its ``wind_speeds``
+#: entry: half an IEC 2 m/s bin. The trim, the linearisation and the scheduling all use
+#: ``wind_speeds``, so a record from another bin would be simulated about the wrong point.
+WIND_MEAN_TOLERANCE = 1.0
+
+
+class SimulationDivergedError(RuntimeError):
+    """A run left the physically possible range (non-finite state, or an output beyond
+    :attr:`KernelPlant.output_limits`): the closed loop is unstable or the step too large."""
+
 
 #: Default low-pass corner of the scheduling pitch filter (rad/s): slow enough that the
 #: scheduling variable follows the mean operating point rather than the turbulence
@@ -92,6 +110,10 @@ class KernelPlant:
     rated_speed : generator-speed reference Ω_rated (rad/s).
     linearize : optional ``linearize(wind_speed) -> control.StateSpace`` with inputs
         (wind, pitch_cmd, gen_torque) and outputs ``output_names``, deviations from trim.
+    pitch_limits : optional (min, max) pitch command (rad): every controller's command is
+        saturated there, with anti-windup (see :func:`simulate`).
+    output_limits : dict output name → largest physically possible |y| (SI); a run whose
+        output leaves it, or turns non-finite, has diverged and :func:`simulate` raises.
     """
 
     rhs: object
@@ -102,6 +124,8 @@ class KernelPlant:
     rated_speed: float
     linearize: object = field(default=None, repr=False)
     name: str = "plant"
+    pitch_limits: tuple | None = None
+    output_limits: dict = field(default_factory=dict)
 
     def index(self, name: str) -> int:
         if name not in self.output_names:
@@ -131,6 +155,11 @@ def turbine_plant(model=None) -> KernelPlant:
         rated_speed=float(model.rated_rotor_speed),
         linearize=model.linearize,
         name=model.name,
+        pitch_limits=(float(model.pitch_min), float(model.pitch_max)),
+        # divergence: twice the rated speed is far past any overspeed trip; a tower-base moment
+        # of 10 m of tower-top deflection is far past the tower's strength
+        output_limits={"gen_speed": 2.0 * float(model.rated_rotor_speed),
+                       "tower_base_my": 10.0 * float(model.tower_base_moment_per_m)},
     )
 
 
@@ -216,6 +245,29 @@ def discretize(controller, dt):
     d = control.c2d(s, dt, method="tustin")
     return (np.asarray(d.A, float), np.asarray(d.B, float).ravel(), np.asarray(d.C, float).ravel(),
             np.array([float(np.squeeze(d.D))]))
+
+
+def split_integrator(controller):
+    """(r, C_r): C(s) = r/s + C_r(s) for a SISO controller with one pole at s = 0.
+
+    The simulator runs r/s as a separate integrator (trapezoid rule = Tustin, so the sum is
+    the Tustin discretisation of C exactly) and clamps it at the pitch limits as ROSCO clamps
+    its integrator (anti-windup); C_r has no pole at 0 and cannot wind up. A controller
+    without a pole at 0 gives (0, C); one with several is returned whole, unclamped.
+    """
+    import control
+
+    c = _as_lti(controller, "controller")
+    tf = control.tf(c)
+    num = np.trim_zeros(np.atleast_1d(np.squeeze(tf.num[0][0])).astype(float), "f")
+    den = np.trim_zeros(np.atleast_1d(np.squeeze(tf.den[0][0])).astype(float), "f")
+    tiny = 1e-12 * np.max(np.abs(den))
+    if den.size < 2 or abs(den[-1]) > tiny or (den.size > 2 and abs(den[-2]) <= tiny):
+        return 0.0, c
+    d1 = den[:-1]
+    r = float(num[-1] / d1[-1]) if num.size else 0.0
+    rest = np.polysub(num, r * d1)[:-1]  # (num − r·d1)/s: its constant term is zero
+    return r, control.tf(rest if rest.size else [0.0], d1)
 
 
 _FORMS = ("output", "gains")
@@ -413,7 +465,8 @@ def _bank(controller, dt):
 
 
 def _make_bank(controller, dt):
-    """(schedule_pitch, per-local (A, B, C, D) of the output-blended part, filter corner,
+    """(schedule_pitch, per-local (A, B, C, D, r) of the output-blended part (r: the pitch
+    controller's integrator gain, run apart, see :func:`split_integrator`), filter corner,
     scheduled-PI arrays (kp, ki, Af, Bf, Cf, Df, limits) or None; limits (2,) in rad, ±inf
     for none).
 
@@ -426,14 +479,15 @@ def _make_bank(controller, dt):
     mats = []
     for k in range(controller.schedule_pitch.size):
         cb, ca = controller.local(k)
-        Ab, Bb, Cb, Db = none if gains else discretize(cb, dt)
+        r, rest = (0.0, None) if gains else split_integrator(cb)
+        Ab, Bb, Cb, Db = none if gains else discretize(rest, dt)
         Aa, Ba, Ca, Da = none if ca is None else discretize(ca, dt)
         nb, na = Ab.shape[0], Aa.shape[0]
         A = np.zeros((nb + na, nb + na))
         A[:nb, :nb], A[nb:, nb:] = Ab, Aa
         B = np.zeros((nb + na, 2))
         B[:nb, 0], B[nb:, 1] = Bb, Ba
-        mats.append((A, B, np.concatenate([Cb, Ca]), np.array([Db[0], Da[0]])))
+        mats.append((A, B, np.concatenate([Cb, Ca]), np.array([Db[0], Da[0]]), r))
     pi = None
     if gains:
         Af, Bf, Cf, Df = discretize(controller.error_filter, dt)
@@ -492,9 +546,15 @@ def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
         x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
 
 
+_NONFINITE = 63  # divergence code of a non-finite output (else the index into the output limits)
+
+
 @njit(cache=True)
 def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim):
+             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
+             cmd_lim, lim_idx, lim_val, Rq):
+    """One run; returns −1, or 64·step + code at the first step where it diverged (code: the
+    index of the output limit exceeded, or _NONFINITE)."""
     nx = x.size
     nc = Ad.shape[1]
     nf = Af.shape[0]
@@ -507,6 +567,12 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
     xc = np.zeros((K, nc))
     xn = np.empty(nc)
     uk = np.empty(K)
+    # each local's integrator r_q/s apart from its state space (trapezoid = Tustin), clamped as
+    # ROSCO clamps its integrator: the trim pitch plus the integral stays within the limits
+    iq = np.zeros(K)
+    ilo = cmd_lim[0] - beta0
+    ihi = cmd_lim[1] - beta0
+    e_prev = 0.0
     xf = np.zeros(nf)
     xfn = np.empty(nf)
     integ = 0.0
@@ -517,6 +583,12 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
     for k in range(nsteps):
         t = k * dt
         _kout(kind, x, _wind_at(w, wdt, t), bcmd, torque, p, y)
+        for i in range(ny):
+            if not math.isfinite(y[i]):
+                return 64 * k + _NONFINITE
+        for i in range(lim_idx.size):
+            if abs(y[lim_idx[i]]) > lim_val[i]:
+                return 64 * k + i
         if k % rec_every == 0:
             for i in range(ny):
                 Yr[i, j] = y[i]
@@ -529,6 +601,9 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
             s = Dd[q, 0] * e + Dd[q, 1] * v
             for i in range(nc):
                 s += Cd[q, i] * xc[q, i]
+            if Rq[q] != 0.0:
+                iq[q] = min(max(iq[q] + Rq[q] * 0.5 * dt * (e + e_prev), ilo), ihi)
+                s += iq[q]
             uk[q] = s
             for i in range(nc):
                 a = Bd[q, i, 0] * e + Bd[q, i, 1] * v
@@ -537,6 +612,7 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
                 xn[i] = a
             for i in range(nc):
                 xc[q, i] = xn[i]
+        e_prev = e
         # Piecewise-linear weights in the filtered pitch, clamped at the ends: (1 − f) on q, f on q + 1.
         q = 0
         f = 0.0
@@ -580,20 +656,24 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
             hi = lim[1] - beta0
             integ = min(max(integ, lo), hi)
             u += min(max(kpv * ef + integ, lo), hi)
-        bcmd = beta0 + u
+        bcmd = min(max(beta0 + u, cmd_lim[0]), cmd_lim[1])
         bf += a_filt * (bcmd - bf)
         _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
+    return -1
 
 
 @njit(cache=True, parallel=True)
 def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
-               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim):
-    """All runs, one per prange iteration; the controller bank is shared by the batch."""
+               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
+               cmd_lim, lim_idx, lim_val, Rq, status):
+    """All runs, one per prange iteration; the controller bank is shared by the batch.
+    ``status[r]``: −1, or where run r diverged (see :func:`_run_one`)."""
     K = sched_pitch.size
     for r in prange(X0.shape[0]):
         x = X0[r].copy()
-        _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-                 beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf, Cf, Df, lim)
+        status[r] = _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
+                             beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf,
+                             Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq)
 
 
 @njit(cache=True)
@@ -718,7 +798,7 @@ def wind_series(rotor_radius, wind_speeds, seeds, duration, dt, turbulence_class
 
 def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=600.0, dt=0.02,
              record_dt=0.1, transient=60.0, wind_dt=None, turbulence_class="B", linear=False,
-             wind_rotor_radius=None) -> SimulationResult:
+             wind_rotor_radius=None, wind_mean_tol=WIND_MEAN_TOLERANCE) -> SimulationResult:
     """Simulate the closed loop for every (wind speed, seed), all runs batched.
 
     Parameters
@@ -738,10 +818,32 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         starts (discarded), s. dt : integration and controller step, s. record_dt : sample
         spacing of the recorded outputs, s (a multiple of ``dt``).
     linear : integrate the linearisation at each wind speed instead of the nonlinear model.
+    wind_mean_tol : largest |mean of a given wind record − its wind speed|, m/s (default
+        :data:`WIND_MEAN_TOLERANCE`).
 
     Returns
     -------
     SimulationResult with outputs (W, S, n) for every plant output, ``pitch_cmd`` and ``wind``.
+
+    Raises
+    ------
+    ValueError
+        for a step ``dt`` above 1/|λ|max of the linearised plant (:data:`MAX_STEP_EIGENVALUE`;
+        the limit is in the message), or a wind record whose mean is off its wind speed.
+    SimulationDivergedError
+        when a run diverges (non-finite, or an output beyond ``plant.output_limits``: for the
+        turbine twice the rated generator speed or the tower-base moment of 10 m of tower-top
+        deflection), naming its wind speed, seed and time.
+
+    Pitch limits and anti-windup: with ``plant.pitch_limits`` (the turbine's pitch range) the
+    command of every compiled controller is saturated there, and every integrator is clamped
+    as ROSCO clamps its own (the trim pitch plus the integral stays within the limits):
+    ROSCO's form of a scheduled PI does so itself (see :class:`ScheduledController`); an LTI
+    pitch controller (also ``rosco_baseline``, a designed one, each local of an
+    output-blended schedule) runs its pole at s = 0 as a separate integrator
+    (:func:`split_integrator`) that is clamped the same way, the rest of it (filters, lead-lag,
+    ATD: no pole at 0) cannot wind up. Where the limits are not reached the result is that of
+    the unsaturated loop. A callable controller's command is used as it is.
     """
     plant = turbine_plant(plant) if not isinstance(plant, KernelPlant) else plant
     dt = positive_scalar(dt, "dt")
@@ -780,6 +882,13 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
             raise ValueError(f"wind covers {(wind.shape[2] - 1) * wind_dt:g} s but transient + duration = {total:g} s")
         if not np.all(np.isfinite(wind)):
             raise ValueError("wind contains NaN or inf")
+        means = wind.mean(axis=2)
+        off = np.abs(means - vs[:, None]) > positive_scalar(wind_mean_tol, "wind_mean_tol")
+        if np.any(off):
+            iw, js = np.argwhere(off)[0]
+            raise ValueError(f"wind[{iw}, {js}] has mean {means[iw, js]:.3f} m/s but wind_speeds[{iw}] = {vs[iw]:g} m/s "
+                             f"(tolerance {wind_mean_tol:g} m/s): pass the record's own mean wind speed, which sets "
+                             "the trim and the scheduling")
         seeds = None if seeds is None else np.atleast_1d(np.asarray(seeds))
     W, S = wind.shape[:2]
     R = W * S
@@ -787,6 +896,7 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
     ny = len(plant.output_names)
     i_speed, i_vel = plant.index("gen_speed"), plant.index("tower_top_vel")
 
+    _check_step(plant, vs, dt)
     trims = [plant.trim(v) for v in vs]
     beta0 = np.repeat([t[1] for t in trims], S)
     torque = np.repeat([t[2] for t in trims], S)
@@ -812,12 +922,19 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
     n_rec = (nsteps + rec_every - 1) // rec_every
     Y = np.empty((R, ny + 1, n_rec))
     omega_ref = np.full(R, plant.rated_speed)
+    lim_names = tuple(plant.output_limits)
+    lim_idx = np.array([plant.index(n) for n in lim_names], dtype=np.int64)
+    lim_val = np.array([float(plant.output_limits[n]) for n in lim_names])
+    status = np.full(R, -1, dtype=np.int64)
 
     if callable(controller) and not _is_lti_like(controller) and not isinstance(controller, ScheduledController):
         label = getattr(controller, "__name__", "callable")
-        _run_callable(controller, step_all, outputs_all, kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y, plant.output_names)
+        _run_callable(controller, step_all, outputs_all, kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y,
+                      plant.output_names, lim_idx, lim_val, status)
+        _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
     else:
         label = getattr(controller, "name", "controller")
+        _warn_unstable(plant, controller, vs)
         sched_pitch, mats, fw, pi = _bank(controller, dt)
         K = sched_pitch.size
         nc = max(1, max(m[0].shape[0] for m in mats))
@@ -825,18 +942,22 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         Bd = np.zeros((K, nc, 2))
         Cd = np.zeros((K, nc))
         Dd = np.zeros((K, 2))
-        for q, (A, B, C, D) in enumerate(mats):
+        Rq = np.zeros(K)
+        for q, (A, B, C, D, r) in enumerate(mats):
             n = A.shape[0]
-            Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :] = A, B, C, D
+            Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :], Rq[q] = A, B, C, D, r
         a_filt = 1.0 - math.exp(-fw * dt)
         if pi is None:
             pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
             Af, Bf, Cf, Df, lim = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1), np.array([-np.inf, np.inf])
         else:
             pi_on, (kp, ki, Af, Bf, Cf, Df, lim) = True, pi
+        cmd_lim = np.array((-np.inf, np.inf) if plant.pitch_limits is None else plant.pitch_limits, dtype=float)
         run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
                   beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on,
-                  *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim)))
+                  *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim, cmd_lim)),
+                  lim_idx, lim_val, Rq, status)
+    _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
 
     skip = int(round(transient / record_dt))
     t_rec = np.arange(n_rec) * record_dt
@@ -852,13 +973,56 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
     )
 
 
+def _check_step(plant, vs, dt):
+    """Reject a step the RK4 integration cannot resolve (see :data:`MAX_STEP_EIGENVALUE`)."""
+    if plant.linearize is None:
+        return
+    fastest = max(float(np.max(np.abs(np.linalg.eigvals(np.asarray(plant.linearize(v).A))), initial=0.0)) for v in vs)
+    if fastest * dt > MAX_STEP_EIGENVALUE:
+        raise ValueError(f"dt={dt:g} s is too large for this plant: its fastest mode has |λ| = {fastest:.3g} rad/s, so "
+                         f"dt must be ≤ {MAX_STEP_EIGENVALUE / fastest:.3g} s (RK4 would be inaccurate or unstable)")
+
+
+def _warn_unstable(plant, controller, vs):
+    """Warn (ClosedLoopUnstableWarning) where the linearised loop is unstable: saturations
+    may keep such a run bounded (a limit cycle between the pitch limits), but it is no result."""
+    if plant.linearize is None:
+        return
+    import warnings
+
+    from .closedloop import ClosedLoopUnstableWarning, unstable_message, unstable_poles
+
+    for v in vs:
+        bad = unstable_poles(plant, controller, v)
+        if bad.size:
+            warnings.warn(unstable_message(controller, v, bad) + "; the simulation runs on the pitch limits",
+                          ClosedLoopUnstableWarning, stacklevel=3)
+
+
+def _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, label, linear):
+    bad = np.flatnonzero(status >= 0)
+    if not bad.size:
+        return
+    r = int(bad[0])
+    step, code = divmod(int(status[r]), 64)
+    what = ("a non-finite output" if code == _NONFINITE
+            else f"|{lim_names[code]}| above its physical limit {lim_val[code]:.4g}")
+    seed = f"seed {seeds[r % S]}" if seeds is not None else f"record {r % S}"
+    raise SimulationDivergedError(
+        f"{'linear ' if linear else ''}simulation with controller {label!r} diverged at wind speed {vs[r // S]:g} m/s, "
+        f"{seed}, t = {step * dt:.1f} s into the run (the record starts after {transient:g} s) ({what}; "
+        f"{bad.size} of {status.size} runs): "
+        "the closed loop is unstable at this operating point, or dt is too large")
+
+
 def _is_lti_like(c) -> bool:
     import control
 
     return isinstance(c, control.LTI) or (hasattr(c, "tf") and callable(getattr(c, "tf")))
 
 
-def _run_callable(fn, step_all, outputs_all, kind, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names):
+def _run_callable(fn, step_all, outputs_all, kind, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names,
+                  lim_idx, lim_val, status):
     X = X0.copy()
     R = X.shape[0]
     bcmd = beta0.copy()
@@ -867,6 +1031,15 @@ def _run_callable(fn, step_all, outputs_all, kind, P, X0, Wr, wdt, dt, nsteps, r
     j = 0
     for k in range(nsteps):
         t = k * dt
+        # checked at the record steps: a per-step numpy check would cost as much as the step
+        bad = (~np.all(np.isfinite(y), axis=1) | np.any(np.abs(y[:, lim_idx]) > lim_val, axis=1)
+               if k % rec_every == 0 else np.zeros(0, bool))
+        if np.any(bad):
+            r = np.flatnonzero(bad)
+            nonfinite = ~np.all(np.isfinite(y[r]), axis=1)
+            over = np.argmax(np.abs(y[r][:, lim_idx]) > lim_val, axis=1)
+            status[r] = 64 * k + np.where(nonfinite, _NONFINITE, over)
+            return
         cmd = np.asarray(fn(t, {n: y[:, i].copy() for i, n in enumerate(names)}), dtype=float)
         if cmd.shape != (R,) or not np.all(np.isfinite(cmd)):
             raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}")

@@ -25,12 +25,14 @@ import dataclasses
 import json
 import math
 import sys
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ._checks import positive_scalar
+from .closedloop import closed_loop_poles, unstable_message, unstable_poles
 
 __all__ = [
     "WEIBULL_K",
@@ -261,9 +263,15 @@ def linear_prediction(model, controller, wind_speed, *, output="tower_base_my", 
 
     S_W is :func:`specdesign.wind.rotor_effective_spectrum` (NTM class ``turbulence_class``).
     omega defaults to :func:`prediction_grid` (600 s, 30 rad/s).
+
+    Raises ValueError when the controller destabilises the loop (naming it and the unstable
+    poles): |T|²S_W of an unstable loop is finite but describes no response.
     """
     from . import spectral, wind
 
+    bad = unstable_poles(model, controller, wind_speed)
+    if bad.size:
+        raise ValueError(unstable_message(controller, wind_speed, bad) + "; a linear prediction of an unstable loop is meaningless")
     w = prediction_grid() if omega is None else np.asarray(omega, dtype=float)
     radius = _rotor_radius(model)
     sw = wind.rotor_effective_spectrum(w, wind_speed, radius, turbulence_class=turbulence_class)
@@ -506,6 +514,9 @@ class Campaign:
         (:func:`volterra_response`) on the same wind (``run_campaign(volterra=k)``; NaN for
         controllers without a linear form), else {}: a prediction that includes the
         aerodynamic nonlinearity, still made from the linear loop.
+    unstable : (C, W) bool: the controller destabilises the linearised loop or its simulation
+        diverged at that wind speed; its values and predictions there are NaN (with a
+        warning when the campaign ran), and the tables print "unstable".
     """
 
     controllers: tuple
@@ -523,6 +534,11 @@ class Campaign:
     linear_values: dict = field(default_factory=dict, repr=False)
     volterra_values: dict = field(default_factory=dict, repr=False)
     volterra_order: int = 0
+    unstable: np.ndarray | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        if self.unstable is None:
+            object.__setattr__(self, "unstable", np.zeros((len(self.controllers), np.size(self.wind_speeds)), bool))
 
     def index(self, controller: str) -> int:
         if controller not in self.controllers:
@@ -543,18 +559,44 @@ def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, trans
                     turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0):
     """One wind speed, every controller, the same seeds: indicators, spectra, predictions."""
     from . import wind as wmod
-    from .simulate import SimulationResult, simulate, wind_series
+    from .closedloop import ClosedLoopUnstableWarning
+    from .simulate import SimulationDivergedError, SimulationResult, simulate, wind_series
 
     n_keep = len(seeds) if keep_series is True else int(keep_series)
     radius = _rotor_radius(model)
     wdt = record_dt
     wind = wind_series(radius, [v], seeds, transient + duration + wdt, wdt, turbulence_class)
     out = {"values": {}, "linear": {}, "volterra": {}, "pred": [], "welch": {k: [] for k in _SPECTRA}, "ppsd": {k: [] for k in _SPECTRA},
-           "series": {}}
-    omega = None
+           "series": {}, "unstable": []}
+    omega = welch_psd(np.zeros((1, int(round(duration / record_dt)))), record_dt, nperseg)[0]
+    nan_ind = {k: np.full((1, len(seeds)), np.nan) for k in _INDICATORS}
     for name, c in controllers.items():
-        r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
-                     record_dt=record_dt, transient=transient)
+        bad = unstable_poles(model, c, v) if _has_linear_form(c) else np.zeros(0)
+        if bad.size:
+            warnings.warn(unstable_message(c, v, bad) + f"; campaign results of {name!r} at {v:g} m/s are NaN",
+                          ClosedLoopUnstableWarning, stacklevel=3)
+        r = None
+        if not bad.size:  # an unstable loop is not simulated: nothing of it would be a result
+            try:
+                r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
+                             record_dt=record_dt, transient=transient)
+            except SimulationDivergedError as err:
+                warnings.warn(f"{err}; campaign results of {name!r} at {v:g} m/s are NaN", ClosedLoopUnstableWarning,
+                              stacklevel=3)
+                bad = np.array([np.nan])
+        out["unstable"].append(bool(bad.size))
+        if r is None:  # every entry NaN
+            for k in _INDICATORS:
+                out["values"].setdefault(k, []).append(nan_ind[k][0])
+                if linear_twin:
+                    out["linear"].setdefault(k, []).append(nan_ind[k][0])
+                if volterra:
+                    out["volterra"].setdefault(k, []).append(nan_ind[k][0])
+            out["pred"].append(np.nan)
+            for k in _SPECTRA:
+                out["welch"][k].append(np.full(omega.size, np.nan))
+                out["ppsd"][k].append(np.full(omega.size, np.nan))
+            continue
         ind = indicators(r.outputs, r.dt, m)
         for k, val in ind.as_dict().items():
             out["values"].setdefault(k, []).append(val[0])
@@ -685,7 +727,9 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
         from .simulate import SimulationResult
 
         for name in names:
-            rs = [p["series"][name] for p in points]
+            rs = [p["series"].get(name) for p in points]
+            if any(r is None for r in rs):  # diverged somewhere (warned): no series to keep
+                continue
             outs = {k: np.concatenate([r.outputs[k] for r in rs], axis=0) for k in rs[0].outputs}
             series[name] = SimulationResult(time=rs[0].time, wind_speeds=vs, seeds=rs[0].seeds, outputs=outs, dt=rs[0].dt,
                                             sim_dt=rs[0].sim_dt, controller=name)
@@ -702,6 +746,7 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
         volterra_values={k: np.stack([np.stack(p["volterra"][k]) for p in points], axis=1) for k in _INDICATORS}
         if volterra else {},
         volterra_order=int(volterra),
+        unstable=np.array([p["unstable"] for p in points]).T,
     )
 
 
@@ -738,14 +783,16 @@ def concat_campaigns(campaigns) -> Campaign:
         c0, wind_speeds=vs, values=cat([c.values for c in camps]),
         predicted_del=np.concatenate([c.predicted_del for c in camps], axis=1),
         welch=cat([c.welch for c in camps]), predicted_psd=cat([c.predicted_psd for c in camps]), series=series,
-        linear_values=cat([c.linear_values for c in camps]), volterra_values=cat([c.volterra_values for c in camps]))
+        linear_values=cat([c.linear_values for c in camps]), volterra_values=cat([c.volterra_values for c in camps]),
+        unstable=np.concatenate([c.unstable for c in camps], axis=1))
 
 
 # ----------------------------------------------------------------------------- tables
 @dataclass(frozen=True)
 class Table:
     """A plain table: ``columns`` (header strings) and ``rows`` (label, values), values as
-    floats (NaN shown empty). ``fmt`` formats the values; ``title`` and ``note`` are text."""
+    floats (NaN shown empty). ``fmt`` formats the values; ``title`` and ``note`` are text.
+    ``marks``: per value column, a word shown in place of NaN (e.g. "unstable")."""
 
     title: str
     columns: tuple
@@ -753,15 +800,17 @@ class Table:
     fmt: str = "{:.2f} %"
     note: str = ""
     row_fmt: tuple = ()  # (label, fmt) pairs overriding ``fmt`` for those rows (e.g. pp)
+    marks: tuple = ()
 
-    def _cell(self, v, fmt=None):
-        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else (fmt or self.fmt).format(v)
+    def _cell(self, v, fmt=None, mark=""):
+        return mark if v is None or (isinstance(v, float) and math.isnan(v)) else (fmt or self.fmt).format(v)
 
     def to_markdown(self) -> str:
         head = "| " + " | ".join(self.columns) + " |"
         sep = "|" + "|".join("---" for _ in self.columns) + "|"
         fmts = dict(self.row_fmt)
-        body = ["| " + " | ".join([label] + [self._cell(float(v), fmts.get(label)) for v in vals]) + " |"
+        marks = tuple(self.marks) + ("",) * (len(self.columns) - 1 - len(self.marks))
+        body = ["| " + " | ".join([label] + [self._cell(float(v), fmts.get(label), mk) for v, mk in zip(vals, marks)]) + " |"
                 for label, vals in self.rows]
         text = [f"**{self.title}**", "", head, sep, *body]
         if self.note:
@@ -789,6 +838,12 @@ def _speed_columns(vs):
     return tuple(["Indicator"] + [f"{v:g} m/s" for v in vs] + ["Mean"])
 
 
+def _unstable_marks(campaign, *names):
+    """Per speed column (+ Mean): "unstable" where any of the controllers is."""
+    bad = np.any(campaign.unstable[[campaign.index(n) for n in names]], axis=0)
+    return tuple("unstable" if b else "" for b in bad) + ("",)
+
+
 def table2(campaign: Campaign, designed: str, baseline: str, *, k=WEIBULL_K, scale=WEIBULL_A) -> Table:
     """The paper's Table 2: relative change (%) of each indicator, designed vs baseline, per
     wind speed, and the Weibull-weighted mean (weights: :func:`weibull_weights`)."""
@@ -803,6 +858,7 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k=WEIBULL_K, sca
         note=f"Relative change 100·(X_{designed}/X_{baseline} − 1) over {campaign.seeds.size} paired seeds of "
              f"{campaign.duration:g} s; DEL with m = {campaign.m:g}, 1 Hz. Mean: weighted by the Weibull pdf "
              f"(k = {k}, A = {scale} m/s) at the operating points, normalised.",
+        marks=_unstable_marks(campaign, designed, baseline),
     )
 
 
@@ -940,6 +996,7 @@ def table3(campaign: Campaign, designed: str, baseline: str, *, promised=None, m
         note=f"{acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with m = {campaign.m:g} at 1 Hz; "
              "linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
         row_fmt=tuple(pp),
+        marks=_unstable_marks(campaign, designed, baseline),
     )
 
 

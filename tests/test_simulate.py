@@ -71,7 +71,8 @@ def test_rk4_matches_analytic_step_response_with_fourth_order_convergence():
 
 def test_batched_runs_equal_single_runs():
     rng = np.random.default_rng(1)
-    wind = 1 + 0.3 * rng.standard_normal((2, 3, 601))
+    # each row's records around its own mean wind speed (1 and 2 m/s): simulate checks that
+    wind = np.array([1.0, 2.0])[:, None, None] + 0.3 * rng.standard_normal((2, 3, 601))
     c = control.tf([-0.5, -0.2], [1, 0])
     kw = dict(wind_dt=0.05, duration=20.0, dt=0.01, record_dt=0.05, transient=5.0)
     allr = sm.simulate(osc_plant(), c, [1.0, 2.0], wind=wind, **kw)
@@ -356,7 +357,9 @@ def test_rosco_scheduled_saturates_its_integrator_as_rosco_does(model):
     assert_allclose(fast["gen_speed"], slow["gen_speed"], rtol=0, atol=1e-10)
     pc = fast["pitch_cmd"]
     assert pc.min() >= model.pitch_min and np.mean(pc <= model.pitch_min + 1e-12) > 0.01  # saturated at times
-    free = sm.simulate(model, dataclasses.replace(sc, pitch_limits=None), [v], **kw)
+    # without limits anywhere (neither the PI's nor the plant's command saturation) it winds up
+    unlimited = dataclasses.replace(sm.turbine_plant(model), pitch_limits=None)
+    free = sm.simulate(unlimited, dataclasses.replace(sc, pitch_limits=None), [v], **kw)
     assert free["pitch_cmd"].min() < model.pitch_min - np.radians(1.0)
     with pytest.raises(ValueError, match="pitch_limits"):
         dataclasses.replace(sc, pitch_limits=(0.5, 0.1))

@@ -1,0 +1,155 @@
+"""Stability and divergence are errors, not results (issue "Nothing silently wrong", §2).
+
+A controller that destabilises the loop must never be reported as a fatigue reduction: a
+single linear prediction raises, a campaign keeps the other controllers' results and marks
+the unstable ones NaN with a warning ("unstable" in the tables), a diverging simulation
+raises naming the run; steps the integrator cannot resolve and wind records about another
+mean speed are refused up front; every path that reaches a pitch limit has anti-windup.
+"""
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+from specdesign import fatigue, simulate as sm, turbine, validate as va
+from specdesign.closedloop import ClosedLoopUnstableWarning
+
+
+@pytest.fixture(scope="module")
+def model():
+    return turbine.iea15mw()
+
+
+@pytest.fixture(scope="module")
+def rosco(model):
+    return turbine.rosco_baseline(model, 19.0)
+
+
+@pytest.mark.parametrize("factor", [-1.0, 100.0])
+def test_linear_prediction_of_a_destabilising_controller_raises(model, rosco, factor):
+    bad = factor * rosco
+    poles = va.closed_loop_poles(model, bad, 19.0)
+    assert np.max(poles.real) > 0  # independent: the interconnection's poles say unstable
+    with pytest.raises(ValueError, match=r"destabilises the linearised turbine at 19 m/s .*poles"):
+        va.linear_prediction(model, bad, 19.0)
+    # ROSCO itself is stable and predicts a finite DEL
+    assert np.max(va.closed_loop_poles(model, rosco, 19.0).real) < 0
+    assert np.isfinite(va.linear_prediction(model, rosco, 19.0).del_)
+
+
+def test_closed_loop_poles_match_the_interconnection(model, rosco):
+    # the same loop closed by closedloop.closed_loop (control.interconnect on named signals)
+    from specdesign import closedloop
+
+    cl = closedloop.closed_loop(model.linearize(19.0), rosco, warn=False)
+    np.testing.assert_allclose(np.sort_complex(va.closed_loop_poles(model, rosco, 19.0)),
+                               np.sort_complex(cl.poles()), rtol=1e-7, atol=1e-9)
+
+
+def test_simulate_raises_naming_the_run_when_the_loop_diverges(model, rosco):
+    # ROSCO's PI with its sign flipped: the rotor runs away past twice its rated speed
+    with pytest.warns(ClosedLoopUnstableWarning, match=r"destabilises .* 19 m/s"), \
+            pytest.raises(sm.SimulationDivergedError, match=r"diverged at wind speed 19 m/s, seed 3, .*gen_speed"):
+        sm.simulate(model, -rosco, [19.0], seeds=[3], duration=300.0)
+
+
+def test_simulate_warns_when_the_pitch_limits_keep_an_unstable_loop_bounded(model, rosco):
+    # ROSCO × 100: a limit cycle between the pitch limits, bounded but no result: a warning
+    with pytest.warns(ClosedLoopUnstableWarning, match=r"destabilises .* 19 m/s .*pitch limits"):
+        r = sm.simulate(model, 100.0 * rosco, [19.0], seeds=[3], duration=300.0)
+    assert r["pitch_cmd"].min() == model.pitch_min and r["pitch_cmd"].max() == model.pitch_max
+
+
+def test_campaign_marks_an_unstable_controller_and_keeps_the_others(model, rosco):
+    with pytest.warns(ClosedLoopUnstableWarning, match="'flipped'.*19 m/s"):
+        camp = va.run_campaign({"ROSCO": rosco, "flipped": -rosco}, [19.0], [1, 2], model=model, duration=100.0,
+                               transient=20.0, progress=False, linear_twin=True, keep_series=1)
+    assert camp.unstable.tolist() == [[False], [True]]
+    assert np.all(np.isnan(camp.values["tower_del"][1])) and np.all(np.isnan(camp.predicted_del[1]))
+    assert np.all(np.isfinite(camp.values["tower_del"][0])) and np.isfinite(camp.predicted_del[0, 0])
+    t3 = va.table3(camp, "flipped", "ROSCO").to_markdown()
+    assert "| Linear prediction | unstable |" in t3 and "| Rainflow evaluation | unstable |" in t3
+    assert "unstable" in va.table2(camp, "flipped", "ROSCO").to_markdown()
+    assert "unstable" not in va.table2(camp, "ROSCO", "ROSCO").to_markdown()
+
+
+def test_a_step_too_large_is_refused_with_the_limit(model, rosco):
+    # the IEA 15 MW's fastest linear mode is its pitch actuator, |λ| = 3.14 rad/s
+    lam = max(np.max(np.abs(np.linalg.eigvals(np.asarray(model.linearize(v).A)))) for v in (19.0,))
+    limit = sm.MAX_STEP_EIGENVALUE / lam
+    with pytest.raises(ValueError, match=rf"dt=2.5 s is too large .* dt must be ≤ {limit:.3g} s"):
+        sm.simulate(model, rosco, [19.0], seeds=[1], dt=2.5, record_dt=2.5, duration=100.0)
+    sm.simulate(model, rosco, [19.0], seeds=[1], dt=0.1, record_dt=0.1, duration=20.0, transient=0.0)  # accepted
+
+
+def test_wind_records_about_another_mean_speed_are_refused(model, rosco):
+    wind = sm.wind_series(model.rotor_radius, [15.0], [1], 120.0, 0.1)
+    with pytest.raises(ValueError, match=r"mean 15.* wind_speeds\[0\] = 19 m/s"):
+        sm.simulate(model, rosco, [19.0], wind=wind, wind_dt=0.1, duration=60.0, transient=20.0)
+    sm.simulate(model, turbine.rosco_baseline(model, 15.0), [15.0], wind=wind, wind_dt=0.1, duration=60.0,
+                transient=20.0)  # its own speed: accepted
+
+
+# ----------------------------------------------------------------------------- anti-windup
+V_FLOOR = 12.5  # near rated the pitch reaches its minimum (0 rad) on every seed
+KW = dict(seeds=[1, 2], duration=300.0, dt=0.02, record_dt=0.1, transient=20.0)
+
+
+@pytest.fixture(scope="module")
+def floor_runs(model):
+    lti = turbine.rosco_baseline(model, V_FLOOR)
+    rosco_form = sm.rosco_scheduled(model, [V_FLOOR])  # ROSCO's own clamped integrator, frozen gains
+    unlimited = dataclasses.replace(sm.turbine_plant(model), pitch_limits=None)
+    return dict(lti=sm.simulate(model, lti, [V_FLOOR], **KW), rosco=sm.simulate(model, rosco_form, [V_FLOOR], **KW),
+                free=sm.simulate(unlimited, lti, [V_FLOOR], **KW))
+
+
+def _del(r):
+    return np.array([fatigue.del_rainflow(x, 4.0, r.duration) for x in r["tower_base_my"][0]])
+
+
+def test_the_lti_rosco_path_does_not_wind_up_at_the_pitch_floor(model, floor_runs):
+    lti, rosco, free = floor_runs["lti"], floor_runs["rosco"], floor_runs["free"]
+    # the floor is reached (else this test proves nothing), and without limits the PI winds up
+    assert np.mean(lti["pitch_cmd"] <= model.pitch_min + 1e-12) > 0.01
+    assert free["pitch_cmd"].min() < model.pitch_min - np.radians(1.0)
+    # with the limits: the command never leaves the pitch range
+    assert lti["pitch_cmd"].min() >= model.pitch_min
+    # conditional integration behaves as ROSCO's clamped integrator: the same loads within a
+    # few percent (the wound-up PI of the issue doubled the DEL at 15 m/s: 149 vs 70 MN·m)
+    assert np.all(np.abs(_del(lti) / _del(rosco) - 1) < 0.05), (_del(lti), _del(rosco))
+
+
+def test_designed_lti_controllers_have_anti_windup_too(model):
+    # a designed pitch + ATD pair (ROSCO's PI with more gain, a lead-lag ATD), output-blended
+    import control
+
+    pitch = 1.3 * turbine.rosco_baseline(model, V_FLOOR)
+    atd = control.tf([-0.03, -0.02], [1.0, 0.3])
+    sc = sm.scheduled(model, {V_FLOOR: pitch}, {V_FLOOR: atd}, name="designed")
+    r = sm.simulate(model, sc, [V_FLOOR], **KW)
+    unlimited = dataclasses.replace(sm.turbine_plant(model), pitch_limits=None)
+    free = sm.simulate(unlimited, sc, [V_FLOOR], **KW)
+    assert np.mean(r["pitch_cmd"] <= model.pitch_min + 1e-12) > 0.01 and r["pitch_cmd"].min() >= model.pitch_min
+    assert free["pitch_cmd"].min() < model.pitch_min - np.radians(1.0)
+    # no wind-up: every time the command leaves the floor it does so within a second of the
+    # unclamped command turning upwards, never after a long recovery
+    at_floor = r["pitch_cmd"][0, 0] <= model.pitch_min + 1e-12
+    runs = np.diff(np.r_[0, at_floor.astype(int), 0])
+    lengths = np.flatnonzero(runs == -1) - np.flatnonzero(runs == 1)
+    free_below = free["pitch_cmd"][0, 0] < model.pitch_min
+    fruns = np.diff(np.r_[0, free_below.astype(int), 0])
+    free_lengths = np.flatnonzero(fruns == -1) - np.flatnonzero(fruns == 1)
+    assert lengths.max() < free_lengths.max()
+
+
+def test_results_are_unchanged_where_no_limit_is_reached(model, rosco):
+    # 19 m/s stays far from the pitch limits: the saturated loop equals the unsaturated one exactly
+    kw = dict(seeds=[1], duration=200.0, transient=20.0)
+    a = sm.simulate(model, rosco, [19.0], **kw)
+    b = sm.simulate(dataclasses.replace(sm.turbine_plant(model), pitch_limits=None), rosco, [19.0], **kw)
+    assert a["pitch_cmd"].min() > model.pitch_min + 0.05
+    np.testing.assert_array_equal(a["tower_base_my"], b["tower_base_my"])
