@@ -42,6 +42,9 @@ _PARAMS = {
 }
 KINDS = tuple(_PARAMS)
 _JSON_VERSION = 1
+#: Largest order of an integrator or differentiator element: a controller is a low-order
+#: filter, and s^n of a larger n has no use in loop shaping (n = 1e9 hung the polynomial product).
+MAX_ORDER = 4
 
 
 @dataclass(frozen=True)
@@ -66,8 +69,8 @@ class Element:
         k = self.kind
         if k == "gain" and p["k"] == 0:
             raise ValueError("gain: k must be non-zero (a zero controller has no loop to shape)")
-        if k in ("integrator", "differentiator") and (p["order"] < 1 or p["order"] != self.params["order"]):
-            raise ValueError(f"{k}: order must be an integer ≥ 1")
+        if k in ("integrator", "differentiator") and not (1 <= p["order"] <= MAX_ORDER and p["order"] == self.params["order"]):
+            raise ValueError(f"{k}: order={self.params['order']!r} must be an integer from 1 to {MAX_ORDER}")
         if k in ("real_pole", "real_zero") and p["omega"] == 0:
             raise ValueError(f"{k}: omega must be ≠ 0 rad/s; use an integrator/differentiator for s = 0")
         if k in ("complex_pole", "complex_zero"):
@@ -262,11 +265,25 @@ class Controller:
 
     @classmethod
     def from_dict(cls, data) -> Controller:
+        """The controller of :meth:`to_dict`; every key is checked and an error names the element index."""
         if not isinstance(data, dict) or "elements" not in data:
             raise ValueError("data must be a dict with an 'elements' list (from Controller.to_dict)")
+        extra = set(data) - {"version", "elements"}
+        if extra:
+            raise ValueError(f"unknown controller keys {sorted(extra)}; allowed: 'version', 'elements'")
         if data.get("version", _JSON_VERSION) != _JSON_VERSION:
-            raise ValueError(f"unsupported controller format version {data.get('version')}")
-        return cls(tuple(Element(e["kind"], dict(e["params"])) for e in data["elements"]))
+            raise ValueError(f"unsupported controller format version {data.get('version')!r} (this version reads {_JSON_VERSION})")
+        if not isinstance(data["elements"], list):
+            raise ValueError(f"'elements' must be a list of {{'kind', 'params'}} objects, got {type(data['elements']).__name__}")
+        out = []
+        for i, e in enumerate(data["elements"]):
+            if not isinstance(e, dict) or set(e) != {"kind", "params"} or not isinstance(e["params"], dict):
+                raise ValueError(f"element {i}: must be an object with exactly 'kind' and 'params' (an object), got {e!r}")
+            try:
+                out.append(Element(e["kind"], dict(e["params"])))
+            except (TypeError, ValueError) as err:
+                raise ValueError(f"element {i}: {err}") from None
+        return cls(tuple(out))
 
     def to_json(self, **kwargs) -> str:
         """JSON text; floats are written with repr precision, so the round trip is exact."""

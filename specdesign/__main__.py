@@ -27,8 +27,9 @@ def main(argv: list[str] | None = None) -> int:
             from specdesign.validate import run_config
 
             run_config(args.config, out=args.out)
-    except (ValueError, TypeError, FileNotFoundError) as e:
-        # bad input from the user: the message names it; a traceback would only hide it
+    except (ValueError, TypeError, OSError) as e:
+        # bad input from the user (a file, a key, an unwritable folder): the message names it;
+        # a traceback would only hide it
         print(f"specdesign {args.command}: error: {e}", file=sys.stderr)
         return 2
     return 0
