@@ -66,6 +66,8 @@ WEIBULL_K = 2.2
 WEIBULL_A = 11.29
 #: OpenFAST channel → workbench output name.
 OPENFAST_CHANNELS = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power"}
+#: SI unit each workbench series must arrive in (read_outputs converts rpm, deg, kN·m, kW, …)
+_SERIES_UNITS = {"gen_speed": "rad/s", "tower_base_my": "N·m", "pitch": "rad", "power": "W"}
 _INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd")
 _LABELS = {
     "gen_speed_sd": "Generator speed SD",
@@ -189,6 +191,10 @@ def series_from_openfast(outputs, channels=OPENFAST_CHANNELS):
         for o in outs:
             if ch not in o.channels:
                 raise ValueError(f"{o.path}: channel {ch!r} was not read; pass channels={list(channels)} to read_outputs")
+            want = _SERIES_UNITS.get(name)
+            if want is not None and o.units[ch] != want:
+                raise ValueError(f"{o.path}: channel {ch!r} is in {o.original_units[ch]!r}, which does not convert to "
+                                 f"{want} (the unit {name!r} needs); a unit the reader does not know is not guessed")
         series[name] = np.stack([o.channels[ch] for o in outs])
     return series, dts[0]
 

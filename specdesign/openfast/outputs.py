@@ -32,6 +32,14 @@ _UNITS = {
     "knm": ("N·m", 1e3),
     "kn·m": ("N·m", 1e3),
     "kn*m": ("N·m", 1e3),
+    "kn.m": ("N·m", 1e3),
+    "mn.m": ("N·m", 1e6),
+    "mnm": ("N·m", 1e6),
+    "n.m": ("N·m", 1.0),
+    "n·m": ("N·m", 1.0),
+    "n*m": ("N·m", 1.0),
+    "deg/s2": ("rad/s^2", math.pi / 180.0),
+    "m/s2": ("m/s^2", 1.0),
     "mn-m": ("N·m", 1e6),
     "n-m": ("N·m", 1.0),
     "nm": ("N·m", 1.0),
@@ -151,8 +159,37 @@ def _read_text(path: Path):
     return data, names, units, info.get("description", "")
 
 
+def _binary_size(path: Path) -> int:
+    """The byte length an OpenFAST binary output must have by its own header (the layout
+    openfast-io's ``load_binary_output`` reads: file ID 1 with packed time, 2 and 4 int16
+    channels with scales, 3 float64 channels)."""
+    import struct
+
+    with open(path, "rb") as f:
+        head = f.read(2 + 2 + 4 + 4)
+        if len(head) < 10:
+            raise ValueError(f"{path}: truncated OpenFAST binary output ({len(head)} bytes of header)")
+        file_id = struct.unpack("h", head[:2])[0]
+        off = 4 if file_id == 4 else 2
+        len_name = struct.unpack("h", head[2:4])[0] if file_id == 4 else 10
+        n_ch, nt = struct.unpack("ii", head[off:off + 8])
+        pos = off + 8 + 16 + (0 if file_id == 3 else 8 * n_ch)
+        f.seek(pos)
+        raw = f.read(4)
+        if len(raw) < 4:
+            raise ValueError(f"{path}: truncated OpenFAST binary output (header ends at byte {pos})")
+        len_desc = struct.unpack("i", raw)[0]
+    return (pos + 4 + len_desc + 2 * (n_ch + 1) * len_name + (4 * nt if file_id == 1 else 0)
+            + nt * n_ch * (8 if file_id == 3 else 2))
+
+
 def _read_binary(path: Path):
     from openfast_io.FAST_output_reader import load_binary_output
+
+    expected, actual = _binary_size(path), path.stat().st_size
+    if expected != actual:
+        raise ValueError(f"{path}: the binary header describes {expected} bytes but the file has {actual}: "
+                         "truncated, appended to, or not an OpenFAST output")
 
     try:
         data, info, _ = load_binary_output(str(path))
@@ -183,6 +220,9 @@ def _read_one(path, channels) -> OpenFASTOutput:
     if not np.all(np.isfinite(data)):
         r, c = np.argwhere(~np.isfinite(data))[0]
         raise ValueError(f"{path}: channel {names[c]!r} has a non-finite value at row {r}")
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise ValueError(f"{path}: duplicate channel name(s) {dup}; each OutList channel must appear once")
     idx = {n: i for i, n in enumerate(names)}
     time_name = next((n for n in names if n.lower() == "time"), names[0])
     wanted = [n for n in names if n != time_name] if channels is None else list(channels)
@@ -199,6 +239,13 @@ def _read_one(path, channels) -> OpenFASTOutput:
         orig[n] = units[idx[n]]
     if time.size < 2:
         raise ValueError(f"{path}: needs at least 2 time steps, got {time.size} (truncated file?)")
+    step = np.diff(time)
+    h = float(np.median(step))
+    # uniform to the precision the text format prints time with (OpenFAST: ≥ 4 decimals)
+    if not (h > 0 and np.all(step > 0) and np.max(np.abs(step - h)) <= 1e-3 * h + 1e-6):
+        i = int(np.argmax(np.abs(step - h))) if h > 0 else int(np.argmin(step))
+        raise ValueError(f"{path}: the time axis must increase uniformly; step {i} is {step[i]:g} s where the others "
+                         f"are {h:g} s (rows {i + 1}-{i + 2}: a restart or a merged file?)")
     return OpenFASTOutput(path=path, time=time, channels=out, units=si_units, original_units=orig, description=desc)
 
 
