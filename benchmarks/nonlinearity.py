@@ -16,12 +16,13 @@ F  frequency range and wind spectrum: synthesised variance vs ∫S_W, prediction
 G  a quasi-static operating-point mixture of linear predictions (does it explain the rest?).
 
 Run: python benchmarks/nonlinearity.py [--seeds 40] [--speed 19] [--quick]
-Controllers are designed on the fly (≈ 25 s per speed) and cached in /tmp.
+Controllers are designed on the fly (≈ 10 s per speed) and cached as JSON in build/cache,
+keyed by the design code and library versions.
 """
 from __future__ import annotations
 
 import argparse
-import pickle
+import json
 import time
 from pathlib import Path
 
@@ -208,16 +209,43 @@ def rosco_integral_scheduled(model, v, dt=DT, wind_speeds=None, filter_omega=0.1
 
 
 # ----------------------------------------------------------------------------- helpers
-def designs_for(model, v, cache=Path("/tmp/nonlin")):
+CACHE = Path(__file__).resolve().parents[1] / "build" / "cache"  # the project's build folder (git-ignored)
+# the code a design depends on: a change to any of it (or to numpy/scipy/control) is a new key
+_DESIGN_SOURCES = ("specdesign/qft.py", "specdesign/spec.py", "specdesign/turbine.py", "specdesign/closedloop.py",
+                   "specdesign/spectral.py", "specdesign/wind.py", "loopshaping/qft.py", "loopshaping/check.py")
+
+
+def _design_file(v):
+    import hashlib
+
+    import control
+    import scipy
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for rel in _DESIGN_SOURCES:
+        h.update((root / rel).read_bytes())
+    h.update(f"design_qft(iea15mw(), {v!r}) numpy {np.__version__} scipy {scipy.__version__} "
+             f"control {control.__version__}".encode())
+    return CACHE / f"qft_{v:g}mps_{h.hexdigest()[:16]}.json"
+
+
+def designs_for(model, v):
+    """(C_β, C_atd) of design_qft(model, v), cached as JSON transfer functions keyed by the
+    design code, the library versions and the options (benchmarks reuse them between runs)."""
+    import control
+
     from specdesign.qft import design_qft
 
-    cache.mkdir(parents=True, exist_ok=True)
-    f = cache / f"qft_{v:g}.pkl"
+    f = _design_file(v)
     if f.exists():
-        return pickle.loads(f.read_bytes())
+        data = json.loads(f.read_text())
+        return tuple(control.tf(c["num"], c["den"]) for c in (data["pitch"], data["atd"]))
     d = design_qft(model, v)
     out = (d.pitch_controller, d.atd_controller)
-    f.write_bytes(pickle.dumps(out))
+    f.parent.mkdir(parents=True, exist_ok=True)
+    f.write_text(json.dumps({k: {"num": list(map(float, c.num[0][0])), "den": list(map(float, c.den[0][0]))}
+                             for k, c in zip(("pitch", "atd"), out)}))
     return out
 
 
@@ -481,7 +509,7 @@ def main(argv=None):
               f"(ROSCO DEL {mix['ROSCO'] / 1e6:.1f}, QFT {mix['QFT'] / 1e6:.1f} MN·m) vs {pr:.2f} % at the trim")
     # H ---------------------------------------------------------------------------------
     sched_speeds = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
-    if not args.quick and all((Path("/tmp/nonlin") / f"qft_{s:g}.pkl").exists() for s in sched_speeds):
+    if not args.quick and all(_design_file(s).exists() for s in sched_speeds):
         from specdesign.simulate import rosco_scheduled
 
         ds = {s: designs_for(model, s) for s in sched_speeds}

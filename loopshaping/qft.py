@@ -341,19 +341,32 @@ class Spec:
     def weights(self, omegas, n_cases, design=None) -> np.ndarray:
         """|W| at ``omegas`` (rad/s), shape (n_omega, n_cases). Tracking: the ratio."""
         if self.kind == "tracking" and self.weight is None:
-            up = np.abs(self._value(self.kind_args["upper"], omegas, 1, "upper", design))
-            low = np.abs(self._value(self.kind_args["lower"], omegas, 1, "lower", design))
+            up = self._magnitude(self.kind_args["upper"], omegas, 1, "upper", design)
+            low = self._magnitude(self.kind_args["lower"], omegas, 1, "lower", design)
             with np.errstate(divide="ignore"):
                 w = up / low
         else:
-            if not (_is_lti(self.weight) or callable(self.weight)):
-                raw = np.asarray(self.weight)
-                if np.isrealobj(raw) and np.any(raw < 0):
-                    raise ValueError(f"weight of spec {self.name!r} must be ≥ 0 (linear magnitude, not dB)")
-            w = np.abs(self._value(self.weight, omegas, n_cases, "weight", design)).astype(float)
+            w = self._magnitude(self.weight, omegas, n_cases, "weight", design)
         w = np.broadcast_to(w, (len(omegas), w.shape[1] if w.shape[1] != 1 else n_cases)).copy()
-        if np.any(np.isnan(w)) or np.any(w < 0):
-            raise ValueError(f"weight of spec {self.name!r} must be ≥ 0 (np.inf for no constraint)")
+        if np.any(np.isnan(w)):
+            raise ValueError(f"weight of spec {self.name!r} is NaN at some frequency (np.inf for no constraint)")
+        return w
+
+    def _magnitude(self, obj, omegas, n_cases, what, design):
+        """|obj| at ``omegas``; numbers, arrays and callables returning real values must be
+        > 0 (a linear magnitude: not dB, and taking |·| of a negative one silently would hide
+        the mistake), and no magnitude may be 0 (|T| ≤ 0 is a bound no controller meets)."""
+        raw = obj(np.asarray(omegas, float)) if callable(obj) and not _is_lti(obj) else obj
+        if not _is_lti(raw) and not (isinstance(raw, (list, tuple)) and raw and all(_is_lti(o) for o in raw)):
+            arr = np.asarray(raw)
+            if np.isrealobj(arr) and arr.dtype != object and np.any(arr <= 0):
+                raise ValueError(f"{what} of spec {self.name!r} must be > 0 (a linear magnitude, not dB; np.inf for "
+                                 f"no constraint), got a minimum of {np.min(arr)!r}")
+        w = np.abs(self._value(obj, omegas, n_cases, what, design)).astype(float)
+        if np.any(w == 0):
+            i = int(np.argmax(np.any(w == 0, axis=1)))
+            raise ValueError(f"{what} of spec {self.name!r} is 0 at ω = {np.asarray(omegas, float)[i]:g} rad/s "
+                             "(|T| ≤ 0 cannot be met; a zero of the weighting function on the jω axis?)")
         return w
 
     def coefficients(self, omegas, plants, design=None):

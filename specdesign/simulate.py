@@ -407,8 +407,8 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains")
     """The ROSCO baseline PI (tower damping off) with its gain schedule on filtered pitch.
 
     ``form="gains"`` (default) is ROSCO's own scheduling: K_p and K_i of
-    ``turbine.rosco_baseline(model, v)`` at ``wind_speeds`` (m/s; default every 1 m/s over the
-    model's above-rated range), placed at each speed's trim pitch, interpolated linearly in
+    ``turbine.rosco_baseline(model, v)`` at ``wind_speeds`` (m/s; default every whole m/s where
+    the model's above-rated range and the gain schedule overlap: 12-25 m/s), placed at each speed's trim pitch, interpolated linearly in
     the filtered pitch command, applied to one error filtered by ``turbine.speed_filter()``
     with one integrator of K_i(β_f)·e_f, integrator and output saturated at the model's pitch
     limits as ROSCO's PI does (anti-windup). ``form="output"`` blends the outputs of the local
@@ -418,16 +418,17 @@ def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains")
 
     if model is None:
         model = turbine.iea15mw()
-    if wind_speeds is None:
+    # The gains of turbine.rosco_baseline: pole placement on the straight-line fits of A, B_β.
+    sched = turbine.rosco_gain_schedule(model)
+    if wind_speeds is None:  # every whole m/s where both the model and the gain schedule hold
         lo, hi = getattr(model, "wind_range", (11.0, 25.0))
-        wind_speeds = np.arange(math.ceil(lo), hi + 0.5, 1.0)
+        lo, hi = max(lo, float(np.min(sched.v))), min(hi, float(np.max(sched.v)))
+        wind_speeds = np.arange(math.ceil(lo), math.floor(hi) + 0.5, 1.0)
     vs = [float(v) for v in np.atleast_1d(np.asarray(wind_speeds, dtype=float))]
     if form == "output":
         return scheduled(model, {v: turbine.rosco_baseline(model, v) for v in vs}, name=name)
     if form != "gains":
         raise ValueError(f"form must be one of {_FORMS}, got {form!r}")
-    # The gains of turbine.rosco_baseline: pole placement on the straight-line fits of A, B_β.
-    sched = turbine.rosco_gain_schedule(model)
     v = np.array(sorted(set(vs)))
     kp, ki = sched.gains(v)
     plant = turbine_plant(model)

@@ -692,8 +692,16 @@ class RoscoSchedule:
 
     def gains(self, wind_speeds):
         """(Kp, Ki) at ``wind_speeds`` (m/s; scalar or array) from the straight-line fits of A
-        and B_β over ``v``, by the same pole placement as ``Kp``, ``Ki`` (ROSCO's sign)."""
+        and B_β over ``v``, by the same pole placement as ``Kp``, ``Ki`` (ROSCO's sign).
+
+        Raises ValueError outside the schedule's wind speeds: the line fits are not
+        extrapolated (ROSCO's own schedule ends there too).
+        """
         v = np.asarray(wind_speeds, dtype=float)
+        lo, hi = float(np.min(self.v)), float(np.max(self.v))
+        if not np.all(np.isfinite(v)) or np.any(v < lo - 1e-9) or np.any(v > hi + 1e-9):
+            raise ValueError(f"wind_speeds={wind_speeds!r} m/s: the gain schedule covers {lo:g}-{hi:g} m/s only "
+                             "(build it over a wider range with rosco_gain_schedule(model, wind_speeds=...))")
         a = np.polyval(np.polyfit(self.v, self.A, 1), v)
         b = np.polyval(np.polyfit(self.v, self.B_beta, 1), v)
         return (2 * self.zeta_pc * self.omega_pc + a) / b, self.omega_pc**2 / b
