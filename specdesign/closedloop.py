@@ -294,11 +294,10 @@ def closed_loop_poles(model, controller, wind_speed) -> np.ndarray:
         K = controller.schedule_pitch.size
         w = [float(np.interp(b0, controller.schedule_pitch, np.eye(K)[q])) for q in range(K)]
         parts = [(w[q], controller.local(q)) for q in range(K) if w[q] != 0]
-        cb = sum((wq * control.ss(c) for wq, (c, _) in parts), control.ss([], [], [], [[0.0]]))
-        ca = sum((wq * control.ss(a) for wq, (_, a) in parts if a is not None), control.ss([], [], [], [[0.0]]))
-        # two blended locals integrate the same error: their difference is an uncontrollable
-        # mode at s = 0 of the parallel realisation, not of the loop
-        cb, ca = (control.minreal(x, verbose=False) if x.nstates else x for x in (cb, ca))
+        # blend as the simulator runs the locals: the integrators (split_integrator) summed into
+        # one, so two locals integrating the same error leave no spurious pole at s = 0
+        cb = _blend([(wq, c) for wq, (c, _) in parts])
+        ca = _blend([(wq, a) for wq, (_, a) in parts if a is not None])
     else:
         cb, ca = control.ss(_as_lti(controller, "controller")), control.ss([], [], [], [[0.0]])
     K2 = control.ss([], [], [], [[1.0, 1.0]]) * control.append(cb, ca)  # [C_β, C_atd]: 1×2
@@ -316,3 +315,16 @@ def unstable_message(controller, wind_speed, poles) -> str:
     name = getattr(controller, "name", None) or type(controller).__name__
     listing = ", ".join(f"{z.real:.4g}{z.imag:+.4g}j" for z in poles)
     return f"controller {name!r} destabilises the linearised turbine at {wind_speed:g} m/s (closed-loop poles {listing})"
+
+
+def _blend(weighted):
+    """Σ w·C as one state-space system with a single integrator: Σ w·r/s + Σ w·C_r."""
+    import control
+
+    from .simulate import split_integrator
+
+    r, rest = 0.0, control.ss([], [], [], [[0.0]])
+    for wq, c in weighted:
+        rq, cr = split_integrator(c)
+        r, rest = r + wq * rq, rest + wq * control.ss(cr)
+    return rest + control.ss(control.tf([r], [1.0, 0.0])) if r != 0 else rest

@@ -153,3 +153,14 @@ def test_results_are_unchanged_where_no_limit_is_reached(model, rosco):
     b = sm.simulate(dataclasses.replace(sm.turbine_plant(model), pitch_limits=None), rosco, [19.0], **kw)
     assert a["pitch_cmd"].min() > model.pitch_min + 0.05
     np.testing.assert_array_equal(a["tower_base_my"], b["tower_base_my"])
+
+
+def test_blended_locals_with_integrators_are_stable_between_their_speeds(model):
+    # Two locals that integrate the same error, blended at 16 m/s: one integrator, as the
+    # simulator runs them (a parallel realisation would add a spurious pole at s = 0 and call
+    # a stable loop unstable); the blend equals the explicit sum of the two responses.
+    sc = sm.scheduled(model, {15.0: turbine.rosco_baseline(model, 15.0), 17.0: turbine.rosco_baseline(model, 17.0)})
+    poles = va.closed_loop_poles(model, sc, 16.0)
+    assert np.max(poles.real) < 0
+    assert np.isfinite(va.linear_prediction(model, sc, 16.0).del_)
+    assert np.max(va.closed_loop_poles(model, sm.rosco_scheduled(model), 16.3).real) < 0
