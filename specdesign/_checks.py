@@ -70,10 +70,31 @@ def as_signal(x, name: str = "x", *, min_samples: int = 2) -> np.ndarray:
 
 def positive_scalar(value, name: str) -> float:
     """Validate a finite, strictly positive real scalar."""
+    if np.iscomplexobj(value):
+        raise TypeError(f"{name} is complex; pass a real number")
     try:
         v = float(value)
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
     if not np.isfinite(v) or v <= 0:
         raise ValueError(f"{name}={value!r} must be finite and > 0")
+    return v
+
+
+def representable(value, positive, what: str, hint: str) -> np.ndarray:
+    """``value`` unchanged if float64 holds it: finite, and a normal number (>= ~2.2e-308 in
+    magnitude) wherever ``positive`` (a bool array, or a bool) says the true value is nonzero.
+
+    Otherwise OverflowError naming ``what`` (e.g. "damage_rate(m=50)") with ``hint``: a damage
+    ∝ load^m leaves float64's range both ways at a large Wöhler exponent, and an inf or a 0
+    in its place would only turn up later as a silently wrong ratio or DEL.
+    """
+    v = np.asarray(value)
+    mag = np.abs(v)
+    bad_over = ~np.isfinite(mag)
+    bad_under = np.asarray(positive, dtype=bool) & (mag < np.finfo(float).tiny)
+    if np.any(bad_over):
+        raise OverflowError(f"{what} exceeds float64's range (~1.8e308); {hint}")
+    if np.any(bad_under):
+        raise OverflowError(f"{what} underflows float64's range (a nonzero value below ~2.2e-308); {hint}")
     return v

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ._checks import as_signal, positive_scalar
+from ._checks import as_real, as_signal, positive_scalar, representable
 
 __all__ = [
     "Cycles",
@@ -249,8 +249,12 @@ class SNCurve:
         return self.s_ref * self.knee_cycles ** (-1.0 / self.m)
 
     def cycles_to_failure(self, ranges) -> np.ndarray:
-        """N(S) for ranges S (load units); a zero range never fails (inf)."""
-        s = np.asarray(ranges, dtype=float)
+        """N(S) for ranges S (load units); a zero range never fails (inf).
+
+        At a large exponent N itself may leave float64's range (inf above ~1.8e308 cycles,
+        0 below ~1e-308): :func:`miner_damage` and :func:`del_rainflow` never form it.
+        """
+        s = as_real(ranges, "ranges")
         with np.errstate(divide="ignore"):
             n = (self.s_ref / s) ** self.m
             if self.knee_cycles is not None:
@@ -264,18 +268,32 @@ def miner_damage(ranges, counts, sn: SNCurve) -> float:
 
     ``counts`` are the cycle counts n_i (0.5 for half cycles); ``sn`` is a range-based
     :class:`SNCurve`.
+
+    Raises OverflowError when the damage is outside float64's range (above ~1.8e308, or a
+    nonzero damage below ~2.2e-308: ranges far from S_ref at a large exponent) instead of
+    returning inf or 0; the DEL (:func:`del_rainflow`) is computed scaled and stays finite.
     """
     if not isinstance(sn, SNCurve):
         raise TypeError(f"sn must be an SNCurve, got {type(sn).__name__}")
-    s = np.asarray(ranges, dtype=float)
-    n = np.asarray(counts, dtype=float)
+    s = as_real(ranges, "ranges")
+    n = as_real(counts, "counts")
     if s.shape != n.shape or s.ndim != 1:
         raise ValueError(f"ranges and counts must be 1-D of the same length, got {s.shape} and {n.shape}")
     if not (np.all(np.isfinite(s)) and np.all(s >= 0)):
         raise ValueError("ranges must be finite and >= 0 (cycle ranges, peak to valley)")
     if not (np.all(np.isfinite(n)) and np.all(n >= 0)):
         raise ValueError("counts must be finite and >= 0")
-    return float(np.sum(n / sn.cycles_to_failure(s)))
+    # n/N written as n (S/S_ref)^m: N itself leaves float64's range first (1/N of a
+    # subnormal N is inexact); the sum overflows only if the damage does (every term >= 0)
+    with np.errstate(over="ignore", under="ignore"):
+        d = n * (s / sn.s_ref) ** sn.m
+        if sn.knee_cycles is not None:
+            sk = sn.knee_range
+            d = np.where(s < sk, n / sn.knee_cycles * (s / sk) ** sn.m2, d)
+        d = float(np.sum(d))
+    representable(d, bool(np.any((n > 0) & (s > 0))), f"the Miner damage (m={sn.m:g}, s_ref={sn.s_ref:g})",
+                  "compute the DEL (del_rainflow) instead, or choose s_ref in the load's range")
+    return d
 
 
 def goodman_ranges(ranges, means, ultimate) -> np.ndarray:
@@ -286,8 +304,8 @@ def goodman_ranges(ranges, means, ultimate) -> np.ndarray:
     moments. A cycle whose |mean| reaches the ultimate load is a static failure: ValueError.
     """
     su = positive_scalar(ultimate, "ultimate")
-    s = np.asarray(ranges, dtype=float)
-    mu = np.abs(np.asarray(means, dtype=float))
+    s = as_real(ranges, "ranges")
+    mu = np.abs(as_real(means, "means"))
     if s.shape != mu.shape:
         raise ValueError(f"ranges and means must have the same shape, got {s.shape} and {mu.shape}")
     if np.any(mu >= su):
@@ -321,7 +339,16 @@ def del_rainflow(x, m, duration, n_eq_rate: float = 1.0, *, ultimate=None, resid
     if top == 0.0:
         return 0.0
     # DEL is homogeneous of degree 1 in the load: ranges relative to the largest never overflow
-    return top * float((np.sum(c.counts * (s / top) ** m) / n_eq) ** (1.0 / m))
+    # (the largest term is 0.5 or 1), and those that underflow carry < 1e-308 of the sum
+    with np.errstate(under="ignore"):
+        return top * float((np.sum(c.counts * (s / top) ** m) / n_eq) ** (1.0 / m))
+
+
+def _log_sum_pow(ranges, counts, m) -> float:
+    """ln Σ n_i S_i^m (ranges S_i > 0 somewhere), scaled by the largest range so that no S^m is formed."""
+    top = float(np.max(ranges))
+    with np.errstate(under="ignore"):
+        return m * np.log(top) + float(np.log(np.sum(counts * (ranges / top) ** m)))
 
 
 @dataclass(frozen=True)
@@ -338,11 +365,18 @@ class VarianceDamageFit:
     residual_std: float
 
     def predict(self, variance) -> np.ndarray:
-        """Damage D predicted for variance(s) in load units squared: e^b Var^a / L_ult^m."""
-        v = np.asarray(variance, dtype=float)
+        """Damage D predicted for variance(s) in load units squared: e^b Var^a / L_ult^m.
+
+        Evaluated in logarithms (L_ult^m alone overflows for L_ult = 1e8 N·m at m = 40);
+        OverflowError if D itself is outside float64's range.
+        """
+        v = as_real(variance, "variance")
         if np.any(~np.isfinite(v)) or np.any(v <= 0):
             raise ValueError("variance must be finite and > 0 (load units squared)")
-        return np.exp(self.b) * v**self.a / self.ultimate**self.m
+        with np.errstate(over="ignore", under="ignore"):
+            d = np.exp(self.b + self.a * np.log(v) - self.m * np.log(self.ultimate))
+        return representable(d, True, f"the predicted damage (m={self.m:g})",
+                             "predict at a variance nearer the fitted ones, or choose ultimate in the load's range")
 
 
 def fit_variance_damage(records, m, *, ultimate=1.0) -> VarianceDamageFit:
@@ -367,15 +401,16 @@ def fit_variance_damage(records, m, *, ultimate=1.0) -> VarianceDamageFit:
     recs = [as_signal(r, f"records[{i}]", min_samples=3) for i, r in enumerate(records)]
     if len(recs) < 2:
         raise ValueError(f"records needs at least 2 load histories to fit a and b, got {len(recs)}")
-    sn = SNCurve(m, su)
     var = np.array([np.var(r) for r in recs])
-    dmg = np.array([miner_damage(c.ranges, c.counts, sn) for c in map(rainflow, recs)])
-    if np.any(var <= 0) or np.any(dmg <= 0):
+    cycles = [rainflow(r) for r in recs]
+    if np.any(var <= 0) or any(c.ranges.size == 0 or np.max(c.ranges) == 0 for c in cycles):
         raise ValueError("records must not contain constant signals (zero variance, zero damage)")
     lx = np.log(var)
     if np.ptp(lx) == 0:
         raise ValueError("records all have the same variance; a and b are not identifiable")
-    ly = np.log(su**m * dmg)
+    # ln(L_ult^m D) = ln Σ n S^m (the damage at S_ref = 1), in logarithms: neither L_ult^m nor
+    # S^m is formed, so the fit holds for any load scale and m <= 100
+    ly = np.array([_log_sum_pow(c.ranges, c.counts, m) for c in cycles])
     a, b = np.polyfit(lx, ly, 1)
     res = ly - (a * lx + b)
     dof = max(len(recs) - 2, 1)
@@ -388,8 +423,8 @@ def economic_cost(damages, weights) -> np.ndarray:
     ``damages`` has shape (..., n_components) (dimensionless Miner damages, or damage
     rates); ``weights`` the n_components costs π_i (currency per unit damage, >= 0).
     """
-    d = np.asarray(damages, dtype=float)
-    w = np.asarray(weights, dtype=float)
+    d = as_real(damages, "damages")
+    w = as_real(weights, "weights")
     if w.ndim != 1:
         raise ValueError(f"weights must be 1-D (one cost per component), got shape {w.shape}")
     if d.ndim == 0 or d.shape[-1] != w.size:

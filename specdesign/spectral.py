@@ -14,12 +14,12 @@ Conventions (see WORKBENCH.md):
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.special import gamma
 
-from ._checks import as_omega, as_psd, as_real, positive_scalar
+from ._checks import as_omega, as_psd, as_real, positive_scalar, representable
 
 __all__ = [
     "METHODS",
@@ -79,7 +79,7 @@ def moments(omega, psd, orders=(0, 1, 2, 4)) -> np.ndarray:
     """
     w = as_omega(omega)
     s = as_psd(psd, w.size)
-    o = np.atleast_1d(np.asarray(orders, dtype=float))
+    o = np.atleast_1d(as_real(orders, "orders"))
     if o.ndim != 1 or not np.all(np.isfinite(o)) or np.any(o < 0):
         raise ValueError(f"orders must be a sequence of finite, non-negative moment orders, got {orders!r}")
     return s @ _moment_matrix(w, o)
@@ -253,8 +253,25 @@ def _damage_parts(mom, m, method):
             # α2 → 1 (a single spectral line): their coefficients are 0/0 there; the
             # narrow-band result is the limit of all of them.
             a2 = np.real(mo[4]) / np.sqrt(np.real(mo[0]) * np.real(mo[5]))
-            narrow = ((1.0 - a2) < _NARROW) | ~np.isfinite(d)
+            # (NaN only: an inf is an overflow at a huge m, which the narrow band must not hide)
+            narrow = ((1.0 - a2) < _NARROW) | np.isnan(d)
             d = np.where(narrow, _nb(mo, m), d)
+    # On unit-variance moments every method is finite up to m ≈ 170, where Dirlik's Γ(1+m)
+    # overflows (its largest term ν_p 2^m q^m Γ(1+m) is < 1e188 ν_p at m = 100: q, the mean
+    # range of its exponential part in units of 2√m0, is below 0.5 on every spectrum tried
+    # and → 0 towards a single line)
+    d_re = np.real(d)
+    if np.any(alive & np.isinf(d_re)):
+        raise OverflowError(f"m={m:g} is too large for float64: even the spectrum scaled to unit variance has a "
+                            f"damage above 1.8e308 with method={method!r} (m <= 100 is supported by every method)")
+    # what remains is a method used outside its range: Zhao-Baker's Rayleigh weight 1 - w turns
+    # negative on very wide-band spectra (α2 ≲ 0.15) and its damage with it; a DEL of that is NaN
+    bad = alive & ~(d_re > 0)
+    if np.any(bad):
+        a2 = np.real(mo[4]) / np.sqrt(np.real(mo[0]) * np.real(mo[5]))
+        raise ValueError(f"method={method!r} gives a damage <= 0 (or NaN) at m={m:g} for a spectrum with "
+                         f"α2 = {float(np.min(np.where(bad, a2, np.inf))):.3g}: the spectrum is outside the "
+                         "method's range of validity; use method='dirlik'")
     return np.where(alive, d, 0.0), s0
 
 
@@ -262,15 +279,15 @@ def _damage_from_moments(mom, m, method):
     """Damage rate for a moment array (..., 6) in _ORDERS; handles degenerate spectra.
 
     Raises OverflowError where the damage itself is not representable in float64 (large
-    loads at a large Wöhler exponent): its DEL still is (:func:`del_spectral`).
+    or tiny loads at a large Wöhler exponent): its DEL still is (:func:`del_spectral`).
     """
     dn, s0 = _damage_parts(mom, m, method)
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore", under="ignore"):
         d = dn * s0 ** (0.5 * m)
-    if not np.all(np.isfinite(d)):
-        raise OverflowError(f"the damage rate at m={m:g} exceeds float64 (load scale √m0 up to {np.sqrt(np.max(s0)):.3g}); "
-                            "compute the DEL (del_spectral), or express the load in larger units")
-    return d
+    return representable(d, np.real(dn) > 0, f"the damage rate at m={m:g} (load scale √m0 from "
+                         f"{np.sqrt(np.min(s0)):.3g} to {np.sqrt(np.max(s0)):.3g})",
+                         "compute the DEL (del_spectral) or a ratio (exact_change, sensitivity), "
+                         "which never form it, or express the load in other units")
 
 
 def _prepare(omega, psd, m):
@@ -300,6 +317,17 @@ def damage_rate(omega, psd, m, method: str = "dirlik") -> np.ndarray:
     ndarray, shape (...)
         E[Σ S_i^m] per second (load units^m / s). Zero for an all-zero PSD; the narrow-band
         limit for a (near) single-line PSD.
+
+    Raises
+    ------
+    OverflowError
+        If a damage is outside float64's range: it scales as √m0^m, so N·m loads (√m0 ~ 1e7)
+        overflow from m ≈ 40 and tiny ones underflow. An inf or 0 would be silently wrong
+        in every ratio made of it; :func:`del_spectral`, :func:`sensitivity` and
+        :func:`exact_change` work on the unit-variance spectrum and stay exact at any scale.
+    ValueError
+        If ``method`` gives a damage <= 0 for the spectrum (Zhao-Baker on very wide-band
+        spectra at a large m), and for invalid arguments.
     """
     w, s, m = _prepare(omega, psd, m)
     _check_method(method)
@@ -311,6 +339,11 @@ def del_spectral(omega, psd, m, method: str = "dirlik", n_eq_rate: float = 1.0) 
 
     DEL = (damage_rate / n_eq_rate)^(1/m): the constant range that, cycled n_eq_rate times a
     second, does the damage of the spectrum. Same arguments as :func:`damage_rate`.
+
+    Computed as √m0 · (d₁ / n_eq_rate)^(1/m), d₁ the damage rate of the spectrum scaled to unit
+    variance, so it is finite and exact (DEL(c²·S) = c·DEL(S)) for any m <= 100 and any load
+    scale, where the damage rate itself would overflow. Beyond m ≈ 170 even d₁ leaves float64
+    (Dirlik's Γ(1 + m)): OverflowError, never inf.
     """
     rate = positive_scalar(n_eq_rate, "n_eq_rate")
     w, s, m = _prepare(omega, psd, m)
@@ -337,7 +370,7 @@ def dirlik_range_pdf(omega, psd, ranges) -> np.ndarray:
     """
     w = as_omega(omega)
     s = as_psd(psd, w.size)
-    r = np.asarray(ranges, dtype=float)
+    r = as_real(ranges, "ranges")
     if r.ndim != 1 or not np.all(np.isfinite(r)) or np.any(r < 0):
         raise ValueError("ranges must be a 1-D array of finite, non-negative cycle ranges (load units)")
     mom = s @ _moment_matrix(w, _ORDERS)
@@ -452,19 +485,40 @@ def predicted_change(omega, sensitivity, t_mag2, w_mag2) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Change:
-    """Exact change between two spectra (percent; positive = reduction)."""
+    """Exact change between two spectra (percent; positive = reduction).
+
+    ``damage_before`` and ``damage_after`` (damage rates, load units^m / s) are formed only
+    when read: the reductions are exact at any load scale, the damages may not fit in float64
+    (OverflowError, see :func:`damage_rate`).
+    """
 
     damage_reduction: np.ndarray
     del_reduction: np.ndarray
-    damage_before: np.ndarray
-    damage_after: np.ndarray
+    # (unit-variance damage rates n0, n1; variances s0, s1; m) of before and after
+    _parts: tuple = field(repr=False, compare=False)
+
+    @property
+    def damage_before(self) -> np.ndarray:
+        n0, s0, _, _, m = self._parts
+        return _scaled_damage(n0, s0, m)
+
+    @property
+    def damage_after(self) -> np.ndarray:
+        _, _, n1, s1, m = self._parts
+        return _scaled_damage(n1, s1, m)
+
+
+def _scaled_damage(dn, s0, m):
+    with np.errstate(over="ignore", under="ignore"):
+        d = dn * s0 ** (0.5 * m)
+    return representable(d, dn > 0, f"the damage rate at m={m:g}", "use the reductions, which are exact at any scale")
 
 
 def del_reduction(damage_reduction, m):
     """DEL reduction (%) equivalent to a damage reduction (%) at Wöhler exponent ``m``:
     100·(1 − (1 − ΔD/100)^(1/m)). A damage reduction of 100 % or more (possible for the
     first-order Eq. 10 estimate, never for an exact one) means no damage left: 100 %."""
-    ratio = np.clip(1.0 - np.asarray(damage_reduction, dtype=float) / 100.0, 0.0, None)
+    ratio = np.clip(1.0 - as_real(damage_reduction, "damage_reduction") / 100.0, 0.0, None)
     return 100.0 * (1.0 - ratio ** (1.0 / positive_scalar(m, "m")))
 
 
@@ -482,9 +536,11 @@ def exact_change(omega, psd_before, psd_after, m, method: str = "dirlik") -> Cha
     (n0, s0), (n1, s1) = (_damage_parts(x @ a, m, method) for x in (before, after))
     if np.any(n0 <= 0):
         raise ValueError("psd_before has zero damage (all-zero spectrum); a relative change is undefined")
-    # the ratio from the unit-variance damages and the variance ratio: no overflow at large m
+    # ln(D_after/D_before) from the unit-variance damages and the variance ratio: no damage is
+    # formed, so no overflow at a large m; the DEL ratio is exp(ln(ratio)/m), taken directly
+    # (not back from the rounded damage reduction) so a near-total reduction keeps its digits
     with np.errstate(divide="ignore"):
-        ratio = np.where(n1 > 0, np.exp(np.log(n1 / n0) + 0.5 * m * np.log(s1 / s0)), 0.0)
-    damage = 100.0 * (1.0 - ratio)
-    return Change(damage, del_reduction(damage, m), _damage_from_moments(before @ a, m, method),
-                  _damage_from_moments(after @ a, m, method))
+        log_ratio = np.where(n1 > 0, np.log(np.where(n1 > 0, n1, 1.0) / n0) + 0.5 * m * np.log(s1 / s0), -np.inf)
+    with np.errstate(over="ignore"):
+        damage = -100.0 * np.expm1(log_ratio)
+    return Change(damage, -100.0 * np.expm1(log_ratio / m), (n0, s0, n1, s1, m))
