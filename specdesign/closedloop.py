@@ -30,6 +30,9 @@ from ._checks import as_omega, as_psd, positive_scalar
 __all__ = [
     "ClosedLoopUnstableWarning",
     "closed_loop_poles",
+    "closed_loop_matrices",
+    "loop_parts",
+    "hidden_origin_poles",
     "unstable_poles",
     "unstable_message",
     "closed_loop",
@@ -273,22 +276,27 @@ def loop_maps(plant, pitch_controller, omega, atd_controller=None, atd_measureme
     )
 
 
-def closed_loop_poles(model, controller, wind_speed) -> np.ndarray:
-    """Poles (1/s) of the linearised turbine at ``wind_speed`` (m/s) closed by ``controller``.
+def loop_parts(model, controller, wind_speed):
+    """The linearised loop at ``wind_speed`` (m/s) as :func:`specdesign.simulate.simulate` runs it.
 
-    ``model``: TurbineModel or :class:`specdesign.simulate.KernelPlant` with a linearisation;
-    ``controller``: anything :func:`specdesign.simulate.simulate` runs with a linear form (LTI,
-    Controller, ScheduledController: blended at the trim pitch of ``wind_speed``, as
-    :func:`specdesign.validate.closed_loop_response` blends it); β = −C_β·Ω_g − C_atd·ẋ_top.
+    Returns ``(G, rows, K)``: ``G`` the plant's linearisation (``control.StateSpace``, inputs
+    wind, pitch_cmd, gen_torque by position, deviations from trim), ``rows`` the indices of
+    (gen_speed, tower_top_vel) among its outputs, and ``K`` the continuous 1×2 controller on
+    them, β = −K·[Ω_g, ẋ_top] = −C_β·Ω_g − C_atd·ẋ_top. A ScheduledController is blended at the
+    trim pitch of ``wind_speed`` (as :func:`specdesign.validate.closed_loop_response` blends it),
+    its locals' integrators summed into one (:func:`specdesign.simulate.split_integrator`).
+    ``model``: TurbineModel or KernelPlant with a linearisation.
     """
     import control
 
     from .simulate import ScheduledController, _as_lti, turbine_plant
 
     plant = turbine_plant(model)
+    if plant.linearize is None:
+        raise ValueError(f"plant {plant.name!r} has no linearisation: its closed-loop poles are unknown")
     G = control.ss(plant.linearize(wind_speed))
     names = list(plant.output_names)
-    meas = G[[names.index("gen_speed"), names.index("tower_top_vel")], 1]  # pitch_cmd → (Ω_g, ẋ_top), by position
+    rows = [names.index("gen_speed"), names.index("tower_top_vel")]
     if isinstance(controller, ScheduledController):
         b0 = plant.trim(wind_speed)[1]
         K = controller.schedule_pitch.size
@@ -301,13 +309,81 @@ def closed_loop_poles(model, controller, wind_speed) -> np.ndarray:
     else:
         cb, ca = control.ss(_as_lti(controller, "controller")), control.ss([], [], [], [[0.0]])
     K2 = control.ss([], [], [], [[1.0, 1.0]]) * control.append(cb, ca)  # [C_β, C_atd]: 1×2
-    return np.asarray(control.feedback(meas, K2, sign=-1).poles())
+    return G, rows, K2
 
 
-def unstable_poles(model, controller, wind_speed) -> np.ndarray:
-    """The closed-loop poles with Re ≥ 0 (1/s), sorted; empty when the loop is stable."""
-    p = closed_loop_poles(model, controller, wind_speed)
-    return np.sort_complex(p[p.real >= 0])
+def closed_loop_matrices(model, controller, wind_speed, *, parts=None):
+    """``(A, b)`` of the linearised closed loop at ``wind_speed`` (m/s): states [plant;
+    controller] (:func:`loop_parts`, or its result ``parts``), ``b`` the column of the wind
+    input (m/s)."""
+    G, rows, K = loop_parts(model, controller, wind_speed) if parts is None else parts
+    A, B, C, D = (np.asarray(x, dtype=float) for x in (G.A, G.B, G.C, G.D))
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (K.A, K.B, K.C, K.D))
+    nk = Ak.shape[0] if K.nstates else 0
+    Ak, Bk, Ck = Ak.reshape(nk, nk), Bk.reshape(nk, 2), Ck.reshape(1, nk)
+    bw, bu = B[:, 0], B[:, 1]
+    cm, dmw, dmu = C[rows], D[rows, 0], D[rows, 1]
+    den = 1.0 + float(Dk[0] @ dmu)  # u = −K·(cm x + dmw w + dmu u): solved for u
+    if abs(den) < 1e-12:
+        raise ValueError("the loop is ill-posed: 1 + K(∞)·P(∞) = 0 (the controller cancels the plant's feedthrough)")
+    ux, uc, uw = -(Dk[0] @ cm) / den, -Ck[0] / den, -float(Dk[0] @ dmw) / den
+    mx, mc, mw = cm + np.outer(dmu, ux), np.outer(dmu, uc), dmw + dmu * uw
+    Acl = np.block([[A + np.outer(bu, ux), np.outer(bu, uc)], [Bk @ mx, Ak + Bk @ mc]])
+    return Acl, np.concatenate([bw + bu * uw, Bk @ mw])
+
+
+#: Relative size (of the largest |pole|) under which a closed-loop pole counts as s = 0.
+ORIGIN_TOL = 1e-9
+
+
+def closed_loop_poles(model, controller, wind_speed) -> np.ndarray:
+    """Poles (1/s) of the linearised turbine at ``wind_speed`` (m/s) closed by ``controller``.
+
+    ``model``: TurbineModel or :class:`specdesign.simulate.KernelPlant` with a linearisation;
+    ``controller``: anything :func:`specdesign.simulate.simulate` runs with a linear form (LTI,
+    Controller, ScheduledController: blended at the trim pitch of ``wind_speed``, as
+    :func:`specdesign.validate.closed_loop_response` blends it); β = −C_β·Ω_g − C_atd·ẋ_top.
+    """
+    return np.linalg.eigvals(closed_loop_matrices(model, controller, wind_speed)[0])
+
+
+def hidden_origin_poles(A, b, poles=None) -> np.ndarray:
+    """Boolean mask over ``poles`` (default: the eigenvalues of ``A``): poles at s = 0 (within
+    :data:`ORIGIN_TOL`) whose mode the input ``b`` cannot excite (PBH test: left eigenvector
+    ⟂ b), i.e. a conserved quantity such as ∫ẋ_top − x_top when an ATD controller integrates
+    the tower-top velocity (a 1×2 H∞ controller split into its SISO pitch and ATD parts does).
+    Such a mode neither grows nor responds to the wind: it is no instability."""
+    import scipy.linalg
+
+    lam, wl = scipy.linalg.eig(A, left=True, right=False)
+    if poles is None:
+        poles = lam
+    scale = max(1.0, float(np.max(np.abs(lam), initial=0.0)))
+    at0 = np.abs(lam) <= ORIGIN_TOL * scale
+    nb = float(np.linalg.norm(b))
+    hidden0 = at0 & (np.abs(wl.conj().T @ b) <= 1e-8 * np.linalg.norm(wl, axis=0) * max(nb, 1e-300))
+    out = np.zeros(np.size(poles), bool)
+    # match the given poles to the eigenvalues just computed (the same ones, maybe reordered)
+    for z in lam[hidden0]:
+        cand = np.flatnonzero(~out & (np.abs(np.asarray(poles) - z) <= ORIGIN_TOL * scale))
+        if cand.size:
+            out[cand[0]] = True
+    return out
+
+
+def unstable_poles(model, controller, wind_speed, *, parts=None) -> np.ndarray:
+    """The closed-loop poles with Re ≥ 0 (1/s), sorted; empty when the loop is stable.
+
+    A pole at s = 0 (within :data:`ORIGIN_TOL`) counts as unstable (the response to the wind
+    would drift), unless the wind cannot excite its mode (:func:`hidden_origin_poles`).
+    ``parts``: :func:`loop_parts` of the same arguments, if already at hand."""
+    A, b = closed_loop_matrices(model, controller, wind_speed, parts=parts)
+    p = np.linalg.eigvals(A)
+    scale = max(1.0, float(np.max(np.abs(p), initial=0.0)))
+    cand = (p.real >= 0) | (np.abs(p) <= ORIGIN_TOL * scale)
+    if np.any(cand & (np.abs(p) <= ORIGIN_TOL * scale)):
+        cand &= ~hidden_origin_poles(A, b, p)
+    return np.sort_complex(p[cand])
 
 
 def unstable_message(controller, wind_speed, poles) -> str:

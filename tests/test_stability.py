@@ -164,3 +164,160 @@ def test_blended_locals_with_integrators_are_stable_between_their_speeds(model):
     assert np.max(poles.real) < 0
     assert np.isfinite(va.linear_prediction(model, sc, 16.0).del_)
     assert np.max(va.closed_loop_poles(model, sm.rosco_scheduled(model), 16.3).real) < 0
+
+
+# ----------------------------------------------------------------------------- hidden modes at s = 0
+def test_an_integrating_atd_leaves_a_conserved_mode_at_zero_not_an_instability(model, rosco):
+    # An ATD controller with a pole at 0 integrates the tower-top velocity: ∫ẋ_top − x_top is
+    # conserved, a closed-loop pole at s = 0 the wind cannot excite (what a 1×2 H∞ controller
+    # split into SISO pitch and ATD parts carries). Its rounding (here +1.5e-16) decided
+    # "unstable": linear_prediction raised and a campaign dropped the controller.
+    import control
+
+    sc = sm.scheduled(model, {19.0: rosco}, {19.0: control.tf([0.05], [1.0, 0.0])}, name="ATD-I")
+    poles = va.closed_loop_poles(model, sc, 19.0)
+    assert np.min(np.abs(poles)) < 1e-12  # the conserved mode is there
+    assert np.max(poles.real[np.abs(poles) > 1e-9]) < -0.05  # every other mode decays
+    from specdesign import closedloop
+
+    assert closedloop.unstable_poles(model, sc, 19.0).size == 0
+    assert np.isfinite(va.linear_prediction(model, sc, 19.0).del_)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ClosedLoopUnstableWarning)
+        r = sm.simulate(model, sc, [19.0], seeds=[1], duration=100.0, transient=20.0)
+    assert np.all(np.isfinite(r["tower_base_my"]))
+    # with the opposite sign the loop is truly unstable (a tower-mode pair): still reported
+    bad = closedloop.unstable_poles(model, sm.scheduled(model, {19.0: rosco}, {19.0: control.tf([-0.05], [1.0, 0.0])}), 19.0)
+    assert bad.size == 2 and np.all(np.abs(np.abs(bad.imag) - 1.27) < 0.05)
+
+
+def test_hidden_origin_poles_is_the_pbh_test():
+    from specdesign.closedloop import hidden_origin_poles
+
+    A = np.array([[0.0, 1.0], [0.0, -2.0]])
+    assert hidden_origin_poles(A, np.array([1.0, 0.0])).tolist() == [False, False]  # the wind drives it: a drift
+    assert sorted(hidden_origin_poles(A, np.array([-1.0, 2.0])).tolist()) == [False, True]  # left eigvec [2, 1] ⟂ b
+
+
+# ----------------------------------------------------------------------------- the sampled loop
+def test_sampled_loop_radius_predicts_the_simulated_decay(model):
+    # Independent of the formula: the slowest mode of the linear simulation (kernel: RK4 with
+    # the command held, Tustin controller) decays per second at log(ρ)/dt.
+    c = 5.0 * turbine.rosco_baseline(model, 19.0)
+    dt = 0.1
+    rate = np.log(sm.sampled_loop_radius(model, c, 19.0, dt)) / dt
+    n = int(400.0 / dt) + 2
+    wind = np.full((1, 1, n), 19.0)
+    wind[..., 10:30] += 0.2  # a 2 s gust from t = 1 s
+    free = dataclasses.replace(sm.turbine_plant(model), pitch_limits=None)
+    r = sm.simulate(free, c, [19.0], wind=wind, wind_dt=dt, duration=400.0, dt=dt, record_dt=dt, transient=0.0,
+                    linear=True)
+    y = np.abs(r["gen_speed"][0, 0] - model.rated_rotor_speed)
+    win = int(40.0 / dt)
+    starts = np.arange(int(60.0 / dt), int(300.0 / dt), win)
+    env = np.array([y[i:i + win].max() for i in starts])
+    fitted = np.polyfit(starts * dt, np.log(env), 1)[0]
+    assert rate < 0 and abs(fitted / rate - 1) < 0.05, (fitted, rate)
+
+
+def test_a_step_the_sampled_loop_cannot_take_is_refused_with_its_limit(model):
+    # ROSCO × 2 at 13 m/s: stable in continuous time (max Re −0.015 1/s), but the command held
+    # over a 0.3 s step adds enough lag to destabilise it; 0.3 s passes the plant's own bound (0.32 s)
+    import re
+
+    c = 2.0 * turbine.rosco_baseline(model, 13.0)
+    assert np.max(va.closed_loop_poles(model, c, 13.0).real) < 0
+    with pytest.raises(ValueError, match=r"dt=0.3 s is too large for controller .* at 13 m/s.*dt must be ≤ 0.2\d\d s") as err:
+        sm.simulate(model, c, [13.0], seeds=[1], dt=0.3, record_dt=0.3, duration=60.0)
+    limit = float(re.search(r"dt must be ≤ ([0-9.]+) s", str(err.value)).group(1))
+    assert sm.sampled_loop_radius(model, c, 13.0, limit) < 1.0 < sm.sampled_loop_radius(model, c, 13.0, 0.3)
+    assert sm.sampled_loop_radius(model, c, 13.0, 0.02) < 1.0
+    sm.simulate(model, c, [13.0], seeds=[1], dt=0.25, record_dt=0.25, duration=60.0)  # accepted
+
+
+def test_a_campaign_refuses_the_step_before_simulating_anything(model, rosco, monkeypatch):
+    def no_simulation(*a, **k):
+        raise AssertionError("simulated before the step was checked")
+
+    monkeypatch.setattr(sm, "simulate", no_simulation)
+    bad = 2.0 * turbine.rosco_baseline(model, 13.0)
+    with pytest.raises(ValueError, match=r"campaign controller 'strong'.*13 m/s.*dt must be ≤"):
+        va.run_campaign({"ROSCO": rosco, "strong": bad}, [19.0, 13.0], [1], model=model, dt=0.3, record_dt=0.3,
+                        duration=60.0, progress=False)
+
+
+def test_a_campaign_keeps_the_stable_speeds_of_a_controller_unstable_at_one(model):
+    # ROSCO(19 m/s) × 6: stable at 13 m/s (max Re −0.022 1/s), unstable at 25 m/s (+0.007 1/s)
+    c = 6.0 * turbine.rosco_baseline(model, 19.0)
+    base = turbine.rosco_baseline(model, 19.0)
+    with pytest.warns(ClosedLoopUnstableWarning, match="'x6'.*25 m/s"):
+        camp = va.run_campaign({"base": base, "x6": c}, [13.0, 25.0], [1], model=model, duration=60.0, transient=20.0,
+                               progress=False, keep_series=1)
+    assert camp.unstable.tolist() == [[False, False], [False, True]]
+    s = camp.series["x6"]["tower_base_my"]
+    assert np.all(np.isfinite(s[0])) and np.all(np.isnan(s[1]))  # 13 m/s kept, 25 m/s NaN
+    md = va.table2(camp, "x6", "base").to_markdown()
+    row = next(line for line in md.splitlines() if line.startswith("| Tower base DEL |"))
+    cells = [c.strip() for c in row.strip().strip("|").split("|")]
+    assert cells[1].endswith("%") and cells[2] == "unstable" and cells[3] == "unstable"  # 13, 25 m/s, the Mean
+
+
+# ----------------------------------------------------------------------------- anti-windup, slow modes
+# A designed controller whose rest has a slow pole: ROSCO's PI times a lag (s + 0.05)/(s + 0.02).
+# Its integral alone is not the pitch it holds: the lag's mode (0.02 rad/s) carries a residue
+# of the opposite sign. Clamping the integral alone at the limits (as ROSCO clamps its own)
+# changed this loop at 15-25 m/s with the pitch 4.7° above its floor (by 3 load SDs).
+def _lagged(model, v):
+    import control
+
+    return control.tf([1.0, 0.05], [1.0, 0.02]) * turbine.rosco_baseline(model, v)
+
+
+def test_a_slow_controller_is_unchanged_where_no_limit_is_reached(model):
+    c = _lagged(model, 19.0)
+    r, rest = sm.split_integrator(c)
+    assert r != 0 and sm.split_slow(rest)[0] is not None  # it has a slow part
+    kw = dict(seeds=[1, 2], duration=300.0, transient=30.0)
+    a = sm.simulate(model, c, [15.0, 19.0, 25.0], **kw)
+    b = sm.simulate(dataclasses.replace(sm.turbine_plant(model), pitch_limits=None), c, [15.0, 19.0, 25.0], **kw)
+    assert a["pitch_cmd"].min() > model.pitch_min + np.radians(3.0)
+    np.testing.assert_array_equal(a["tower_base_my"], b["tower_base_my"])
+
+
+def test_split_slow_is_exact():
+    import control
+
+    c = control.tf([1.0, 3.0, 0.5], np.poly([-0.04, -1.0, -2.0]))  # one pole under SLOW_OMEGA
+    slow, fast = sm.split_slow(c)
+    np.testing.assert_allclose(control.ss(slow).poles(), [-0.04], rtol=1e-9)
+    assert np.all(np.abs(control.ss(fast).poles()) > sm.SLOW_OMEGA)
+    w = 1j * np.logspace(-3, 2, 40)
+    np.testing.assert_allclose(np.asarray(slow(w)) + np.asarray(fast(w)), np.asarray(c(w)), rtol=1e-10)
+    assert sm.split_slow(control.tf([1.0], [1.0, 1.0]))[0] is None
+
+
+def test_a_slow_controller_does_not_wind_up_at_the_pitch_floor(model, floor_runs):
+    c = _lagged(model, V_FLOOR)
+    r = sm.simulate(model, c, [V_FLOOR], **KW)
+    free = sm.simulate(dataclasses.replace(sm.turbine_plant(model), pitch_limits=None), c, [V_FLOOR], **KW)
+    pc, fc = r["pitch_cmd"][0, 0], free["pitch_cmd"][0, 0]
+    assert np.mean(pc <= model.pitch_min + 1e-12) > 0.05 and pc.min() >= model.pitch_min  # seed 1 sits on the floor
+    assert fc.min() < model.pitch_min - np.radians(10.0)  # unclamped it winds up (−30°)
+
+    def longest(mask):
+        d = np.diff(np.r_[0, mask.astype(int), 0])
+        return (np.flatnonzero(d == -1) - np.flatnonzero(d == 1)).max()
+
+    # on the floor for 27 s at most, where the wound-up command stays below it for 67 s
+    assert longest(pc <= model.pitch_min + 1e-12) < 0.6 * longest(fc < model.pitch_min)
+    # loads: those of ROSCO's clamped PI within 15 % (54 vs 56 MN·m), where the wound-up loop doubles them (101)
+    d, d_rosco, d_free = _del(r)[0], _del(floor_runs["rosco"])[0], _del(free)[0]
+    assert abs(d / d_rosco - 1) < 0.15 and d_free > 1.5 * d_rosco, (d, d_rosco, d_free)
+
+
+def test_a_scheduled_pi_without_its_own_limits_takes_the_plants(model, floor_runs):
+    # ROSCO's form with pitch_limits=None used to run its integrator unclamped while the plant
+    # saturated the command (wind-up); it now clamps at the plant's limits: ROSCO exactly.
+    sc = dataclasses.replace(sm.rosco_scheduled(model, [V_FLOOR]), pitch_limits=None)
+    r = sm.simulate(model, sc, [V_FLOOR], **KW)
+    np.testing.assert_array_equal(r["pitch_cmd"], floor_runs["rosco"]["pitch_cmd"])
