@@ -7,17 +7,25 @@ moving a pole or zero does not change the low-frequency gain:
 ============== ============================= ====================================
 kind           parameters                    factor
 ============== ============================= ====================================
-gain           k (≠ 0, may be negative)      k
-integrator     order n ≥ 1                   1/s^n
-differentiator order n ≥ 1                   s^n
+gain           k (finite, ≠ 0, may be < 0)   k
+integrator     order n, 1 ≤ n ≤ 4            1/s^n
+differentiator order n, 1 ≤ n ≤ 4            s^n
 real_pole      omega (rad/s, ≠ 0; < 0: RHP)  1/(s/ω + 1)
 real_zero      omega (rad/s, ≠ 0; < 0: RHP)  s/ω + 1
 complex_pole   omega > 0 (rad/s), |zeta| < 1 1/((s/ω)² + 2ζ s/ω + 1)
 complex_zero   omega > 0 (rad/s), |zeta| < 1 (s/ω)² + 2ζ s/ω + 1
 lead_lag       zero, pole > 0 (rad/s)        (s/zero + 1)/(s/pole + 1)
-notch          omega > 0, zeta_zero ≥ 0,     (s² + 2ζ_z ω s + ω²)/(s² + 2ζ_p ω s + ω²)
-               zeta_pole > 0
+notch          omega > 0,                    (s² + 2ζ_z ω s + ω²)/(s² + 2ζ_p ω s + ω²)
+               0 ≤ zeta_zero ≤ 10,
+               0 < zeta_pole ≤ 10
 ============== ============================= ====================================
+
+Bounds (so that a typo is an error, not a hang or a silently degenerate polynomial): every
+parameter is a finite number; every frequency |ω| lies in [MIN_OMEGA, MAX_OMEGA] = [1e-12,
+1e12] rad/s; integrator/differentiator orders are integers up to MAX_ORDER = 4; notch damping
+ratios are at most MAX_NOTCH_ZETA = 10; a controller has at most MAX_DEGREE = 64 poles and at
+most 64 zeros. An error names the parameter, and the element index when read by
+:meth:`Controller.from_dict` (``element 2: notch: ...``).
 
 Controllers are immutable: ``add``, ``replace``, ``remove`` and ``set`` return new ones.
 """
@@ -45,6 +53,14 @@ _JSON_VERSION = 1
 #: Largest order of an integrator or differentiator element: a controller is a low-order
 #: filter, and s^n of a larger n has no use in loop shaping (n = 1e9 hung the polynomial product).
 MAX_ORDER = 4
+#: Range of every element frequency |ω| (rad/s): outside it 1/ω² under- or overflows towards a
+#: degenerate polynomial, and no loop is shaped at 1e-12 or 1e12 rad/s.
+MIN_OMEGA, MAX_OMEGA = 1e-12, 1e12
+#: Largest damping ratio of a notch (ζ_z and ζ_p): beyond it the "notch" is a plain gain change.
+MAX_NOTCH_ZETA = 10.0
+#: Largest number of poles (and of zeros) of a controller: polynomial coefficients of a higher
+#: degree carry no significant digits, and a controller of thousands of elements only hangs.
+MAX_DEGREE = 64
 
 
 @dataclass(frozen=True)
@@ -55,9 +71,11 @@ class Element:
     params: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        if self.kind not in _PARAMS:
+        if not isinstance(self.kind, str) or self.kind not in _PARAMS:
             raise ValueError(f"element kind={self.kind!r} is not one of {KINDS}")
         want = set(_PARAMS[self.kind])
+        if not isinstance(self.params, dict):
+            raise TypeError(f"element {self.kind!r}: params must be a dict {_PARAMS[self.kind]}, got {type(self.params).__name__}")
         if set(self.params) != want:
             raise TypeError(f"element {self.kind!r} takes parameters {_PARAMS[self.kind]}; got {sorted(self.params)}")
         p = {}
@@ -75,11 +93,19 @@ class Element:
             raise ValueError(f"{k}: omega must be ≠ 0 rad/s; use an integrator/differentiator for s = 0")
         if k in ("complex_pole", "complex_zero"):
             if p["omega"] <= 0 or not abs(p["zeta"]) < 1:
-                raise ValueError(f"{k}: needs omega > 0 rad/s and |zeta| < 1 (else use two real elements)")
+                raise ValueError(f"{k}: needs omega > 0 rad/s and |zeta| < 1 (else use two real elements); "
+                                 f"got omega={p['omega']!r}, zeta={p['zeta']!r}")
         if k == "lead_lag" and (p["zero"] <= 0 or p["pole"] <= 0):
-            raise ValueError("lead_lag: zero and pole must be > 0 rad/s")
-        if k == "notch" and (p["omega"] <= 0 or p["zeta_zero"] < 0 or p["zeta_pole"] <= 0):
-            raise ValueError("notch: needs omega > 0 rad/s, zeta_zero ≥ 0 and zeta_pole > 0")
+            raise ValueError(f"lead_lag: zero and pole must be > 0 rad/s; got zero={p['zero']!r}, pole={p['pole']!r}")
+        if k == "notch":
+            if p["omega"] <= 0:
+                raise ValueError(f"notch: omega={p['omega']!r} must be > 0 rad/s")
+            if not (0 <= p["zeta_zero"] <= MAX_NOTCH_ZETA and 0 < p["zeta_pole"] <= MAX_NOTCH_ZETA):
+                raise ValueError(f"notch: needs 0 ≤ zeta_zero ≤ {MAX_NOTCH_ZETA:g} and 0 < zeta_pole ≤ "
+                                 f"{MAX_NOTCH_ZETA:g}; got zeta_zero={p['zeta_zero']!r}, zeta_pole={p['zeta_pole']!r}")
+        for name in ("omega", "zero", "pole"):
+            if name in p and not MIN_OMEGA <= abs(p[name]) <= MAX_OMEGA:
+                raise ValueError(f"{k}: {name}={p[name]!r} rad/s must have |{name}| in [{MIN_OMEGA:g}, {MAX_OMEGA:g}] rad/s")
         object.__setattr__(self, "params", p)
 
     def polys(self):
@@ -177,6 +203,9 @@ class Controller:
         for i, e in enumerate(els):
             if not isinstance(e, Element):
                 raise TypeError(f"elements[{i}] is a {type(e).__name__}, not a loopshaping.controller.Element")
+        degrees = np.array([[len(n) - 1, len(d) - 1] for n, d in (e.polys() for e in els)]).reshape(-1, 2).sum(axis=0)
+        if degrees.max(initial=0) > MAX_DEGREE:
+            raise ValueError(f"a controller of {degrees[1]} poles and {degrees[0]} zeros: at most {MAX_DEGREE} of each")
         object.__setattr__(self, "elements", els)
 
     # -- editing (new objects)
@@ -271,8 +300,9 @@ class Controller:
         extra = set(data) - {"version", "elements"}
         if extra:
             raise ValueError(f"unknown controller keys {sorted(extra)}; allowed: 'version', 'elements'")
-        if data.get("version", _JSON_VERSION) != _JSON_VERSION:
-            raise ValueError(f"unsupported controller format version {data.get('version')!r} (this version reads {_JSON_VERSION})")
+        version = data.get("version", _JSON_VERSION)
+        if type(version) is not int or version != _JSON_VERSION:
+            raise ValueError(f"unsupported controller format version {version!r} (this version reads the integer {_JSON_VERSION})")
         if not isinstance(data["elements"], list):
             raise ValueError(f"'elements' must be a list of {{'kind', 'params'}} objects, got {type(data['elements']).__name__}")
         out = []

@@ -137,7 +137,7 @@ class Template:
             raise ValueError(f"responses must have shape (n_omega={w.size}, n_cases ≥ 1); got {np.shape(self.responses)}")
         if not np.all(np.isfinite(r)):
             raise ValueError("responses must be finite; a plant has a pole on the imaginary axis at a design frequency")
-        nominal = int(self.nominal)
+        nominal = _case_index(self.nominal, r.shape[1])
         if not -r.shape[1] <= nominal < r.shape[1]:
             raise ValueError(f"nominal={self.nominal} is not a case index (n_cases={r.shape[1]})")
         nominal %= r.shape[1]
@@ -261,15 +261,27 @@ class Template:
             raise ValueError("systems is empty; give the models at the operating points")
         if int(n_between) < 0:
             raise ValueError(f"n_between={n_between} must be ≥ 0")
+        nominal = _case_index(nominal, len(systems)) % len(systems)
         cases, nom = [], 0
         for k, P in enumerate(systems):
-            if k == nominal % len(systems):
+            if k == nominal:
                 nom = len(cases)
             cases.append(P)
             if k + 1 < len(systems):
                 for t in np.linspace(0, 1, int(n_between) + 2)[1:-1]:
                     cases.append((1 - t) * P + t * systems[k + 1])
         return cls.from_systems(cases, omegas, nom, disk_radius)
+
+
+def _case_index(nominal, n_cases, name="nominal") -> int:
+    """An integer case index (negative counts from the end); a float, a bool or a string is
+    an error rather than a silently truncated index."""
+    if isinstance(nominal, (bool, np.bool_)) or not isinstance(nominal, (numbers.Integral, np.integer)):
+        raise ValueError(f"{name}={nominal!r} must be an integer index of a plant case (0..{n_cases - 1})")
+    nominal = int(nominal)
+    if not -n_cases <= nominal < n_cases:
+        raise ValueError(f"{name}={nominal} is not a case index (n_cases={n_cases})")
+    return nominal
 
 
 def _indices_of(grid, values, name) -> np.ndarray:
@@ -291,6 +303,10 @@ class Spec:
 
     ``weight``: a number, an array (one value per design frequency, or (n_omega, n_cases)),
     a SISO LTI (|W(jω)| is used) or a callable ``fn(omegas)``; np.inf means "no constraint".
+    Numbers, arrays, real values a callable returns and static LTIs are linear magnitudes and
+    must be > 0 (a negative one is an error, not silently |·|: it is likely dB); no form may
+    be 0 at a design frequency (|T| ≤ 0 cannot be met). A wrong form is a TypeError and a
+    wrong value a ValueError, each naming the argument (``weight``, ``upper``, ``lower``).
     ``band = (low, high)`` in rad/s restricts the spec to those frequencies. ``kind_args``:
     ``sensor`` (noise: the sensor dynamics H), ``upper``/``lower`` (tracking: the weight is
     then the ratio |upper|/|lower|, or give ``weight`` = the ratio), ``A``, ``B``, ``C``,
@@ -325,7 +341,10 @@ class Spec:
         elif self.weight is None:
             raise TypeError(f"kind={self.kind!r} needs a weight (number, array, LTI or callable)")
         if self.band is not None:
-            lo, hi = (float(v) for v in self.band)
+            try:
+                lo, hi = (float(v) for v in self.band)
+            except (TypeError, ValueError):
+                raise ValueError(f"band={self.band!r} must be (low, high) in rad/s") from None
             if not 0 <= lo <= hi:
                 raise ValueError(f"band={self.band} must be (low, high) in rad/s with 0 ≤ low ≤ high")
             object.__setattr__(self, "band", (lo, hi))
@@ -357,11 +376,23 @@ class Spec:
         > 0 (a linear magnitude: not dB, and taking |·| of a negative one silently would hide
         the mistake), and no magnitude may be 0 (|T| ≤ 0 is a bound no controller meets)."""
         raw = obj(np.asarray(omegas, float)) if callable(obj) and not _is_lti(obj) else obj
-        if not _is_lti(raw) and not (isinstance(raw, (list, tuple)) and raw and all(_is_lti(o) for o in raw)):
-            arr = np.asarray(raw)
-            if np.isrealobj(arr) and arr.dtype != object and np.any(arr <= 0):
+        ltis = [raw] if _is_lti(raw) else list(raw) if isinstance(raw, (list, tuple)) and raw and all(
+            _is_lti(o) for o in raw) else None
+        if ltis is None:
+            arr = np.asarray(float(raw) if isinstance(raw, numbers.Real) and not isinstance(raw, bool) else raw)
+            if arr.dtype.kind not in "iufc" or isinstance(raw, (bool, np.bool_)):
+                kind = "a callable returning " if callable(obj) else ""
+                raise TypeError(f"{what} of spec {self.name!r} must be a number, an array of numbers, an LTI or a "
+                                f"callable of ω returning numbers; got {kind}{type(raw).__name__} {raw!r:.60}")
+            if arr.dtype.kind != "c" and np.any(arr <= 0):
                 raise ValueError(f"{what} of spec {self.name!r} must be > 0 (a linear magnitude, not dB; np.inf for "
                                  f"no constraint), got a minimum of {np.min(arr)!r}")
+        else:
+            for i, o in enumerate(ltis):  # a static LTI is a number: checked like one
+                if o.ninputs == 1 and o.noutputs == 1 and _static_gain(o) is not None and _static_gain(o) <= 0:
+                    at = f"[{i}]" if len(ltis) > 1 else ""
+                    raise ValueError(f"{what}{at} of spec {self.name!r} is the static gain {_static_gain(o):g}; it must "
+                                     "be > 0 (a linear magnitude, not dB)")
         w = np.abs(self._value(obj, omegas, n_cases, what, design)).astype(float)
         if np.any(w == 0):
             i = int(np.argmax(np.any(w == 0, axis=1)))
@@ -416,10 +447,25 @@ class Spec:
         if design is None or len(design) != len(omegas) or not np.allclose(design, omegas):
             raise ValueError(f"{what} of spec {self.name!r} is an array given at the design frequencies; "
                              "to evaluate it elsewhere (dense check) give an LTI or a callable of ω")
-        arr = arr.reshape(len(omegas), -1) if arr.ndim == 1 else arr
-        if arr.shape[0] != len(omegas):
-            raise ValueError(f"{what} of spec {self.name!r} must have one row per design frequency ({len(omegas)})")
-        return arr
+        if arr.ndim > 2 or arr.shape[0] != len(omegas):
+            raise ValueError(f"{what} of spec {self.name!r} must have one value (or row) per design frequency "
+                             f"({len(omegas)}); got shape {arr.shape}")
+        return arr.reshape(len(omegas), -1) if arr.ndim == 1 else arr
+
+
+def _static_gain(sys):
+    """The gain of an LTI without dynamics (no states, or constant numerator and
+    denominator), else None."""
+    import control as ct
+
+    if isinstance(sys, ct.TransferFunction):
+        num, den = np.trim_zeros(sys.num[0][0], "f"), np.trim_zeros(sys.den[0][0], "f")
+        if num.size <= 1 and den.size == 1:
+            return float(np.real(num[0] / den[0])) if num.size else 0.0
+        return None
+    if isinstance(sys, ct.StateSpace) and sys.nstates == 0:
+        return float(np.real(sys.D[0, 0]))
+    return None
 
 
 def tracking_pairs(P):
@@ -633,7 +679,7 @@ def bounds(template: Template, kind, weight=None, phases_deg=None, *, band=None,
     W = spec.weights(w_all, A.shape[1], design=w_all)
     keep &= ~np.all(np.isinf(W), axis=1)
     if np.any(np.isinf(W[keep])):
-        raise ValueError("weight may be np.inf only for all cases of a frequency at once")
+        raise ValueError(f"weight of spec {spec.name!r} may be np.inf only for all cases of a frequency at once")
     if not np.any(keep):
         raise ValueError(f"spec {spec.name!r} constrains no design frequency (all weights infinite or out of band)")
     idx = np.flatnonzero(keep)

@@ -600,12 +600,15 @@ def _campaign_point(model, controllers, v, seeds, duration, dt, record_dt, trans
         for k, val in ind.as_dict().items():
             out["values"].setdefault(k, []).append(val[0])
         if linear_twin:
+            lin = {k: np.full((1, len(seeds)), np.nan) for k in _INDICATORS}
             if _has_linear_form(c):
-                rl = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
-                              record_dt=record_dt, transient=transient, linear=True)
-                lin = indicators(rl.outputs, rl.dt, m).as_dict()
-            else:
-                lin = {k: np.full((1, len(seeds)), np.nan) for k in _INDICATORS}
+                try:
+                    rl = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
+                                  record_dt=record_dt, transient=transient, linear=True)
+                    lin = indicators(rl.outputs, rl.dt, m).as_dict()
+                except SimulationDivergedError as err:  # keep the nonlinear results: only the twin is NaN
+                    warnings.warn(f"{err}; the linear twin of {name!r} at {v:g} m/s is NaN", ClosedLoopUnstableWarning,
+                                  stacklevel=3)
             for k, val in lin.items():
                 out["linear"].setdefault(k, []).append(val[0])
         if volterra:
@@ -657,6 +660,29 @@ def _has_linear_form(c) -> bool:
     return isinstance(c, ScheduledController) or _is_lti_like(c)
 
 
+def _check_campaign_step(model, controllers, vs, dt):
+    """Up front, before the first simulation: a step too large for the plant, or for any
+    controller where its loop is stable (:func:`specdesign.simulate.simulate` would refuse it
+    at that wind speed only after the earlier speeds had run)."""
+    from ._checks import positive_scalar
+    from .simulate import _check_loop_step, _check_step, turbine_plant
+
+    dt = positive_scalar(dt, "dt")
+    plant = turbine_plant(model)
+    if plant.linearize is None:
+        return
+    _check_step(plant, vs, dt)
+    for name, c in controllers.items():
+        if not _has_linear_form(c):
+            continue
+        for v in vs:
+            if not unstable_poles(plant, c, float(v)).size:  # an unstable loop is reported by the campaign
+                try:
+                    _check_loop_step(plant, c, float(v), dt)
+                except ValueError as err:
+                    raise ValueError(f"campaign controller {name!r}: {err}") from None
+
+
 def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0, dt=0.02, record_dt=0.1,
                  transient=60.0, m=4.0, predict=True, turbulence_class="B", keep_series=False,
                  linear_twin=False, volterra=0, executor=None, progress=None, nperseg=None) -> Campaign:
@@ -700,6 +726,7 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
         raise ValueError(f"volterra={volterra!r} must be 0 (none) or an order 1, 2 or 3")
     if volterra and not hasattr(model, "aero_expansion"):
         raise TypeError(f"volterra={volterra} needs a turbine.TurbineModel, got {type(model).__name__}")
+    _check_campaign_step(model, controllers, vs, dt)
     args = [(model, controllers, float(v), seeds, duration, dt, record_dt, transient, m, predict, turbulence_class,
              keep_series, nperseg, bool(linear_twin), int(volterra)) for v in vs]
     show = (sys.stderr.isatty()) if progress is None else bool(progress)
@@ -728,11 +755,14 @@ def run_campaign(controllers, wind_speeds, seeds, *, model=None, duration=600.0,
 
         for name in names:
             rs = [p["series"].get(name) for p in points]
-            if any(r is None for r in rs):  # diverged somewhere (warned): no series to keep
+            ok = next((r for r in rs if r is not None), None)
+            if ok is None:  # unstable or diverged at every speed (warned): no series to keep
                 continue
-            outs = {k: np.concatenate([r.outputs[k] for r in rs], axis=0) for k in rs[0].outputs}
-            series[name] = SimulationResult(time=rs[0].time, wind_speeds=vs, seeds=rs[0].seeds, outputs=outs, dt=rs[0].dt,
-                                            sim_dt=rs[0].sim_dt, controller=name)
+            # where it was unstable or diverged (warned), NaN series: the other speeds are kept
+            outs = {k: np.concatenate([(r.outputs[k] if r is not None else np.full_like(ok.outputs[k], np.nan))
+                                       for r in rs], axis=0) for k in ok.outputs}
+            series[name] = SimulationResult(time=ok.time, wind_speeds=vs, seeds=ok.seeds, outputs=outs, dt=ok.dt,
+                                            sim_dt=ok.sim_dt, controller=name)
     return Campaign(
         controllers=names, wind_speeds=vs, seeds=seeds, duration=float(duration), dt=float(record_dt), m=float(m),
         values=values,
@@ -839,9 +869,10 @@ def _speed_columns(vs):
 
 
 def _unstable_marks(campaign, *names):
-    """Per speed column (+ Mean): "unstable" where any of the controllers is."""
+    """Per speed column (+ Mean): "unstable" where any of the controllers is (the Mean too
+    when any speed is: its NaN is theirs, not a missing number)."""
     bad = np.any(campaign.unstable[[campaign.index(n) for n in names]], axis=0)
-    return tuple("unstable" if b else "" for b in bad) + ("",)
+    return tuple("unstable" if b else "" for b in bad) + ("unstable" if np.any(bad) else "",)
 
 
 def table2(campaign: Campaign, designed: str, baseline: str, *, k=WEIBULL_K, scale=WEIBULL_A) -> Table:
@@ -1056,84 +1087,133 @@ def _coefficients(v, path, where):
 
 def load_controller(spec: dict, base: Path, model, *, config=None, name="controller"):
     """A controller from a campaign-file entry (``docs/validation.md``: kind "rosco" or
-    "file"); every key of the entry and of the controller file is checked."""
+    "file"); every key of the entry and of the controller file is checked, and every error
+    is a :class:`ConfigError` (or FileNotFoundError/OSError) naming the file and the key."""
     import control
 
     from .simulate import ScheduledController, rosco_scheduled, scheduled
 
     where = f"controllers.{name}"
+    base = Path(base)
     src = config if config is not None else base
     if not isinstance(spec, dict):
         raise ConfigError(f"{src}: {where} must be a table with 'kind' = \"rosco\" or 'file' = \"<controller.json>\"")
     kind = spec.get("kind", "file")
-    if kind not in _CONTROLLER_KEYS:
+    if not isinstance(kind, str) or kind not in _CONTROLLER_KEYS:
         raise ConfigError(f"{src}: {where}.kind={kind!r} must be \"rosco\" or \"file\"")
     extra = set(spec) - _CONTROLLER_KEYS[kind]
     if extra:
         raise ConfigError(f"{src}: unknown key(s) {sorted(extra)} in {where}; allowed for kind \"{kind}\": "
                           f"{sorted(_CONTROLLER_KEYS[kind])}")
+    label = spec.get("name", name)
+    _need(isinstance(label, str) and label, src, f"{where}.name", "a non-empty string (the controller's label)")
     if kind == "rosco":
         vs = spec.get("wind_speeds")
         if vs is not None:
-            _need(isinstance(vs, list) and vs and all(_is_number(v) and v > 0 for v in vs), src, f"{where}.wind_speeds",
-                  "a non-empty list of wind speeds in m/s")
-        return rosco_scheduled(model, vs, name=spec.get("name", name))
-    _need(isinstance(spec.get("file"), str), src, f"{where}.file", "the path of a controller JSON file")
+            vs = _wind_speeds(vs, model, src, f"{where}.wind_speeds")
+        try:
+            return rosco_scheduled(model, vs, name=label)
+        except ValueError as e:
+            raise ConfigError(f"{src}: {where}.wind_speeds: {e}") from None
+    _need(isinstance(spec.get("file"), str) and spec["file"], src, f"{where}.file", "the path of a controller JSON file")
     path = (base / spec["file"]).resolve()
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"{src}: {where}.file: controller file {path} does not exist")
+    if not path.is_file():
+        raise ConfigError(f"{src}: {where}.file: {path} is not a file; give the path of a controller JSON file")
     try:
-        data = json.loads(path.read_text())
-    except json.JSONDecodeError as e:
-        raise ConfigError(f"{path}: not valid JSON ({e})") from None
+        text = path.read_bytes()
+    except OSError as e:
+        raise type(e)(f"{src}: {where}.file: cannot read {path} ({e.strerror or e})") from None
+    data = _load_json(text, path, "a controller file")
 
     def tf(d, key):
         if isinstance(d, dict) and "elements" in d:
             from loopshaping.controller import Controller
 
             try:
-                return Controller.from_dict(d).tf()
+                num, den = Controller.from_dict(d).polys()
             except (TypeError, ValueError) as e:
                 raise ConfigError(f"{path}: {key}: {e}") from None
-        if not isinstance(d, dict) or set(d) != {"num", "den"}:
+        elif isinstance(d, dict) and set(d) == {"num", "den"}:
+            num, den = _coefficients(d["num"], path, f"{key}.num"), _coefficients(d["den"], path, f"{key}.den")
+            _need(den[0] != 0, path, f"{key}.den", "a list whose leading coefficient is non-zero")
+        else:
             raise ConfigError(f"{path}: {key} must hold exactly 'num' and 'den' coefficient lists (descending powers "
                               f"of s) or a loopshaping Controller ('elements', from Controller.to_dict); got {d!r:.80}")
-        num, den = _coefficients(d["num"], path, f"{key}.num"), _coefficients(d["den"], path, f"{key}.den")
-        _need(den[0] != 0, path, f"{key}.den", "a list whose leading coefficient is non-zero")
+        _need(np.any(num != 0), path, key, "a non-zero controller (num is all zeros; leave an unused loop out)")
         _need(np.trim_zeros(num, "f").size <= den.size, path, key, "proper (no more zeros than poles)")
         return control.tf(num, den)
 
+    def per_speed(items, key, n):
+        _need(isinstance(items, list) and len(items) == n, path, key, f"a list of one controller per wind speed ({n})")
+        return [tf(c, f"{key}[{i}]") for i, c in enumerate(items)]
+
     if not isinstance(data, dict):
         raise ConfigError(f"{path}: a controller file holds a JSON object, got {type(data).__name__}")
-    label = spec.get("name", name)
-    if "wind_speeds" in data:
-        extra = set(data) - {"wind_speeds", "pitch", "atd"}
+    keys = set(data)
+    if keys & {"num", "den", "elements", "version"}:  # one controller
+        return tf(data, "the file")
+    if "wind_speeds" in keys:
+        extra = keys - {"wind_speeds", "pitch", "atd"}
         if extra:
             raise ConfigError(f"{path}: unknown key(s) {sorted(extra)}; a scheduled controller has 'wind_speeds', "
                               "'pitch' and optionally 'atd'")
-        vs = data["wind_speeds"]
-        _need(isinstance(vs, list) and vs and all(_is_number(v) and v > 0 for v in vs), path, "wind_speeds",
-              "a non-empty list of wind speeds in m/s")
-        pitch, atd = data.get("pitch"), data.get("atd")
-        _need(isinstance(pitch, list) and len(pitch) == len(vs), path, "pitch", f"a list of one controller per wind speed ({len(vs)})")
-        _need(atd is None or (isinstance(atd, list) and len(atd) == len(vs)), path, "atd",
-              f"a list of one controller per wind speed ({len(vs)})")
-        return scheduled(model, {float(v): tf(p, f"pitch[{i}]") for i, (v, p) in enumerate(zip(vs, pitch))},
-                         None if atd is None else {float(v): tf(a, f"atd[{i}]") for i, (v, a) in enumerate(zip(vs, atd))},
-                         name=label)
-    if "pitch" in data:
-        extra = set(data) - {"pitch", "atd"}
+        vs = _wind_speeds(data["wind_speeds"], model, path, "wind_speeds")
+        _need("pitch" in keys, path, "pitch", f"a list of one controller per wind speed ({len(vs)})")
+        pitch = per_speed(data["pitch"], "pitch", len(vs))
+        atd = None if data.get("atd") is None else per_speed(data["atd"], "atd", len(vs))
+        try:
+            return scheduled(model, dict(zip(vs, pitch)), None if atd is None else dict(zip(vs, atd)), name=label)
+        except (TypeError, ValueError) as e:
+            raise ConfigError(f"{path}: {e}") from None
+    if "pitch" in keys:
+        extra = keys - {"pitch", "atd"}
         if extra:
             raise ConfigError(f"{path}: unknown key(s) {sorted(extra)}; a pitch + ATD controller has 'pitch' and 'atd'")
         c = tf(data["pitch"], "pitch")
         if data.get("atd") is not None:
             return ScheduledController(np.zeros(1), (c,), (tf(data["atd"], "atd"),), name=label)
         return c
-    return tf(data, "the file")
+    raise ConfigError(f"{path}: unknown key(s) {sorted(keys)}; a controller file holds {{'num', 'den'}}, "
+                      "{'elements'} (Controller.to_dict), {'pitch', 'atd'} or {'wind_speeds', 'pitch', 'atd'} "
+                      "(docs/validation.md)")
+
+
+def _wind_speeds(vs, model, path, key) -> list:
+    """Distinct wind speeds (m/s) inside the model's range, or ConfigError naming ``key``."""
+    _need(isinstance(vs, list) and vs and all(_is_number(v) for v in vs), path, key,
+          "a non-empty list of wind speeds in m/s")
+    _need(len({float(v) for v in vs}) == len(vs), path, key, f"a list of distinct wind speeds, got {vs}")
+    for v in vs:
+        try:
+            model._check_wind(v)
+        except ValueError as e:
+            raise ConfigError(f"{path}: {key}: {e}") from None
+    return [float(v) for v in vs]
+
+
+def _load_json(text: bytes, path: Path, what: str):
+    """JSON with every object's keys distinct (a repeated key would silently keep the last)."""
+    def pairs(items):
+        out = {}
+        for k, v in items:
+            if k in out:
+                raise ConfigError(f"{path}: key {k!r} appears twice in one object; keep one")
+            out[k] = v
+        return out
+
+    try:
+        return json.loads(text, object_pairs_hook=pairs)
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise ConfigError(f"{path}: {what} must be valid UTF-8 JSON ({e})") from None
 
 
 def _read_config(path: Path) -> dict:
-    text = path.read_bytes()
+    try:
+        text = path.read_bytes()
+    except OSError as e:
+        raise type(e)(f"{path}: cannot read the campaign file ({e.strerror or e})") from None
     if path.suffix.lower() == ".toml":
         import tomllib
 
@@ -1141,10 +1221,40 @@ def _read_config(path: Path) -> dict:
             return tomllib.loads(text.decode())
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
             raise ConfigError(f"{path}: invalid TOML ({e})") from None
+    if path.suffix.lower() != ".json":
+        raise ConfigError(f"{path}: a campaign file is a .toml or .json file (by its extension)")
+    return _load_json(text, path, "a .json campaign file")
+
+
+#: a run longer than a day (transient or recorded) is a typo, not a fatigue campaign
+_MAX_DURATION = 86400.0
+#: seeds are non-negative and below 2**32 (numpy's SeedSequence takes them as given)
+_MAX_SEED = 2**32
+
+
+def _checked_seeds(seeds, path) -> np.ndarray:
+    """The campaign's seeds (:func:`seeds_from`: an int n → 0..n−1), each 0 ≤ s < 2**32."""
+    items = seeds if isinstance(seeds, list) else [seeds]
+    ok = all(isinstance(s, int) and not isinstance(s, bool) and 0 <= s < _MAX_SEED for s in items)
+    _need(ok, path, "seeds", "an integer n ≥ 1 (the seeds 0..n−1) or a non-empty list of distinct integers "
+          f"0 ≤ seed < 2**32, got {seeds!r:.80}")
     try:
-        return json.loads(text)
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise ConfigError(f"{path}: invalid JSON ({e}); use a .toml or .json file") from None
+        return seeds_from(seeds)
+    except ValueError as e:
+        raise ConfigError(f"{path}: {e}") from None
+
+
+def _output_folder(folder: Path, path: Path, key: str) -> Path:
+    """Create ``folder`` and check that a file can be written there, before anything runs."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / ".specdesign_write_test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as e:
+        raise type(e)(f"{path}: {key}: the output folder {folder} cannot be created or written "
+                      f"({e.strerror or e}); choose a writable folder") from None
+    return folder
 
 
 def read_config(path, out=None) -> dict:
@@ -1153,14 +1263,17 @@ def read_config(path, out=None) -> dict:
     Returns the arguments of the campaign: ``controllers`` (loaded), ``wind_speeds``,
     ``seeds``, ``kwargs`` for :func:`run_campaign`, ``baseline``, ``designed``, ``promised``
     and ``out`` (created and checked writable). Raises :class:`ConfigError` (a ValueError)
-    naming the file and the key, FileNotFoundError, or PermissionError, before anything runs.
+    naming the file and the key, FileNotFoundError, or another OSError (an output folder that
+    cannot be written, naming it), before anything runs.
     """
     from . import turbine
     from .simulate import _check_step, turbine_plant
 
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"config file {path} does not exist")
+    if not path.is_file():
+        raise ConfigError(f"{path}: not a file; give a .toml or .json campaign file")
     cfg = _read_config(path)
     if not isinstance(cfg, dict):
         raise ConfigError(f"{path}: a campaign file holds a table (TOML) or an object (JSON)")
@@ -1172,23 +1285,17 @@ def read_config(path, out=None) -> dict:
             raise ConfigError(f"{path}: missing required key {key!r}")
     _need(cfg.get("turbine", "iea15mw") == "iea15mw", path, "turbine", "\"iea15mw\" (the only embedded model)")
     model = turbine.iea15mw()
-    vs = cfg["wind_speeds"]
-    _need(isinstance(vs, list) and vs and all(_is_number(v) for v in vs), path, "wind_speeds",
-          "a non-empty list of wind speeds in m/s")
-    for v in vs:
-        try:
-            model._check_wind(v)
-        except ValueError as e:
-            raise ConfigError(f"{path}: wind_speeds: {e}") from None
-    try:
-        seeds = seeds_from(cfg["seeds"])
-    except ValueError as e:
-        raise ConfigError(f"{path}: {e}") from None
+    vs = _wind_speeds(cfg["wind_speeds"], model, path, "wind_speeds")
+    seeds = _checked_seeds(cfg["seeds"], path)
     kw = dict(duration=_number(cfg, "duration", path, 600.0), dt=_number(cfg, "dt", path, 0.02),
               record_dt=_number(cfg, "record_dt", path, 0.1), transient=_number(cfg, "transient", path, 60.0, positive=False),
               m=_number(cfg, "wohler_exponent", path, 4.0))
+    for key in ("duration", "transient"):
+        _need(kw[key] <= _MAX_DURATION, path, key, f"at most {_MAX_DURATION:g} s (one day) per run, got {kw[key]:g} s")
     rec = kw["record_dt"] / kw["dt"]
     _need(abs(rec - round(rec)) <= 1e-9 * rec and round(rec) >= 1, path, "record_dt", f"a whole multiple of dt={kw['dt']:g} s")
+    _need(kw["duration"] >= 10 * kw["record_dt"], path, "duration",
+          f"at least 10 output samples, ≥ {10 * kw['record_dt']:g} s at record_dt={kw['record_dt']:g} s")
     try:
         _check_step(turbine_plant(model), np.asarray(vs, float), kw["dt"])
     except ValueError as e:
@@ -1198,34 +1305,46 @@ def read_config(path, out=None) -> dict:
     twin = cfg.get("linear_twin", False)
     _need(isinstance(twin, bool), path, "linear_twin", "true or false (a TOML/JSON boolean, not a string)")
     vol = cfg.get("volterra", 0)
-    _need(vol in (0, 1, 2, 3) and not isinstance(vol, bool), path, "volterra", "0 (none) or an order 1, 2 or 3")
+    _need(isinstance(vol, int) and not isinstance(vol, bool) and vol in (0, 1, 2, 3), path, "volterra",
+          "0 (none) or an order 1, 2 or 3 (an integer)")
     ctrl = cfg["controllers"]
     _need(isinstance(ctrl, dict) and ctrl, path, "controllers", "a table of named controllers ([controllers.NAME])")
     controllers = {str(n): load_controller(spec, path.parent, model, config=path, name=str(n)) for n, spec in ctrl.items()}
     names = list(controllers)
     baseline, designed = cfg.get("baseline", names[0]), cfg.get("designed", names[-1])
     for key, val in (("baseline", baseline), ("designed", designed)):
-        _need(val in controllers, path, key, f"one of the controllers {names}")
+        _need(isinstance(val, str) and val in controllers, path, key, f"one of the controllers {names}")
+    _need(len(names) < 2 or baseline != designed, path, "designed",
+          f"another controller than baseline={baseline!r} (Tables 2-3 compare the two)")
+    try:  # the step each controller's sampled loop needs, as run_campaign checks it, but naming the file
+        _check_campaign_step(model, controllers, np.asarray(vs, float), kw["dt"])
+    except ValueError as e:
+        raise ConfigError(f"{path}: dt: {e}") from None
     promised = cfg.get("promised")
-    if promised is not None:
+    if "promised" in cfg:  # a JSON null is not "no promise": leave the key out for that
         _need(isinstance(promised, dict), path, "promised", "a table wind speed (m/s) → promised DEL reduction (%)")
+        out_p = {}
         for k, val in promised.items():
             try:
                 v = float(k)
             except ValueError:
                 raise ConfigError(f"{path}: promised: key {k!r} must be a wind speed in m/s") from None
+            if isinstance(val, dict):  # TOML reads 19.5 = … as the dotted key 19 → 5
+                raise ConfigError(f"{path}: promised.{k} must be a promised reduction in %, got a table; "
+                                  f"quote a decimal wind speed in TOML: \"{k}.{next(iter(val), '5')}\" = …")
             _need(any(abs(v - w) < 1e-9 for w in vs), path, f"promised.{k}", f"at one of the wind_speeds {vs}")
-            _need(_is_number(val), path, f"promised.{k}", "a promised reduction in %")
-        promised = {float(k): float(v) for k, v in promised.items()}
+            _need(_is_number(val) and val < 100, path, f"promised.{k}", "a promised reduction in % (a number < 100)")
+            _need(v not in out_p, path, f"promised.{k}", f"given once (the wind speed {v:g} m/s appears twice)")
+            out_p[v] = float(val)
+        promised = out_p
     output = cfg.get("output", "validation_output")
     _need(isinstance(output, str) and output, path, "output", "a folder name")
-    folder = Path(out if out is not None else path.parent / output)
-    folder.mkdir(parents=True, exist_ok=True)  # OSError (e.g. PermissionError) here, not after the campaign
-    probe = folder / ".specdesign_write_test"
-    probe.write_text("")
-    probe.unlink()
+    if out is not None:
+        folder = _output_folder(Path(out), path, "--out")
+    else:
+        folder = _output_folder(path.parent / output, path, "output")
     kw.update(turbulence_class=tc, linear_twin=twin, volterra=int(vol), model=model)
-    return dict(controllers=controllers, wind_speeds=[float(v) for v in vs], seeds=seeds, kwargs=kw, baseline=baseline,
+    return dict(controllers=controllers, wind_speeds=vs, seeds=seeds, kwargs=kw, baseline=baseline,
                 designed=designed, promised=promised, out=folder)
 
 

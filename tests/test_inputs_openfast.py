@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from specdesign import fatigue, validate as va
 from specdesign.openfast import read_outputs
@@ -74,3 +76,91 @@ def test_binary_header_and_length_must_agree(tmp_path, data, file_id):
         f.write(b"\x00" * 16)  # appended bytes the header does not describe
     with pytest.raises(ValueError, match="binary header describes"):
         read_outputs(p)
+
+
+@pytest.mark.parametrize("unit, factor, si", [
+    ("(kN-m)", 1e3, "N·m"), ("(kNm)", 1e3, "N·m"), ("(kN*m)", 1e3, "N·m"), ("(KN-M)", 1e3, "N·m"),
+    ("(MN-m)", 1e6, "N·m"), ("(N-m)", 1.0, "N·m"), ("(Nm)", 1.0, "N·m"),
+])
+def test_every_spelling_of_a_moment_arrives_in_n_m(tmp_path, data, unit, factor, si):
+    i = NAMES.index("TwrBsMyt")
+    units = list(UNITS)
+    units[i] = unit
+    d = data.copy()
+    d[:, i] = data[:, i] * 1e3 / factor  # the same physical moment (data is in kN·m)
+    write_text(tmp_path / "m.out", d, units=units)
+    out = read_outputs(tmp_path / "m.out", CH)
+    assert out.units["TwrBsMyt"] == si and out.original_units["TwrBsMyt"] == unit.strip("()")
+    np.testing.assert_allclose(out["TwrBsMyt"], data[:, i] * 1e3, rtol=1e-9)
+
+
+def test_milli_is_not_mega(tmp_path, data):
+    # lower-case m is milli: "mN-m" is not converted as if it were MN·m, and the workbench refuses it
+    units = list(UNITS)
+    units[NAMES.index("TwrBsMyt")] = "(mN-m)"
+    write_text(tmp_path / "milli.out", data, units=units)
+    out = read_outputs(tmp_path / "milli.out", CH)
+    assert out.units["TwrBsMyt"] == "mN-m"
+    with pytest.raises(ValueError, match="'TwrBsMyt' is in 'mN-m'"):
+        va.series_from_openfast(out)
+
+
+@pytest.mark.parametrize("unit", ["(ms)", "(min)", "(-)"])
+def test_the_time_must_be_in_seconds(tmp_path, data, unit):
+    units = list(UNITS)
+    units[0] = unit
+    write_text(tmp_path / "t.out", data, units=units)
+    with pytest.raises(ValueError, match=r"t.out: channel 'Time' is in .*seconds"):
+        read_outputs(tmp_path / "t.out")
+
+
+def test_a_file_without_time_channel_is_an_error(tmp_path, data):
+    names = list(NAMES)
+    names[0] = "Clock"
+    write_text(tmp_path / "nt.out", data, names=names)
+    with pytest.raises(ValueError, match="nt.out: no 'Time' channel"):
+        read_outputs(tmp_path / "nt.out")
+
+
+@pytest.mark.parametrize("what, offset, value, match", [
+    ("file id", 0, ("h", 9), "binary file ID 9 is not an OpenFAST output format"),
+    ("channels", 2, ("i", -4), "gives -4 channels"),
+    ("steps", 6, ("i", 0), "0 time steps"),
+])
+def test_a_corrupt_binary_header_is_an_error(tmp_path, data, what, offset, value, match):
+    import struct
+
+    p = tmp_path / "c.outb"
+    write_binary(p, data, file_id=3)
+    raw = bytearray(p.read_bytes())
+    fmt, v = value
+    raw[offset:offset + struct.calcsize(fmt)] = struct.pack(fmt, v)
+    p.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=match):
+        read_outputs(p)
+
+
+def test_a_truncated_binary_file_is_an_error(tmp_path, data):
+    p = tmp_path / "t.outb"
+    write_binary(p, data, file_id=3)
+    p.write_bytes(p.read_bytes()[:-8])
+    with pytest.raises(ValueError, match="binary header describes .* but the file has"):
+        read_outputs(p)
+
+
+def test_a_non_finite_value_names_channel_and_row(tmp_path, data):
+    d = data.copy()
+    d[7, NAMES.index("GenPwr")] = np.nan
+    write_text(tmp_path / "nan.out", d)
+    with pytest.raises(ValueError, match="channel 'GenPwr' has a non-finite value at row 7"):
+        read_outputs(tmp_path / "nan.out")
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(row=st.integers(1, 198), shift=st.floats(-0.2, 0.2).filter(lambda s: abs(s) > 1e-3))
+def test_any_jump_in_the_time_axis_is_found(tmp_path, row, shift):
+    d = _signals()
+    d[row:, 0] += shift
+    write_text(tmp_path / "j.out", d)
+    with pytest.raises(ValueError, match=rf"step {row - 1} is"):
+        read_outputs(tmp_path / "j.out")

@@ -7,9 +7,16 @@ errors for truncated files and missing channels (naming file, line and channel),
 conversion of every selected channel to SI with its original unit recorded.
 
 Unit conversions (exact factors): rpm → rad/s (×2π/60), deg → rad, deg/s → rad/s,
-kN·m → N·m (×1e3), kN → N, kW → W (×1e3), MW → W, MN·m → N·m. Units already SI (s, m,
-m/s, m/s^2, rad, rad/s, N, N·m, W, -) pass through; any other unit is kept unchanged
-and recorded as such (``si_unit == original unit``).
+kN·m → N·m (×1e3), kN → N, kW → W (×1e3), MW → W, MN·m → N·m (spellings kN-m, kNm, kN*m,
+kN.m, kN·m; case-insensitive except the prefix M, mega, against m, milli, which is not
+converted). Units already SI (s, m, m/s, m/s^2, rad, rad/s, N, N·m, W, -) pass through; any
+other unit is kept unchanged and recorded as such (``si_unit == original unit``), and a
+consumer that needs a given SI unit checks ``units`` (``validate.series_from_openfast``
+refuses a tower moment, speed, pitch or power it cannot convert).
+
+Checked on reading, each an error naming the file: a ``Time`` channel in seconds (s or sec),
+distinct channel names, a time axis increasing uniformly, finite values, and for binary
+files a header (file ID 1-4, channel and step counts ≥ 1) that agrees with the file length.
 """
 from __future__ import annotations
 
@@ -68,6 +75,8 @@ def to_si(unit: str) -> tuple[str, float]:
     if u.startswith("(") and u.endswith(")"):
         u = u[1:-1]
     key = u.replace(" ", "").lower()
+    if u[:1] == "m" and key[1:] in ("w", "n", "n-m", "nm", "n.m", "n·m", "n*m"):
+        return u, 1.0  # milli (mW, mN·m), not the mega (MW, MN·m) the table means: not converted
     if key in _UNITS:
         return _UNITS[key]
     return u, 1.0
@@ -170,15 +179,22 @@ def _binary_size(path: Path) -> int:
         if len(head) < 10:
             raise ValueError(f"{path}: truncated OpenFAST binary output ({len(head)} bytes of header)")
         file_id = struct.unpack("h", head[:2])[0]
+        if file_id not in (1, 2, 3, 4):
+            raise ValueError(f"{path}: binary file ID {file_id} is not an OpenFAST output format (1-4)")
         off = 4 if file_id == 4 else 2
         len_name = struct.unpack("h", head[2:4])[0] if file_id == 4 else 10
         n_ch, nt = struct.unpack("ii", head[off:off + 8])
+        if n_ch < 1 or nt < 1 or len_name < 1:
+            raise ValueError(f"{path}: the binary header gives {n_ch} channels, {nt} time steps and {len_name}-character "
+                             "names; a corrupt or non-OpenFAST file")
         pos = off + 8 + 16 + (0 if file_id == 3 else 8 * n_ch)
         f.seek(pos)
         raw = f.read(4)
         if len(raw) < 4:
             raise ValueError(f"{path}: truncated OpenFAST binary output (header ends at byte {pos})")
         len_desc = struct.unpack("i", raw)[0]
+        if len_desc < 0:
+            raise ValueError(f"{path}: the binary header gives a description of {len_desc} bytes; a corrupt file")
     return (pos + 4 + len_desc + 2 * (n_ch + 1) * len_name + (4 * nt if file_id == 1 else 0)
             + nt * n_ch * (8 if file_id == 3 else 2))
 
@@ -224,12 +240,17 @@ def _read_one(path, channels) -> OpenFASTOutput:
     if dup:
         raise ValueError(f"{path}: duplicate channel name(s) {dup}; each OutList channel must appear once")
     idx = {n: i for i, n in enumerate(names)}
-    time_name = next((n for n in names if n.lower() == "time"), names[0])
+    time_name = next((n for n in names if n.lower() == "time"), None)
+    if time_name is None:
+        raise ValueError(f"{path}: no 'Time' channel among {names[:8]}{' …' if len(names) > 8 else ''}; "
+                         "an OpenFAST output starts with Time (s)")
     wanted = [n for n in names if n != time_name] if channels is None else list(channels)
     missing = [n for n in wanted if n not in idx]
     if missing:
         raise ValueError(f"{path}: channel(s) {missing} not found; available: {[n for n in names if n != time_name]}")
     t_unit, t_fac = to_si(units[idx[time_name]])
+    if t_unit != "s":
+        raise ValueError(f"{path}: channel {time_name!r} is in {units[idx[time_name]]!r}; the time must be in seconds (s)")
     time = data[:, idx[time_name]] * t_fac
     out, si_units, orig = {}, {}, {}
     for n in wanted:
