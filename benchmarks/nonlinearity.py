@@ -16,8 +16,10 @@ F  frequency range and wind spectrum: synthesised variance vs ∫S_W, prediction
 G  a quasi-static operating-point mixture of linear predictions (does it explain the rest?).
 
 Run: python benchmarks/nonlinearity.py [--seeds 40] [--speed 19] [--quick]
-Controllers are designed on the fly (≈ 10 s per speed) and cached as JSON in build/cache,
-keyed by the design code and library versions.
+Controllers are designed on the fly (≈ 10 s per speed) and cached as JSON in build/cache
+(inside the project, git-ignored), keyed by a hash of the code that designs them (every
+module of specdesign/ and loopshaping/, the package data), the turbine model's parameters,
+the wind speed and the library versions: any change is a new key, never a stale design.
 """
 from __future__ import annotations
 
@@ -210,42 +212,66 @@ def rosco_integral_scheduled(model, v, dt=DT, wind_speeds=None, filter_omega=0.1
 
 # ----------------------------------------------------------------------------- helpers
 CACHE = Path(__file__).resolve().parents[1] / "build" / "cache"  # the project's build folder (git-ignored)
-# the code a design depends on: a change to any of it (or to numpy/scipy/control) is a new key
-_DESIGN_SOURCES = ("specdesign/qft.py", "specdesign/spec.py", "specdesign/turbine.py", "specdesign/closedloop.py",
-                   "specdesign/spectral.py", "specdesign/wind.py", "loopshaping/qft.py", "loopshaping/check.py")
+# the code a design depends on: every module of both packages and the shipped data (a design
+# reaches through many of them; hashing them all can only invalidate too often, never too rarely)
+_DESIGN_SOURCES = ("specdesign", "loopshaping")
 
 
-def _design_file(v):
+def _design_key(model, v) -> str:
+    """sha256 of the design code, the package data, the model's parameters, v and the library
+    versions: what ``design_qft(model, v)`` depends on."""
+    import dataclasses
     import hashlib
-
-    import control
-    import scipy
+    import importlib.metadata as md
 
     root = Path(__file__).resolve().parents[1]
     h = hashlib.sha256()
-    for rel in _DESIGN_SOURCES:
-        h.update((root / rel).read_bytes())
-    h.update(f"design_qft(iea15mw(), {v!r}) numpy {np.__version__} scipy {scipy.__version__} "
-             f"control {control.__version__}".encode())
-    return CACHE / f"qft_{v:g}mps_{h.hexdigest()[:16]}.json"
+    for pkg in _DESIGN_SOURCES:
+        for f in sorted((root / pkg).rglob("*")):
+            if f.is_file() and (f.suffix == ".py" or "data" in f.relative_to(root / pkg).parts):
+                h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+    for fld in dataclasses.fields(model):
+        val = getattr(model, fld.name)
+        h.update(fld.name.encode() + b"=" + (np.ascontiguousarray(val).tobytes() if isinstance(val, np.ndarray)
+                                             else repr(val).encode()) + b"\0")
+    versions = []
+    for lib in ("numpy", "scipy", "control", "cvxpy", "numba"):
+        try:
+            versions.append(f"{lib} {md.version(lib)}")
+        except md.PackageNotFoundError:
+            versions.append(f"{lib} -")
+    h.update(f"design_qft(model, {float(v)!r}) {'; '.join(versions)}".encode())
+    return h.hexdigest()
+
+
+def _design_file(model, v):
+    return CACHE / f"qft_{float(v):g}mps_{_design_key(model, v)[:20]}.json"
 
 
 def designs_for(model, v):
-    """(C_β, C_atd) of design_qft(model, v), cached as JSON transfer functions keyed by the
-    design code, the library versions and the options (benchmarks reuse them between runs)."""
+    """(C_β, C_atd) of design_qft(model, v), cached as JSON transfer functions under
+    build/cache, keyed by the design code, the model, v and the library versions
+    (:func:`_design_key`); an unreadable cache file is designed again and replaced."""
+    import os
+
     import control
 
     from specdesign.qft import design_qft
 
-    f = _design_file(v)
+    f = _design_file(model, v)
     if f.exists():
-        data = json.loads(f.read_text())
-        return tuple(control.tf(c["num"], c["den"]) for c in (data["pitch"], data["atd"]))
+        try:
+            data = json.loads(f.read_text())
+            return tuple(control.tf(data[k]["num"], data[k]["den"]) for k in ("pitch", "atd"))
+        except (ValueError, KeyError, TypeError) as e:
+            print(f"cache file {f} is unreadable ({e}); designing again")
     d = design_qft(model, v)
     out = (d.pitch_controller, d.atd_controller)
     f.parent.mkdir(parents=True, exist_ok=True)
-    f.write_text(json.dumps({k: {"num": list(map(float, c.num[0][0])), "den": list(map(float, c.den[0][0]))}
-                             for k, c in zip(("pitch", "atd"), out)}))
+    tmp = f.with_name(f"{f.name}.{os.getpid()}.tmp")  # written whole, then renamed: no half-written cache file
+    tmp.write_text(json.dumps({k: {"num": list(map(float, c.num[0][0])), "den": list(map(float, c.den[0][0]))}
+                               for k, c in zip(("pitch", "atd"), out)}))
+    os.replace(tmp, f)
     return out
 
 
@@ -509,7 +535,7 @@ def main(argv=None):
               f"(ROSCO DEL {mix['ROSCO'] / 1e6:.1f}, QFT {mix['QFT'] / 1e6:.1f} MN·m) vs {pr:.2f} % at the trim")
     # H ---------------------------------------------------------------------------------
     sched_speeds = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
-    if not args.quick and all(_design_file(s).exists() for s in sched_speeds):
+    if not args.quick and all(_design_file(model, s).exists() for s in sched_speeds):
         from specdesign.simulate import rosco_scheduled
 
         ds = {s: designs_for(model, s) for s in sched_speeds}
