@@ -57,6 +57,7 @@ import numpy as np
 from numba import njit, prange
 
 from ._checks import positive_scalar
+from .rosco import rosco_scheduled
 from .turbine import outputs as _turbine_outputs
 from .turbine import rhs as _turbine_rhs
 
@@ -441,48 +442,6 @@ def scheduled(model, pitch, atd=None, *, filter_omega=SCHEDULE_FILTER_OMEGA, nam
         filter_omega=filter_omega,
         name=name,
     )
-
-
-def rosco_scheduled(model=None, wind_speeds=None, *, name="ROSCO", form="gains") -> ScheduledController:
-    """The ROSCO baseline PI (tower damping off) with its gain schedule on filtered pitch.
-
-    ``form="gains"`` (default) is ROSCO's own scheduling: K_p and K_i of
-    ``turbine.rosco_baseline(model, v)`` at ``wind_speeds`` (m/s; default every whole m/s where
-    the model's above-rated range and the gain schedule overlap: 12-25 m/s), placed at each speed's trim pitch, interpolated linearly in
-    the filtered pitch command, applied to one error filtered by ``turbine.speed_filter()``
-    with one integrator of K_i(β_f)·e_f, integrator and output saturated at the model's pitch
-    limits as ROSCO's PI does (anti-windup). ``form="output"`` blends the outputs of the local
-    PIs instead (the general scheme of :func:`scheduled`; kept for comparison).
-    """
-    from . import turbine
-
-    if model is None:
-        model = turbine.iea15mw()
-    # The gains of turbine.rosco_baseline: pole placement on the straight-line fits of A, B_β.
-    sched = turbine.rosco_gain_schedule(model)
-    if wind_speeds is None:  # every whole m/s where both the model and the gain schedule hold
-        lo, hi = getattr(model, "wind_range", (11.0, 25.0))
-        lo, hi = max(lo, float(np.min(sched.v))), min(hi, float(np.max(sched.v)))
-        wind_speeds = np.arange(math.ceil(lo), math.floor(hi) + 0.5, 1.0)
-    vs = [float(v) for v in np.atleast_1d(np.asarray(wind_speeds, dtype=float))]
-    if form == "output":
-        return scheduled(model, {v: turbine.rosco_baseline(model, v) for v in vs}, name=name)
-    if form != "gains":
-        raise ValueError(f"form must be one of {_FORMS}, got {form!r}")
-    v = np.array(sorted(set(vs)))
-    kp, ki = sched.gains(v)
-    plant = turbine_plant(model)
-    beta = np.array([plant.trim(s)[1] for s in v])
-    order = np.argsort(beta)
-    sc = ScheduledController.gain_scheduled_pi(beta[order], kp[order], ki[order], turbine.speed_filter(), name=name,
-                                               pitch_limits=(model.pitch_min, model.pitch_max))
-    # Same controller as rosco_baseline at each speed (checked against its transfer function).
-    jw = 1j * np.array([0.05, 0.5, 2.0])
-    for k, s in enumerate(v[order]):
-        ref = np.asarray(turbine.rosco_baseline(model, float(s), schedule=sched)(jw), complex)
-        if not np.allclose(np.asarray(sc.pitch[k](jw), complex), ref, rtol=1e-9, atol=0):
-            raise RuntimeError(f"rosco_scheduled's gains at {s:g} m/s differ from turbine.rosco_baseline")
-    return sc
 
 
 _BANKS: dict = {}

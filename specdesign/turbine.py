@@ -1,4 +1,4 @@
-"""The embedded IEA 15 MW reduced-order model: trim, linearisation and the ROSCO baseline.
+"""The embedded IEA 15 MW reduced-order model: trim and linearisation (ROSCO: :mod:`specdesign.rosco`).
 
 The model: rigid-drivetrain rotor (aerodynamic torque from Cp(λ, β), thrust from Ct(λ, β)),
 first tower fore-aft mode driven by thrust with the rotor seeing the relative wind U − ẋ_top,
@@ -444,7 +444,11 @@ class TurbineModel:
         return x
 
     # -- trim and linearisation -------------------------------------------------------------
-    def _check_wind(self, wind_speed):
+    def check_wind_speed(self, wind_speed) -> float:
+        """``wind_speed`` (m/s) as a float, checked to be within ``wind_range``.
+
+        Raises ValueError outside the above-rated range where the model is valid.
+        """
         v = positive_scalar(wind_speed, "wind_speed")
         lo, hi = self.wind_range
         if not lo <= v <= hi:
@@ -453,6 +457,8 @@ class TurbineModel:
                 "constant-torque, pitch-regulated model is valid"
             )
         return v
+
+    _check_wind = check_wind_speed  # TODO(issue 13): remove once callers switch
 
     def _aero_torque(self, wind, omega, pitch):
         x = np.array([omega, 0.0, 0.0, pitch, 0.0])
@@ -467,7 +473,7 @@ class TurbineModel:
         """
         from scipy.optimize import brentq
 
-        v = self._check_wind(wind_speed)
+        v = self.check_wind_speed(wind_speed)
         omega = self.rated_rotor_speed
         torque = self.rated_generator_torque
 
@@ -666,107 +672,24 @@ def iea15mw() -> TurbineModel:
     )
 
 
-# ----------------------------------------------------------------------------- ROSCO baseline
-@dataclass(frozen=True)
-class RoscoSchedule:
-    """ROSCO's pitch PI gain schedule computed from a :class:`TurbineModel`.
-
-    Arrays over ``v`` (m/s): ``pitch_op`` (rad), ``Kp`` (s), ``Ki`` (-), and the first-order
-    rotor model δΩ̇ = A δΩ + B_beta δβ + B_wind δv: ``A`` (1/s), ``B_beta`` (1/s²),
-    ``B_wind`` (rad/m). ``A_fit`` and ``B_beta_fit`` are the straight-line fits over ``v`` that
-    ROSCO's tuning uses for the gains (``second_order_PI(..., linearize=True)``).
-    Gains follow ROSCO's sign: pitch = Kp·e + Ki∫e with e = reference − filtered speed.
-    """
-
-    v: np.ndarray
-    pitch_op: np.ndarray
-    Kp: np.ndarray
-    Ki: np.ndarray
-    A: np.ndarray
-    B_beta: np.ndarray
-    B_wind: np.ndarray
-    A_fit: np.ndarray
-    B_beta_fit: np.ndarray
-    omega_pc: float
-    zeta_pc: float
-
-    def gains(self, wind_speeds):
-        """(Kp, Ki) at ``wind_speeds`` (m/s; scalar or array) from the straight-line fits of A
-        and B_β over ``v``, by the same pole placement as ``Kp``, ``Ki`` (ROSCO's sign).
-
-        Raises ValueError outside the schedule's wind speeds: the line fits are not
-        extrapolated (ROSCO's own schedule ends there too).
-        """
-        v = np.asarray(wind_speeds, dtype=float)
-        lo, hi = float(np.min(self.v)), float(np.max(self.v))
-        if not np.all(np.isfinite(v)) or np.any(v < lo - 1e-9) or np.any(v > hi + 1e-9):
-            raise ValueError(f"wind_speeds={wind_speeds!r} m/s: the gain schedule covers {lo:g}-{hi:g} m/s only "
-                             "(build it over a wider range with rosco_gain_schedule(model, wind_speeds=...))")
-        a = np.polyval(np.polyfit(self.v, self.A, 1), v)
-        b = np.polyval(np.polyfit(self.v, self.B_beta, 1), v)
-        return (2 * self.zeta_pc * self.omega_pc + a) / b, self.omega_pc**2 / b
+# ----------------------------------------------------------------------------- ROSCO (specdesign.rosco)
+#: Names that live in :mod:`specdesign.rosco` and stay importable from here (public contract:
+#: ``specdesign.turbine.rosco_baseline``). Resolved on first access: :mod:`specdesign.rosco`
+#: imports this module, so importing it here at load time would be circular.
+_ROSCO_NAMES = ("RoscoSchedule", "rosco_gain_schedule", "speed_filter", "rosco_baseline")
 
 
-def _rotor_coefficients(model: TurbineModel, v: float):
-    """(pitch_op, A, B_beta, B_wind) of the rotor equation at the trim, from the kernel's Jacobian."""
-    op = model.trim(v)
-    A, B, _, _ = model.jacobians(op)
-    # Row 0 is δΩ̇; column 3 is the pitch state, input 0 the wind.
-    return op.pitch, A[0, 0], A[0, 3], B[0, 0]
+def __getattr__(name):
+    if name in _ROSCO_NAMES:
+        from . import rosco
+
+        return getattr(rosco, name)
+    if name == "_rotor_coefficients":  # TODO(issue 13): remove once callers switch
+        from .rosco import first_order_rotor_model
+
+        return first_order_rotor_model
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def rosco_gain_schedule(model: TurbineModel, wind_speeds=None, *, omega_pc: float = 0.2, zeta_pc: float = 1.0) -> RoscoSchedule:
-    """ROSCO's pitch PI schedule by pole placement on the first-order rotor model.
-
-    With e = Ω_ref − Ω and β = Kp·e + Ki∫e, the closed rotor loop is
-    s² + (B_β·Kp − A)s + B_β·Ki; matching s² + 2ζ_pc ω_pc s + ω_pc² gives
-    Kp = (2ζ_pc ω_pc + A)/B_β and Ki = ω_pc²/B_β, where, as in ROSCO, A and B_β are replaced
-    by their straight-line fits over ``wind_speeds``.
-
-    wind_speeds (m/s): default ROSCO's grid, 30 speeds from rated (exclusive) to 25 m/s.
-    omega_pc (rad/s), zeta_pc (-): desired closed-loop rotor-speed poles.
-    """
-    omega_pc = positive_scalar(omega_pc, "omega_pc")
-    zeta_pc = positive_scalar(zeta_pc, "zeta_pc")
-    if wind_speeds is None:
-        wind_speeds = np.linspace(model.rated_wind_speed(), model.wind_range[1], 31)[1:]
-    v = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
-    if v.ndim != 1 or v.size < 2:
-        raise ValueError(f"wind_speeds must be a 1-D array of at least 2 speeds in m/s (the gains use a line fit), got shape {v.shape}")
-    rows = np.array([_rotor_coefficients(model, s) for s in v])
-    pitch, A, Bb, Bw = rows.T
-    A_fit = np.polyval(np.polyfit(v, A, 1), v)
-    B_fit = np.polyval(np.polyfit(v, Bb, 1), v)
-    return RoscoSchedule(
-        v=v, pitch_op=pitch, Kp=(2 * zeta_pc * omega_pc + A_fit) / B_fit, Ki=omega_pc**2 / B_fit,
-        A=A, B_beta=Bb, B_wind=Bw, A_fit=A_fit, B_beta_fit=B_fit, omega_pc=omega_pc, zeta_pc=zeta_pc,
-    )
-
-
-def speed_filter(corner: float = 1.0081, damping: float = 0.7):
-    """ROSCO's 2nd-order generator-speed low-pass F(s) = ω_f²/(s² + 2ζω_f s + ω_f²), ω_f in rad/s."""
-    import control
-
-    wf = positive_scalar(corner, "corner")
-    z = positive_scalar(damping, "damping")
-    return control.tf([wf**2], [1.0, 2 * z * wf, wf**2])
-
-
-def rosco_baseline(model: TurbineModel, wind_speed, *, omega_pc: float = 0.2, zeta_pc: float = 1.0, schedule: RoscoSchedule | None = None):
-    """ROSCO's baseline pitch controller at ``wind_speed`` (m/s) as C(s) = (Kp + Ki/s)·F_lpf(s).
-
-    Sign convention of the workbench: β = −C·Ω_g (pitch in rad, generator speed in rad/s), so
-    ROSCO's negative gains on e = reference − speed give C directly, and L = C·P_{Ω,β} has both
-    factors negative at low frequency. Kp, Ki come from the straight-line fits of
-    :func:`rosco_gain_schedule` (default grid) evaluated at ``wind_speed``; F_lpf is
-    :func:`speed_filter`. Tower damping off, as in the paper's baseline.
-    """
-    import control
-
-    v = model._check_wind(wind_speed)
-    if schedule is None:
-        schedule = rosco_gain_schedule(model, omega_pc=omega_pc, zeta_pc=zeta_pc)
-    kp, ki = (float(g) for g in schedule.gains(v))
-    pi = control.tf([kp, ki], [1.0, 0.0])
-    c = pi * speed_filter()
-    return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=f"ROSCO_PI@{v:g}mps".replace(".", "p"))
+def __dir__():
+    return sorted(set(globals()) | set(_ROSCO_NAMES) | {"_rotor_coefficients"})
