@@ -58,6 +58,7 @@ from numba import njit, prange
 
 from ._checks import positive_scalar
 from .rosco import rosco_scheduled
+from .wind import seed_for, wind_series
 from .turbine import outputs as _turbine_outputs
 from .turbine import rhs as _turbine_rhs
 
@@ -805,30 +806,6 @@ class SimulationResult:
     def duration(self) -> float:
         """Length of each recorded run, s (n_samples × dt)."""
         return float(self.time.size * self.dt)
-
-
-def seed_for(wind_speed: float, seed: int) -> int:
-    """Integer seed of the wind series for (wind speed, seed): ``seed·1000 + round(10·v)``.
-
-    Every (v, seed) pair gets its own series (v < 100 m/s), and two controllers run with the
-    same seed see exactly the same wind: the paired comparison of the validation.
-    """
-    return int(seed) * 1000 + int(round(10.0 * float(wind_speed)))
-
-
-def wind_series(rotor_radius, wind_speeds, seeds, duration, dt, turbulence_class="B"):
-    """Rotor-effective wind (W, S, n) in m/s: mean plus :func:`specdesign.wind.synthesize` of
-    :func:`specdesign.wind.rotor_effective_spectrum` at each mean speed, seeds from :func:`seed_for`."""
-    from . import wind as wmod
-
-    out = []
-    for v in wind_speeds:
-        def spec(om, v=v):
-            return wmod.rotor_effective_spectrum(om, v, rotor_radius, turbulence_class=turbulence_class)
-
-        s = wmod.synthesize(spec, duration, dt, [seed_for(v, s) for s in seeds])
-        out.append(v + np.asarray(s, dtype=float))
-    return np.stack(out)
 
 
 def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=600.0, dt=0.02,

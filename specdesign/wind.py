@@ -8,6 +8,8 @@ All spectra are one-sided and per rad/s (∫₀^∞ S(ω) dω = variance, (m/s)�
   coherence, γ(f) = ∫₀^{2R} exp(−12 √((f r/U)² + (0.12 r/L_c)²)) p_R(r) dr, with p_R the
   density of the distance between two random points of the disc and L_c = 8.1·42 m.
 - :func:`synthesize`: Gaussian time series with a given one-sided PSD, reproducible per seed.
+- :func:`wind_series`: the rotor-effective wind records the simulator runs on, one per
+  (mean wind speed, seed), seeded by :func:`seed_for`.
 """
 from __future__ import annotations
 
@@ -16,7 +18,8 @@ import numpy as np
 
 from ._checks import as_omega, positive_scalar
 
-__all__ = ["TURBULENCE_CLASSES", "kaimal_spectrum", "disc_coherence", "rotor_effective_spectrum", "synthesize"]
+__all__ = ["TURBULENCE_CLASSES", "kaimal_spectrum", "disc_coherence", "rotor_effective_spectrum", "synthesize", "seed_for",
+           "wind_series"]
 
 #: IEC 61400-1 ed. 3/4 reference turbulence intensities I_ref by turbulence class.
 TURBULENCE_CLASSES = {"A+": 0.18, "A": 0.16, "B": 0.14, "C": 0.12}
@@ -147,3 +150,71 @@ def synthesize(spectrum_or_callable, duration, dt, seeds, *, random_amplitude=Tr
         spec[row, k] = z * amp
     # irfft(Y)[t] = (1/n)[Y0 + 2 Σ Re(Y_k e^{2πikt/n}) ...], so Y_k = n X_k / 2 gives Σ Re(X_k e^{iω_k t}).
     return np.fft.irfft(spec * (n / 2), n=n, axis=-1)
+
+
+def seed_for(wind_speed: float, seed: int) -> int:
+    """Integer seed of the wind series for (wind speed, seed): ``seed·1000 + round(10·v)``.
+
+    Every (v, seed) pair gets its own series (v < 100 m/s), and two controllers run with the
+    same seed see exactly the same wind: the paired comparison of the validation.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Mean wind speed v (m/s).
+    seed : int
+        The run's seed.
+
+    Returns
+    -------
+    int
+        The seed of :func:`synthesize` for that record.
+
+    Examples
+    --------
+    >>> seed_for(19.0, 3)
+    3190
+    """
+    return int(seed) * 1000 + int(round(10.0 * float(wind_speed)))
+
+
+def wind_series(rotor_radius: float, wind_speeds, seeds, duration: float, dt: float,
+                turbulence_class: str = "B") -> np.ndarray:
+    """Rotor-effective wind records: the mean plus turbulence, one per (wind speed, seed).
+
+    Each record is its mean speed plus :func:`synthesize` of :func:`rotor_effective_spectrum`
+    at that speed, seeded by :func:`seed_for`, so a record depends on (v, seed) only.
+
+    Parameters
+    ----------
+    rotor_radius : float
+        Rotor radius (m) of the rotor-disc coherence.
+    wind_speeds : sequence of float
+        Mean wind speeds (m/s), W of them.
+    seeds : sequence of int
+        Seeds, S of them.
+    duration : float
+        Length of each record (s).
+    dt : float
+        Sample spacing (s).
+    turbulence_class : str, optional
+        IEC turbulence class: "A+", "A", "B" or "C".
+
+    Returns
+    -------
+    numpy.ndarray
+        Wind speed (m/s), shape (W, S, round(duration/dt)).
+
+    Examples
+    --------
+    >>> wind_series(120.0, [19.0], [1, 2], 60.0, 0.1).shape
+    (1, 2, 600)
+    """
+    out = []
+    for v in wind_speeds:
+        def spec(om, v=v):
+            return rotor_effective_spectrum(om, v, rotor_radius, turbulence_class=turbulence_class)
+
+        s = synthesize(spec, duration, dt, [seed_for(v, s) for s in seeds])
+        out.append(v + np.asarray(s, dtype=float))
+    return np.stack(out)
