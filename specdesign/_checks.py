@@ -11,8 +11,11 @@ __all__ = ["as_omega", "as_psd", "as_signal", "as_real", "positive_scalar"]
 
 
 def as_real(x, name: str) -> np.ndarray:
-    """``x`` as a float64 array; complex input is a TypeError (taking its real part silently
-    would drop the imaginary part of, e.g., a frequency response passed where |T|² belongs)."""
+    """``x`` (argument ``name``, any unit) as a float64 array; complex or non-numeric input is a TypeError.
+
+    Taking the real part silently would drop the imaginary part of, e.g., a frequency response
+    passed where |T|² belongs.
+    """
     a = np.asarray(x)
     if np.iscomplexobj(a):
         raise TypeError(f"{name} is complex; pass real values (e.g. np.abs(T)**2 for a squared magnitude, "
@@ -44,7 +47,7 @@ def as_omega(omega, name: str = "omega", *, allow_zero: bool = True) -> np.ndarr
 
 
 def as_psd(psd, n: int, name: str = "psd") -> np.ndarray:
-    """Validate a one-sided PSD stack of shape (..., n): finite, non-negative."""
+    """Validate a one-sided PSD stack (load units² per rad/s) of shape (..., n): finite, non-negative."""
     s = as_real(psd, name)
     if s.ndim == 0 or s.shape[-1] != n:
         raise ValueError(f"{name} must have shape (..., {n}) to match the frequency grid, got {s.shape}")
@@ -57,7 +60,7 @@ def as_psd(psd, n: int, name: str = "psd") -> np.ndarray:
 
 
 def as_signal(x, name: str = "x", *, min_samples: int = 2) -> np.ndarray:
-    """Validate a 1-D, finite time series."""
+    """Validate a 1-D, finite time series (load units) of at least ``min_samples`` samples."""
     a = as_real(x, name)
     if a.ndim != 1:
         raise ValueError(f"{name} must be a 1-D time series, got shape {a.shape}")
@@ -69,7 +72,7 @@ def as_signal(x, name: str = "x", *, min_samples: int = 2) -> np.ndarray:
 
 
 def positive_scalar(value, name: str) -> float:
-    """Validate a finite, strictly positive real scalar."""
+    """Validate a finite, strictly positive real scalar (in the unit of argument ``name``) and return it as a float."""
     if np.iscomplexobj(value):
         raise TypeError(f"{name} is complex; pass a real number")
     try:
@@ -82,12 +85,14 @@ def positive_scalar(value, name: str) -> float:
 
 
 def representable(value, positive, what: str, hint: str) -> np.ndarray:
-    """``value`` unchanged if float64 holds it: finite, and a normal number (>= ~2.2e-308 in
-    magnitude) wherever ``positive`` (a bool array, or a bool) says the true value is nonzero.
+    """Return ``value`` (a damage, any unit) unchanged if float64 holds it, else raise OverflowError naming ``what``.
 
-    Otherwise OverflowError naming ``what`` (e.g. "damage_rate(m=50)") with ``hint``: a damage
-    ∝ load^m leaves float64's range both ways at a large Wöhler exponent, and an inf or a 0
-    in its place would only turn up later as a silently wrong ratio or DEL.
+    Held means finite, and a normal number (>= ~2.2e-308 in magnitude) wherever ``positive``
+    (a bool array, or a bool) says the true value is nonzero.
+
+    The error names ``what`` (e.g. "damage_rate(m=50)") and adds ``hint``: a damage ∝ load^m
+    leaves float64's range both ways at a large Wöhler exponent, and an inf or a 0 in its
+    place would only turn up later as a silently wrong ratio or DEL.
     """
     v = np.asarray(value)
     mag = np.abs(v)

@@ -14,10 +14,12 @@ half cycle (which carries no damage anyway).
 """
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from ._checks import as_real, as_signal, positive_scalar, representable
 
@@ -36,16 +38,24 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Cycles:
-    """Rainflow cycles of one signal.
+    """Rainflow cycles of one signal, as returned by :func:`rainflow`.
 
-    Attributes
+    ``len(cycles)`` is the number of entries (full and half cycles alike); :attr:`total`
+    counts half cycles 0.5.
+
+    Parameters
     ----------
-    ranges : ndarray
-        Cycle ranges (peak-to-valley), in the units of the signal.
-    means : ndarray
+    ranges : ndarray, shape (k,)
+        Cycle ranges (peak-to-valley, not amplitudes), in the units of the signal.
+    means : ndarray, shape (k,)
         Cycle means, in the units of the signal.
-    counts : ndarray
+    counts : ndarray, shape (k,)
         1.0 for full cycles, 0.5 for half cycles of the residue.
+
+    See Also
+    --------
+    rainflow : Counts them.
+    miner_damage : Their damage on an S-N curve.
     """
 
     ranges: np.ndarray
@@ -173,7 +183,7 @@ def _rainflow_periodic(x):
     return ranges[:nc], means[:nc], counts[:nc]
 
 
-def rainflow(x, residue: str = "half") -> Cycles:
+def rainflow(x: ArrayLike, residue: str = "half") -> Cycles:
     """Rainflow-count a time series (ASTM E1049 three-point method, exact, no binning).
 
     Parameters
@@ -191,6 +201,33 @@ def rainflow(x, residue: str = "half") -> Cycles:
     Cycles
         ``ranges`` (peak to valley), ``means`` and ``counts`` (1.0 or 0.5), in counting order.
         A constant signal gives no cycles.
+
+    Raises
+    ------
+    ValueError
+        If ``residue`` is not "half" or "periodic", or ``x`` is not 1-D, has fewer than 2
+        samples or contains NaN or inf.
+    TypeError
+        If ``x`` is complex or not numeric.
+
+    See Also
+    --------
+    del_rainflow : The damage equivalent load of the counted cycles.
+
+    Examples
+    --------
+    >>> from specdesign.fatigue import rainflow
+    >>> c = rainflow([0.0, 3.0, 1.0, 4.0, 0.0])
+    >>> c.ranges, c.counts
+    (array([2., 4., 4.]), array([1. , 0.5, 0.5]))
+    >>> c.total
+    2.0
+
+    One period of a periodic record: the two half cycles of the residue close into one.
+
+    >>> c = rainflow([0.0, 3.0, 1.0, 4.0, 0.0], residue="periodic")
+    >>> c.ranges, c.counts
+    (array([2., 4.]), array([1., 1.]))
     """
     if residue not in ("half", "periodic"):
         raise ValueError(f"residue={residue!r} must be 'half' or 'periodic'")
@@ -223,8 +260,35 @@ class SNCurve:
     knee_cycles : float or None
         Cycle count at the knee (e.g. 1e7), None for a single slope.
     m2 : float or None
-        Exponent below the knee (required with ``knee_cycles``); use a large value for an
+        Exponent below the knee (> 0, required with ``knee_cycles``); use a large value for an
         endurance limit.
+
+    Raises
+    ------
+    ValueError
+        If ``m``, ``s_ref``, ``knee_cycles`` or ``m2`` is not finite and > 0, or only one of
+        ``knee_cycles`` and ``m2`` is given.
+    TypeError
+        If one of them is complex or not a number.
+
+    See Also
+    --------
+    miner_damage : Palmgren-Miner damage of cycles on this curve.
+
+    Examples
+    --------
+    >>> from specdesign.fatigue import SNCurve
+    >>> sn = SNCurve(m=4, s_ref=100.0)               # fails in 1 cycle at a range of 100
+    >>> sn.cycles_to_failure([10.0, 50.0, 0.0])
+    array([10000.,    16.,    inf])
+
+    Bilinear, with slope 5 below the knee at 1e6 cycles:
+
+    >>> sn = SNCurve(m=3, s_ref=1000.0, knee_cycles=1e6, m2=5.0)
+    >>> print(f"{sn.knee_range:.6g}")
+    10
+    >>> print(", ".join(f"{n:.6g}" for n in sn.cycles_to_failure([20.0, 5.0])))
+    125000, 3.2e+07
     """
 
     m: float
@@ -248,11 +312,27 @@ class SNCurve:
             return None
         return self.s_ref * self.knee_cycles ** (-1.0 / self.m)
 
-    def cycles_to_failure(self, ranges) -> np.ndarray:
+    def cycles_to_failure(self, ranges: ArrayLike) -> np.ndarray:
         """N(S) for ranges S (load units); a zero range never fails (inf).
 
         At a large exponent N itself may leave float64's range (inf above ~1.8e308 cycles,
         0 below ~1e-308): :func:`miner_damage` and :func:`del_rainflow` never form it.
+
+        Parameters
+        ----------
+        ranges : array_like
+            Cycle ranges S (peak to valley, load units), >= 0. Not validated beyond being
+            real: a negative or NaN range gives a meaningless N.
+
+        Returns
+        -------
+        ndarray
+            Cycles to failure N(S) (dimensionless), same shape as ``ranges``.
+
+        Raises
+        ------
+        TypeError
+            If ``ranges`` is complex or not numeric.
         """
         s = as_real(ranges, "ranges")
         with np.errstate(divide="ignore"):
@@ -263,15 +343,49 @@ class SNCurve:
         return n
 
 
-def miner_damage(ranges, counts, sn: SNCurve) -> float:
+def miner_damage(ranges: ArrayLike, counts: ArrayLike, sn: SNCurve) -> float:
     """Palmgren-Miner damage Σ n_i / N(S_i) (dimensionless) for cycle ranges S_i (load units).
 
-    ``counts`` are the cycle counts n_i (0.5 for half cycles); ``sn`` is a range-based
-    :class:`SNCurve`.
+    Computed as Σ n_i (S_i/S_ref)^m (N itself is never formed), piecewise for a bilinear
+    curve.
 
-    Raises OverflowError when the damage is outside float64's range (above ~1.8e308, or a
-    nonzero damage below ~2.2e-308: ranges far from S_ref at a large exponent) instead of
-    returning inf or 0; the DEL (:func:`del_rainflow`) is computed scaled and stays finite.
+    Parameters
+    ----------
+    ranges : array_like, shape (k,)
+        Cycle ranges S_i (peak to valley, not amplitudes), load units; finite, >= 0.
+    counts : array_like, shape (k,)
+        Cycle counts n_i (1 for full cycles, 0.5 for half cycles); finite, >= 0.
+    sn : SNCurve
+        Range-based S-N curve, in the load units of ``ranges``.
+
+    Returns
+    -------
+    float
+        The damage D (dimensionless; failure at D = 1) of the cycles, not a rate: divide by
+        the record's duration (s) for a damage per second.
+
+    Raises
+    ------
+    TypeError
+        If ``sn`` is not an :class:`SNCurve`, or ``ranges``/``counts`` are complex or not
+        numeric.
+    ValueError
+        If ``ranges`` and ``counts`` are not 1-D of the same length, or have NaN, inf or
+        negative values.
+    OverflowError
+        If the damage is outside float64's range (above ~1.8e308, or a nonzero damage below
+        ~2.2e-308: ranges far from S_ref at a large exponent) instead of returning inf or 0;
+        the DEL (:func:`del_rainflow`) is computed scaled and stays finite.
+
+    Examples
+    --------
+    >>> from specdesign.fatigue import SNCurve, miner_damage, rainflow
+    >>> sn = SNCurve(m=3, s_ref=10.0)
+    >>> print(f"{miner_damage([2.0, 4.0], [1.0, 0.5], sn):.6f}")   # 0.2³ + 0.5 · 0.4³
+    0.040000
+    >>> c = rainflow([0.0, 3.0, 1.0, 4.0, 0.0])
+    >>> print(f"{miner_damage(c.ranges, c.counts, sn):.6f}")
+    0.072000
     """
     if not isinstance(sn, SNCurve):
         raise TypeError(f"sn must be an SNCurve, got {type(sn).__name__}")
@@ -296,12 +410,39 @@ def miner_damage(ranges, counts, sn: SNCurve) -> float:
     return d
 
 
-def goodman_ranges(ranges, means, ultimate) -> np.ndarray:
+def goodman_ranges(ranges: ArrayLike, means: ArrayLike, ultimate: float) -> np.ndarray:
     """Goodman mean correction: equivalent zero-mean ranges S/(1 - |mean|/ultimate).
 
-    ``ultimate`` is the ultimate load in the units of the signal. Tensile and compressive
-    means are both treated as harmful (|mean|), the usual conservative choice for bending
-    moments. A cycle whose |mean| reaches the ultimate load is a static failure: ValueError.
+    Tensile and compressive means are both treated as harmful (|mean|), the usual
+    conservative choice for bending moments.
+
+    Parameters
+    ----------
+    ranges : array_like
+        Cycle ranges S (peak to valley), load units.
+    means : array_like
+        Cycle means, load units; same shape as ``ranges``.
+    ultimate : float
+        Ultimate load (> 0) in the units of the signal.
+
+    Returns
+    -------
+    ndarray
+        Equivalent zero-mean ranges, load units, same shape as ``ranges``.
+
+    Raises
+    ------
+    ValueError
+        If ``ranges`` and ``means`` differ in shape, ``ultimate`` is not finite and > 0, or
+        a cycle's |mean| reaches the ultimate load (a static failure).
+    TypeError
+        If an argument is complex or not numeric.
+
+    Examples
+    --------
+    >>> from specdesign.fatigue import goodman_ranges
+    >>> goodman_ranges([10.0, 10.0], [0.0, -50.0], ultimate=100.0)
+    array([10., 20.])
     """
     su = positive_scalar(ultimate, "ultimate")
     s = as_real(ranges, "ranges")
@@ -313,7 +454,8 @@ def goodman_ranges(ranges, means, ultimate) -> np.ndarray:
     return s / (1.0 - mu / su)
 
 
-def del_rainflow(x, m, duration, n_eq_rate: float = 1.0, *, ultimate=None, residue: str = "half") -> float:
+def del_rainflow(x: ArrayLike, m: float, duration: float, n_eq_rate: float = 1.0, *, ultimate: float | None = None,
+                 residue: str = "half") -> float:
     """Damage equivalent load of a time series, DEL = (Σ n_i S_i^m / N_eq)^(1/m).
 
     Parameters
@@ -330,6 +472,44 @@ def del_rainflow(x, m, duration, n_eq_rate: float = 1.0, *, ultimate=None, resid
         Ultimate load for the Goodman mean correction (:func:`goodman_ranges`); None: no correction.
     residue : {"half", "periodic"}
         Residue handling of :func:`rainflow`.
+
+    Returns
+    -------
+    float
+        The DEL, a cycle **range** in the unit of ``x``: the constant range that, cycled
+        n_eq_rate times a second for ``duration`` seconds, does the damage of the record.
+        0.0 for a constant signal. It does not depend on the S-N curve's S_ref.
+
+    Raises
+    ------
+    ValueError
+        If ``m``, ``duration``, ``n_eq_rate`` or ``ultimate`` is not finite and > 0, a
+        cycle's |mean| reaches ``ultimate``, ``residue`` is unknown, or ``x`` is not a 1-D
+        finite series of at least 2 samples.
+    TypeError
+        If an argument is complex or not numeric.
+
+    See Also
+    --------
+    specdesign.spectral.del_spectral : The DEL from a PSD.
+
+    Examples
+    --------
+    A sine of amplitude 10 and period 10 s over 600 s: 60 cycles of range 20, so
+    DEL = 20 · (60/600)^(1/4) at m = 4:
+
+    >>> import numpy as np
+    >>> from specdesign.fatigue import del_rainflow
+    >>> t = np.arange(0.0, 600.0, 0.05)                          # s
+    >>> x = 10.0 * np.sin(2 * np.pi * t / 10.0)                  # e.g. MN·m
+    >>> print(f"{del_rainflow(x, m=4, duration=600.0, residue='periodic'):.4f}")
+    11.2468
+    >>> print(f"{20.0 * 0.1 ** 0.25:.4f}")
+    11.2468
+    >>> print(f"{del_rainflow(x, m=4, duration=600.0):.4f}")     # residue as half cycles
+    11.2261
+    >>> print(f"{del_rainflow(x + 50.0, 4, 600.0, ultimate=500.0):.4f}")   # Goodman
+    12.4734
     """
     m = positive_scalar(m, "m")
     n_eq = positive_scalar(duration, "duration") * positive_scalar(n_eq_rate, "n_eq_rate")
@@ -356,6 +536,26 @@ class VarianceDamageFit:
     """Power-law surrogate ln(L_ult^m · D) = a · ln(Var) + b (natural logarithms).
 
     D is the Miner damage of a record for N = (L_ult/S)^m (S the range), Var its variance.
+    Built by :func:`fit_variance_damage`.
+
+    Parameters
+    ----------
+    a : float
+        Slope of ln(L_ult^m · D) against ln(Var) (dimensionless; m/2 for Gaussian records of
+        one spectral shape).
+    b : float
+        Intercept: ln(L_ult^m · D) = ln Σ n_i S_i^m (S in load units) at Var = 1 load unit²,
+        for records of the fitted duration.
+    m : float
+        Wöhler exponent of the fit.
+    ultimate : float
+        L_ult, the S_ref of the range-based S-N curve, load units.
+    residual_std : float
+        Standard deviation of the residuals of the log fit (dimensionless).
+
+    See Also
+    --------
+    fit_variance_damage : Fits it.
     """
 
     a: float
@@ -364,11 +564,30 @@ class VarianceDamageFit:
     ultimate: float
     residual_std: float
 
-    def predict(self, variance) -> np.ndarray:
+    def predict(self, variance: ArrayLike) -> np.ndarray:
         """Damage D predicted for variance(s) in load units squared: e^b Var^a / L_ult^m.
 
-        Evaluated in logarithms (L_ult^m alone overflows for L_ult = 1e8 N·m at m = 40);
-        OverflowError if D itself is outside float64's range.
+        Evaluated in logarithms (L_ult^m alone overflows for L_ult = 1e8 N·m at m = 40).
+
+        Parameters
+        ----------
+        variance : array_like
+            Variance(s) of the load, load units², finite and > 0.
+
+        Returns
+        -------
+        ndarray
+            Miner damage D (dimensionless) of a record of the fitted duration, same shape as
+            ``variance``.
+
+        Raises
+        ------
+        ValueError
+            If a variance is not finite and > 0.
+        TypeError
+            If ``variance`` is complex or not numeric.
+        OverflowError
+            If D itself is outside float64's range.
         """
         v = as_real(variance, "variance")
         if np.any(~np.isfinite(v)) or np.any(v <= 0):
@@ -379,13 +598,18 @@ class VarianceDamageFit:
                              "predict at a variance nearer the fitted ones, or choose ultimate in the load's range")
 
 
-def fit_variance_damage(records, m, *, ultimate=1.0) -> VarianceDamageFit:
+def fit_variance_damage(records: Iterable[ArrayLike], m: float, *, ultimate: float = 1.0) -> VarianceDamageFit:
     """Fit ln(L_ult^m · D) = a ln(Var) + b over a set of load histories (least squares).
+
+    D is the Miner damage of each whole record (rainflow, half cycles 0.5) for the range-based
+    curve N = (L_ult/S)^m; the fit is done in logarithms, so it holds at any load scale.
 
     Parameters
     ----------
-    records : sequence of 1-D arrays (or a 2-D array, one record per row)
-        Load histories (load units); at least two with different variances.
+    records : iterable of array_like
+        Load histories (load units), 1-D, at least 3 samples each (or a 2-D array, one
+        record per row); at least two with different variances, none constant. Use records
+        of equal duration: D is a damage per record, not per second.
     m : float
         Wöhler exponent (> 0); fit one surrogate per exponent.
     ultimate : float
@@ -395,6 +619,27 @@ def fit_variance_damage(records, m, *, ultimate=1.0) -> VarianceDamageFit:
     -------
     VarianceDamageFit
         With ``a``, ``b``, the residual standard deviation of the log fit and ``predict``.
+
+    Raises
+    ------
+    ValueError
+        If ``m`` or ``ultimate`` is not finite and > 0, fewer than two records are given, a
+        record is not 1-D and finite with at least 3 samples, a record is constant, or all
+        records have the same variance.
+    TypeError
+        If an argument is complex or not numeric.
+
+    Examples
+    --------
+    Gaussian white noise at three levels: D ∝ Var^(m/2), so a ≈ 2 at m = 4.
+
+    >>> import numpy as np
+    >>> from specdesign.fatigue import fit_variance_damage
+    >>> rng = np.random.default_rng(0)
+    >>> records = [s * rng.standard_normal(2000) for s in (1.0, 2.0, 4.0)]
+    >>> fit = fit_variance_damage(records, m=4)
+    >>> print(f"a = {fit.a:.2f}")
+    a = 2.00
     """
     m = positive_scalar(m, "m")
     su = positive_scalar(ultimate, "ultimate")
@@ -417,11 +662,34 @@ def fit_variance_damage(records, m, *, ultimate=1.0) -> VarianceDamageFit:
     return VarianceDamageFit(float(a), float(b), m, su, float(np.sqrt(np.sum(res**2) / dof)))
 
 
-def economic_cost(damages, weights) -> np.ndarray:
+def economic_cost(damages: ArrayLike, weights: ArrayLike) -> np.ndarray:
     """Economic fatigue cost J = Σ_i π_i D_i over the last axis.
 
-    ``damages`` has shape (..., n_components) (dimensionless Miner damages, or damage
-    rates); ``weights`` the n_components costs π_i (currency per unit damage, >= 0).
+    Parameters
+    ----------
+    damages : array_like, shape (..., n_components)
+        Dimensionless Miner damages D_i (or damage rates, per second), finite and >= 0.
+    weights : array_like, shape (n_components,)
+        Costs π_i, currency per unit damage, finite and >= 0.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        J in currency (or currency per second for damage rates).
+
+    Raises
+    ------
+    ValueError
+        If ``weights`` is not 1-D, ``damages`` does not end in n_components, or either has
+        NaN, inf or negative values.
+    TypeError
+        If an argument is complex or not numeric.
+
+    Examples
+    --------
+    >>> from specdesign.fatigue import economic_cost
+    >>> economic_cost([[0.1, 0.2], [0.3, 0.0]], weights=[2.0, 1.0])
+    array([0.4, 0.6])
     """
     d = as_real(damages, "damages")
     w = as_real(weights, "weights")
