@@ -344,7 +344,7 @@ def rosco_scheduled(model: TurbineModel | None = None, wind_speeds=None, *, name
     >>> sc.form, sc.schedule_pitch.size
     ('gains', 14)
     """
-    from .simulate import ScheduledController, scheduled, turbine_plant
+    from .simulate import FORMS, ScheduledController, scheduled, turbine_plant
 
     if model is None:
         model = iea15mw()
@@ -358,7 +358,7 @@ def rosco_scheduled(model: TurbineModel | None = None, wind_speeds=None, *, name
     if form == "output":
         return scheduled(model, {v: rosco_baseline(model, v) for v in vs}, name=name)
     if form != "gains":
-        raise ValueError(f"form must be one of {('output', 'gains')}, got {form!r}")
+        raise ValueError(f"form must be one of {FORMS}, got {form!r}")
     v = np.array(sorted(set(vs)))
     kp, ki = sched.gains(v)
     plant = turbine_plant(model)

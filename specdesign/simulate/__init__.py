@@ -1,0 +1,150 @@
+"""Batched time-domain simulation of the turbine in closed loop with any pitch controller.
+
+The plant is the compiled right-hand side of :mod:`specdesign.turbine` (the same function the
+linearisation differentiates), integrated by fixed-step RK4 inside one ``@njit`` loop that
+runs all seeds and wind speeds in parallel (``prange`` over runs). The wind is linearly
+interpolated between its samples for the RK4 stages; the pitch command and generator
+torque are held over a step (the controller is discrete, sampled at the simulation step).
+
+Controller convention (as everywhere in the workbench)::
+
+    β_cmd = β₀ − C_β·(Ω_g − Ω_rated) − C_atd·ẋ_top
+
+with C_β the pitch controller on the generator speed (β = −C·Ω_g in deviations) and an
+optional active-tower-damping controller C_atd on the tower-top fore-aft velocity (m/s),
+summed into the pitch command with the same negative-feedback sign as in
+:mod:`specdesign.closedloop`. β₀ is the trim pitch at the run's mean wind speed.
+
+Gain scheduling (``ScheduledController``) has two forms, both scheduled on β_f, the pitch
+command low-pass filtered (first order, ``filter_omega``), with piecewise-linear weights
+between K scheduling pitches β_k, clamped at the ends:
+
+* ``form="output"`` (general designed controllers, :func:`scheduled`): the K local
+  controllers run in parallel on the same measurements and their *outputs* are blended
+  (as in the seed paper). For PI locals with different K_i this computes
+  K_i(β_f)·∫e, not ∫K_i(β_f)·e: the two differ by a coupling term K_i′(β_f)·β̇_f·∫e while
+  β_f moves (see ``docs/nonlinearity.md``).
+* ``form="gains"`` (ROSCO's own scheduling, the default of :func:`rosco_scheduled`): one PI
+  whose gains are interpolated in β_f and applied to one filtered error with ONE
+  integrator of K_i(β_f)·e_f, u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_rated − Ω_g).
+  Discrete at the simulation step as the LTI path is (Tustin): F by Tustin, the integral
+  by the trapezoid rule with the gain of the current step, I_k = I_{k−1} +
+  K_i(β_f,k)·dt/2·(e_f,k + e_f,k−1). With ``pitch_limits`` (``rosco_scheduled``: the
+  model's) the integrator, as absolute pitch β_0 + I, and the PI output are saturated at
+  them, as ROSCO's PI does (anti-windup near rated, where the pitch reaches its minimum).
+  Without limits, or while they are not reached, and with frozen gains it is exactly the
+  LTI (K_p + K_i/s)·F simulated on the ordinary path.
+
+An ATD controller, if present, is output-blended in both forms.
+
+Three controller kinds are accepted wherever a controller is asked for: a python-control
+LTI system (SISO, proper; discretised by Tustin at the simulation step), a
+``loopshaping.controller.Controller`` (its ``.tf()``), a ``ScheduledController``, or a
+Python callable ``f(t, y) -> pitch_cmd`` (the slow path: called once per step with ``y`` a
+dict of the model outputs, each an array over all runs, returning the absolute pitch
+command in rad for all runs; use it for MPC or other time-domain controllers).
+
+A linear simulation of the same closed loop (``linear=True``) integrates the linearisation
+``model.linearize(v)`` with the same loop, the same RK4 step and the same discrete
+controller, so differences between the two are the plant's nonlinearity only.
+
+Layout
+------
+- :mod:`specdesign.simulate.core`: :func:`simulate`, :class:`KernelPlant`, :func:`turbine_plant`,
+  :class:`SimulationResult`, :class:`SimulationDivergedError`, the step checks
+  (:func:`check_step`, :func:`check_loop_step`, :func:`sampled_loop_radius`).
+- :mod:`specdesign.simulate.schedule`: :class:`ScheduledController`, :func:`scheduled`.
+- :mod:`specdesign.simulate.controllers`: controller preparation (:func:`as_lti`,
+  :func:`discretize`, :func:`split_integrator`, :func:`split_slow`, the discrete bank).
+- :mod:`specdesign.simulate.kernels`: the numba kernels (the compiled loop, the linear plant).
+- :func:`rosco_scheduled` lives in :mod:`specdesign.rosco`, :func:`wind_series` and
+  :func:`seed_for` in :mod:`specdesign.wind`; both are re-exported here.
+"""
+from __future__ import annotations
+
+from ..rosco import rosco_scheduled
+from ..wind import seed_for, wind_series
+from .controllers import SLOW_OMEGA, as_lti, controller_bank, discretize, is_lti_like, split_integrator, split_slow
+from .core import (
+    MAX_STEP_EIGENVALUE,
+    WIND_MEAN_TOLERANCE,
+    KernelPlant,
+    SimulationDivergedError,
+    SimulationResult,
+    check_loop_step,
+    check_step,
+    sampled_loop_radius,
+    simulate,
+    turbine_plant,
+)
+from .kernels import KIND_LINEAR, KIND_TURBINE, NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs
+from .kernels import run_callable
+from .schedule import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController, scheduled
+
+__all__ = [
+    "SimulationDivergedError",
+    "KernelPlant",
+    "ScheduledController",
+    "SimulationResult",
+    "turbine_plant",
+    "scheduled",
+    "rosco_scheduled",
+    "discretize",
+    "split_integrator",
+    "split_slow",
+    "sampled_loop_radius",
+    "simulate",
+    "linear_plant_params",
+    "check_step",
+    "check_loop_step",
+    "is_lti_like",
+    "as_lti",
+    "seed_for",
+    "wind_series",
+    "MAX_STEP_EIGENVALUE",
+    "WIND_MEAN_TOLERANCE",
+    "SCHEDULE_FILTER_OMEGA",
+    "SLOW_OMEGA",
+    "FORMS",
+]
+
+# Old private names of the single-module simulate.py, still imported by callers (validate,
+# closedloop): plain aliases of the public names.
+# TODO(issue 13): remove once callers switch
+_as_lti = as_lti
+_is_lti_like = is_lti_like
+_check_step = check_step
+_check_loop_step = check_loop_step
+_compiled_for = compiled_for
+_lin_rhs = linear_rhs
+_lin_outputs = linear_outputs
+_bank = controller_bank
+_run_callable = run_callable
+_FORMS = FORMS
+_NONFINITE = NONFINITE
+_KIND_TURBINE = KIND_TURBINE
+_KIND_LINEAR = KIND_LINEAR
+
+# The other private names of simulate.py (internals of the compiled loop and of simulate) have no
+# callers; they stay reachable here, by name, until the callers have switched.
+# TODO(issue 13): remove once callers switch
+_LEGACY = {
+    "_turbine_rhs": ("..turbine", "rhs"),
+    "_turbine_outputs": ("..turbine", "outputs"),
+    "_BANKS": (".controllers", "_BANKS"),
+    "_make_bank": (".controllers", "_make_bank"),
+    "_RADIUS_TOL": (".core", "_RADIUS_TOL"),
+    "_warn_unstable": (".core", "_warn_unstable"),
+    "_raise_diverged": (".core", "_raise_diverged"),
+    **{n: (".kernels", n) for n in ("_REBOUND", "_wind_at", "_krhs", "_kout", "_rk4", "_run_one", "_run_batch",
+                                    "_step_all", "_outputs_all")},
+}
+
+
+def __getattr__(name):
+    if name in _LEGACY:
+        import importlib
+
+        module, attr = _LEGACY[name]
+        return getattr(importlib.import_module(module, __name__), attr)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,0 +1,181 @@
+"""Controller preparation for the simulator: SISO checks, Tustin discretisation, the integrator
+and slow-mode splits, and the bank of discrete local controllers the compiled loop runs.
+
+See :func:`specdesign.simulate.simulate` for the anti-windup these splits serve.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._checks import positive_scalar
+
+__all__ = [
+    "is_lti_like",
+    "as_lti",
+    "discretize",
+    "split_integrator",
+    "SLOW_OMEGA",
+    "split_slow",
+    "controller_bank",
+]
+
+
+def is_lti_like(c) -> bool:
+    import control
+
+    return isinstance(c, control.LTI) or (hasattr(c, "tf") and callable(getattr(c, "tf")))
+
+
+
+def as_lti(c, name):
+    import control
+
+    if hasattr(c, "tf") and callable(c.tf) and not isinstance(c, control.LTI):
+        c = c.tf()
+    if not isinstance(c, control.LTI):
+        raise TypeError(f"{name} must be a python-control LTI system or a loopshaping Controller, got {type(c).__name__}")
+    if c.ninputs != 1 or c.noutputs != 1:
+        raise ValueError(f"{name} must be SISO, got {c.noutputs}×{c.ninputs}")
+    if c.isdtime(strict=True):
+        raise ValueError(f"{name} is discrete-time; pass the continuous controller (it is discretised at the simulation step)")
+    return c
+
+
+def discretize(controller, dt):
+    """Tustin discretisation of a SISO continuous controller at step ``dt`` (s).
+
+    Returns ``(A, B, C, D)`` float arrays of shapes (n, n), (n,), (n,) and (1,) of the
+    discrete state-space form x⁺ = A x + B u, y = C x + D u.
+    Raises ValueError for an improper controller (more zeros than poles).
+    """
+    import control
+
+    dt = positive_scalar(dt, "dt")
+    c = as_lti(controller, "controller")
+    if isinstance(c, control.TransferFunction):
+        num, den = np.atleast_1d(np.squeeze(c.num[0][0])), np.atleast_1d(np.squeeze(c.den[0][0]))
+        num = np.trim_zeros(num, "f")
+        if num.size > np.trim_zeros(den, "f").size:
+            raise ValueError("controller is improper (more zeros than poles); add a roll-off pole")
+    s = control.ss(c)
+    n = s.nstates
+    if n == 0:
+        return np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.array([float(np.squeeze(s.D))])
+    d = control.c2d(s, dt, method="tustin")
+    return (np.asarray(d.A, float), np.asarray(d.B, float).ravel(), np.asarray(d.C, float).ravel(),
+            np.array([float(np.squeeze(d.D))]))
+
+
+def split_integrator(controller):
+    """(r, C_r): C(s) = r/s + C_r(s) for a SISO controller with one pole at s = 0.
+
+    The simulator runs r/s as a separate integrator (trapezoid rule = Tustin, so the sum is
+    the Tustin discretisation of C exactly) and clamps it at the pitch limits as ROSCO clamps
+    its integrator (anti-windup); C_r has no pole at 0 and cannot wind up. A controller
+    without a pole at 0 gives (0, C); one with several is returned whole, unclamped.
+    """
+    import control
+
+    c = as_lti(controller, "controller")
+    tf = control.tf(c)
+    num = np.trim_zeros(np.atleast_1d(np.squeeze(tf.num[0][0])).astype(float), "f")
+    den = np.trim_zeros(np.atleast_1d(np.squeeze(tf.den[0][0])).astype(float), "f")
+    tiny = 1e-12 * np.max(np.abs(den))
+    if den.size < 2 or abs(den[-1]) > tiny or (den.size > 2 and abs(den[-2]) <= tiny):
+        return 0.0, c
+    d1 = den[:-1]
+    r = float(num[-1] / d1[-1]) if num.size else 0.0
+    rest = np.polysub(num, r * d1)[:-1]  # (num − r·d1)/s: its constant term is zero
+    return r, control.tf(rest if rest.size else [0.0], d1)
+
+
+#: Corner (rad/s) under which a pole of a pitch controller (besides its integrator) belongs to
+#: its slow part (:func:`split_slow`): a time constant above 10 s, longer than an excursion to
+#: the pitch floor, over which such a mode integrates the speed error as the integrator does.
+#: A controller with a slow part gets conditional integration, one without (PI-like, ROSCO's:
+#: its speed filter is at 1 rad/s) ROSCO's integrator clamp; see :func:`simulate`.
+SLOW_OMEGA = 0.1
+
+
+def split_slow(controller, omega=SLOW_OMEGA):
+    """(C_s or None, C_f): C = C_s + C_f with C_s the modes of ``controller`` (no pole at 0,
+    e.g. C_r of :func:`split_integrator`) with |pole| < ``omega`` (rad/s), strictly proper, and
+    C_f the others plus the feedthrough. Without slow poles: (None, controller), unchanged.
+
+    Block-diagonalised from the ordered real Schur form (a Sylvester equation decouples the
+    blocks), so C_s + C_f equals C to rounding."""
+    import control
+    import scipy.linalg
+
+    c = control.ss(as_lti(controller, "controller"))
+    A, B, C, D = (np.asarray(x, dtype=float) for x in (c.A, c.B, c.C, c.D))
+    n = A.shape[0]
+    if n == 0 or not np.any(np.abs(np.linalg.eigvals(A)) < omega):
+        return None, controller
+    T, Z, k = scipy.linalg.schur(A, output="real", sort=lambda x, y: math.hypot(x, y) < omega)
+    X = scipy.linalg.solve_sylvester(T[:k, :k], -T[k:, k:], -T[:k, k:])
+    V = Z @ np.block([[np.eye(k), X], [np.zeros((n - k, k)), np.eye(n - k)]])
+    Bt, Ct = np.linalg.solve(V, B), C @ V
+    slow = control.ss(T[:k, :k], Bt[:k], Ct[:, :k], np.zeros_like(D))
+    fast = control.ss(T[k:, k:], Bt[k:], Ct[:, k:], D) if k < n else control.ss([], [], [], D)
+    return slow, fast
+
+
+_BANKS: dict = {}
+
+
+def controller_bank(controller, dt):
+    """Discrete arrays of one controller (K local 2-input controllers) and its filter corner.
+
+    Memoised per (controller object, dt): a campaign simulates the same controllers at
+    every wind speed, and discretising a 15-point ROSCO schedule costs more than a run.
+    """
+    key = (id(controller), float(dt))
+    hit = _BANKS.get(key)
+    if hit is not None and hit[0] is controller:
+        return hit[1]
+    out = _make_bank(controller, dt)
+    if len(_BANKS) > 64:
+        _BANKS.clear()
+    _BANKS[key] = (controller, out)
+    return out
+
+
+def _make_bank(controller, dt):
+    """(schedule_pitch, per-local (A, B, C, D, r, ns) of the output-blended part (r: the
+    pitch controller's integrator gain, run apart, see :func:`split_integrator`; its first ns
+    states: the modes of the rest under SLOW_OMEGA, :func:`split_slow`), filter corner,
+    scheduled-PI arrays (kp, ki, Af, Bf, Cf, Df, limits) or None; limits (2,) in rad, ±inf
+    for none).
+
+    In ``form="gains"`` the local pitch controllers are not in the blended bank (only the ATD
+    locals are); the PI runs as one filter, one integrator and interpolated gains."""
+    from .schedule import ScheduledController
+
+    if not isinstance(controller, ScheduledController):
+        controller = ScheduledController(np.zeros(1), (as_lti(controller, "controller"),), None, name="controller")
+    gains = controller.form == "gains"
+    none = (np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1))
+    mats = []
+    for k in range(controller.schedule_pitch.size):
+        cb, ca = controller.local(k)
+        r, rest = (0.0, None) if gains else split_integrator(cb)
+        slow, rest = (None, rest) if gains or r == 0.0 else split_slow(rest)
+        As, Bs, Cs, Ds = none if slow is None else discretize(slow, dt)  # states first: the kernel's ns
+        Ab, Bb, Cb, Db = none if gains else discretize(rest, dt)
+        Aa, Ba, Ca, Da = none if ca is None else discretize(ca, dt)
+        ns, nb, na = As.shape[0], Ab.shape[0], Aa.shape[0]
+        nt = ns + nb + na
+        A = np.zeros((nt, nt))
+        A[:ns, :ns], A[ns:ns + nb, ns:ns + nb], A[ns + nb:, ns + nb:] = As, Ab, Aa
+        B = np.zeros((nt, 2))
+        B[:ns, 0], B[ns:ns + nb, 0], B[ns + nb:, 1] = Bs, Bb, Ba
+        mats.append((A, B, np.concatenate([Cs, Cb, Ca]), np.array([(Ds[0] if ns else 0.0) + Db[0], Da[0]]), r, ns))
+    pi = None
+    if gains:
+        Af, Bf, Cf, Df = discretize(controller.error_filter, dt)
+        lim = (-np.inf, np.inf) if controller.pitch_limits is None else controller.pitch_limits
+        pi = (controller.kp, controller.ki, Af, Bf, Cf, Df, np.array(lim, dtype=float))
+    return controller.schedule_pitch, mats, controller.filter_omega, pi

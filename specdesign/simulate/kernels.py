@@ -1,0 +1,386 @@
+"""The compiled closed-loop simulator: numba kernels of :mod:`specdesign.simulate`.
+
+One ``@njit`` loop integrates a batch of runs in parallel (``prange`` over runs): per run, fixed-step
+RK4 of the plant kernel pair with the wind linearly interpolated between its samples, the pitch
+command and generator torque held over a step, and the discrete controller bank of
+:mod:`specdesign.simulate.controllers` (output-blended locals, each with its integrator run
+apart and clamped or conditionally integrated, and ROSCO's gain-scheduled PI) scheduled on the
+filtered pitch command. See :mod:`specdesign.simulate` for the conventions.
+
+The plant is a kernel pair ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` /
+``outputs(x, wind, pitch_cmd, gen_torque, p, y)``: the turbine's (:func:`specdesign.turbine.rhs`),
+the linear one of this module (:func:`linear_rhs`, parameters from :func:`linear_plant_params`), or
+any user pair (:func:`compiled_for` rebinds the same loop code to it). Everything here is driven
+by :func:`specdesign.simulate.simulate`; nothing is meant to be called directly but
+:func:`linear_plant_params`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ..turbine import outputs as _turbine_outputs
+from ..turbine import rhs as _turbine_rhs
+
+__all__ = [
+    "KIND_TURBINE",
+    "KIND_LINEAR",
+    "NONFINITE",
+    "linear_rhs",
+    "linear_outputs",
+    "linear_plant_params",
+    "compiled_for",
+    "run_callable",
+]
+
+
+# ----------------------------------------------------------------------------- linear kernel
+# Parameter layout of the linear kernel: [nx, ny, u0(3), y0(ny), A, B(nx×3), C(ny×nx), D(ny×3)]
+@njit(cache=True)
+def linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
+    nx = int(p[0])
+    ny = int(p[1])
+    du0 = wind - p[2]
+    du1 = pitch_cmd - p[3]
+    du2 = gen_torque - p[4]
+    a = 5 + ny
+    b = a + nx * nx
+    for i in range(nx):
+        s = p[b + 3 * i] * du0 + p[b + 3 * i + 1] * du1 + p[b + 3 * i + 2] * du2
+        for j in range(nx):
+            s += p[a + i * nx + j] * x[j]
+        dx[i] = s
+
+
+@njit(cache=True)
+def linear_outputs(x, wind, pitch_cmd, gen_torque, p, y):
+    nx = int(p[0])
+    ny = int(p[1])
+    du0 = wind - p[2]
+    du1 = pitch_cmd - p[3]
+    du2 = gen_torque - p[4]
+    c = 5 + ny + nx * nx + 3 * nx
+    d = c + ny * nx
+    for i in range(ny):
+        s = p[5 + i] + p[d + 3 * i] * du0 + p[d + 3 * i + 1] * du1 + p[d + 3 * i + 2] * du2
+        for j in range(nx):
+            s += p[c + i * nx + j] * x[j]
+        y[i] = s
+
+
+def linear_plant_params(sys, u0, y0) -> np.ndarray:
+    """Flat parameter array of the linear kernel for ``sys`` (deviation model, inputs
+    wind/pitch_cmd/gen_torque in that order) around inputs ``u0`` and outputs ``y0`` (SI)."""
+    A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
+    if B.shape[1] != 3:
+        raise ValueError(f"linear plant must have 3 inputs (wind, pitch_cmd, gen_torque), got {B.shape[1]}")
+    nx, ny = A.shape[0], C.shape[0]
+    return np.concatenate([[nx, ny], np.asarray(u0, float), np.asarray(y0, float), A.ravel(), B.ravel(), C.ravel(), D.ravel()])
+
+
+# ----------------------------------------------------------------------------- compiled loop
+@njit(cache=True)
+def _wind_at(w, wdt, t):
+    s = t / wdt
+    i = int(s)
+    if i >= w.size - 1:
+        return w[w.size - 1]
+    f = s - i
+    return w[i] * (1.0 - f) + w[i + 1] * f
+
+
+#: Kernel kinds of the compiled loop: the turbine's kernel pair, or the linear one.
+KIND_TURBINE, KIND_LINEAR = 0, 1
+
+
+@njit(cache=True)
+def _krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
+    # The built-in kernels are called directly (a function passed as an argument would
+    # defeat numba's on-disk cache); other kernels get rebound copies, see compiled_for.
+    if kind == KIND_TURBINE:
+        _turbine_rhs(x, wind, pitch_cmd, gen_torque, p, dx)
+    else:
+        linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx)
+
+
+@njit(cache=True)
+def _kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
+    if kind == KIND_TURBINE:
+        _turbine_outputs(x, wind, pitch_cmd, gen_torque, p, y)
+    else:
+        linear_outputs(x, wind, pitch_cmd, gen_torque, p, y)
+
+
+@njit(cache=True)
+def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
+    n = x.size
+    _krhs(kind, x, _wind_at(w, wdt, t), beta_cmd, torque, p, k1)
+    for i in range(n):
+        xt[i] = x[i] + 0.5 * dt * k1[i]
+    wm = _wind_at(w, wdt, t + 0.5 * dt)
+    _krhs(kind, xt, wm, beta_cmd, torque, p, k2)
+    for i in range(n):
+        xt[i] = x[i] + 0.5 * dt * k2[i]
+    _krhs(kind, xt, wm, beta_cmd, torque, p, k3)
+    for i in range(n):
+        xt[i] = x[i] + dt * k3[i]
+    _krhs(kind, xt, _wind_at(w, wdt, t + dt), beta_cmd, torque, p, k4)
+    for i in range(n):
+        x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+
+
+#: Divergence code of a non-finite output (else the index into the output limits).
+NONFINITE = 63
+
+
+@njit(cache=True)
+def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
+             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
+             cmd_lim, lim_idx, lim_val, Rq, Ns):
+    """One run; returns −1, or 64·step + code at the first step where it diverged (code: the
+    index of the output limit exceeded, or NONFINITE)."""
+    nx = x.size
+    nc = Ad.shape[1]
+    nf = Af.shape[0]
+    k1 = np.empty(nx)
+    k2 = np.empty(nx)
+    k3 = np.empty(nx)
+    k4 = np.empty(nx)
+    xt = np.empty(nx)
+    y = np.empty(ny)
+    xc = np.zeros((K, nc))
+    xn = np.empty((K, nc))
+    uk = np.empty(K)
+    # Anti-windup (see simulate). Each local's integrator r_q/s runs apart from its state space
+    # (trapezoid = Tustin). Ns[q] = 0 (PI-like): clamped as ROSCO clamps its integrator, the
+    # trim pitch plus the integral within the limits. Ns[q] > 0 (its first Ns[q] states are
+    # poles under SLOW_OMEGA): conditional integration, the integrator and those states frozen
+    # while the command is saturated and their update would drive it further past the limit.
+    iq = np.zeros(K)
+    inc = np.zeros(K)
+    dslow = np.zeros(K)
+    ilo = cmd_lim[0] - beta0
+    ihi = cmd_lim[1] - beta0
+    e_prev = 0.0
+    xf = np.zeros(nf)
+    xfn = np.empty(nf)
+    integ = 0.0
+    ef_prev = 0.0
+    bcmd = beta0
+    bf = beta0
+    j = 0
+    for k in range(nsteps):
+        t = k * dt
+        _kout(kind, x, _wind_at(w, wdt, t), bcmd, torque, p, y)
+        for i in range(ny):
+            if not math.isfinite(y[i]):
+                return 64 * k + NONFINITE
+        for i in range(lim_idx.size):
+            if abs(y[lim_idx[i]]) > lim_val[i]:
+                return 64 * k + i
+        if k % rec_every == 0:
+            for i in range(ny):
+                Yr[i, j] = y[i]
+            Yr[ny, j] = bcmd
+            j += 1
+        # Both loops feed back with a minus sign: β = −C_β·ΔΩ_g − C_atd·ẋ_top.
+        e = -(y[i_speed] - omega_ref)
+        v = -y[i_vel]
+        slow = False
+        for q in range(K):
+            s = Dd[q, 0] * e + Dd[q, 1] * v
+            for i in range(nc):
+                s += Cd[q, i] * xc[q, i]
+            for i in range(nc):
+                a = Bd[q, i, 0] * e + Bd[q, i, 1] * v
+                for m in range(nc):
+                    a += Ad[q, i, m] * xc[q, m]
+                xn[q, i] = a
+            if Rq[q] != 0.0:
+                if Ns[q] == 0:
+                    iq[q] = min(max(iq[q] + Rq[q] * 0.5 * dt * (e + e_prev), ilo), ihi)
+                else:  # tentatively; undone below if the command saturates this way
+                    slow = True
+                    inc[q] = Rq[q] * 0.5 * dt * (e + e_prev)
+                    iq[q] += inc[q]
+                    d = inc[q]
+                    for i in range(Ns[q]):
+                        d += Cd[q, i] * (xn[q, i] - xc[q, i])
+                    dslow[q] = d
+                s += iq[q]
+            uk[q] = s
+        e_prev = e
+        # Piecewise-linear weights in the filtered pitch, clamped at the ends: (1 − f) on q, f on q + 1.
+        q = 0
+        f = 0.0
+        if K == 1 or bf <= sched_pitch[0]:
+            q = 0
+        elif bf >= sched_pitch[K - 1]:
+            q = K - 1
+        else:
+            while sched_pitch[q + 1] < bf:
+                q += 1
+            f = (bf - sched_pitch[q]) / (sched_pitch[q + 1] - sched_pitch[q])
+        # Output blending (of the ATD locals only, in the scheduled-PI form).
+        if f == 0.0:
+            u = uk[q]
+        else:
+            u = (1.0 - f) * uk[q] + f * uk[q + 1]
+        if slow:
+            over = beta0 + u - cmd_lim[1]
+            if over <= 0.0:
+                over = min(beta0 + u - cmd_lim[0], 0.0)
+            if over != 0.0:  # saturated: freeze the slow parts that push further past the limit
+                for r in range(K):
+                    if Ns[r] > 0 and Rq[r] != 0.0 and dslow[r] * over > 0.0:
+                        iq[r] -= inc[r]
+                        uk[r] -= inc[r]
+                        for i in range(Ns[r]):
+                            xn[r, i] = xc[r, i]
+                if f == 0.0:
+                    u = uk[q]
+                else:
+                    u = (1.0 - f) * uk[q] + f * uk[q + 1]
+        for r in range(K):
+            for i in range(nc):
+                xc[r, i] = xn[r, i]
+        if pi_on:
+            # ROSCO's form: one filtered error, gains interpolated in β_f, one integrator of
+            # K_i(β_f)·e_f (trapezoid = Tustin of 1/s, so frozen gains give the LTI exactly).
+            ef = Df[0] * e
+            for i in range(nf):
+                ef += Cf[i] * xf[i]
+            for i in range(nf):
+                a = Bf[i] * e
+                for m in range(nf):
+                    a += Af[i, m] * xf[m]
+                xfn[i] = a
+            for i in range(nf):
+                xf[i] = xfn[i]
+            if f == 0.0:
+                kpv = kp[q]
+                kiv = ki[q]
+            else:
+                kpv = (1.0 - f) * kp[q] + f * kp[q + 1]
+                kiv = (1.0 - f) * ki[q] + f * ki[q + 1]
+            integ += kiv * 0.5 * dt * (ef + ef_prev)
+            ef_prev = ef
+            # ROSCO saturates the integrator (the trim pitch + ∫) and the PI output at the
+            # pitch limits: anti-windup. With infinite limits this is the plain PI.
+            lo = lim[0] - beta0
+            hi = lim[1] - beta0
+            integ = min(max(integ, lo), hi)
+            u += min(max(kpv * ef + integ, lo), hi)
+        bcmd = min(max(beta0 + u, cmd_lim[0]), cmd_lim[1])
+        bf += a_filt * (bcmd - bf)
+        _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
+    return -1
+
+
+@njit(cache=True, parallel=True)
+def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
+               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
+               cmd_lim, lim_idx, lim_val, Rq, Ns, status):
+    """All runs, one per prange iteration; the controller bank is shared by the batch.
+    ``status[r]``: −1, or where run r diverged (see :func:`_run_one`)."""
+    K = sched_pitch.size
+    for r in prange(X0.shape[0]):
+        x = X0[r].copy()
+        status[r] = _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
+                             beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf,
+                             Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq, Ns)
+
+
+@njit(cache=True)
+def _step_all(kind, P, X, W, wdt, t, dt, bcmd, torque, Y):
+    """One RK4 step of every run with a given pitch command, then the outputs at t + dt.
+
+    Serial: on the callable path the Python controller dominates, and a parallel launch per
+    step would cost more than it saves."""
+    for r in range(X.shape[0]):
+        nx = X.shape[1]
+        k1 = np.empty(nx)
+        k2 = np.empty(nx)
+        k3 = np.empty(nx)
+        k4 = np.empty(nx)
+        xt = np.empty(nx)
+        x = X[r]
+        _rk4(kind, x, W[r], wdt, t, dt, bcmd[r], torque[r], P[r], k1, k2, k3, k4, xt)
+        y = Y[r]
+        _kout(kind, x, _wind_at(W[r], wdt, t + dt), bcmd[r], torque[r], P[r], y)
+
+
+@njit(cache=True)
+def _outputs_all(kind, P, X, W, wdt, t, bcmd, torque, Y):
+    for r in range(X.shape[0]):
+        y = Y[r]
+        _kout(kind, X[r], _wind_at(W[r], wdt, t), bcmd[r], torque[r], P[r], y)
+
+
+_REBOUND = {}
+
+
+def compiled_for(rhs, outfn):
+    """(kind, run_batch, step_all, outputs_all) for a kernel pair.
+
+    The turbine and linear kernels use the cached module functions. Any other pair gets
+    copies of the same loop code whose global names ``_krhs``/``_kout`` point at that
+    pair: one source for every kernel, compiled once per process for user kernels.
+    """
+    import types
+
+    if rhs is linear_rhs:
+        return KIND_LINEAR, _run_batch, _step_all, _outputs_all
+    if rhs is _turbine_rhs and outfn is _turbine_outputs:
+        return KIND_TURBINE, _run_batch, _step_all, _outputs_all
+    key = (rhs, outfn)
+    if key not in _REBOUND:
+        g = dict(_run_one.py_func.__globals__)
+
+        def krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
+            rhs(x, wind, pitch_cmd, gen_torque, p, dx)
+
+        def kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
+            outfn(x, wind, pitch_cmd, gen_torque, p, y)
+
+        g["_krhs"], g["_kout"] = njit(krhs), njit(kout)
+
+        def copy(f, **kw):
+            return njit(**kw)(types.FunctionType(f.py_func.__code__, g, f.py_func.__name__))
+
+        g["_rk4"] = copy(_rk4)
+        g["_run_one"] = copy(_run_one)
+        _REBOUND[key] = (0, copy(_run_batch, parallel=True), copy(_step_all), copy(_outputs_all))
+    return _REBOUND[key]
+
+
+def run_callable(fn, step_all, outputs_all, kind, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names,
+                  lim_idx, lim_val, status):
+    X = X0.copy()
+    R = X.shape[0]
+    bcmd = beta0.copy()
+    y = np.empty((R, ny))
+    outputs_all(kind, P, X, Wr, wdt, 0.0, bcmd, torque, y)
+    j = 0
+    for k in range(nsteps):
+        t = k * dt
+        # checked at the record steps: a per-step numpy check would cost as much as the step
+        bad = (~np.all(np.isfinite(y), axis=1) | np.any(np.abs(y[:, lim_idx]) > lim_val, axis=1)
+               if k % rec_every == 0 else np.zeros(0, bool))
+        if np.any(bad):
+            r = np.flatnonzero(bad)
+            nonfinite = ~np.all(np.isfinite(y[r]), axis=1)
+            over = np.argmax(np.abs(y[r][:, lim_idx]) > lim_val, axis=1)
+            status[r] = 64 * k + np.where(nonfinite, NONFINITE, over)
+            return
+        cmd = np.asarray(fn(t, {n: y[:, i].copy() for i, n in enumerate(names)}), dtype=float)
+        if cmd.shape != (R,) or not np.all(np.isfinite(cmd)):
+            raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}")
+        if k % rec_every == 0:
+            Y[:, :ny, j] = y
+            Y[:, ny, j] = bcmd  # the command held during the previous step, as in the compiled loop
+            j += 1
+        bcmd = cmd
+        step_all(kind, P, X, Wr, wdt, t, dt, bcmd, torque, y)

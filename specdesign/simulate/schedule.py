@@ -1,0 +1,162 @@
+"""Gain-scheduled controllers: local controllers scheduled on the filtered pitch command.
+
+:class:`ScheduledController` in its two forms (output blending of designed locals, ROSCO's
+gain-scheduled PI) and :func:`scheduled`, which builds one from controllers designed per wind
+speed. See :mod:`specdesign.simulate` for how the simulator runs them and
+:func:`specdesign.rosco.rosco_scheduled` for ROSCO's.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._checks import positive_scalar
+from .controllers import as_lti
+
+__all__ = ["SCHEDULE_FILTER_OMEGA", "FORMS", "ScheduledController", "scheduled"]
+
+#: Default low-pass corner of the scheduling pitch filter (rad/s): slow enough that the
+#: scheduling variable follows the mean operating point rather than the turbulence
+#: (ROSCO filters its scheduling pitch at 0.1 × the 1 rad/s speed-filter corner).
+SCHEDULE_FILTER_OMEGA = 0.1
+
+
+
+#: The two forms of :class:`ScheduledController`.
+FORMS = ("output", "gains")
+
+
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
+class ScheduledController:
+    """Local pitch (and optional ATD) controllers scheduled on filtered pitch.
+
+    schedule_pitch : (K,) increasing scheduling pitches β_k (rad), one per local controller.
+    pitch : K continuous SISO controllers C_β,k on the generator speed (β = −C·Ω_g): the
+        local controllers (in ``form="gains"``, the frozen-gain PIs (K_p,k + K_i,k/s)·F).
+    atd : K continuous SISO controllers on tower-top velocity (β −= C_atd·ẋ_top), or None;
+        output-blended in both forms.
+    filter_omega : corner (rad/s) of the first-order low-pass on the pitch command that
+        gives the scheduling variable β_f.
+    name : label used in tables and figures.
+    form : ``"output"`` blends the local controllers' outputs; ``"gains"`` runs ROSCO's form,
+        u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt with e_f = error_filter·(Ω_rated − Ω_g), the gains
+        interpolated linearly in β_f (see the module docstring). Build it with
+        :meth:`gain_scheduled_pi`.
+    kp, ki : (K,) PI gains at the scheduling pitches (``form="gains"`` only; in the workbench's
+        convention C = (K_p + K_i/s)·F, i.e. ROSCO's negative gains), rad/(rad/s) and rad/rad.
+    error_filter : SISO LTI filter F on the speed error (``form="gains"`` only).
+    pitch_limits : (min, max) absolute pitch (rad) at which ``form="gains"`` saturates its
+        integrator (the trim pitch plus ∫K_i·e_f) and its PI output, as ROSCO's PI does
+        (anti-windup). :func:`simulate` narrows them to the plant's pitch limits, and uses the
+        plant's alone when this is None (default): the integrator never winds up beyond what
+        the actuator can reach; on a plant without limits, None means no saturation.
+    """
+
+    schedule_pitch: np.ndarray
+    pitch: tuple
+    atd: tuple | None = None
+    filter_omega: float = SCHEDULE_FILTER_OMEGA
+    name: str = "controller"
+    form: str = "output"
+    kp: np.ndarray | None = field(default=None, repr=False)
+    ki: np.ndarray | None = field(default=None, repr=False)
+    error_filter: object = field(default=None, repr=False)
+    pitch_limits: tuple | None = None
+
+    def __post_init__(self):
+        b = np.atleast_1d(np.asarray(self.schedule_pitch, dtype=float))
+        if b.ndim != 1 or b.size < 1 or np.any(np.diff(b) <= 0) or not np.all(np.isfinite(b)):
+            raise ValueError(f"schedule_pitch must be a 1-D strictly increasing array of pitches in rad, got {b}")
+        object.__setattr__(self, "schedule_pitch", b)
+        if len(self.pitch) != b.size:
+            raise ValueError(f"pitch needs one controller per scheduling pitch ({b.size}), got {len(self.pitch)}")
+        if self.atd is not None and len(self.atd) != b.size:
+            raise ValueError(f"atd needs one controller per scheduling pitch ({b.size}), got {len(self.atd)}")
+        positive_scalar(self.filter_omega, "filter_omega")
+        if self.form not in FORMS:
+            raise ValueError(f"form must be one of {FORMS}, got {self.form!r}")
+        if self.form == "output":
+            if self.kp is not None or self.ki is not None or self.error_filter is not None or self.pitch_limits is not None:
+                raise ValueError("kp, ki, error_filter and pitch_limits are for form='gains' only")
+            return
+        if self.pitch_limits is not None:
+            lim = tuple(float(x) for x in self.pitch_limits)
+            if len(lim) != 2 or not lim[0] < lim[1] or any(math.isnan(x) for x in lim):
+                raise ValueError(f"pitch_limits must be (min, max) pitch in rad with min < max, got {self.pitch_limits!r}")
+            object.__setattr__(self, "pitch_limits", lim)
+        gains = []
+        for g, nm in ((self.kp, "kp"), (self.ki, "ki")):
+            a = np.atleast_1d(np.asarray(g, dtype=float)) if g is not None else None
+            if a is None or a.shape != b.shape or not np.all(np.isfinite(a)):
+                raise ValueError(f"form='gains' needs {nm} as {b.size} finite gains, one per scheduling pitch, got {g!r}")
+            gains.append(a)
+        object.__setattr__(self, "kp", gains[0])
+        object.__setattr__(self, "ki", gains[1])
+        f = as_lti(self.error_filter, "error_filter")
+        object.__setattr__(self, "error_filter", f)
+        # The local controllers must be the frozen-gain PIs, or the linear prediction (which
+        # blends them) would describe another controller than the one simulated.
+        jw = 1j * np.array([0.03, 0.3, 1.0, 3.0])
+        fj = np.asarray(f(jw), complex)
+        for k in range(b.size):
+            ref = (gains[0][k] + gains[1][k] / jw) * fj
+            got = np.asarray(as_lti(self.pitch[k], f"pitch[{k}]")(jw), complex)
+            if not np.allclose(got, ref, rtol=1e-8, atol=0):
+                raise ValueError(f"pitch[{k}] is not (kp[{k}] + ki[{k}]/s)·error_filter; build form='gains' "
+                                 "with ScheduledController.gain_scheduled_pi")
+
+    def local(self, k: int):
+        """(C_β, C_atd or None) of the k-th local controller."""
+        return self.pitch[k], (None if self.atd is None else self.atd[k])
+
+    @classmethod
+    def gain_scheduled_pi(cls, schedule_pitch, kp, ki, error_filter, *, atd=None,
+                          filter_omega=SCHEDULE_FILTER_OMEGA, name="PI", pitch_limits=None) -> "ScheduledController":
+        """ROSCO-form gain-scheduled PI: u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_ref − Ω_g).
+
+        schedule_pitch (rad), kp, ki : (K,) gains at the scheduling pitches, in the
+        workbench's convention C = (K_p + K_i/s)·F (ROSCO's negative gains).
+        error_filter : SISO LTI F on the speed error (e.g. :func:`specdesign.rosco.speed_filter`).
+        atd : K ATD controllers (output-blended) or None.
+        pitch_limits : (min, max) pitch (rad) saturating the integrator and the PI output
+            (ROSCO's anti-windup), or None (the simulated plant's limits, see the class).
+        """
+        import control
+
+        f = as_lti(error_filter, "error_filter")
+        kp = np.atleast_1d(np.asarray(kp, dtype=float))
+        ki = np.atleast_1d(np.asarray(ki, dtype=float))
+        if kp.shape != ki.shape or kp.ndim != 1:
+            raise ValueError(f"kp and ki must be 1-D arrays of the same length, got shapes {kp.shape} and {ki.shape}")
+        pitch = tuple(control.tf([a, c], [1.0, 0.0]) * f for a, c in zip(kp, ki))
+        return cls(schedule_pitch, pitch, None if atd is None else tuple(atd), filter_omega, name,
+                   form="gains", kp=kp, ki=ki, error_filter=f, pitch_limits=pitch_limits)
+
+
+def scheduled(model, pitch, atd=None, *, filter_omega=SCHEDULE_FILTER_OMEGA, name="designed") -> ScheduledController:
+    """Build a ScheduledController from controllers designed per wind speed.
+
+    pitch : dict wind speed (m/s) → pitch controller C_β (LTI or Controller).
+    atd : dict wind speed (m/s) → ATD controller, same keys, or None.
+    model : TurbineModel or KernelPlant whose trim gives each wind speed's scheduling pitch.
+    """
+    if not isinstance(pitch, dict) or not pitch:
+        raise TypeError("pitch must be a non-empty dict {wind_speed_m_s: controller}")
+    if atd is not None and set(atd) != set(pitch):
+        raise ValueError(f"atd must have the same wind speeds as pitch: {sorted(pitch)} vs {sorted(atd)}")
+    from .core import turbine_plant
+
+    plant = turbine_plant(model)
+    vs = sorted(pitch)
+    b = np.array([plant.trim(v)[1] for v in vs])
+    order = np.argsort(b)
+    vs = [vs[i] for i in order]
+    return ScheduledController(
+        schedule_pitch=b[order],
+        pitch=tuple(as_lti(pitch[v], f"pitch[{v}]") for v in vs),
+        atd=None if atd is None else tuple(as_lti(atd[v], f"atd[{v}]") for v in vs),
+        filter_omega=filter_omega,
+        name=name,
+    )
