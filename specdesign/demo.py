@@ -31,18 +31,16 @@ def run_demo(out="specdesign_output", *, fast=False, wind_speed=19.0, spec_reduc
     specification promises. target_reduction : predicted tower-base DEL reduction (%) the
     QFT design aims at. Returns a dict of the headline numbers.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # figures only written to files: no pyplot, no backend
 
     from . import qft, spec, validate
     from .plots.fatigue import plot_sensitivity
     from .plots.qft import plot_design_bode, plot_design_nichols
     from .plots.spec import plot_specification
     from .plots.validation import plot_spectra, plot_time_series
+    from .rosco import rosco_baseline
     from .simulate import scheduled
-    from .turbine import iea15mw, rosco_baseline
+    from .turbine import iea15mw
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -56,12 +54,12 @@ def run_demo(out="specdesign_output", *, fast=False, wind_speed=19.0, spec_reduc
     base = spec.baseline_analysis(model, v)
     peak = base.omega[np.argmax(np.where(base.omega > 0.6, base.sensitivity, -np.inf))]
     _say(f"      baseline DEL {base.del_1hz / 1e6:.2f} MN·m; ΔD% peak above 0.6 rad/s at {peak:.3f} rad/s (tower mode)")
-    fig, ax = plt.subplots(figsize=(7, 3.5))
+    fig = Figure(figsize=(7, 3.5))
+    ax = fig.subplots()
     plot_sensitivity(base.omega, base.sensitivity, ax=ax)
     ax.set_title(f"Damage sensitivity ΔD%(ω), tower-base moment, ROSCO, {v:g} m/s")
     fig.tight_layout()
     fig.savefig(out / "1_sensitivity.png", dpi=120)
-    plt.close(fig)
 
     _say(f"[2/4] specification promising {spec_reduction:g} % less damage (notches above 0.6 rad/s)")
     shaped = spec.shape_to_target(base, spec_reduction, keep_below=0.6)
@@ -69,24 +67,24 @@ def run_demo(out="specdesign_output", *, fast=False, wind_speed=19.0, spec_reduc
         _say(f"      notch {n.omega_n:.3f} rad/s, {n.depth_db:.2f} dB, width {n.width:.3f}")
     p = shaped.promise
     _say(f"      promise: damage −{p.exact_damage:.2f} % (Eq. 10: −{p.predicted_damage:.2f} %), DEL −{p.exact_del:.2f} %")
-    fig, ax = plt.subplots(figsize=(7, 3.5))
+    fig = Figure(figsize=(7, 3.5))
+    ax = fig.subplots()
     plot_specification(base, shaped.specification, ax=ax)
     ax.set_title(f"Tower-load specification W_MyT at {v:g} m/s")
     fig.tight_layout()
     fig.savefig(out / "2_specification.png", dpi=120)
-    plt.close(fig)
 
     _say(f"[3/4] QFT design: pitch controller + active tower damping, target −{target_reduction:g} % DEL")
     design = qft.design_qft(model, v, target_reduction=target_reduction, spec_reduction=spec_reduction)
     _say("      " + design.summary())
     _say(f"      C_β(s) = {_tf_text(design.pitch_controller)}")
     _say(f"      C_ATD(s) = {_tf_text(design.atd_controller)}")
-    fig = plot_design_nichols(design)
+    fig = Figure(figsize=(14, 5.5))
+    plot_design_nichols(design, axes=fig.subplots(1, 2))
     fig.savefig(out / "3_nichols.png", dpi=120)
-    plt.close(fig)
-    fig = plot_design_bode(design, model)
+    fig = Figure(figsize=(9, 7.5))
+    plot_design_bode(design, model, axes=fig.subplots(2, 1, sharex=True))
     fig.savefig(out / "3_bode.png", dpi=120)
-    plt.close(fig)
 
     _say(f"[4/4] validation: {n_seeds} paired seeds × {duration:g} s, nonlinear model, rainflow DEL")
     controllers = {
@@ -102,15 +100,15 @@ def run_demo(out="specdesign_output", *, fast=False, wind_speed=19.0, spec_reduc
         (out / f"{name}.md").write_text(table.to_markdown())
         table.to_csv(out / f"{name}.csv")
     _say(t3.to_markdown())
-    fig, axes = plt.subplots(2, 1, figsize=(8, 7))
+    fig = Figure(figsize=(8, 7))
+    axes = fig.subplots(2, 1)
     plot_spectra(camp, v, "gen_speed", ax=axes[0])
     plot_spectra(camp, v, "tower_base_my", ax=axes[1])
     fig.tight_layout()
     fig.savefig(out / "4_spectra.png", dpi=120)
-    plt.close(fig)
-    axes = plot_time_series(camp.series, v)
-    axes[0].figure.savefig(out / "4_time_series.png", dpi=120)
-    plt.close(axes[0].figure)
+    fig = Figure(figsize=(8, 8))
+    plot_time_series(camp.series, v, axes=fig.subplots(4, 1, sharex=True))
+    fig.savefig(out / "4_time_series.png", dpi=120)
 
     # the designed controllers and a campaign file, so `python -m specdesign validate` can rerun
     # or extend the validation (more seeds, other wind speeds) without redesigning

@@ -7,7 +7,7 @@ import pytest
 from specdesign import spec
 from specdesign.demo import run_demo
 from specdesign.turbine import iea15mw
-from specdesign.validate import run_config
+from specdesign.cli import run_config
 
 
 def _row(path, label):

@@ -10,8 +10,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from specdesign import validate as va
-from specdesign.__main__ import main
+from specdesign import cli, validate as va
+from specdesign.cli import main
 
 PI = {"num": [-0.3, -0.06], "den": [1.0, 0.0]}
 GOOD = {"wind_speeds": [19.0], "seeds": 2, "duration": 30.0, "transient": 5.0,
@@ -30,15 +30,15 @@ def no_simulation(monkeypatch):
     def boom(*a, **k):
         raise AssertionError("run_campaign was called before the file was fully checked")
 
-    monkeypatch.setattr(va, "run_campaign", boom)
+    monkeypatch.setattr(cli, "run_campaign", boom)
 
 
 def _bad(tmp_path, change, match, controller=PI):
     cfg = json.loads(json.dumps(GOOD))
     change(cfg)
     path = _write(tmp_path, cfg, controller)
-    with pytest.raises(va.ConfigError, match=match):
-        va.read_config(path)
+    with pytest.raises(cli.ConfigError, match=match):
+        cli.read_config(path)
     return path
 
 
@@ -126,7 +126,7 @@ def test_unwritable_output_is_refused_before_any_run(tmp_path, no_simulation, ca
     cfg = dict(GOOD, output="afile/sub")  # a folder under a regular file cannot be created
     path = _write(tmp_path, cfg)
     with pytest.raises(OSError):
-        va.read_config(path)
+        cli.read_config(path)
     assert main(["validate", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err and "afile" in err
@@ -145,9 +145,9 @@ def test_invalid_syntax_and_missing_files_are_user_errors(tmp_path, capsys):
 
 def test_an_integer_means_the_same_seeds_in_a_file_and_in_run_campaign(tmp_path):
     # documented meaning (docs/validation.md): n → the seeds 0..n−1
-    c = va.read_config(_write(tmp_path, GOOD))
+    c = cli.read_config(_write(tmp_path, GOOD))
     assert c["seeds"].tolist() == [0, 1] == va.seeds_from(2).tolist()
-    assert va.read_config(_write(tmp_path, dict(GOOD, seeds=[5, 7])))["seeds"].tolist() == [5, 7]
+    assert cli.read_config(_write(tmp_path, dict(GOOD, seeds=[5, 7])))["seeds"].tolist() == [5, 7]
 
 
 @pytest.mark.parametrize("text, match", [
@@ -159,39 +159,39 @@ def test_an_integer_means_the_same_seeds_in_a_file_and_in_run_campaign(tmp_path)
 def test_a_repeated_json_key_is_an_error_not_the_last_value(tmp_path, no_simulation, text, match):
     (tmp_path / "pi.json").write_text(json.dumps(PI))
     (tmp_path / "c.json").write_text(text)
-    with pytest.raises(va.ConfigError, match=match):
-        va.read_config(tmp_path / "c.json")
+    with pytest.raises(cli.ConfigError, match=match):
+        cli.read_config(tmp_path / "c.json")
     (tmp_path / "pi.json").write_text('{"num": [1.0], "num": [2.0], "den": [1.0, 1.0]}')
     (tmp_path / "c2.json").write_text(json.dumps(GOOD))
-    with pytest.raises(va.ConfigError, match=r"pi.json: key 'num' appears twice"):
-        va.read_config(tmp_path / "c2.json")
+    with pytest.raises(cli.ConfigError, match=r"pi.json: key 'num' appears twice"):
+        cli.read_config(tmp_path / "c2.json")
 
 
 def test_a_campaign_file_is_toml_or_json_by_its_extension(tmp_path, no_simulation):
     (tmp_path / "pi.json").write_text(json.dumps(PI))
     (tmp_path / "c.cfg").write_text(json.dumps(GOOD))
-    with pytest.raises(va.ConfigError, match=r"c.cfg: a campaign file is a .toml or .json file"):
-        va.read_config(tmp_path / "c.cfg")
+    with pytest.raises(cli.ConfigError, match=r"c.cfg: a campaign file is a .toml or .json file"):
+        cli.read_config(tmp_path / "c.cfg")
     (tmp_path / "c.toml").write_text('wind_speeds = [19.0]\nseeds = 2\nduration = 30.0\n[controllers.PI]\nfile = "pi.json"\n'
                                      '[promised]\n19.0 = 10.0\n')  # unquoted: the dotted key 19 → 0
-    with pytest.raises(va.ConfigError, match=r'quote a decimal wind speed in TOML: "19.0"'):
-        va.read_config(tmp_path / "c.toml")
-    with pytest.raises(va.ConfigError, match="not a file"):
-        va.read_config(tmp_path)
+    with pytest.raises(cli.ConfigError, match=r'quote a decimal wind speed in TOML: "19.0"'):
+        cli.read_config(tmp_path / "c.toml")
+    with pytest.raises(cli.ConfigError, match="not a file"):
+        cli.read_config(tmp_path)
 
 
 def test_a_controller_file_that_is_not_utf8_json_names_the_file(tmp_path, no_simulation):
     (tmp_path / "c.json").write_text(json.dumps(GOOD))
     (tmp_path / "pi.json").write_bytes(b"\xff\x00\x81{")
-    with pytest.raises(va.ConfigError, match=r"pi.json: a controller file must be valid UTF-8 JSON"):
-        va.read_config(tmp_path / "c.json")
+    with pytest.raises(cli.ConfigError, match=r"pi.json: a controller file must be valid UTF-8 JSON"):
+        cli.read_config(tmp_path / "c.json")
 
 
 def test_the_output_folder_named_by_out_is_checked_too(tmp_path, no_simulation, capsys):
     path = _write(tmp_path, GOOD)
     (tmp_path / "taken").write_text("")
     with pytest.raises(OSError, match=r"--out: the output folder .*taken.* cannot be created or written"):
-        va.read_config(path, out=tmp_path / "taken")
+        cli.read_config(path, out=tmp_path / "taken")
     assert main(["validate", str(path), "--out", str(tmp_path / "taken")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--out" in err and "writable" in err
@@ -205,7 +205,7 @@ def test_a_read_only_output_folder_is_refused_before_any_run(tmp_path, no_simula
     try:
         path = _write(tmp_path, dict(GOOD, output="ro"))
         with pytest.raises(PermissionError, match=r"output: the output folder .*ro cannot be created or written"):
-            va.read_config(path)
+            cli.read_config(path)
         assert main(["validate", str(path)]) == 2
         assert "Traceback" not in capsys.readouterr().err
     finally:
@@ -224,7 +224,7 @@ def test_a_programming_error_keeps_its_traceback(tmp_path, monkeypatch):
     def bug(*a, **k):
         raise TypeError("internal")
 
-    monkeypatch.setattr(va, "run_campaign", bug)
+    monkeypatch.setattr(cli, "run_campaign", bug)
     with pytest.raises(TypeError, match="internal"):
         main(["validate", str(_write(tmp_path, GOOD))])
 
@@ -252,8 +252,8 @@ def test_every_wrong_value_names_its_key(tmp_path, no_simulation, data):
     key = data.draw(st.sampled_from(sorted(_STRICT)))
     value = data.draw(_STRICT[key])
     path = _write(tmp_path, dict(GOOD, **{key: value}))
-    with pytest.raises(va.ConfigError) as e:
-        va.read_config(path)
+    with pytest.raises(cli.ConfigError) as e:
+        cli.read_config(path)
     assert str(path) in str(e.value) and key in str(e.value)
 
 
@@ -263,7 +263,7 @@ def test_a_step_too_large_for_a_controller_is_refused_before_any_run(tmp_path, n
         assert set(controllers) == {"PI", "ROSCO"} and list(vs) == [19.0]
         raise ValueError(f"campaign controller 'PI': dt={dt:g} s is too large for controller 'PI' at 19 m/s")
 
-    monkeypatch.setattr(va, "_check_campaign_step", refuse)
+    monkeypatch.setattr(cli, "check_campaign_step", refuse)
     path = _bad(tmp_path, lambda c: None, r"c.json: dt: campaign controller 'PI': dt=0.02 s is too large")
     assert main(["validate", str(path)]) == 2
     assert "Traceback" not in capsys.readouterr().err

@@ -8,11 +8,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from specdesign import fatigue, validate as va
-from specdesign.openfast import read_outputs
+from specdesign import fatigue
+from specdesign.openfast import OPENFAST_CHANNELS, read_outputs, series_from_openfast
 from test_openfast_outputs import NAMES, UNITS, _signals, write_binary, write_text
 
-CH = list(va.OPENFAST_CHANNELS)
+CH = list(OPENFAST_CHANNELS)
 
 
 @pytest.fixture
@@ -31,8 +31,8 @@ def test_a_knm_tower_moment_gives_the_same_del_as_nm(tmp_path, data):
     nm_units[i] = "(N-m)"
     write_text(tmp_path / "knm.out", knm, units=units_knm)
     write_text(tmp_path / "nm.out", data, units=nm_units)
-    a, _ = va.series_from_openfast(read_outputs(tmp_path / "knm.out", CH))
-    b, dt = va.series_from_openfast(read_outputs(tmp_path / "nm.out", CH))
+    a, _ = series_from_openfast(read_outputs(tmp_path / "knm.out", CH))
+    b, dt = series_from_openfast(read_outputs(tmp_path / "nm.out", CH))
     np.testing.assert_allclose(a["tower_base_my"], b["tower_base_my"], rtol=1e-6)
     assert fatigue.del_rainflow(a["tower_base_my"][0], 4, 10.0) == pytest.approx(
         fatigue.del_rainflow(b["tower_base_my"][0], 4, 10.0), rel=1e-6)
@@ -44,7 +44,7 @@ def test_a_unit_that_does_not_convert_is_an_error(tmp_path, data):
     write_text(tmp_path / "kip.out", data, units=units)
     out = read_outputs(tmp_path / "kip.out", CH)
     with pytest.raises(ValueError, match="'TwrBsMyt' is in 'kip-ft'.*N·m"):
-        va.series_from_openfast(out)
+        series_from_openfast(out)
 
 
 def test_duplicate_channel_names_are_an_error(tmp_path, data):
@@ -102,7 +102,7 @@ def test_milli_is_not_mega(tmp_path, data):
     out = read_outputs(tmp_path / "milli.out", CH)
     assert out.units["TwrBsMyt"] == "mN-m"
     with pytest.raises(ValueError, match="'TwrBsMyt' is in 'mN-m'"):
-        va.series_from_openfast(out)
+        series_from_openfast(out)
 
 
 @pytest.mark.parametrize("unit", ["(ms)", "(min)", "(-)"])

@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 
 from specdesign import simulate as sm
 from specdesign import turbine
+from specdesign import cli
 from specdesign import validate as va
 
 # The paper's Table 2 (per-speed changes, %) and its printed Weibull means.
@@ -279,7 +280,7 @@ def test_figures(campaign):
 def test_openfast_outputs_through_the_same_indicators(tmp_path):
     from test_openfast_outputs import write_text
 
-    from specdesign.openfast import read_outputs
+    from specdesign.openfast import OPENFAST_CHANNELS, read_outputs, series_from_openfast
 
     dt, n = 0.05, 12000
     t = np.arange(n) * dt
@@ -287,8 +288,8 @@ def test_openfast_outputs_through_the_same_indicators(tmp_path):
     data = np.column_stack([t, 7.5 + 0.5 * np.sin(w * t), 1e5 + 2e4 * np.sin(w * t), 15 + np.sin(w * t), 1.5e4 + 0 * t])
     for k in range(2):
         write_text(tmp_path / f"r{k}.out", data)
-    outs = read_outputs(sorted(tmp_path.glob("*.out")), list(va.OPENFAST_CHANNELS))
-    ser, dt_read = va.series_from_openfast(outs)
+    outs = read_outputs(sorted(tmp_path.glob("*.out")), list(OPENFAST_CHANNELS))
+    ser, dt_read = series_from_openfast(outs)
     ind = va.indicators(ser, dt_read)
     # TwrBsMyt in kN·m: amplitude 2e4 kN·m = 2e7 N·m, 0.25 Hz
     assert_allclose(ind.tower_del, 2 * 2e7 * 0.25**0.25, rtol=2e-3)
@@ -309,13 +310,13 @@ def test_run_config_writes_tables_and_figures(tmp_path, model):
         "baseline": "PI", "designed": "PI+ATD", "promised": {"19": 10.0},
     }
     (tmp_path / "campaign.json").write_text(json.dumps(cfg))
-    camp = va.run_config(tmp_path / "campaign.json", out=tmp_path / "out")
+    camp = cli.run_config(tmp_path / "campaign.json", out=tmp_path / "out")
     assert camp.controllers == ("PI", "PI+ATD")
     for f in ("table2.md", "table2.csv", "table3.md", "table3.csv", "indicators.csv", "fig8_19mps.png", "fig9_19mps.png", "fig10.png"):
         assert (tmp_path / "out" / f).is_file(), f
     assert "Specification" in (tmp_path / "out" / "table3.md").read_text()
     # the command line with a TOML file: same schema, output folder from --out
-    from specdesign.__main__ import main
+    from specdesign.cli import main
 
     (tmp_path / "c.toml").write_text('wind_speeds = [19.0]\nseeds = [4]\nduration = 30.0\ntransient = 5.0\n'
                                      '[controllers.PI]\nfile = "pi.json"\n')
@@ -325,13 +326,13 @@ def test_run_config_writes_tables_and_figures(tmp_path, model):
     # bad configs name the file and the key
     (tmp_path / "bad.toml").write_text('wind_speeds = [19.0]\nseeds = 2\ncolour = "red"\n[controllers.PI]\nfile = "pi.json"\n')
     with pytest.raises(ValueError, match=r"bad\.toml.*colour"):
-        va.run_config(tmp_path / "bad.toml")
+        cli.run_config(tmp_path / "bad.toml")
     (tmp_path / "nokey.toml").write_text('wind_speeds = [19.0]\nseeds = 2\n')
     with pytest.raises(ValueError, match="controllers"):
-        va.run_config(tmp_path / "nokey.toml")
+        cli.run_config(tmp_path / "nokey.toml")
     (tmp_path / "badfile.json").write_text(json.dumps({**cfg, "controllers": {"X": {"file": "missing.json"}}}))
     with pytest.raises(FileNotFoundError, match="missing.json"):
-        va.run_config(tmp_path / "badfile.json")
+        cli.run_config(tmp_path / "badfile.json")
 
 
 def test_campaign_with_a_process_pool_equals_the_local_run(model):
@@ -365,3 +366,67 @@ def test_table_row_formats_mark_percentage_points():
     md = t.to_markdown()
     assert "| Reduction | 25.00 % |" in md
     assert "| Deviation | 1.50 pp |" in md
+
+
+# ----------------------------------------------------------------------------- layout (issue 13)
+def test_validate_imports_no_figures_and_no_loopshaping():
+    import subprocess
+    import sys
+
+    code = ("import sys, specdesign.validate\n"
+            "bad = [k for k in sys.modules if k in ('matplotlib', 'loopshaping') or k.startswith(('matplotlib.', "
+            "'loopshaping.', 'specdesign.plots'))]\n"
+            "assert not bad, bad\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def test_moved_names_are_reexported_or_deprecated():
+    import warnings
+
+    from specdesign import openfast
+
+    assert va.series_from_openfast is openfast.series_from_openfast
+    assert va.OPENFAST_CHANNELS is openfast.OPENFAST_CHANNELS
+    for name in ("ConfigError", "read_config", "load_controller", "run_config"):
+        with pytest.warns(DeprecationWarning, match=f"specdesign.cli.{name}"):
+            assert getattr(va, name) is getattr(cli, name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for name in va.__all__:  # every public name is importable without a warning
+            getattr(va, name)
+    with pytest.raises(AttributeError):
+        va.no_such_name  # noqa: B018
+
+
+def test_no_module_chooses_a_matplotlib_backend():
+    from pathlib import Path
+
+    import specdesign
+
+    root = Path(specdesign.__file__).parent
+    offenders = [str(p.relative_to(root)) for p in root.rglob("*.py")
+                 if p.name != "cli.py" and "matplotlib.use(" in p.read_text()]
+    assert not offenders, offenders
+
+
+@pytest.mark.parametrize("module", ["specdesign.validate.stats", "specdesign.validate.indicators",
+                                    "specdesign.validate.prediction", "specdesign.validate.volterra",
+                                    "specdesign.validate.campaign", "specdesign.validate.tables", "specdesign.cli",
+                                    "specdesign.openfast.series"])
+def test_public_names_have_numpydoc_docstrings(module):
+    import importlib
+    import inspect
+
+    from numpydoc.validate import validate
+
+    mod = importlib.import_module(module)
+    bad = {}
+    for name in mod.__all__:
+        obj = getattr(mod, name)
+        if not (inspect.isfunction(obj) or inspect.isclass(obj)):
+            continue
+        errs = [code for code, _ in validate(f"{module}.{name}")["errors"] if code in ("GL08", "PR01", "PR02", "RT01")]
+        if errs:
+            bad[name] = errs
+    assert not bad, bad

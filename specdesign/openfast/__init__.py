@@ -2,6 +2,7 @@
 
 - :func:`read_linearization` (``.lin`` files → azimuth-averaged, MBC-transformed named LTI)
 - :func:`read_outputs` (``.out`` / ``.outb`` → named channels with units)
+- :func:`series_from_openfast` (outputs → the workbench's SI series, :data:`OPENFAST_CHANNELS`)
 """
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ _LAZY = {
     "LinearizationData": ".lin",
     "read_outputs": ".outputs",
     "OpenFASTOutput": ".outputs",
+    "series_from_openfast": ".series",
+    "OPENFAST_CHANNELS": ".series",
 }
 
 __all__ = list(_LAZY)

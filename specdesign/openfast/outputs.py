@@ -11,7 +11,7 @@ kN·m → N·m (×1e3), kN → N, kW → W (×1e3), MW → W, MN·m → N·m (sp
 kN.m, kN·m; case-insensitive except the prefix M, mega, against m, milli, which is not
 converted). Units already SI (s, m, m/s, m/s^2, rad, rad/s, N, N·m, W, -) pass through; any
 other unit is kept unchanged and recorded as such (``si_unit == original unit``), and a
-consumer that needs a given SI unit checks ``units`` (``validate.series_from_openfast``
+consumer that needs a given SI unit checks ``units`` (``openfast.series_from_openfast``
 refuses a tower moment, speed, pitch or power it cannot convert).
 
 Checked on reading, each an error naming the file: a ``Time`` channel in seconds (s or sec),

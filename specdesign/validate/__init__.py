@@ -1,0 +1,79 @@
+"""Offline validation: indicators, spectra, paired-seed statistics and the paper's Tables 2-3.
+
+Works on arrays, so the same post-processing serves :func:`specdesign.simulate.simulate` runs
+and the user's OpenFAST outputs (:func:`specdesign.openfast.series_from_openfast`).
+
+Modules, in the order they build on each other:
+
+- :mod:`~specdesign.validate.indicators`: per-run indicators (the paper's four, plus pitch
+  rate): tower-base DEL by rainflow (a range, N·m, 1 Hz convention, Wöhler exponent m = 4 by
+  default), generator-speed SD (rad/s), mean electrical power (W), pitch SD (rad) and
+  pitch-rate SD (rad/s).
+- :mod:`~specdesign.validate.stats`: Weibull weights, Welch spectra per rad/s, pooling over
+  seeds and paired-seed changes with jackknife or bootstrap standard errors.
+- :mod:`~specdesign.validate.prediction`: the closed-loop map T_{y,w}(jω) of any controller
+  the simulator runs and the linear prediction |T|²S_W with its spectral DEL.
+- :mod:`~specdesign.validate.volterra`: the Volterra (perturbation) series of the nonlinear
+  loop and the DEL it predicts.
+- :mod:`~specdesign.validate.campaign`: controllers × wind speeds × paired seeds, simulated
+  and post-processed (:class:`Campaign`), with the up-front checks.
+- :mod:`~specdesign.validate.tables`: the paper's Tables 2-3 and the acceptance of a design.
+
+Per wind speed, seeds are pooled the way fatigue adds up: DEL over S seeds of equal length
+is (mean_s DEL_s^m)^{1/m} (the DEL of the concatenated damage), SDs are pooled as
+√(mean_s var_s), the power is the plain mean. A *relative change* designed vs baseline is
+100·(X_designed/X_baseline − 1) %; a *reduction* is minus that. Both controllers see the same
+seeds (paired), and standard errors come from the jackknife over paired seeds (delete one
+seed from both controllers), or a seeded paired bootstrap.
+
+Weibull mean (Table 2's "Mean" column): Σ w_i c_i with w_i = f(v_i)/Σ_j f(v_j), f the Weibull
+pdf with k = 2.2, A = 11.29 m/s evaluated at the operating points. This reproduces the means
+printed in the paper's Table 2 from its per-speed values (tested).
+
+Campaign files and the command line (reading a TOML/JSON campaign, writing tables, CSV and
+figures) live in :mod:`specdesign.cli`; this package imports neither matplotlib nor
+:mod:`specdesign.plots` nor :mod:`loopshaping`.
+"""
+from __future__ import annotations
+
+from ..closedloop import closed_loop_poles  # noqa: F401  (reachable here as before; not part of __all__)
+from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
+from .campaign import Campaign, check_campaign_step, check_plant_step, concat_campaigns, run_campaign, seeds_from
+from .indicators import INDICATORS, Indicators, indicators
+from .prediction import LinearPrediction, closed_loop_response, linear_prediction, prediction_grid
+from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, weibull_weights,
+                    welch_psd)
+from .tables import Acceptance, Table, acceptance, table2, table3
+from .volterra import VolterraPrediction, volterra_prediction, volterra_response
+
+__all__ = [
+    # stats
+    "WEIBULL_K", "WEIBULL_A", "weibull_weights", "welch_psd", "pool", "resampled_se", "PairedChange", "paired_change",
+    # indicators
+    "INDICATORS", "Indicators", "indicators",
+    # OpenFAST outputs (home: specdesign.openfast)
+    "OPENFAST_CHANNELS", "series_from_openfast",
+    # prediction
+    "closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction",
+    # volterra
+    "volterra_response", "VolterraPrediction", "volterra_prediction",
+    # campaign
+    "Campaign", "run_campaign", "concat_campaigns", "seeds_from", "check_plant_step", "check_campaign_step",
+    # tables
+    "Table", "table2", "table3", "Acceptance", "acceptance",
+]
+
+#: names that moved to :mod:`specdesign.cli` (campaign files are the command line's business)
+_MOVED_TO_CLI = ("ConfigError", "read_config", "load_controller", "run_config")
+
+
+def __getattr__(name):
+    if name in _MOVED_TO_CLI:
+        import warnings
+
+        warnings.warn(f"specdesign.validate.{name} moved to specdesign.cli.{name}; import it from there",
+                      DeprecationWarning, stacklevel=2)
+        from .. import cli
+
+        return getattr(cli, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

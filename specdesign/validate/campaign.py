@@ -1,0 +1,435 @@
+"""Campaigns: controllers × wind speeds × paired seeds, simulated and post-processed into
+indicators, Welch spectra, linear and Volterra predictions, with the up-front checks that
+refuse a bad step before the first simulation."""
+from __future__ import annotations
+
+import dataclasses
+import sys
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._checks import positive_scalar
+from ..closedloop import unstable_poles
+from ._loop import check_loop_step, check_step, has_linear_form
+from ._point import SPECTRA, campaign_point
+from .indicators import INDICATORS
+from .stats import PairedChange, paired_change
+
+__all__ = ["Campaign", "run_campaign", "concat_campaigns", "seeds_from", "check_plant_step", "check_campaign_step"]
+
+
+def seeds_from(seeds) -> np.ndarray:
+    """The seeds of a campaign, in a campaign file and in :func:`run_campaign` alike.
+
+    Parameters
+    ----------
+    seeds : int or sequence of int
+        An integer n means the n seeds 0, 1, …, n − 1; a sequence lists distinct integer seeds.
+
+    Returns
+    -------
+    numpy.ndarray
+        (S,) int64 seeds.
+
+    Raises
+    ------
+    ValueError
+        An integer below 1, an empty sequence, a non-integer or repeated seed.
+
+    Examples
+    --------
+    >>> seeds_from(3).tolist(), seeds_from([7, 2]).tolist()
+    ([0, 1, 2], [7, 2])
+    """
+    if isinstance(seeds, (int, np.integer)) and not isinstance(seeds, bool):
+        if seeds < 1:
+            raise ValueError(f"seeds={seeds!r}: an integer n means the seeds 0..n−1 and must be ≥ 1")
+        return np.arange(int(seeds), dtype=np.int64)
+    items = list(np.atleast_1d(np.asarray(seeds, dtype=object)))
+    if not items or not all(isinstance(s, (int, np.integer)) and not isinstance(s, bool) for s in items):
+        raise ValueError(f"seeds must be an integer n (the seeds 0..n−1) or a non-empty list of integers, got {seeds!r}")
+    out = np.asarray(items, dtype=np.int64)
+    if len(set(out.tolist())) != out.size:
+        raise ValueError(f"seeds must be distinct, got {out.tolist()}")
+    return out
+
+
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
+class Campaign:
+    """Results of controllers × wind speeds × seeds (paired: every controller saw the same seeds).
+
+    Parameters
+    ----------
+    controllers : tuple of str
+        Controller names, in order (C).
+    wind_speeds : numpy.ndarray
+        (W,) wind speeds (m/s).
+    seeds : numpy.ndarray
+        (S,) seeds.
+    duration : float
+        Record length (s).
+    dt : float
+        Sample spacing of the records (s).
+    m : float
+        Wöhler exponent of the DEL.
+    values : dict
+        Indicator → (C, W, S) per-run values (units: :class:`~specdesign.validate.Indicators`).
+    predicted_del : numpy.ndarray
+        (C, W) linear prediction of the tower-base DEL (Dirlik on |T|²S_W, N·m); NaN for
+        controllers without a linear form (callables).
+    omega : numpy.ndarray
+        (nω,) Welch grid (rad/s).
+    welch : dict
+        Output → (C, W, nω) seed-averaged Welch PSD (SI² per rad/s).
+    predicted_psd : dict
+        Output → (C, W, nω) |T|²S_W on the same grid.
+    series : dict, optional
+        Controller → :class:`~specdesign.simulate.SimulationResult` (W, k, n) of the first k
+        seeds kept (``keep_series``), else {}.
+    linear_values : dict, optional
+        Like ``values``, from the same seeds run through the *linearised* model
+        (``run_campaign(linear_twin=True)``; NaN for controllers without a linear form), else
+        {}. It splits the prediction error into the spectral method's part and the plant's
+        nonlinearity (:func:`~specdesign.validate.acceptance`).
+    volterra_values : dict, optional
+        Like ``values``, from the Volterra series of order ``volterra_order``
+        (:func:`~specdesign.validate.volterra_response`) on the same wind
+        (``run_campaign(volterra=k)``; NaN for controllers without a linear form), else {}: a
+        prediction that includes the aerodynamic nonlinearity, still made from the linear loop.
+    volterra_order : int, default 0
+        Order of ``volterra_values`` (0: none).
+    unstable : numpy.ndarray, optional
+        (C, W) bool: the controller destabilises the linearised loop or its simulation
+        diverged at that wind speed; its values and predictions there are NaN (with a warning
+        when the campaign ran), and the tables print "unstable". Default: all False.
+
+    See Also
+    --------
+    run_campaign : runs one.
+    concat_campaigns : joins campaigns over different wind speeds.
+    """
+
+    controllers: tuple
+    wind_speeds: np.ndarray
+    seeds: np.ndarray
+    duration: float
+    dt: float
+    m: float
+    values: dict = field(repr=False)
+    predicted_del: np.ndarray = field(repr=False)
+    omega: np.ndarray = field(repr=False)
+    welch: dict = field(repr=False)
+    predicted_psd: dict = field(repr=False)
+    series: dict = field(default_factory=dict, repr=False)
+    linear_values: dict = field(default_factory=dict, repr=False)
+    volterra_values: dict = field(default_factory=dict, repr=False)
+    volterra_order: int = 0
+    unstable: np.ndarray | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        if self.unstable is None:
+            object.__setattr__(self, "unstable", np.zeros((len(self.controllers), np.size(self.wind_speeds)), bool))
+
+    def index(self, controller: str) -> int:
+        """Position of a controller in :attr:`controllers`.
+
+        Parameters
+        ----------
+        controller : str
+            Its name.
+
+        Returns
+        -------
+        int
+            Index along the first axis of the arrays.
+
+        Raises
+        ------
+        ValueError
+            A name that is not in the campaign.
+        """
+        if controller not in self.controllers:
+            raise ValueError(f"controller {controller!r} not in the campaign {self.controllers}")
+        return self.controllers.index(controller)
+
+    def change(self, designed: str, baseline: str, indicator: str = "tower_del", **kw) -> PairedChange:
+        """:func:`~specdesign.validate.paired_change` of ``indicator`` between two controllers.
+
+        Parameters
+        ----------
+        designed, baseline : str
+            Controller names.
+        indicator : str, default "tower_del"
+            The indicator compared.
+        **kw
+            ``method``, ``n_boot``, ``seed`` of :func:`~specdesign.validate.paired_change`.
+
+        Returns
+        -------
+        PairedChange
+            Change (%) and SE (pp) per wind speed.
+        """
+        i, j = self.index(designed), self.index(baseline)
+        return paired_change(self.values[indicator][i], self.values[indicator][j], indicator, m=self.m,
+                             wind_speeds=self.wind_speeds, **kw)
+
+
+def check_plant_step(model, wind_speeds, dt: float) -> None:
+    """Refuse an integration step the plant's RK4 cannot resolve, before any simulation.
+
+    Parameters
+    ----------
+    model : TurbineModel or KernelPlant
+        The plant (:func:`specdesign.simulate.turbine_plant` accepts it).
+    wind_speeds : array_like
+        Wind speeds of the campaign (m/s).
+    dt : float
+        Integration step (s).
+
+    Raises
+    ------
+    ValueError
+        ``dt`` is too large for the fastest mode of the linearised plant at some wind speed
+        (the message gives the largest step it allows).
+    """
+    from ..simulate import turbine_plant
+
+    check_step(turbine_plant(model), np.asarray(wind_speeds, float), dt)
+
+
+def check_campaign_step(model, controllers: Mapping, wind_speeds, dt: float) -> None:
+    """Refuse, before the first simulation, a step too large for the plant or for a controller.
+
+    :func:`specdesign.simulate.simulate` would refuse such a step at that wind speed only after
+    the earlier speeds had run. A controller whose loop is unstable at a speed is not checked
+    there (the campaign reports it as unstable); callables are not checked.
+
+    Parameters
+    ----------
+    model : TurbineModel or KernelPlant
+        The plant.
+    controllers : mapping
+        Name → controller.
+    wind_speeds : array_like
+        Wind speeds of the campaign (m/s).
+    dt : float
+        Integration and controller step (s).
+
+    Raises
+    ------
+    ValueError
+        ``dt`` is not positive, too large for the plant (:func:`check_plant_step`), or one at
+        which a controller's sampled loop is unstable (naming the controller).
+    """
+    from ..simulate import turbine_plant
+
+    dt = positive_scalar(dt, "dt")
+    plant = turbine_plant(model)
+    if plant.linearize is None:
+        return
+    check_step(plant, wind_speeds, dt)
+    for name, c in controllers.items():
+        if not has_linear_form(c):
+            continue
+        for v in wind_speeds:
+            if not unstable_poles(plant, c, float(v)).size:  # an unstable loop is reported by the campaign
+                try:
+                    check_loop_step(plant, c, float(v), dt)
+                except ValueError as err:
+                    raise ValueError(f"campaign controller {name!r}: {err}") from None
+
+
+def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, duration: float = 600.0, dt: float = 0.02,
+                 record_dt: float = 0.1, transient: float = 60.0, m: float = 4.0, predict: bool = True,
+                 turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
+                 volterra: int = 0, executor=None, progress: bool | None = None,
+                 nperseg: int | None = None) -> Campaign:
+    """Run every controller at every wind speed on the same seeds and post-process.
+
+    Parameters
+    ----------
+    controllers : dict
+        Name → controller (LTI, Controller, ScheduledController or callable; see
+        :mod:`specdesign.simulate`).
+    wind_speeds : array_like
+        Mean wind speeds (m/s).
+    seeds : int or sequence of int
+        Distinct integers, or an integer n for the seeds 0..n−1 (:func:`seeds_from`, as in
+        campaign files); every controller sees the same wind series per (wind speed, seed)
+        (:func:`specdesign.simulate.seed_for`).
+    model : TurbineModel, optional
+        Default ``turbine.iea15mw()``.
+    duration : float, default 600.0
+        Recorded time per run (s).
+    dt : float, default 0.02
+        Integration and controller step (s).
+    record_dt : float, default 0.1
+        Output spacing (s), a multiple of ``dt``.
+    transient : float, default 60.0
+        Time simulated first and discarded (s).
+    m : float, default 4.0
+        Wöhler exponent of the DEL.
+    predict : bool, default True
+        Compute the linear predictions (|T|²S_W, Dirlik DEL) for LTI-like controllers.
+    turbulence_class : {"A", "B", "C"}, default "B"
+        IEC NTM class of the wind.
+    keep_series : bool or int, default False
+        Keep time series in ``Campaign.series``: True for every seed, an int k for the first k
+        seeds (enough for Fig. 9), False for none (memory: C·W·k·n·8 bytes per output).
+    linear_twin : bool, default False
+        Also run every LTI-like controller through the linearised model on the same wind
+        (twice the simulation time): ``Campaign.linear_values``; :func:`~specdesign.validate.acceptance`
+        then splits the deviation into the spectral method's part (linear-model rainflow −
+        prediction) and the plant nonlinearity's part (nonlinear − linear-model rainflow).
+    volterra : {0, 1, 2, 3}, default 0
+        0 (none), or the order of the Volterra series (:func:`~specdesign.validate.volterra_response`)
+        evaluated for every LTI-like controller on the same wind and window, FFT-fast:
+        ``Campaign.volterra_values``, which :func:`~specdesign.validate.acceptance` compares
+        with rainflow too.
+    executor : concurrent.futures.Executor, optional
+        Wind speeds are submitted as separate tasks (a dask.distributed Client qualifies).
+        Default: run locally, the compiled simulator already using every core. For a local
+        process pool use a "spawn" context,
+        ``ProcessPoolExecutor(mp_context=multiprocessing.get_context("spawn"))``: numba's
+        OpenMP threads make fork() unsafe.
+    progress : bool, optional
+        Show a tqdm bar over wind speeds; None → only when stderr is a terminal.
+    nperseg : int, optional
+        Welch segment length (:func:`~specdesign.validate.welch_psd`).
+
+    Returns
+    -------
+    Campaign
+        Indicators, spectra and predictions of every controller, wind speed and seed.
+
+    Raises
+    ------
+    TypeError
+        ``controllers`` is not a non-empty dict, or ``volterra`` asks for a model without
+        ``aero_expansion``.
+    ValueError
+        Invalid seeds or ``volterra``, or a step too large (:func:`check_campaign_step`),
+        before the first simulation; errors of :func:`specdesign.simulate.simulate`.
+    """
+    if not isinstance(controllers, dict) or not controllers:
+        raise TypeError("controllers must be a non-empty dict {name: controller}")
+    if model is None:
+        from .. import turbine
+
+        model = turbine.iea15mw()
+    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    seeds = seeds_from(seeds)
+    if volterra not in (0, 1, 2, 3) or isinstance(volterra, bool):
+        raise ValueError(f"volterra={volterra!r} must be 0 (none) or an order 1, 2 or 3")
+    if volterra and not hasattr(model, "aero_expansion"):
+        raise TypeError(f"volterra={volterra} needs a turbine.TurbineModel, got {type(model).__name__}")
+    check_campaign_step(model, controllers, vs, dt)
+    args = [(model, controllers, float(v), seeds, duration, dt, record_dt, transient, m, predict, turbulence_class,
+             keep_series, nperseg, bool(linear_twin), int(volterra)) for v in vs]
+    show = (sys.stderr.isatty()) if progress is None else bool(progress)
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=len(args), desc="validation", unit="wind speed", disable=not show)
+    try:
+        if executor is None:
+            points = []
+            for a in args:
+                points.append(campaign_point(*a))
+                bar.update()
+        else:
+            futs = [executor.submit(campaign_point, *a) for a in args]
+            points = []
+            for f in futs:
+                points.append(f.result())
+                bar.update()
+    finally:
+        bar.close()
+    names = tuple(controllers)
+    values = {k: np.stack([np.stack(p["values"][k]) for p in points], axis=1) for k in INDICATORS}
+    series = {}
+    if keep_series:
+        from ..simulate import SimulationResult
+
+        for name in names:
+            rs = [p["series"].get(name) for p in points]
+            ok = next((r for r in rs if r is not None), None)
+            if ok is None:  # unstable or diverged at every speed (warned): no series to keep
+                continue
+            # where it was unstable or diverged (warned), NaN series: the other speeds are kept
+            outs = {k: np.concatenate([(r.outputs[k] if r is not None else np.full_like(ok.outputs[k], np.nan))
+                                       for r in rs], axis=0) for k in ok.outputs}
+            series[name] = SimulationResult(time=ok.time, wind_speeds=vs, seeds=ok.seeds, outputs=outs, dt=ok.dt,
+                                            sim_dt=ok.sim_dt, controller=name)
+    return Campaign(
+        controllers=names, wind_speeds=vs, seeds=seeds, duration=float(duration), dt=float(record_dt), m=float(m),
+        values=values,
+        predicted_del=np.array([p["pred"] for p in points]).T,
+        omega=points[0]["omega"],
+        welch={k: np.stack([np.stack(p["welch"][k]) for p in points], axis=1) for k in SPECTRA},
+        predicted_psd={k: np.stack([np.stack(p["ppsd"][k]) for p in points], axis=1) for k in SPECTRA},
+        series=series,
+        linear_values={k: np.stack([np.stack(p["linear"][k]) for p in points], axis=1) for k in INDICATORS}
+        if linear_twin else {},
+        volterra_values={k: np.stack([np.stack(p["volterra"][k]) for p in points], axis=1) for k in INDICATORS}
+        if volterra else {},
+        volterra_order=int(volterra),
+        unstable=np.array([p["unstable"] for p in points]).T,
+    )
+
+
+def concat_campaigns(campaigns: Iterable[Campaign]) -> Campaign:
+    """One :class:`Campaign` from campaigns over different wind speeds.
+
+    E.g. one campaign per operating point, each with that point's designed controllers under
+    the same names. Wind speeds are stacked in the given order.
+
+    Parameters
+    ----------
+    campaigns : iterable of Campaign
+        Campaigns sharing controller names, seeds, duration, sampling, m, Welch grid, linear
+        twin, Volterra order and kept series, over distinct wind speeds.
+
+    Returns
+    -------
+    Campaign
+        The campaigns side by side along the wind-speed axis.
+
+    Raises
+    ------
+    TypeError
+        An empty sequence or an item that is not a Campaign.
+    ValueError
+        Campaigns run with different settings, or a repeated wind speed.
+    """
+    camps = list(campaigns)
+    if not camps or not all(isinstance(c, Campaign) for c in camps):
+        raise TypeError("campaigns must be a non-empty sequence of validate.Campaign")
+    c0 = camps[0]
+    for k, c in enumerate(camps[1:], 1):
+        same = (c.controllers == c0.controllers and np.array_equal(c.seeds, c0.seeds) and c.duration == c0.duration
+                and c.dt == c0.dt and c.m == c0.m and np.array_equal(c.omega, c0.omega)
+                and bool(c.linear_values) == bool(c0.linear_values) and bool(c.series) == bool(c0.series)
+                and c.volterra_order == c0.volterra_order)
+        if not same:
+            raise ValueError(f"campaigns[{k}] differs from campaigns[0] in controllers, seeds, duration, dt, m, Welch "
+                             "grid, linear twin, Volterra order or kept series: run them with the same settings")
+    vs = np.concatenate([c.wind_speeds for c in camps])
+    if len(set(vs.tolist())) != vs.size:
+        raise ValueError(f"campaigns repeat a wind speed ({vs.tolist()} m/s)")
+
+    def cat(dicts, axis=1):
+        return {k: np.concatenate([d[k] for d in dicts], axis=axis) for k in dicts[0]} if dicts[0] else {}
+
+    series = {}
+    for name in c0.series:
+        rs = [c.series[name] for c in camps]
+        series[name] = dataclasses.replace(rs[0], wind_speeds=np.concatenate([r.wind_speeds for r in rs]),
+                                           outputs=cat([r.outputs for r in rs], axis=0))
+    return dataclasses.replace(
+        c0, wind_speeds=vs, values=cat([c.values for c in camps]),
+        predicted_del=np.concatenate([c.predicted_del for c in camps], axis=1),
+        welch=cat([c.welch for c in camps]), predicted_psd=cat([c.predicted_psd for c in camps]), series=series,
+        linear_values=cat([c.linear_values for c in camps]), volterra_values=cat([c.volterra_values for c in camps]),
+        unstable=np.concatenate([c.unstable for c in camps], axis=1))

@@ -1,0 +1,120 @@
+"""Per-run indicators: tower-base DEL by rainflow, generator-speed SD, mean power, pitch and
+pitch-rate SD, from arrays (a simulation's outputs or :func:`specdesign.openfast.series_from_openfast`)."""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import positive_scalar
+
+__all__ = ["INDICATORS", "Indicators", "indicators"]
+
+#: Names of the indicators, in the order of :meth:`Indicators.as_dict` and of the output files.
+INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd")
+
+
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
+class Indicators:
+    """Per-run indicators, each an array shaped like the runs (e.g. (W, S)).
+
+    Parameters
+    ----------
+    tower_del : numpy.ndarray
+        Tower-base damage-equivalent load (N·m, a range, 1 Hz convention).
+    gen_speed_sd : numpy.ndarray
+        Standard deviation of the generator speed (rad/s).
+    mean_power : numpy.ndarray
+        Mean electrical power (W).
+    pitch_sd : numpy.ndarray
+        Standard deviation of the blade pitch (rad).
+    pitch_rate_sd : numpy.ndarray
+        Standard deviation of the pitch rate (rad/s).
+    m : float
+        Wöhler exponent of the DEL.
+    duration : float
+        Record length used for the equivalent cycle count N_eq (s).
+
+    See Also
+    --------
+    indicators : computes them from time series.
+    """
+
+    tower_del: np.ndarray
+    gen_speed_sd: np.ndarray
+    mean_power: np.ndarray
+    pitch_sd: np.ndarray
+    pitch_rate_sd: np.ndarray
+    m: float
+    duration: float
+
+    def as_dict(self) -> dict[str, np.ndarray]:
+        """The five indicators by name (:data:`INDICATORS`), without ``m`` and ``duration``.
+
+        Returns
+        -------
+        dict
+            Indicator name → array.
+        """
+        return {k: getattr(self, k) for k in INDICATORS}
+
+
+def indicators(series: Mapping, dt: float, m: float = 4.0) -> Indicators:
+    """Indicators of every run in ``series``.
+
+    Parameters
+    ----------
+    series : mapping
+        ``tower_base_my`` (N·m), ``gen_speed`` (rad/s), ``power`` (W) and ``pitch`` (rad),
+        each shaped (..., n) (a :class:`~specdesign.simulate.SimulationResult` qualifies, as
+        does the first result of :func:`specdesign.openfast.series_from_openfast`).
+    dt : float
+        Sample spacing (s).
+    m : float, default 4.0
+        Wöhler exponent of the tower-base DEL (S-N curve with S the range).
+
+    Returns
+    -------
+    Indicators
+        Arrays shaped (...,): one value per run.
+
+    Raises
+    ------
+    ValueError
+        A series is missing, the arrays differ in shape or hold fewer than 2 samples, or
+        ``dt``/``m`` is not a positive number.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(600) * 0.1
+    >>> s = {"tower_base_my": np.sin(t), "gen_speed": 0.8 + 0.01 * np.sin(t),
+    ...      "power": np.full(600, 15e6), "pitch": np.zeros(600)}
+    >>> float(indicators(s, 0.1).mean_power)
+    15000000.0
+    """
+    from ..fatigue import del_rainflow
+
+    dt = positive_scalar(dt, "dt")
+    m = positive_scalar(m, "m")
+    get = series.__getitem__
+    try:
+        my, om, pw, pb = (np.asarray(get(k), dtype=float) for k in ("tower_base_my", "gen_speed", "power", "pitch"))
+    except KeyError as e:
+        raise ValueError(f"series lacks {e}; it needs tower_base_my, gen_speed, power and pitch") from None
+    if not (my.shape == om.shape == pw.shape == pb.shape) or my.shape[-1] < 2:
+        raise ValueError(f"series arrays must share a shape (..., n ≥ 2); got {my.shape}, {om.shape}, {pw.shape}, {pb.shape}")
+    n = my.shape[-1]
+    duration = n * dt
+    flat = my.reshape(-1, n)
+    dels = np.array([del_rainflow(row, m, duration) for row in flat]).reshape(my.shape[:-1])
+    return Indicators(
+        tower_del=dels,
+        gen_speed_sd=om.std(axis=-1),
+        mean_power=pw.mean(axis=-1),
+        pitch_sd=pb.std(axis=-1),
+        pitch_rate_sd=(np.diff(pb, axis=-1) / dt).std(axis=-1),
+        m=m,
+        duration=duration,
+    )
