@@ -6,272 +6,59 @@ a 2nd-order pitch actuator with rate and position limits, and a generator torque
 input (constant, ``rated_generator_torque``, above rated). Figures come from the shipped
 ``specdesign/data/iea15mw`` (IEA Wind Task 37 and NREL ROSCO, Apache-2.0; see NOTICE.md).
 
-Kernel interface
-----------------
-One compiled right-hand side serves the nonlinear simulator and the linearisation, so the
-linear model is by construction the Jacobian of what the simulator integrates.
-
-``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` and ``outputs(x, wind, pitch_cmd, gen_torque, p, y)``
-are module-level ``@numba.njit(cache=True)`` functions, callable from other ``@njit`` code.
-They are composed of ``aero_loads(p, omega, v_rel, beta)`` → (torque, thrust),
-``mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)`` and
-``outputs_from(x, dx, gen_torque, p, y)``, so a kernel that changes only the aerodynamics
-reuses the rest:
-
-- ``x`` (float64[5], read) and ``dx`` (float64[5], written) follow :data:`STATE_NAMES`:
-
-  ====  =================  ======  =====================================================
-  idx   name               unit    meaning
-  ====  =================  ======  =====================================================
-  0     ``rotor_speed``    rad/s   rotor = generator speed (gearbox ratio 1)
-  1     ``tower_top_disp`` m       first fore-aft modal coordinate = tower-top deflection
-  2     ``tower_top_vel``  m/s     its rate
-  3     ``pitch``          rad     collective blade pitch
-  4     ``pitch_rate``     rad/s   actuator internal rate state (see below)
-  ====  =================  ======  =====================================================
-
-- ``wind`` (m/s) rotor-effective wind speed, ``pitch_cmd`` (rad) collective pitch demand,
-  ``gen_torque`` (N·m) generator torque on the rotor shaft: scalars (float).
-- ``p`` is the flat float64 parameter array of :meth:`TurbineModel.kernel_params`: a header of
-  ``_HEADER`` scalars (indices ``P_*`` in this module) followed by the bicubic Cp and Ct
-  patch coefficients, each of shape (n_tsr − 1, n_pitch − 1, 4, 4) flattened in C order.
-- ``y`` (float64[6], written) follows :data:`OUTPUT_NAMES`: generator speed (rad/s), tower-base
-  fore-aft moment (N·m, deviation of the modal part: k_My · x_top), tower-top acceleration (m/s²),
-  tower-top velocity (m/s), pitch (rad), electrical power (W = η_gen · T_gen · Ω).
-
-Pitch actuator: β̈ = ω_a²(β_cmd − β) − 2ζ_a ω_a β̇ₛ with ω_a = 3.14 rad/s, ζ_a = 0.707; the
-pitch moves at β̇ₛ = clip(β̇, ±rate_limit) and stops at the position limits; the internal rate
-does not wind up beyond the rate limit. At trim the rate is 0 and the pitch inside its
-limits, so the saturations play no part in the linearisation.
+The state, input and output vectors and the compiled kernel are those of
+:mod:`specdesign.turbine.kernel`; the data and the table preparation are in
+:mod:`specdesign.turbine.tables`.
 """
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
 from functools import cached_property
-from importlib import resources
 
 import numpy as np
-from numba import njit
 
-from ._checks import positive_scalar
+from .._checks import positive_scalar
+from .kernel import (
+    HEADER_SIZE,
+    INPUT_NAMES,
+    OUTPUT_NAMES,
+    P_ACT_OMEGA,
+    P_ACT_ZETA,
+    P_DPITCH,
+    P_DTSR,
+    P_GEN_EFF,
+    P_INERTIA,
+    P_MY_PER_M,
+    P_N_PITCH,
+    P_N_TSR,
+    P_PITCH0,
+    P_PITCH_MAX,
+    P_PITCH_MIN,
+    P_RADIUS,
+    P_RATE_LIM,
+    P_RHO,
+    P_TSR0,
+    P_TWR_DAMP,
+    P_TWR_MASS,
+    P_TWR_STIFF,
+    STATE_NAMES,
+    aero_loads,
+    bicubic,
+    mechanics,
+    outputs,
+    outputs_from,
+    rhs,
+)
+from .tables import bicubic_coefficients, read_rotor_table, read_text, uniform_step
 
-__all__ = [
-    "STATE_NAMES",
-    "INPUT_NAMES",
-    "OUTPUT_NAMES",
-    "rhs",
-    "outputs",
-    "aero_loads",
-    "mechanics",
-    "outputs_from",
-    "TurbineModel",
-    "OperatingPoint",
-    "AeroExpansion",
-    "RoscoSchedule",
-    "iea15mw",
-    "rosco_baseline",
-    "rosco_gain_schedule",
-]
+__all__ = ["LOAD_INPUT_NAMES", "AERO_VARIABLES", "OperatingPoint", "AeroExpansion", "TurbineModel", "iea15mw"]
 
-STATE_NAMES = ("rotor_speed", "tower_top_disp", "tower_top_vel", "pitch", "pitch_rate")
-INPUT_NAMES = ("wind", "pitch_cmd", "gen_torque")
-OUTPUT_NAMES = ("gen_speed", "tower_base_my", "tower_top_acc", "tower_top_vel", "pitch", "power")
 #: Extra inputs of ``linearize(..., load_inputs=True)``: disturbances added to the aerodynamic
 #: torque (N·m) and thrust (N).
 LOAD_INPUT_NAMES = ("aero_torque", "thrust")
 #: Arguments of the aerodynamic loads that :class:`AeroExpansion` expands in.
 AERO_VARIABLES = ("rotor_speed", "relative_wind", "pitch")
-
-# Header of the flat kernel parameter array.
-P_RHO, P_RADIUS, P_INERTIA = 0, 1, 2
-P_TWR_MASS, P_TWR_STIFF, P_TWR_DAMP, P_MY_PER_M = 3, 4, 5, 6
-P_ACT_OMEGA, P_ACT_ZETA, P_RATE_LIM, P_PITCH_MIN, P_PITCH_MAX = 7, 8, 9, 10, 11
-P_GEN_EFF = 12
-P_N_TSR, P_TSR0, P_DTSR, P_N_PITCH, P_PITCH0, P_DPITCH = 13, 14, 15, 16, 17, 18
-_HEADER = 20
-
-_DATA = "data/iea15mw"
-
-
-# ----------------------------------------------------------------------------- kernel
-@njit(cache=True)
-def _bicubic(p, offset, tsr, pitch):
-    """Evaluate one C2 bicubic table (coefficients at p[offset:]) at (tsr, pitch rad)."""
-    n_tsr = int(p[P_N_TSR])
-    n_pitch = int(p[P_N_PITCH])
-    u = (tsr - p[P_TSR0]) / p[P_DTSR]
-    v = (pitch - p[P_PITCH0]) / p[P_DPITCH]
-    # Outside the table the coefficient is held at its edge value rather than extrapolated:
-    # a cubic extrapolation can run away during a simulator transient.
-    u = min(max(u, 0.0), n_tsr - 1.0)
-    v = min(max(v, 0.0), n_pitch - 1.0)
-    i = min(int(u), n_tsr - 2)
-    j = min(int(v), n_pitch - 2)
-    u -= i
-    v -= j
-    base = offset + (i * (n_pitch - 1) + j) * 16
-    out = 0.0
-    uk = 1.0
-    for k in range(4):
-        row = p[base + 4 * k] + v * (p[base + 4 * k + 1] + v * (p[base + 4 * k + 2] + v * p[base + 4 * k + 3]))
-        out += uk * row
-        uk *= u
-    return out
-
-
-@njit(cache=True)
-def aero_loads(p, omega, v_rel, beta):
-    """(aerodynamic torque N·m, thrust N) at rotor speed ``omega`` (rad/s), wind relative to
-    the tower top ``v_rel`` (m/s) and pitch ``beta`` (rad), from the compiled Cp/Ct interpolant."""
-    radius = p[P_RADIUS]
-    area = np.pi * radius * radius
-    # Kept positive so that a wild transient cannot divide by zero.
-    v = max(v_rel, 0.1)
-    tsr = max(omega, 1e-6) * radius / v
-    n_cells = (int(p[P_N_TSR]) - 1) * (int(p[P_N_PITCH]) - 1) * 16
-    cp = _bicubic(p, _HEADER, tsr, beta)
-    ct = _bicubic(p, _HEADER + n_cells, tsr, beta)
-    q_dyn = 0.5 * p[P_RHO] * area * v * v
-    # Aerodynamic torque = P/Ω = q_dyn·R·Cp/λ, written without 1/Ω.
-    return q_dyn * radius * cp / tsr, q_dyn * ct
-
-
-@njit(cache=True)
-def mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx):
-    """State derivative given the aerodynamic loads: rigid drivetrain, first tower fore-aft
-    mode, pitch actuator with rate and position limits (written into ``dx``). Shared by
-    :func:`rhs` and by kernels that replace only the aerodynamics."""
-    beta = x[3]
-    beta_rate = x[4]
-    qd = x[2]
-    dx[0] = (aero_torque - gen_torque) / p[P_INERTIA]
-    dx[1] = qd
-    dx[2] = (thrust - p[P_TWR_STIFF] * x[1] - p[P_TWR_DAMP] * qd) / p[P_TWR_MASS]
-
-    rate_lim = p[P_RATE_LIM]
-    rate = min(max(beta_rate, -rate_lim), rate_lim)
-    if (beta >= p[P_PITCH_MAX] and rate > 0.0) or (beta <= p[P_PITCH_MIN] and rate < 0.0):
-        rate = 0.0
-    wa = p[P_ACT_OMEGA]
-    acc = wa * wa * (pitch_cmd - beta) - 2.0 * p[P_ACT_ZETA] * wa * rate
-    # No wind-up of the internal rate beyond the rate limit.
-    if (beta_rate >= rate_lim and acc > 0.0) or (beta_rate <= -rate_lim and acc < 0.0):
-        acc = 0.0
-    dx[3] = rate
-    dx[4] = acc
-
-
-@njit(cache=True)
-def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
-    """State derivative of the reduced IEA 15 MW model, written into ``dx``.
-
-    See the module docstring, section "Kernel interface", for the state vector, units and
-    the layout of the parameter array ``p`` (from :meth:`TurbineModel.kernel_params`).
-    """
-    # The rotor sees the wind relative to the moving tower top.
-    aero_torque, thrust = aero_loads(p, x[0], wind - x[2], x[3])
-    mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)
-
-
-@njit(cache=True)
-def outputs_from(x, dx, gen_torque, p, y):
-    """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``."""
-    y[0] = x[0]
-    y[1] = p[P_MY_PER_M] * x[1]
-    y[2] = dx[2]
-    y[3] = x[2]
-    y[4] = x[3]
-    y[5] = p[P_GEN_EFF] * gen_torque * x[0]
-
-
-@njit(cache=True)
-def outputs(x, wind, pitch_cmd, gen_torque, p, y):
-    """Outputs of the reduced model in the order of :data:`OUTPUT_NAMES`, written into ``y``.
-
-    Same arguments as :func:`rhs`; ``y`` is float64[6]: gen_speed (rad/s), tower_base_my
-    (N·m), tower_top_acc (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical).
-    """
-    dx = np.empty(5)
-    rhs(x, wind, pitch_cmd, gen_torque, p, dx)
-    outputs_from(x, dx, gen_torque, p, y)
-
-
-# ----------------------------------------------------------------------------- data
-def _read_text(name: str) -> str:
-    return resources.files("specdesign").joinpath(f"{_DATA}/{name}").read_text()
-
-
-def _read_rotor_table():
-    """Parse the ROSCO-format Cp/Ct/Cq text table: pitch (deg), TSR, and (n_tsr, n_pitch) blocks."""
-    lines = _read_text("Cp_Ct_Cq.IEA15MW.txt").splitlines()
-    pitch = tsr = None
-    blocks = {}
-    i = 0
-    while i < len(lines):
-        line = lines[i].strip().lower()
-        if line.startswith("# pitch angle vector"):
-            pitch = np.array(lines[i + 1].split(), float)
-        elif line.startswith("# tsr vector"):
-            tsr = np.array(lines[i + 1].split(), float)
-        elif line.startswith("#") and "coefficient" in line:
-            key = line.split()[1][:2]  # "po", "th", "to"
-            rows = []
-            j = i + 1
-            while len(rows) < len(tsr):
-                if lines[j].strip():
-                    rows.append(np.array(lines[j].split(), float))
-                j += 1
-            blocks[key] = np.array(rows)
-            i = j
-            continue
-        i += 1
-    return tsr, pitch, blocks["po"], blocks["th"]
-
-
-def _uniform(grid, name):
-    step = np.diff(grid)
-    if not np.allclose(step, step[0], rtol=1e-9, atol=1e-12):
-        raise ValueError(f"the {name} axis of the rotor table must be uniform for the compiled interpolant")
-    return float(step[0])
-
-
-# Hermite basis: for a cubic on [0, 1] with values f0, f1 and slopes d0, d1, the monomial
-# coefficients are H @ [f0, f1, d0, d1].
-_H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [-3.0, 3.0, -2.0, -1.0], [2.0, -2.0, 1.0, 1.0]])
-
-
-def _bicubic_coefficients(tsr, pitch_rad, table):
-    """Per-cell bicubic coefficients a[i, j, k, l] (f = Σ a_kl u^k v^l) reproducing the
-    interpolating tensor-product cubic spline of ``table`` (scipy RectBivariateSpline, s=0).
-
-    Within each cell that spline is one bicubic polynomial, fixed by f, f_u, f_v, f_uv at the
-    four corners; Hermite patches built from those corner values reproduce it exactly, so the
-    compiled kernel evaluates the same C2 surface scipy fits.
-    """
-    from scipy.interpolate import RectBivariateSpline
-
-    spl = RectBivariateSpline(tsr, pitch_rad, table, kx=3, ky=3, s=0)
-    du = tsr[1] - tsr[0]
-    dv = pitch_rad[1] - pitch_rad[0]
-    f = spl(tsr, pitch_rad)
-    fu = spl(tsr, pitch_rad, dx=1) * du
-    fv = spl(tsr, pitch_rad, dy=1) * dv
-    fuv = spl(tsr, pitch_rad, dx=1, dy=1) * du * dv
-    # Corner matrix G[i, j] = [[f00, f01, fv00, fv01], [f10, f11, fv10, fv11], [fu.., ..], [fuv..]]
-    # in the ordering of _H: rows (value at u=0, value at u=1, slope at u=0, slope at u=1).
-    def corners(a):
-        return np.stack([a[:-1, :-1], a[:-1, 1:], a[1:, :-1], a[1:, 1:]], -1)  # 00, 01, 10, 11
-
-    c_f, c_fu, c_fv, c_fuv = corners(f), corners(fu), corners(fv), corners(fuv)
-    g = np.empty(f[:-1, :-1].shape + (4, 4))
-    # rows: f(u=0), f(u=1), f_u(u=0), f_u(u=1); columns: same for v.
-    g[..., 0, 0], g[..., 0, 1], g[..., 0, 2], g[..., 0, 3] = c_f[..., 0], c_f[..., 1], c_fv[..., 0], c_fv[..., 1]
-    g[..., 1, 0], g[..., 1, 1], g[..., 1, 2], g[..., 1, 3] = c_f[..., 2], c_f[..., 3], c_fv[..., 2], c_fv[..., 3]
-    g[..., 2, 0], g[..., 2, 1], g[..., 2, 2], g[..., 2, 3] = c_fu[..., 0], c_fu[..., 1], c_fuv[..., 0], c_fuv[..., 1]
-    g[..., 3, 0], g[..., 3, 1], g[..., 3, 2], g[..., 3, 3] = c_fu[..., 2], c_fu[..., 3], c_fuv[..., 2], c_fuv[..., 3]
-    return _H @ g @ _H.T, spl
-
 
 # ----------------------------------------------------------------------------- results
 @dataclass(frozen=True)
@@ -376,14 +163,14 @@ class TurbineModel:
     # -- compiled-kernel parameters ------------------------------------------------------
     @cached_property
     def _tables(self):
-        cp_coef, cp_spl = _bicubic_coefficients(self.tsr_grid, self.pitch_grid, self.cp_table)
-        ct_coef, ct_spl = _bicubic_coefficients(self.tsr_grid, self.pitch_grid, self.ct_table)
+        cp_coef, cp_spl = bicubic_coefficients(self.tsr_grid, self.pitch_grid, self.cp_table)
+        ct_coef, ct_spl = bicubic_coefficients(self.tsr_grid, self.pitch_grid, self.ct_table)
         return cp_coef, ct_coef, cp_spl, ct_spl
 
     @cached_property
     def _params(self) -> np.ndarray:
         cp_coef, ct_coef, _, _ = self._tables
-        head = np.zeros(_HEADER)
+        head = np.zeros(HEADER_SIZE)
         head[P_RHO] = self.air_density
         head[P_RADIUS] = self.rotor_radius
         head[P_INERTIA] = self.drivetrain_inertia
@@ -399,10 +186,10 @@ class TurbineModel:
         head[P_GEN_EFF] = self.generator_efficiency
         head[P_N_TSR] = self.tsr_grid.size
         head[P_TSR0] = self.tsr_grid[0]
-        head[P_DTSR] = _uniform(self.tsr_grid, "TSR")
+        head[P_DTSR] = uniform_step(self.tsr_grid, "TSR")
         head[P_N_PITCH] = self.pitch_grid.size
         head[P_PITCH0] = self.pitch_grid[0]
-        head[P_DPITCH] = _uniform(self.pitch_grid, "pitch")
+        head[P_DPITCH] = uniform_step(self.pitch_grid, "pitch")
         p = np.concatenate([head, cp_coef.ravel(), ct_coef.ravel()])
         p.flags.writeable = False
         return p
@@ -416,8 +203,8 @@ class TurbineModel:
         p = self._params
         n_cells = (self.tsr_grid.size - 1) * (self.pitch_grid.size - 1) * 16
         tsr, pitch = np.broadcast_arrays(np.asarray(tsr, float), np.asarray(pitch, float))
-        cp = np.array([_bicubic(p, _HEADER, a, b) for a, b in zip(tsr.ravel(), pitch.ravel())]).reshape(tsr.shape)
-        ct = np.array([_bicubic(p, _HEADER + n_cells, a, b) for a, b in zip(tsr.ravel(), pitch.ravel())]).reshape(tsr.shape)
+        cp = np.array([bicubic(p, HEADER_SIZE, a, b) for a, b in zip(tsr.ravel(), pitch.ravel())]).reshape(tsr.shape)
+        ct = np.array([bicubic(p, HEADER_SIZE + n_cells, a, b) for a, b in zip(tsr.ravel(), pitch.ravel())]).reshape(tsr.shape)
         return cp, ct
 
     # -- numpy wrappers -------------------------------------------------------------------
@@ -645,8 +432,8 @@ def iea15mw() -> TurbineModel:
     stiffness, 1.081 rad/s), 1 % damping, tower-base moment at z = 15 m per metre of
     tower-top deflection. Generator efficiency 0.95756 (electrical power = η·T·Ω).
     """
-    par = json.loads(_read_text("parameters.json"))
-    tsr, pitch_deg, cp, ct = _read_rotor_table()
+    par = json.loads(read_text("parameters.json"))
+    tsr, pitch_deg, cp, ct = read_rotor_table()
     return TurbineModel(
         name="IEA-15-240-RWT",
         air_density=par["air_density_kg_m3"],
@@ -670,26 +457,3 @@ def iea15mw() -> TurbineModel:
         cp_table=cp,
         ct_table=ct,
     )
-
-
-# ----------------------------------------------------------------------------- ROSCO (specdesign.rosco)
-#: Names that live in :mod:`specdesign.rosco` and stay importable from here (public contract:
-#: ``specdesign.turbine.rosco_baseline``). Resolved on first access: :mod:`specdesign.rosco`
-#: imports this module, so importing it here at load time would be circular.
-_ROSCO_NAMES = ("RoscoSchedule", "rosco_gain_schedule", "speed_filter", "rosco_baseline")
-
-
-def __getattr__(name):
-    if name in _ROSCO_NAMES:
-        from . import rosco
-
-        return getattr(rosco, name)
-    if name == "_rotor_coefficients":  # TODO(issue 13): remove once callers switch
-        from .rosco import first_order_rotor_model
-
-        return first_order_rotor_model
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_ROSCO_NAMES) | {"_rotor_coefficients"})

@@ -1,0 +1,108 @@
+"""The embedded IEA 15 MW reduced-order model: trim, linearisation and the compiled kernel.
+
+The model: rigid-drivetrain rotor (aerodynamic torque from Cp(λ, β), thrust from Ct(λ, β)),
+first tower fore-aft mode driven by thrust with the rotor seeing the relative wind U − ẋ_top,
+a 2nd-order pitch actuator with rate and position limits, and a generator torque that is an
+input (constant, ``rated_generator_torque``, above rated). Figures come from the shipped
+``specdesign/data/iea15mw`` (IEA Wind Task 37 and NREL ROSCO, Apache-2.0; see NOTICE.md).
+
+Layout
+------
+- :mod:`specdesign.turbine.model`: :class:`TurbineModel` (trim, linearisation, aerodynamic
+  expansion), :class:`OperatingPoint`, :class:`AeroExpansion`, :func:`iea15mw`.
+- :mod:`specdesign.turbine.kernel`: the compiled right-hand side :func:`rhs` / :func:`outputs`
+  (and its parts :func:`aero_loads`, :func:`mechanics`, :func:`outputs_from`), the state,
+  input and output names and the layout of the parameter array: see its docstring, "the
+  kernel interface".
+- :mod:`specdesign.turbine.tables`: the shipped data and the bicubic rotor-table coefficients.
+- ROSCO (:func:`rosco_baseline`, :func:`rosco_gain_schedule`, :class:`RoscoSchedule`,
+  :func:`speed_filter`) lives in :mod:`specdesign.rosco` and is re-exported here.
+"""
+from __future__ import annotations
+
+from .kernel import (
+    HEADER_SIZE,
+    INPUT_NAMES,
+    OUTPUT_NAMES,
+    P_ACT_OMEGA,
+    P_ACT_ZETA,
+    P_DPITCH,
+    P_DTSR,
+    P_GEN_EFF,
+    P_INERTIA,
+    P_MY_PER_M,
+    P_N_PITCH,
+    P_N_TSR,
+    P_PITCH0,
+    P_PITCH_MAX,
+    P_PITCH_MIN,
+    P_RADIUS,
+    P_RATE_LIM,
+    P_RHO,
+    P_TSR0,
+    P_TWR_DAMP,
+    P_TWR_MASS,
+    P_TWR_STIFF,
+    STATE_NAMES,
+    aero_loads,
+    bicubic,
+    mechanics,
+    outputs,
+    outputs_from,
+    rhs,
+)
+from .model import AERO_VARIABLES, LOAD_INPUT_NAMES, AeroExpansion, OperatingPoint, TurbineModel, iea15mw
+from .tables import DATA_DIR, HERMITE, bicubic_coefficients, read_rotor_table, read_text, uniform_step
+
+__all__ = [
+    "STATE_NAMES",
+    "INPUT_NAMES",
+    "OUTPUT_NAMES",
+    "LOAD_INPUT_NAMES",
+    "AERO_VARIABLES",
+    "rhs",
+    "outputs",
+    "aero_loads",
+    "mechanics",
+    "outputs_from",
+    "TurbineModel",
+    "OperatingPoint",
+    "AeroExpansion",
+    "RoscoSchedule",
+    "iea15mw",
+    "rosco_baseline",
+    "rosco_gain_schedule",
+    "speed_filter",
+]
+
+# Old private names of the single-module turbine.py: plain aliases of the public names.
+# TODO(issue 13): remove once callers switch
+_HEADER = HEADER_SIZE
+_DATA = DATA_DIR
+_H = HERMITE
+_bicubic = bicubic
+_bicubic_coefficients = bicubic_coefficients
+_read_text = read_text
+_read_rotor_table = read_rotor_table
+_uniform = uniform_step
+
+#: Names that live in :mod:`specdesign.rosco` and stay importable from here (public contract:
+#: ``specdesign.turbine.rosco_baseline``). Resolved on first access: :mod:`specdesign.rosco`
+#: imports this package, so importing it here at load time would be circular.
+_ROSCO_NAMES = ("RoscoSchedule", "rosco_gain_schedule", "speed_filter", "rosco_baseline")
+
+
+def __getattr__(name):
+    if name in _ROSCO_NAMES:
+        from .. import rosco
+
+        return getattr(rosco, name)
+    if name == "_rotor_coefficients":  # TODO(issue 13): remove once callers switch
+        from ..rosco import first_order_rotor_model
+
+        return first_order_rotor_model
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_ROSCO_NAMES) | {"_rotor_coefficients"})

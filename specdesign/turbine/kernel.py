@@ -1,0 +1,175 @@
+"""The compiled right-hand side of the reduced turbine model (numba), and its interface.
+
+One compiled right-hand side serves the nonlinear simulator and the linearisation, so the
+linear model is by construction the Jacobian of what the simulator integrates.
+
+``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` and ``outputs(x, wind, pitch_cmd, gen_torque, p, y)``
+are module-level ``@numba.njit(cache=True)`` functions, callable from other ``@njit`` code.
+They are composed of ``aero_loads(p, omega, v_rel, beta)`` → (torque, thrust),
+``mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)`` and
+``outputs_from(x, dx, gen_torque, p, y)``, so a kernel that changes only the aerodynamics
+reuses the rest:
+
+- ``x`` (float64[5], read) and ``dx`` (float64[5], written) follow :data:`STATE_NAMES`:
+
+  ====  =================  ======  =====================================================
+  idx   name               unit    meaning
+  ====  =================  ======  =====================================================
+  0     ``rotor_speed``    rad/s   rotor = generator speed (gearbox ratio 1)
+  1     ``tower_top_disp`` m       first fore-aft modal coordinate = tower-top deflection
+  2     ``tower_top_vel``  m/s     its rate
+  3     ``pitch``          rad     collective blade pitch
+  4     ``pitch_rate``     rad/s   actuator internal rate state (see below)
+  ====  =================  ======  =====================================================
+
+- ``wind`` (m/s) rotor-effective wind speed, ``pitch_cmd`` (rad) collective pitch demand,
+  ``gen_torque`` (N·m) generator torque on the rotor shaft: scalars (float).
+- ``p`` is the flat float64 parameter array of :meth:`specdesign.turbine.TurbineModel.kernel_params`: a header of
+  :data:`HEADER_SIZE` scalars (indices ``P_*`` in this module) followed by the bicubic Cp and Ct
+  patch coefficients, each of shape (n_tsr − 1, n_pitch − 1, 4, 4) flattened in C order.
+- ``y`` (float64[6], written) follows :data:`OUTPUT_NAMES`: generator speed (rad/s), tower-base
+  fore-aft moment (N·m, deviation of the modal part: k_My · x_top), tower-top acceleration (m/s²),
+  tower-top velocity (m/s), pitch (rad), electrical power (W = η_gen · T_gen · Ω).
+
+Pitch actuator: β̈ = ω_a²(β_cmd − β) − 2ζ_a ω_a β̇ₛ with ω_a = 3.14 rad/s, ζ_a = 0.707; the
+pitch moves at β̇ₛ = clip(β̇, ±rate_limit) and stops at the position limits; the internal rate
+does not wind up beyond the rate limit. At trim the rate is 0 and the pitch inside its
+limits, so the saturations play no part in the linearisation.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = [
+    "STATE_NAMES",
+    "INPUT_NAMES",
+    "OUTPUT_NAMES",
+    "HEADER_SIZE",
+    "P_RHO", "P_RADIUS", "P_INERTIA", "P_TWR_MASS", "P_TWR_STIFF", "P_TWR_DAMP", "P_MY_PER_M", "P_ACT_OMEGA",
+    "P_ACT_ZETA", "P_RATE_LIM", "P_PITCH_MIN", "P_PITCH_MAX", "P_GEN_EFF", "P_N_TSR", "P_TSR0", "P_DTSR",
+    "P_N_PITCH", "P_PITCH0", "P_DPITCH",
+    "bicubic",
+    "aero_loads",
+    "mechanics",
+    "rhs",
+    "outputs_from",
+    "outputs",
+]
+
+STATE_NAMES = ("rotor_speed", "tower_top_disp", "tower_top_vel", "pitch", "pitch_rate")
+INPUT_NAMES = ("wind", "pitch_cmd", "gen_torque")
+OUTPUT_NAMES = ("gen_speed", "tower_base_my", "tower_top_acc", "tower_top_vel", "pitch", "power")
+
+# Header of the flat kernel parameter array.
+P_RHO, P_RADIUS, P_INERTIA = 0, 1, 2
+P_TWR_MASS, P_TWR_STIFF, P_TWR_DAMP, P_MY_PER_M = 3, 4, 5, 6
+P_ACT_OMEGA, P_ACT_ZETA, P_RATE_LIM, P_PITCH_MIN, P_PITCH_MAX = 7, 8, 9, 10, 11
+P_GEN_EFF = 12
+P_N_TSR, P_TSR0, P_DTSR, P_N_PITCH, P_PITCH0, P_DPITCH = 13, 14, 15, 16, 17, 18
+#: Length of the header of the flat parameter array (the bicubic coefficients follow it).
+HEADER_SIZE = 20
+
+
+
+# ----------------------------------------------------------------------------- kernel
+@njit(cache=True)
+def bicubic(p, offset, tsr, pitch):
+    """Evaluate one C2 bicubic table (coefficients at p[offset:]) at (tsr, pitch rad)."""
+    n_tsr = int(p[P_N_TSR])
+    n_pitch = int(p[P_N_PITCH])
+    u = (tsr - p[P_TSR0]) / p[P_DTSR]
+    v = (pitch - p[P_PITCH0]) / p[P_DPITCH]
+    # Outside the table the coefficient is held at its edge value rather than extrapolated:
+    # a cubic extrapolation can run away during a simulator transient.
+    u = min(max(u, 0.0), n_tsr - 1.0)
+    v = min(max(v, 0.0), n_pitch - 1.0)
+    i = min(int(u), n_tsr - 2)
+    j = min(int(v), n_pitch - 2)
+    u -= i
+    v -= j
+    base = offset + (i * (n_pitch - 1) + j) * 16
+    out = 0.0
+    uk = 1.0
+    for k in range(4):
+        row = p[base + 4 * k] + v * (p[base + 4 * k + 1] + v * (p[base + 4 * k + 2] + v * p[base + 4 * k + 3]))
+        out += uk * row
+        uk *= u
+    return out
+
+
+@njit(cache=True)
+def aero_loads(p, omega, v_rel, beta):
+    """(aerodynamic torque N·m, thrust N) at rotor speed ``omega`` (rad/s), wind relative to
+    the tower top ``v_rel`` (m/s) and pitch ``beta`` (rad), from the compiled Cp/Ct interpolant."""
+    radius = p[P_RADIUS]
+    area = np.pi * radius * radius
+    # Kept positive so that a wild transient cannot divide by zero.
+    v = max(v_rel, 0.1)
+    tsr = max(omega, 1e-6) * radius / v
+    n_cells = (int(p[P_N_TSR]) - 1) * (int(p[P_N_PITCH]) - 1) * 16
+    cp = bicubic(p, HEADER_SIZE, tsr, beta)
+    ct = bicubic(p, HEADER_SIZE + n_cells, tsr, beta)
+    q_dyn = 0.5 * p[P_RHO] * area * v * v
+    # Aerodynamic torque = P/Ω = q_dyn·R·Cp/λ, written without 1/Ω.
+    return q_dyn * radius * cp / tsr, q_dyn * ct
+
+
+@njit(cache=True)
+def mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx):
+    """State derivative given the aerodynamic loads: rigid drivetrain, first tower fore-aft
+    mode, pitch actuator with rate and position limits (written into ``dx``). Shared by
+    :func:`rhs` and by kernels that replace only the aerodynamics."""
+    beta = x[3]
+    beta_rate = x[4]
+    qd = x[2]
+    dx[0] = (aero_torque - gen_torque) / p[P_INERTIA]
+    dx[1] = qd
+    dx[2] = (thrust - p[P_TWR_STIFF] * x[1] - p[P_TWR_DAMP] * qd) / p[P_TWR_MASS]
+
+    rate_lim = p[P_RATE_LIM]
+    rate = min(max(beta_rate, -rate_lim), rate_lim)
+    if (beta >= p[P_PITCH_MAX] and rate > 0.0) or (beta <= p[P_PITCH_MIN] and rate < 0.0):
+        rate = 0.0
+    wa = p[P_ACT_OMEGA]
+    acc = wa * wa * (pitch_cmd - beta) - 2.0 * p[P_ACT_ZETA] * wa * rate
+    # No wind-up of the internal rate beyond the rate limit.
+    if (beta_rate >= rate_lim and acc > 0.0) or (beta_rate <= -rate_lim and acc < 0.0):
+        acc = 0.0
+    dx[3] = rate
+    dx[4] = acc
+
+
+@njit(cache=True)
+def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
+    """State derivative of the reduced IEA 15 MW model, written into ``dx``.
+
+    See the module docstring, section "Kernel interface", for the state vector, units and
+    the layout of the parameter array ``p`` (from :meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    """
+    # The rotor sees the wind relative to the moving tower top.
+    aero_torque, thrust = aero_loads(p, x[0], wind - x[2], x[3])
+    mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)
+
+
+@njit(cache=True)
+def outputs_from(x, dx, gen_torque, p, y):
+    """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``."""
+    y[0] = x[0]
+    y[1] = p[P_MY_PER_M] * x[1]
+    y[2] = dx[2]
+    y[3] = x[2]
+    y[4] = x[3]
+    y[5] = p[P_GEN_EFF] * gen_torque * x[0]
+
+
+@njit(cache=True)
+def outputs(x, wind, pitch_cmd, gen_torque, p, y):
+    """Outputs of the reduced model in the order of :data:`OUTPUT_NAMES`, written into ``y``.
+
+    Same arguments as :func:`rhs`; ``y`` is float64[6]: gen_speed (rad/s), tower_base_my
+    (N·m), tower_top_acc (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical).
+    """
+    dx = np.empty(5)
+    rhs(x, wind, pitch_cmd, gen_torque, p, dx)
+    outputs_from(x, dx, gen_torque, p, y)
