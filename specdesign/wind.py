@@ -41,12 +41,36 @@ def _sigma(mean_speed, turbulence_class):
     return TURBULENCE_CLASSES[turbulence_class] * (0.75 * mean_speed + 5.6)
 
 
-def kaimal_spectrum(omega, mean_speed, turbulence_class="B"):
+def kaimal_spectrum(omega, mean_speed: float, turbulence_class: str = "B") -> np.ndarray:
     """One-sided Kaimal spectrum of the longitudinal wind at a point, ((m/s)² per rad/s).
 
     S(ω) = S_f(ω/2π)/(2π), S_f(f) = 4σ²(L/U)/(1 + 6fL/U)^{5/3} (per Hz), σ = I_ref(0.75U + 5.6)
-    (IEC NTM), L = 8.1·42 m. omega: grid (rad/s, ≥ 0); mean_speed: hub-height mean U (m/s);
-    turbulence_class: "A+", "A", "B" or "C".
+    (IEC NTM), L = 8.1·42 m.
+
+    Parameters
+    ----------
+    omega : array_like
+        Frequency grid (rad/s, ≥ 0, strictly increasing).
+    mean_speed : float
+        Hub-height mean wind speed U (m/s).
+    turbulence_class : str, optional
+        IEC turbulence class: "A+", "A", "B" or "C".
+
+    Returns
+    -------
+    numpy.ndarray
+        S(ω) on ``omega`` ((m/s)² per rad/s).
+
+    Raises
+    ------
+    ValueError
+        For an invalid grid, a non-positive ``mean_speed`` or an unknown class.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> kaimal_spectrum(np.array([0.0, 1.0]), 19.0).shape
+    (2,)
     """
     w = as_omega(omega, "omega")
     u = positive_scalar(mean_speed, "mean_speed")
@@ -56,12 +80,31 @@ def kaimal_spectrum(omega, mean_speed, turbulence_class="B"):
     return s_f / (2 * np.pi)
 
 
-def disc_coherence(omega, mean_speed, rotor_radius):
+def disc_coherence(omega, mean_speed: float, rotor_radius: float) -> np.ndarray:
     """Rotor-disc average γ(ω) of the IEC exponential coherence (dimensionless, ≤ 1).
 
     γ = ∫₀^{2R} exp(−12 √((f r/U)² + (0.12 r/L_c)²)) p_R(r) dr, f = ω/2π, with
     p_R(r) = (4r/(πR²))[acos(r/2R) − (r/2R)√(1 − (r/2R)²)] the distance density of two
-    uniform points on the disc of radius R (m). Gauss-Legendre quadrature in s = √(r/2R).
+    uniform points on the disc of radius R. Gauss-Legendre quadrature in s = √(r/2R).
+
+    Parameters
+    ----------
+    omega : array_like
+        Frequency grid (rad/s, ≥ 0, strictly increasing).
+    mean_speed : float
+        Mean wind speed U (m/s).
+    rotor_radius : float
+        Rotor radius R (m).
+
+    Returns
+    -------
+    numpy.ndarray
+        γ(ω) on ``omega`` (-).
+
+    Raises
+    ------
+    ValueError
+        For an invalid grid or a non-positive ``mean_speed`` or ``rotor_radius``.
     """
     w = as_omega(omega, "omega")
     u = positive_scalar(mean_speed, "mean_speed")
@@ -77,11 +120,39 @@ def disc_coherence(omega, mean_speed, rotor_radius):
     return coh @ weights
 
 
-def rotor_effective_spectrum(omega, mean_speed, rotor_radius, turbulence_class="B"):
+def rotor_effective_spectrum(omega, mean_speed: float, rotor_radius: float,
+                             turbulence_class: str = "B") -> np.ndarray:
     """One-sided PSD of the rotor-effective wind speed ((m/s)² per rad/s): Kaimal × γ(ω).
 
-    omega (rad/s), mean_speed (m/s), rotor_radius (m), turbulence_class "A+", "A", "B", "C".
     See :func:`kaimal_spectrum` and :func:`disc_coherence`.
+
+    Parameters
+    ----------
+    omega : array_like
+        Frequency grid (rad/s, ≥ 0, strictly increasing).
+    mean_speed : float
+        Mean wind speed (m/s).
+    rotor_radius : float
+        Rotor radius (m).
+    turbulence_class : str, optional
+        IEC turbulence class: "A+", "A", "B" or "C".
+
+    Returns
+    -------
+    numpy.ndarray
+        The PSD on ``omega`` ((m/s)² per rad/s).
+
+    Raises
+    ------
+    ValueError
+        For an invalid grid, non-positive speed or radius, or an unknown class.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = rotor_effective_spectrum(np.linspace(0.0, 3.0, 31), 19.0, 120.97)
+    >>> bool(s[0] > s[-1] > 0)
+    True
     """
     return kaimal_spectrum(omega, mean_speed, turbulence_class) * disc_coherence(omega, mean_speed, rotor_radius)
 
@@ -100,13 +171,9 @@ def _seeds(seeds):
     return out
 
 
-def synthesize(spectrum_or_callable, duration, dt, seeds, *, random_amplitude=True):
+def synthesize(spectrum_or_callable, duration: float, dt: float, seeds, *,
+               random_amplitude: bool = True) -> np.ndarray:
     """Zero-mean Gaussian series with a one-sided PSD, shape (n_seeds, n_samples).
-
-    spectrum_or_callable: a callable ``S(omega)`` (omega in rad/s → PSD per rad/s), or a pair
-    ``(omega, psd)`` interpolated linearly (zero outside the grid). duration (s) and dt (s) give
-    n = round(duration/dt) samples at t = k·dt. seeds: an int or sequence of ints; each row
-    depends on its own seed only, so seed 3 gives the same series alone or in a batch.
 
     Harmonics sit at ω_k = 2πk/(n·dt), k = 1 … ⌊(n−1)/2⌋ (no mean, no Nyquist term), each with
     complex Gaussian coefficient of variance 2S(ω_k)Δω, so E[PSD] is S on that grid and the
@@ -115,6 +182,39 @@ def synthesize(spectrum_or_callable, duration, dt, seeds, *, random_amplitude=Tr
     The series is periodic with period n·dt; variance below Δω/2 = π/duration is not
     represented (for a 600 s record at 19 m/s that is ~10 % of the rotor-effective variance,
     as in any FFT synthesis). Add the mean wind speed yourself.
+
+    Parameters
+    ----------
+    spectrum_or_callable : callable or tuple
+        A callable ``S(omega)`` (omega in rad/s → PSD per rad/s), or a pair ``(omega, psd)``
+        interpolated linearly (zero outside the grid).
+    duration : float
+        Length of the series (s); n = round(duration/dt) samples at t = k·dt.
+    dt : float
+        Sample spacing (s).
+    seeds : int or sequence of int
+        Non-negative seeds, one row each; each row depends on its own seed only, so seed 3
+        gives the same series alone or in a batch.
+    random_amplitude : bool, optional
+        Random Gaussian amplitudes (default) or fixed amplitudes with random phases.
+
+    Returns
+    -------
+    numpy.ndarray
+        The series (units of √(PSD·rad/s), m/s for a wind PSD), shape (n_seeds, n).
+
+    Raises
+    ------
+    ValueError
+        For fewer than 4 samples, no or negative seeds, or a PSD that is not finite and
+        non-negative.
+    TypeError
+        For seeds that are not integers or a spectrum of the wrong kind.
+
+    Examples
+    --------
+    >>> synthesize(lambda w: 1.0 / (1.0 + w**2), 60.0, 0.1, [1, 2]).shape
+    (2, 600)
     """
     duration = positive_scalar(duration, "duration")
     dt = positive_scalar(dt, "dt")
