@@ -6,10 +6,14 @@ See :func:`specdesign.simulate.simulate` for the anti-windup these splits serve.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._checks import positive_scalar
+
+if TYPE_CHECKING:  # pragma: no cover
+    import control
 
 __all__ = [
     "is_lti_like",
@@ -23,13 +27,45 @@ __all__ = [
 
 
 def is_lti_like(c) -> bool:
+    """Whether ``c`` is an LTI controller the simulator takes as one (not a callable).
+
+    Parameters
+    ----------
+    c : object
+        A candidate controller.
+
+    Returns
+    -------
+    bool
+        True for a python-control LTI system or an object with a ``tf()`` method (a
+        ``loopshaping.controller.Controller``).
+    """
     import control
 
     return isinstance(c, control.LTI) or (hasattr(c, "tf") and callable(getattr(c, "tf")))
 
+def as_lti(c, name: str) -> control.LTI:
+    """``c`` as a continuous SISO python-control system, checked.
 
+    Parameters
+    ----------
+    c : control.LTI or loopshaping.controller.Controller
+        The controller (a ``Controller`` is converted by its ``.tf()``).
+    name : str
+        Name of the argument, for the error messages.
 
-def as_lti(c, name):
+    Returns
+    -------
+    control.LTI
+        The SISO continuous-time system.
+
+    Raises
+    ------
+    TypeError
+        If ``c`` is neither an LTI system nor has a ``tf()`` method.
+    ValueError
+        If it is not SISO, or is discrete-time.
+    """
     import control
 
     if hasattr(c, "tf") and callable(c.tf) and not isinstance(c, control.LTI):
@@ -43,12 +79,34 @@ def as_lti(c, name):
     return c
 
 
-def discretize(controller, dt):
-    """Tustin discretisation of a SISO continuous controller at step ``dt`` (s).
+def discretize(controller, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Tustin discretisation of a SISO continuous controller at step ``dt``.
 
-    Returns ``(A, B, C, D)`` float arrays of shapes (n, n), (n,), (n,) and (1,) of the
-    discrete state-space form x⁺ = A x + B u, y = C x + D u.
-    Raises ValueError for an improper controller (more zeros than poles).
+    Parameters
+    ----------
+    controller : control.LTI or loopshaping.controller.Controller
+        The continuous SISO controller.
+    dt : float
+        Step (s).
+
+    Returns
+    -------
+    A, B, C, D : numpy.ndarray
+        Float arrays of shapes (n, n), (n,), (n,) and (1,) of the discrete state-space form
+        x⁺ = A x + B u, y = C x + D u.
+
+    Raises
+    ------
+    ValueError
+        For an improper controller (more zeros than poles), a non-SISO or discrete one, or a
+        non-positive ``dt``.
+
+    Examples
+    --------
+    >>> import control
+    >>> A, B, C, D = discretize(control.tf([1.0], [1.0, 1.0]), 0.1)
+    >>> A.shape, D.shape
+    ((1, 1), (1,))
     """
     import control
 
@@ -68,13 +126,37 @@ def discretize(controller, dt):
             np.array([float(np.squeeze(d.D))]))
 
 
-def split_integrator(controller):
+def split_integrator(controller) -> tuple[float, control.LTI]:
     """(r, C_r): C(s) = r/s + C_r(s) for a SISO controller with one pole at s = 0.
 
     The simulator runs r/s as a separate integrator (trapezoid rule = Tustin, so the sum is
     the Tustin discretisation of C exactly) and clamps it at the pitch limits as ROSCO clamps
     its integrator (anti-windup); C_r has no pole at 0 and cannot wind up. A controller
     without a pole at 0 gives (0, C); one with several is returned whole, unclamped.
+
+    Parameters
+    ----------
+    controller : control.LTI or loopshaping.controller.Controller
+        The continuous SISO controller C.
+
+    Returns
+    -------
+    r : float
+        Residue of the pole at s = 0 (units of C per second), 0.0 without one.
+    rest : control.LTI
+        C_r (C itself when r is 0).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a controller that is not a continuous SISO LTI (:func:`as_lti`).
+
+    Examples
+    --------
+    >>> import control
+    >>> r, rest = split_integrator(control.tf([2.0, 3.0], [1.0, 0.0]))
+    >>> r
+    3.0
     """
     import control
 
@@ -95,17 +177,37 @@ def split_integrator(controller):
 #: its slow part (:func:`split_slow`): a time constant above 10 s, longer than an excursion to
 #: the pitch floor, over which such a mode integrates the speed error as the integrator does.
 #: A controller with a slow part gets conditional integration, one without (PI-like, ROSCO's:
-#: its speed filter is at 1 rad/s) ROSCO's integrator clamp; see :func:`simulate`.
+#: its speed filter is at 1 rad/s) ROSCO's integrator clamp; see :func:`specdesign.simulate.simulate`.
 SLOW_OMEGA = 0.1
 
 
-def split_slow(controller, omega=SLOW_OMEGA):
-    """(C_s or None, C_f): C = C_s + C_f with C_s the modes of ``controller`` (no pole at 0,
-    e.g. C_r of :func:`split_integrator`) with |pole| < ``omega`` (rad/s), strictly proper, and
-    C_f the others plus the feedthrough. Without slow poles: (None, controller), unchanged.
+def split_slow(controller, omega: float = SLOW_OMEGA) -> tuple[control.StateSpace | None, control.LTI]:
+    """(C_s or None, C_f): C = C_s + C_f, C_s the modes of ``controller`` slower than ``omega``.
 
+    C_s holds the modes of ``controller`` (no pole at 0, e.g. C_r of :func:`split_integrator`)
+    with |pole| < ``omega``, strictly proper, and C_f the others plus the feedthrough.
     Block-diagonalised from the ordered real Schur form (a Sylvester equation decouples the
-    blocks), so C_s + C_f equals C to rounding."""
+    blocks), so C_s + C_f equals C to rounding.
+
+    Parameters
+    ----------
+    controller : control.LTI or loopshaping.controller.Controller
+        The continuous SISO controller C.
+    omega : float, optional
+        Corner (rad/s) under which a pole is slow (default :data:`SLOW_OMEGA`).
+
+    Returns
+    -------
+    slow : control.StateSpace or None
+        C_s, or None without slow poles.
+    fast : control.LTI
+        C_f (``controller`` itself, unchanged, without slow poles).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a controller that is not a continuous SISO LTI (:func:`as_lti`).
+    """
     import control
     import scipy.linalg
 
@@ -126,11 +228,35 @@ def split_slow(controller, omega=SLOW_OMEGA):
 _BANKS: dict = {}
 
 
-def controller_bank(controller, dt):
+def controller_bank(controller, dt: float) -> tuple:
     """Discrete arrays of one controller (K local 2-input controllers) and its filter corner.
 
     Memoised per (controller object, dt): a campaign simulates the same controllers at
     every wind speed, and discretising a 15-point ROSCO schedule costs more than a run.
+
+    Parameters
+    ----------
+    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
+        The controller (an LTI is one local controller at scheduling pitch 0).
+    dt : float
+        Simulation step (s).
+
+    Returns
+    -------
+    tuple
+        ``(schedule_pitch, mats, filter_omega, pi)``: the (K,) scheduling pitches (rad); per
+        local controller ``(A, B, C, D, r, ns)`` of its output-blended part, discrete at ``dt``
+        (inputs speed error and negated tower-top velocity; ``r`` the pitch controller's
+        integrator gain, run apart, see :func:`split_integrator`; its first ``ns`` states the
+        modes of the rest under :data:`SLOW_OMEGA`, :func:`split_slow`); the scheduling filter
+        corner (rad/s); and the scheduled-PI arrays ``(kp, ki, Af, Bf, Cf, Df, limits)`` of
+        ``form="gains"`` or None (limits (2,) in rad, ±inf for none).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a controller that is not a continuous SISO LTI or a ScheduledController, or an
+        improper one.
     """
     key = (id(controller), float(dt))
     hit = _BANKS.get(key)

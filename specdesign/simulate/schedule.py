@@ -32,26 +32,47 @@ FORMS = ("output", "gains")
 class ScheduledController:
     """Local pitch (and optional ATD) controllers scheduled on filtered pitch.
 
-    schedule_pitch : (K,) increasing scheduling pitches β_k (rad), one per local controller.
-    pitch : K continuous SISO controllers C_β,k on the generator speed (β = −C·Ω_g): the
-        local controllers (in ``form="gains"``, the frozen-gain PIs (K_p,k + K_i,k/s)·F).
-    atd : K continuous SISO controllers on tower-top velocity (β −= C_atd·ẋ_top), or None;
-        output-blended in both forms.
-    filter_omega : corner (rad/s) of the first-order low-pass on the pitch command that
-        gives the scheduling variable β_f.
-    name : label used in tables and figures.
-    form : ``"output"`` blends the local controllers' outputs; ``"gains"`` runs ROSCO's form,
+    The weights are piecewise linear in β_f between the scheduling pitches, clamped at the
+    ends (see :mod:`specdesign.simulate`).
+
+    Parameters
+    ----------
+    schedule_pitch : array_like
+        (K,) strictly increasing scheduling pitches β_k (rad), one per local controller.
+    pitch : tuple
+        K continuous SISO controllers C_β,k on the generator speed (β = −C·Ω_g, rad per
+        rad/s): the local controllers (in ``form="gains"``, the frozen-gain PIs
+        (K_p,k + K_i,k/s)·F).
+    atd : tuple or None, optional
+        K continuous SISO controllers on tower-top velocity (β −= C_atd·ẋ_top, rad per m/s),
+        or None; output-blended in both forms.
+    filter_omega : float, optional
+        Corner (rad/s) of the first-order low-pass on the pitch command that gives the
+        scheduling variable β_f.
+    name : str, optional
+        Label used in tables and figures.
+    form : {"output", "gains"}, optional
+        ``"output"`` blends the local controllers' outputs; ``"gains"`` runs ROSCO's form,
         u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt with e_f = error_filter·(Ω_rated − Ω_g), the gains
-        interpolated linearly in β_f (see the module docstring). Build it with
-        :meth:`gain_scheduled_pi`.
-    kp, ki : (K,) PI gains at the scheduling pitches (``form="gains"`` only; in the workbench's
+        interpolated linearly in β_f. Build it with :meth:`gain_scheduled_pi`.
+    kp, ki : numpy.ndarray or None, optional
+        (K,) PI gains at the scheduling pitches (``form="gains"`` only; in the workbench's
         convention C = (K_p + K_i/s)·F, i.e. ROSCO's negative gains), rad/(rad/s) and rad/rad.
-    error_filter : SISO LTI filter F on the speed error (``form="gains"`` only).
-    pitch_limits : (min, max) absolute pitch (rad) at which ``form="gains"`` saturates its
-        integrator (the trim pitch plus ∫K_i·e_f) and its PI output, as ROSCO's PI does
-        (anti-windup). :func:`simulate` narrows them to the plant's pitch limits, and uses the
-        plant's alone when this is None (default): the integrator never winds up beyond what
-        the actuator can reach; on a plant without limits, None means no saturation.
+    error_filter : control.LTI or None, optional
+        SISO LTI filter F on the speed error (``form="gains"`` only).
+    pitch_limits : tuple of float or None, optional
+        (min, max) absolute pitch (rad) at which ``form="gains"`` saturates its integrator
+        (the trim pitch plus ∫K_i·e_f) and its PI output, as ROSCO's PI does (anti-windup).
+        :func:`specdesign.simulate.simulate` narrows them to the plant's pitch limits, and uses
+        the plant's alone when this is None (default): the integrator never winds up beyond
+        what the actuator can reach; on a plant without limits, None means no saturation.
+
+    Raises
+    ------
+    ValueError
+        For scheduling pitches that are not strictly increasing, a number of locals that
+        does not match them, an unknown ``form``, ``form="gains"`` arguments with
+        ``form="output"``, or locals that are not the frozen-gain PIs of ``kp``, ``ki``.
     """
 
     schedule_pitch: np.ndarray
@@ -107,8 +128,19 @@ class ScheduledController:
                 raise ValueError(f"pitch[{k}] is not (kp[{k}] + ki[{k}]/s)·error_filter; build form='gains' "
                                  "with ScheduledController.gain_scheduled_pi")
 
-    def local(self, k: int):
-        """(C_β, C_atd or None) of the k-th local controller."""
+    def local(self, k: int) -> tuple:
+        """The k-th local controller.
+
+        Parameters
+        ----------
+        k : int
+            Index of the scheduling pitch.
+
+        Returns
+        -------
+        tuple
+            (C_β, C_atd or None).
+        """
         return self.pitch[k], (None if self.atd is None else self.atd[k])
 
     @classmethod
@@ -116,12 +148,44 @@ class ScheduledController:
                           filter_omega=SCHEDULE_FILTER_OMEGA, name="PI", pitch_limits=None) -> "ScheduledController":
         """ROSCO-form gain-scheduled PI: u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_ref − Ω_g).
 
-        schedule_pitch (rad), kp, ki : (K,) gains at the scheduling pitches, in the
-        workbench's convention C = (K_p + K_i/s)·F (ROSCO's negative gains).
-        error_filter : SISO LTI F on the speed error (e.g. :func:`specdesign.rosco.speed_filter`).
-        atd : K ATD controllers (output-blended) or None.
-        pitch_limits : (min, max) pitch (rad) saturating the integrator and the PI output
-            (ROSCO's anti-windup), or None (the simulated plant's limits, see the class).
+        Parameters
+        ----------
+        schedule_pitch : array_like
+            (K,) strictly increasing scheduling pitches (rad).
+        kp : array_like
+            (K,) proportional gains at the scheduling pitches (rad per rad/s), in the
+            workbench's convention C = (K_p + K_i/s)·F (ROSCO's negative gains).
+        ki : array_like
+            (K,) integral gains (rad per rad), same convention.
+        error_filter : control.LTI
+            SISO LTI F on the speed error (e.g. :func:`specdesign.rosco.speed_filter`).
+        atd : sequence or None, optional
+            K ATD controllers (output-blended) or None.
+        filter_omega : float, optional
+            Corner of the scheduling filter (rad/s).
+        name : str, optional
+            Label used in tables and figures.
+        pitch_limits : tuple of float or None, optional
+            (min, max) pitch (rad) saturating the integrator and the PI output (ROSCO's
+            anti-windup), or None (the simulated plant's limits, see the class).
+
+        Returns
+        -------
+        ScheduledController
+            The controller in ``form="gains"``.
+
+        Raises
+        ------
+        ValueError
+            For gains of different lengths or a length that does not match ``schedule_pitch``.
+
+        Examples
+        --------
+        >>> import control
+        >>> f = control.tf([1.0], [0.1, 1.0])
+        >>> sc = ScheduledController.gain_scheduled_pi([0.1, 0.2], [-0.5, -0.4], [-0.05, -0.04], f)
+        >>> sc.form
+        'gains'
         """
         import control
 
@@ -135,12 +199,44 @@ class ScheduledController:
                    form="gains", kp=kp, ki=ki, error_filter=f, pitch_limits=pitch_limits)
 
 
-def scheduled(model, pitch, atd=None, *, filter_omega=SCHEDULE_FILTER_OMEGA, name="designed") -> ScheduledController:
-    """Build a ScheduledController from controllers designed per wind speed.
+def scheduled(model, pitch: dict, atd: dict | None = None, *, filter_omega: float = SCHEDULE_FILTER_OMEGA,
+              name: str = "designed") -> ScheduledController:
+    """Build an output-blended ScheduledController from controllers designed per wind speed.
 
-    pitch : dict wind speed (m/s) → pitch controller C_β (LTI or Controller).
-    atd : dict wind speed (m/s) → ATD controller, same keys, or None.
-    model : TurbineModel or KernelPlant whose trim gives each wind speed's scheduling pitch.
+    Each controller is scheduled at the trim pitch of its wind speed.
+
+    Parameters
+    ----------
+    model : TurbineModel or KernelPlant
+        The plant whose trim gives each wind speed's scheduling pitch.
+    pitch : dict
+        Wind speed (m/s) → pitch controller C_β (LTI or ``loopshaping`` Controller).
+    atd : dict or None, optional
+        Wind speed (m/s) → ATD controller, same keys, or None.
+    filter_omega : float, optional
+        Corner of the scheduling filter (rad/s).
+    name : str, optional
+        Label used in tables and figures.
+
+    Returns
+    -------
+    ScheduledController
+        The controller in ``form="output"``.
+
+    Raises
+    ------
+    TypeError
+        If ``pitch`` is not a non-empty dict.
+    ValueError
+        If ``atd`` has other wind speeds than ``pitch``, or a wind speed is outside the model's range.
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw, rosco_baseline
+    >>> m = iea15mw()
+    >>> sc = scheduled(m, {15.0: rosco_baseline(m, 15.0), 21.0: rosco_baseline(m, 21.0)})
+    >>> sc.schedule_pitch.size
+    2
     """
     if not isinstance(pitch, dict) or not pitch:
         raise TypeError("pitch must be a non-empty dict {wind_speed_m_s: controller}")
