@@ -413,7 +413,8 @@ def test_no_module_chooses_a_matplotlib_backend():
 @pytest.mark.parametrize("module", ["specdesign.validate.stats", "specdesign.validate.indicators",
                                     "specdesign.validate.prediction", "specdesign.validate.volterra",
                                     "specdesign.validate.campaign", "specdesign.validate.tables", "specdesign.cli",
-                                    "specdesign.openfast.series"])
+                                    "specdesign.openfast.series", "specdesign.openfast.outputs",
+                                    "specdesign.openfast.lin"])
 def test_public_names_have_numpydoc_docstrings(module):
     import importlib
     import inspect
@@ -430,3 +431,7 @@ def test_public_names_have_numpydoc_docstrings(module):
         if errs:
             bad[name] = errs
     assert not bad, bad
+    # and their examples run
+    import doctest
+
+    assert doctest.testmod(mod, optionflags=doctest.ELLIPSIS).failed == 0

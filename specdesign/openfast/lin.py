@@ -19,7 +19,9 @@ blade-1-only output) are left as they are and averaged.
 """
 from __future__ import annotations
 
+import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -76,13 +78,30 @@ class _LinFile:
 
 @dataclass(frozen=True)
 class LinearizationData:
-    """An azimuth-averaged, MBC-transformed OpenFAST linearisation.
+    """An azimuth-averaged, MBC-transformed OpenFAST linearisation (:func:`read_linearization`).
 
-    A (nx, nx), B (nx, nu), C (ny, nx), D (ny, nu) in OpenFAST's units, except outputs converted
-    to SI when read with ``si=True`` (see ``y_units``). ``x_desc``, ``u_desc``, ``y_desc``:
-    descriptions (blade triplets renamed with ``[coll]``, ``[cos]``, ``[sin]`` in place of the
-    blade number). Operating point: ``x_op``, ``u_op``, ``y_op`` (averaged, rotating frame),
-    ``wind_speed`` (m/s), ``rotor_speed`` (rad/s), ``azimuths`` (rad) of the files averaged.
+    Matrices in OpenFAST's units, except outputs converted to SI when read with ``si=True``
+    (see ``y_units``). Descriptions rename blade triplets with ``[coll]``, ``[cos]``,
+    ``[sin]`` in place of the blade number. :meth:`to_statespace` selects and names signals.
+
+    Parameters
+    ----------
+    A, B, C, D : numpy.ndarray
+        State-space matrices, (nx, nx), (nx, nu), (ny, nx), (ny, nu).
+    x_desc, u_desc, y_desc : tuple of str
+        Descriptions of the states, inputs and outputs.
+    y_units : tuple of str
+        Unit of each output.
+    x_op, u_op, y_op : numpy.ndarray
+        Operating point (averaged, rotating frame).
+    wind_speed : float
+        Mean wind speed (m/s).
+    rotor_speed : float
+        Rotor speed (rad/s).
+    azimuths : numpy.ndarray
+        Azimuths of the files averaged (rad).
+    paths : tuple of str
+        The files read.
     """
 
     A: np.ndarray
@@ -231,8 +250,25 @@ def _is_float(t):
         return False
 
 
-def read_lin_file(path) -> _LinFile:
-    """Parse one ``.lin`` file (no transform). Errors: ValueError 'file:line: message'."""
+def read_lin_file(path: str | os.PathLike) -> _LinFile:
+    """Parse one ``.lin`` file, without transform.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.lin`` file.
+
+    Returns
+    -------
+    _LinFile
+        Matrices, operating point, descriptions, rotating-frame flags and derivative orders
+        as written in the file, azimuth (rad), rotor speed (rad/s) and wind speed (m/s).
+
+    Raises
+    ------
+    ValueError
+        ``'file:line: message'`` for an unreadable, truncated or malformed file.
+    """
     cur = _Lines(path)
     n = {k: _header_value(cur, key, int) for k, key in _COUNTS.items()}
     azimuth = _header_value(cur, "Azimuth:", float)
@@ -333,11 +369,38 @@ def _state_transform(desc, rotating, order, psi, omega):
     return T, Td, trip
 
 
-def mbc_transform(A, B, C, D, x_desc, x_rot, x_order, u_desc, u_rot, y_desc, y_rot, azimuth, rotor_speed):
+def mbc_transform(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, x_desc, x_rot, x_order, u_desc, u_rot,
+                  y_desc, y_rot, azimuth: float, rotor_speed: float) -> tuple:
     """Multi-blade coordinate transform of one azimuth's (A, B, C, D) (see module docstring).
 
-    azimuth (rad) of blade 1, rotor_speed (rad/s). Returns (A, B, C, D) in the non-rotating
-    frame and the transformed descriptions (x_desc, u_desc, y_desc).
+    Parameters
+    ----------
+    A, B, C, D : numpy.ndarray
+        State-space matrices at this azimuth.
+    x_desc : sequence of str
+        Descriptions of the states (blade triplets are found by the descriptions).
+    x_rot : numpy.ndarray
+        Bool per state: in the rotating frame.
+    x_order : numpy.ndarray
+        Derivative order of each state (2 for velocities of second-order states).
+    u_desc : sequence of str
+        Descriptions of the inputs.
+    u_rot : numpy.ndarray
+        Bool per input: in the rotating frame.
+    y_desc : sequence of str
+        Descriptions of the outputs.
+    y_rot : numpy.ndarray
+        Bool per output: in the rotating frame.
+    azimuth : float
+        Azimuth of blade 1 (rad).
+    rotor_speed : float
+        Rotor speed (rad/s).
+
+    Returns
+    -------
+    tuple
+        (A, B, C, D) in the non-rotating frame and the transformed descriptions
+        (x_desc, u_desc, y_desc).
     """
     Tx, Txd, tx = _state_transform(x_desc, x_rot, x_order, azimuth, rotor_speed)
     tu = _triplets(u_desc, u_rot)
@@ -367,14 +430,38 @@ def _unit(desc):
     return m.group(1) if m else ""
 
 
-def read_linearization(paths, inputs=None, outputs=None, *, si=True):
+def read_linearization(paths: str | os.PathLike | Sequence[str | os.PathLike], inputs=None, outputs=None, *,
+                       si: bool = True) -> LinearizationData:
     """Read the ``.lin`` files of one operating point, MBC-transform and average over azimuth.
 
-    paths: one path or a sequence (one file per azimuth, same signals). si: convert outputs
-    written in rpm, deg, deg/s, kN, kN-m, kW to rad/s, rad, rad/s, N, N·m, W (inputs are
-    already SI in OpenFAST). inputs / outputs: optional selection, as in
-    :meth:`LinearizationData.to_statespace`; when given, the result keeps only those signals.
-    Returns a :class:`LinearizationData`. Malformed files raise ValueError naming file and line.
+    Parameters
+    ----------
+    paths : str or os.PathLike, or a sequence of them
+        One file per azimuth, same signals.
+    inputs, outputs : list or dict, optional
+        Selection, as in :meth:`LinearizationData.to_statespace`; when given, the result keeps
+        only those signals.
+    si : bool, default True
+        Convert outputs written in rpm, deg, deg/s, kN, kN-m, kW to rad/s, rad, rad/s, N,
+        N·m, W (inputs are already SI in OpenFAST).
+
+    Returns
+    -------
+    LinearizationData
+        The averaged, non-rotating-frame linearisation.
+
+    Raises
+    ------
+    ValueError
+        No paths, files of different linearisations, a selection that does not match one
+        description, or a malformed file (naming file and line).
+
+    Examples
+    --------
+    >>> from importlib import resources
+    >>> lin = resources.files("specdesign") / "data/iea15mw/sample_floating_19mps.1.lin"
+    >>> round(read_linearization(lin).wind_speed, 1)
+    19.0
     """
     if isinstance(paths, (str, Path)):
         paths = [paths]

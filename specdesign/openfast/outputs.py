@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -66,10 +67,24 @@ _UNITS = {
 
 
 def to_si(unit: str) -> tuple[str, float]:
-    """Return ``(si_unit, factor)`` for an OpenFAST unit string (``"(rpm)"`` or ``"rpm"``).
+    """The SI unit of an OpenFAST unit string and the factor to it.
 
-    Multiply a channel by ``factor`` to express it in ``si_unit``; unknown units map to
-    themselves with factor 1.0.
+    Parameters
+    ----------
+    unit : str
+        A unit as OpenFAST writes it, with or without parentheses (``"(rpm)"`` or ``"rpm"``).
+
+    Returns
+    -------
+    si_unit : str
+        The SI unit (the unit itself when unknown, or already SI).
+    factor : float
+        Multiply a channel by it to express it in ``si_unit`` (1.0 for an unknown unit).
+
+    Examples
+    --------
+    >>> to_si("(kN-m)")
+    ('N·m', 1000.0)
     """
     u = unit.strip()
     if u.startswith("(") and u.endswith(")"):
@@ -84,16 +99,25 @@ def to_si(unit: str) -> tuple[str, float]:
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class OpenFASTOutput:
-    """Channels of one OpenFAST output file, in SI.
+    """Channels of one OpenFAST output file, in SI (:func:`read_outputs` makes them).
 
-    Attributes
+    ``output["GenSpeed"]`` is the channel's array; ``dt`` and ``duration`` (s) describe the
+    time axis.
+
+    Parameters
     ----------
-    path : Path of the file read.
-    time : (n,) simulation time in s.
-    channels : dict name → (n,) array in SI (see the module docstring for the conversions).
-    units : dict name → SI unit of the array in ``channels``.
-    original_units : dict name → unit written in the file (e.g. ``"rpm"``, ``"kN-m"``).
-    description : the file's description line.
+    path : pathlib.Path
+        The file read.
+    time : numpy.ndarray
+        (n,) simulation time (s).
+    channels : dict
+        Name → (n,) array in SI (see the module docstring for the conversions).
+    units : dict
+        Name → SI unit of the array in ``channels``.
+    original_units : dict
+        Name → unit written in the file (e.g. ``"rpm"``, ``"kN-m"``).
+    description : str, default ""
+        The file's description line.
     """
 
     path: Path
@@ -270,24 +294,32 @@ def _read_one(path, channels) -> OpenFASTOutput:
     return OpenFASTOutput(path=path, time=time, channels=out, units=si_units, original_units=orig, description=desc)
 
 
-def read_outputs(paths, channels=None):
+def read_outputs(paths: str | os.PathLike | Sequence[str | os.PathLike],
+                 channels: Sequence[str] | None = None) -> OpenFASTOutput | list[OpenFASTOutput]:
     """Read OpenFAST ``.out`` (text) / ``.outb`` (binary) outputs and convert channels to SI.
 
     Parameters
     ----------
-    paths : str or PathLike, or a sequence of them.
-    channels : sequence of channel names (e.g. ``["GenSpeed", "TwrBsMyt", "BldPitch1",
-        "GenPwr"]``), or None for every channel. Names are matched exactly (OpenFAST spelling).
+    paths : str or os.PathLike, or a sequence of them
+        The output files.
+    channels : sequence of str, optional
+        Channel names (e.g. ``["GenSpeed", "TwrBsMyt", "BldPitch1", "GenPwr"]``), or None for
+        every channel. Names are matched exactly (OpenFAST spelling).
 
     Returns
     -------
-    OpenFASTOutput for a single path, else a list of them in the order given.
+    OpenFASTOutput or list of OpenFASTOutput
+        One for a single path, else a list of them in the order given.
 
     Raises
     ------
-    ValueError naming the file (and the line or channel) for a binary file with a ``.out``
-    name, a truncated or corrupt file, or a missing channel. FileNotFoundError for a path
-    that does not exist.
+    ValueError
+        Naming the file (and the line or channel): a binary file with a ``.out`` name, a
+        truncated or corrupt file, or a missing channel; an empty sequence of paths.
+    TypeError
+        Channel names that are not strings.
+    FileNotFoundError
+        A path that does not exist.
     """
     if channels is not None:
         if isinstance(channels, str):

@@ -107,8 +107,8 @@ class Campaign:
 
     See Also
     --------
-    run_campaign : runs one.
-    concat_campaigns : joins campaigns over different wind speeds.
+    run_campaign : Runs one.
+    concat_campaigns : Joins campaigns over different wind speeds.
     """
 
     controllers: tuple

@@ -38,7 +38,7 @@ class Indicators:
 
     See Also
     --------
-    indicators : computes them from time series.
+    indicators : Computes them from time series.
     """
 
     tower_del: np.ndarray
@@ -61,7 +61,7 @@ class Indicators:
 
 
 def indicators(series: Mapping, dt: float, m: float = 4.0) -> Indicators:
-    """Indicators of every run in ``series``.
+    """Compute the indicators of every run in ``series``.
 
     Parameters
     ----------

@@ -30,7 +30,7 @@ WEIBULL_A = 11.29
 
 
 def weibull_weights(wind_speeds, k: float = WEIBULL_K, scale: float = WEIBULL_A) -> np.ndarray:
-    """Weights of the operating points: Weibull pdf at each wind speed, normalised to sum 1.
+    """Compute the weights of the operating points: Weibull pdf at each wind speed, normalised to sum 1.
 
     f(v) = (k/A)(v/A)^{k−1} exp(−(v/A)^k), w_i = f(v_i)/Σ f(v_j). With the defaults this
     reproduces the means printed in the paper's Table 2 from its per-speed values.
@@ -118,14 +118,14 @@ def welch_psd(x, dt: float, nperseg: int | None = None, axis: int = -1) -> tuple
     return 2.0 * np.pi * f, p / (2.0 * np.pi)
 
 
-def pool(indicator: str, x, m: float, axis: int = -1) -> np.ndarray:
+def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
     """Pool an indicator over seeds the way it adds up.
 
     Parameters
     ----------
     indicator : str
         One of :data:`~specdesign.validate.indicators.INDICATORS`.
-    x : array_like
+    x : numpy.ndarray
         Per-seed values (the indicator's unit), seeds along ``axis``.
     m : float
         Wöhler exponent (used for ``tower_del``).
@@ -140,7 +140,8 @@ def pool(indicator: str, x, m: float, axis: int = -1) -> np.ndarray:
 
     Examples
     --------
-    >>> float(pool("pitch_sd", [3.0, 4.0], 4.0) ** 2)
+    >>> import numpy as np
+    >>> round(float(pool("pitch_sd", np.array([3.0, 4.0]), 4.0) ** 2), 9)  # mean of the variances
     12.5
     """
     if indicator == "tower_del":
@@ -216,7 +217,7 @@ class PairedChange:
 
     See Also
     --------
-    paired_change : computes it.
+    paired_change : Computes it.
     """
 
     indicator: str

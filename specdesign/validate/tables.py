@@ -187,7 +187,7 @@ class Acceptance:
     rainflow : numpy.ndarray
         100·(1 − DEL_rf,des/DEL_rf,base), seeds pooled by damage, paired (%).
     deviation : numpy.ndarray
-        rainflow − predicted (percentage points).
+        Rainflow − predicted (percentage points).
     se : numpy.ndarray
         Standard error of the deviation over paired seeds (pp; the prediction has none).
     n_seeds : int
@@ -197,18 +197,18 @@ class Acceptance:
     rainflow_linear : numpy.ndarray
         Rainflow reduction on the linearised model (%).
     spectral_deviation : numpy.ndarray
-        rainflow_linear − predicted (pp).
+        Rainflow_linear − predicted (pp).
     se_spectral : numpy.ndarray
         Its standard error (pp).
     nonlinear_deviation : numpy.ndarray
-        rainflow − rainflow_linear (pp).
+        Rainflow − rainflow_linear (pp).
     se_nonlinear : numpy.ndarray
         Its standard error (pp).
     volterra : numpy.ndarray
         Reduction by rainflow on the order-``volterra_order`` Volterra series over the same
         wind (%).
     volterra_deviation : numpy.ndarray
-        rainflow − volterra (pp).
+        Rainflow − volterra (pp).
     se_volterra : numpy.ndarray
         Its standard error over paired seeds (pp).
     volterra_order : int, default 0
