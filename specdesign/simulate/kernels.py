@@ -40,6 +40,23 @@ __all__ = [
 # Parameter layout of the linear kernel: [nx, ny, u0(3), y0(ny), A, B(nx×3), C(ny×nx), D(ny×3)]
 @njit(cache=True)
 def linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
+    """State derivative of the linear plant, ẋ = A x + B (u − u0), written into ``dx``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Deviation state of the linear model, float64[nx].
+    wind : float
+        Rotor-effective wind speed (m/s), absolute.
+    pitch_cmd : float
+        Pitch command (rad), absolute.
+    gen_torque : float
+        Generator torque (N·m), absolute.
+    p : numpy.ndarray
+        Flat parameters from :func:`linear_plant_params`.
+    dx : numpy.ndarray
+        Output: float64[nx], the derivative (written).
+    """
     nx = int(p[0])
     ny = int(p[1])
     du0 = wind - p[2]
@@ -56,6 +73,23 @@ def linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
 
 @njit(cache=True)
 def linear_outputs(x, wind, pitch_cmd, gen_torque, p, y):
+    """Outputs of the linear plant, y = y0 + C x + D (u − u0) (SI), written into ``y``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Deviation state of the linear model, float64[nx].
+    wind : float
+        Rotor-effective wind speed (m/s), absolute.
+    pitch_cmd : float
+        Pitch command (rad), absolute.
+    gen_torque : float
+        Generator torque (N·m), absolute.
+    p : numpy.ndarray
+        Flat parameters from :func:`linear_plant_params`.
+    y : numpy.ndarray
+        Output: float64[ny], the absolute outputs (written).
+    """
     nx = int(p[0])
     ny = int(p[1])
     du0 = wind - p[2]
@@ -71,8 +105,29 @@ def linear_outputs(x, wind, pitch_cmd, gen_torque, p, y):
 
 
 def linear_plant_params(sys, u0, y0) -> np.ndarray:
-    """Flat parameter array of the linear kernel for ``sys`` (deviation model, inputs
-    wind/pitch_cmd/gen_torque in that order) around inputs ``u0`` and outputs ``y0`` (SI)."""
+    """Flat parameter array of the linear kernel (:func:`linear_rhs`, :func:`linear_outputs`).
+
+    Layout: [nx, ny, u0(3), y0(ny), A, B(nx×3), C(ny×nx), D(ny×3)], matrices flattened in C order.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        Deviation model with inputs wind (m/s), pitch_cmd (rad), gen_torque (N·m) in that order.
+    u0 : array_like
+        (3,) inputs at the operating point (SI).
+    y0 : array_like
+        (ny,) outputs at the operating point (SI).
+
+    Returns
+    -------
+    numpy.ndarray
+        The float64 parameter array.
+
+    Raises
+    ------
+    ValueError
+        If ``sys`` does not have 3 inputs.
+    """
     A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
     if B.shape[1] != 3:
         raise ValueError(f"linear plant must have 3 inputs (wind, pitch_cmd, gen_torque), got {B.shape[1]}")
@@ -322,12 +377,26 @@ def _outputs_all(kind, P, X, W, wdt, t, bcmd, torque, Y):
 _REBOUND = {}
 
 
-def compiled_for(rhs, outfn):
-    """(kind, run_batch, step_all, outputs_all) for a kernel pair.
+def compiled_for(rhs, outfn) -> tuple:
+    """The compiled loop functions for a kernel pair.
 
     The turbine and linear kernels use the cached module functions. Any other pair gets
     copies of the same loop code whose global names ``_krhs``/``_kout`` point at that
     pair: one source for every kernel, compiled once per process for user kernels.
+
+    Parameters
+    ----------
+    rhs : numba dispatcher
+        ``@njit`` ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` of the plant.
+    outfn : numba dispatcher
+        ``@njit`` ``outputs(x, wind, pitch_cmd, gen_torque, p, y)`` of the plant.
+
+    Returns
+    -------
+    tuple
+        ``(kind, run_batch, step_all, outputs_all)``: the kernel kind (:data:`KIND_TURBINE`,
+        :data:`KIND_LINEAR`, or 0 for a rebound user pair) and the batch loop, the one-step
+        function and the outputs function of the callable path (:func:`run_callable`).
     """
     import types
 
@@ -357,7 +426,59 @@ def compiled_for(rhs, outfn):
 
 
 def run_callable(fn, step_all, outputs_all, kind, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names,
-                  lim_idx, lim_val, status):
+                 lim_idx, lim_val, status) -> None:
+    """Run a batch with a Python controller ``fn(t, y) -> pitch_cmd`` (the slow path).
+
+    ``fn`` is called once per step with ``y`` a dict of the outputs, each an array over all
+    runs; the command it returns is held over the step. The records are written into ``Y``,
+    and the first divergence of each run into ``status`` (checked at the record steps).
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(t, y)``: time (s), dict output name → (R,) array (SI) → (R,) absolute pitch
+        command (rad).
+    step_all, outputs_all : callable
+        The one-step and outputs functions of :func:`compiled_for`.
+    kind : int
+        Kernel kind of :func:`compiled_for`.
+    P : numpy.ndarray
+        (R, n_p) kernel parameters per run.
+    X0 : numpy.ndarray
+        (R, nx) initial states.
+    Wr : numpy.ndarray
+        (R, n_w) wind per run (m/s).
+    wdt : float
+        Wind sample spacing (s).
+    dt : float
+        Simulation step (s).
+    nsteps : int
+        Number of steps.
+    rec_every : int
+        Steps between records.
+    torque : numpy.ndarray
+        (R,) generator torque (N·m).
+    beta0 : numpy.ndarray
+        (R,) initial pitch command (rad).
+    ny : int
+        Number of plant outputs.
+    Y : numpy.ndarray
+        Output: (R, ny + 1, n_rec) records, the outputs and the pitch command (written).
+    names : sequence of str
+        Output names, the keys of ``y``.
+    lim_idx : numpy.ndarray
+        Indices of the outputs with a physical limit.
+    lim_val : numpy.ndarray
+        Those limits (SI).
+    status : numpy.ndarray
+        Output: (R,) int64, −1 or 64·step + code where the run diverged (code: index into
+        the limits, or :data:`NONFINITE`).
+
+    Raises
+    ------
+    ValueError
+        If ``fn`` returns a command that is not finite or not of shape (R,).
+    """
     X = X0.copy()
     R = X.shape[0]
     bcmd = beta0.copy()
