@@ -26,3 +26,53 @@ def test_unknown_command_is_rejected():
     r = _run("design")
     assert r.returncode == 2
     assert "invalid choice" in r.stderr
+
+
+def test_python_m_specdesign_is_the_cli():
+    r = _run("--version")
+    assert r.returncode == 0 and r.stdout.startswith("specdesign ")
+    from specdesign import __main__, cli
+
+    assert __main__.main is cli.main
+
+
+def _clean_env(**extra):
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
+    env.update(extra)
+    return env
+
+
+def test_the_cli_chooses_agg_only_when_no_backend_was_asked_for(tmp_path):
+    code = ("import sys, matplotlib\nfrom specdesign.cli import main\n"
+            "assert main(['validate', sys.argv[1]]) == 2\nprint(matplotlib.get_backend())\n")
+    missing = str(tmp_path / "missing.toml")
+    r = subprocess.run([sys.executable, "-c", code, missing], capture_output=True, text=True, env=_clean_env())
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().lower() == "agg"
+    r = subprocess.run([sys.executable, "-c", code, missing], capture_output=True, text=True,
+                       env=_clean_env(MPLBACKEND="pdf"))
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().lower() == "pdf"
+
+
+def test_a_campaign_file_writes_its_figures_without_pyplot(tmp_path):
+    """The command-line path end to end in a fresh process where no backend is chosen (pyplot
+    imported first, so the CLI leaves the backend alone): tables, indicators and Figs. 8-10
+    are written on matplotlib.figure.Figure, never through pyplot."""
+    (tmp_path / "pi.json").write_text('{"num": [-0.3, -0.06], "den": [1.0, 0.0]}')
+    (tmp_path / "c.toml").write_text('wind_speeds = [19.0]\nseeds = 1\nduration = 30.0\ntransient = 5.0\n'
+                                     'baseline = "ROSCO"\ndesigned = "PI"\n'
+                                     '[controllers.ROSCO]\nkind = "rosco"\n[controllers.PI]\nfile = "pi.json"\n')
+    code = ("import sys\nimport matplotlib.pyplot as plt\n"  # python-control imports pyplot anyway
+            "def no_pyplot_figure(*a, **k):\n    raise AssertionError('a figure made through pyplot')\n"
+            "plt.figure = plt.subplots = no_pyplot_figure\n"
+            "from specdesign.cli import main\n"
+            "assert main(['validate', sys.argv[1], '--out', sys.argv[2]]) == 0\n")
+    r = subprocess.run([sys.executable, "-c", code, str(tmp_path / "c.toml"), str(tmp_path / "out")],
+                       capture_output=True, text=True, env=_clean_env())
+    assert r.returncode == 0, r.stderr
+    for f in ("table2.md", "table2.csv", "table3.md", "table3.csv", "indicators.csv", "fig8_19mps.png",
+              "fig9_19mps.png", "fig10.png"):
+        assert (tmp_path / "out" / f).stat().st_size > 0, f
