@@ -219,7 +219,8 @@ def load_controller(spec: dict, base: str | os.PathLike, model, *, config: str |
     """
     import control
 
-    from .simulate import ScheduledController, rosco_scheduled, scheduled
+    from .rosco import rosco_scheduled
+    from .simulate import ScheduledController, scheduled
 
     where = f"controllers.{name}"
     base = Path(base)
@@ -315,7 +316,7 @@ def _wind_speeds(vs, model, path, key) -> list:
     _need(len({float(v) for v in vs}) == len(vs), path, key, f"a list of distinct wind speeds, got {vs}")
     for v in vs:
         try:
-            model._check_wind(v)
+            model.check_wind_speed(v)
         except ValueError as e:
             raise ConfigError(f"{path}: {key}: {e}") from None
     return [float(v) for v in vs]
