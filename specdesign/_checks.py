@@ -75,6 +75,8 @@ def positive_scalar(value, name: str) -> float:
     """Validate a finite, strictly positive real scalar (in the unit of argument ``name``) and return it as a float."""
     if np.iscomplexobj(value):
         raise TypeError(f"{name} is complex; pass a real number")
+    if isinstance(value, (bool, np.bool_, str, bytes)):  # float() would take True as 1 and "0.01" as 0.01
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__} {value!r}")
     try:
         v = float(value)
     except (TypeError, ValueError):

@@ -672,12 +672,12 @@ def sensitivity(omega: ArrayLike, psd: ArrayLike, m: float, reduction: float = 0
     Raises
     ------
     ValueError
-        If ``reduction`` is not in (0, 1] (checked without ``analytic`` only), for an unknown
+        If ``reduction`` is not in (0, 1] (checked with ``analytic`` too), for an unknown
         ``method``, ``m`` not finite and > 0, an invalid grid or PSD, or a method giving a
         damage <= 0 outside its range of validity.
     TypeError
-        If ``omega``, ``psd`` or ``m`` is complex or not numeric, or ``float(reduction)``
-        fails with a TypeError (e.g. None or a Python complex).
+        If ``omega``, ``psd``, ``m`` or ``reduction`` is complex or not a real number (a
+        bool, a string or None included).
     OverflowError
         If m is so large (≳ 170) that the damage of even the unit-variance spectrum leaves
         float64.
@@ -707,6 +707,9 @@ def sensitivity(omega: ArrayLike, psd: ArrayLike, m: float, reduction: float = 0
     """
     w, s, m = _prepare(omega, psd, m)
     _check_method(method)
+    red = positive_scalar(reduction, "reduction")
+    if not red <= 1:
+        raise ValueError(f"reduction={reduction!r} must be in (0, 1] (0.01 is a 1 % reduction of S at one frequency)")
     a = _moment_matrix(w, _ORDERS)  # (n, 6)
     # ΔD% is a ratio, invariant to the load scale: work on each spectrum scaled to unit
     # variance so that no damage overflows at a large m
@@ -726,9 +729,6 @@ def sensitivity(omega: ArrayLike, psd: ArrayLike, m: float, reduction: float = 0
             dlogd = np.stack(grads, axis=-1) / d0[..., None]  # (..., 6)
             out = 100.0 * 0.01 * s * (dlogd @ a.T)
         else:
-            red = float(reduction)
-            if not 0 < red <= 1:
-                raise ValueError(f"reduction={reduction!r} must be in (0, 1] (0.01 is a 1 % reduction of S at one frequency)")
             delta = red * s[..., :, None] * a  # (..., n, 6): Δm_n for each frequency k
             dk = _damage_from_moments(mom0[..., None, :] - delta, m, method)
             out = 100.0 * (d0[..., None] - dk) / d0[..., None]

@@ -262,6 +262,11 @@ def test_bad_input_names_the_argument():
         sp.damage_rate(w, s, 4.0, method="rainflow")
     with pytest.raises(ValueError, match="reduction"):
         sp.sensitivity(w, s, 4.0, reduction=0.0)
+    with pytest.raises(ValueError, match="reduction"):
+        sp.sensitivity(w, s, 4.0, reduction=1.5, analytic=True)
+    for bad in (True, "0.01", None, np.complex128(0.01)):  # float() took the first two silently
+        with pytest.raises(TypeError, match="reduction"):
+            sp.sensitivity(w, s, 4.0, reduction=bad)
     with pytest.raises(ValueError, match="t_mag2"):
         sp.predicted_change(w, s, s[:-1], s)
     with pytest.raises(ValueError, match="orders"):
