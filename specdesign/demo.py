@@ -10,6 +10,7 @@ Writes ``summary.md``, the tables (Markdown and CSV) and the figures into ``out`
 from __future__ import annotations
 
 import json
+import os
 import time
 from pathlib import Path
 
@@ -22,14 +23,37 @@ def _say(msg):
     print(msg, flush=True)
 
 
-def run_demo(out="specdesign_output", *, fast=False, wind_speed=19.0, spec_reduction=15.0, target_reduction=25.0,
-             n_seeds=None, duration=None):
-    """Run the 19 m/s design loop and write its tables and figures into ``out``.
+def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False, wind_speed: float = 19.0,
+             spec_reduction: float = 15.0, target_reduction: float = 25.0, n_seeds: int | None = None,
+             duration: float | None = None) -> dict:
+    """Run the design loop at one wind speed and write its tables and figures into ``out``.
 
-    fast : reduced validation (8 seeds of 300 s instead of 50 of 600 s).
-    wind_speed : operating point, m/s. spec_reduction : damage reduction (%) the tower
-    specification promises. target_reduction : predicted tower-base DEL reduction (%) the
-    QFT design aims at. Returns a dict of the headline numbers.
+    Writes ``summary.md``, ``table2.md/.csv``, ``table3.md/.csv``, the designed controllers
+    (``controller_qft.json``), a campaign file that reruns the validation (``validate.toml``)
+    and the figures ``1_sensitivity.png`` … ``4_time_series.png``. Figures are drawn on
+    :class:`matplotlib.figure.Figure`: no pyplot, no backend needed.
+
+    Parameters
+    ----------
+    out : str or os.PathLike, default "specdesign_output"
+        Output folder (created).
+    fast : bool, default False
+        Reduced validation: 8 seeds of 300 s instead of 50 of 600 s.
+    wind_speed : float, default 19.0
+        Operating point (m/s).
+    spec_reduction : float, default 15.0
+        Damage reduction the tower specification promises (%).
+    target_reduction : float, default 25.0
+        Predicted tower-base DEL reduction the QFT design aims at (%).
+    n_seeds : int, optional
+        Paired seeds of the validation (overrides ``fast``).
+    duration : float, optional
+        Recorded time per run (s; overrides ``fast``).
+
+    Returns
+    -------
+    dict
+        The headline numbers (DELs in MN·m, reductions in %, deviations in pp, run time in s).
     """
     from matplotlib.figure import Figure  # figures only written to files: no pyplot, no backend
 

@@ -414,7 +414,7 @@ def test_no_module_chooses_a_matplotlib_backend():
                                     "specdesign.validate.prediction", "specdesign.validate.volterra",
                                     "specdesign.validate.campaign", "specdesign.validate.tables", "specdesign.cli",
                                     "specdesign.openfast.series", "specdesign.openfast.outputs",
-                                    "specdesign.openfast.lin"])
+                                    "specdesign.openfast.lin", "specdesign.demo", "specdesign.plots.validation"])
 def test_public_names_have_numpydoc_docstrings(module):
     import importlib
     import inspect

@@ -17,10 +17,34 @@ def _axes(ax, **kw):
     return ax
 
 
-def plot_spectra(campaign, wind_speed, output="tower_base_my", *, controllers=None, ax=None):
-    """Fig. 8: seed-averaged Welch PSD (solid) and linear prediction |T|²S_W (dashed) of
-    ``output`` at ``wind_speed`` (m/s) for each controller of a :class:`~specdesign.validate.Campaign`.
-    Log-log axes, ω in rad/s, PSD per rad/s. Returns the axes."""
+def plot_spectra(campaign, wind_speed: float, output: str = "tower_base_my", *, controllers=None, ax=None):
+    """Fig. 8: seed-averaged Welch PSD (solid) and linear prediction |T|²S_W (dashed).
+
+    Log-log axes, ω in rad/s, PSD per rad/s.
+
+    Parameters
+    ----------
+    campaign : specdesign.validate.Campaign
+        The campaign.
+    wind_speed : float
+        One of its wind speeds (m/s).
+    output : {"tower_base_my", "gen_speed"}, default "tower_base_my"
+        Output whose spectra are drawn.
+    controllers : sequence of str, optional
+        Controllers to draw (default all).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default a new pyplot figure).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes.
+
+    Raises
+    ------
+    ValueError
+        A wind speed or output that the campaign does not hold.
+    """
     ax = _axes(ax)
     i = int(np.argmin(np.abs(campaign.wind_speeds - float(wind_speed))))
     if abs(campaign.wind_speeds[i] - float(wind_speed)) > 1e-9:
@@ -46,12 +70,33 @@ def plot_spectra(campaign, wind_speed, output="tower_base_my", *, controllers=No
     return ax
 
 
-def plot_time_series(series, wind_speed, *, seed_index=0, controllers=None, axes=None):
-    """Fig. 9: generator speed (rpm), tower-base moment (MN·m), power (MW) and pitch (deg) of
-    one seed at ``wind_speed`` (m/s) for each controller.
+def plot_time_series(series, wind_speed: float, *, seed_index: int = 0, controllers=None, axes=None):
+    """Fig. 9: generator speed (rpm), tower-base moment (MN·m), power (MW) and pitch (deg).
 
-    series : dict controller → :class:`~specdesign.simulate.SimulationResult` (e.g.
-    ``Campaign.series``). axes : four stacked axes or None (a new figure). Returns the axes.
+    One seed at one wind speed, for each controller.
+
+    Parameters
+    ----------
+    series : dict
+        Controller → :class:`~specdesign.simulate.SimulationResult` (e.g. ``Campaign.series``).
+    wind_speed : float
+        A simulated wind speed (m/s).
+    seed_index : int, default 0
+        Index of the seed among the kept ones.
+    controllers : sequence of str, optional
+        Controllers to draw (default all of ``series``).
+    axes : sequence of matplotlib.axes.Axes, optional
+        Four stacked axes (default a new pyplot figure).
+
+    Returns
+    -------
+    numpy.ndarray
+        The four axes.
+
+    Raises
+    ------
+    ValueError
+        Not four axes, or a wind speed that was not simulated.
     """
     if axes is None:
         import matplotlib.pyplot as plt
@@ -82,12 +127,25 @@ def plot_time_series(series, wind_speed, *, seed_index=0, controllers=None, axes
 
 
 def plot_reductions(acc, *, ax=None):
-    """Fig. 10: tower-base DEL reduction (%) vs mean wind speed (m/s): linear prediction and
-    rainflow evaluation with ±1 standard error bars (paired seeds), plus rainflow on the
-    linearised model when the campaign had a linear twin (the gap between the two rainflow
-    curves is the plant nonlinearity's part) and the Volterra prediction when the campaign had
-    one (``run_campaign(volterra=k)``). ``acc`` is an
-    :class:`~specdesign.validate.Acceptance`. Returns the axes."""
+    """Fig. 10: tower-base DEL reduction (%) vs mean wind speed (m/s).
+
+    Linear prediction and rainflow evaluation with ±1 standard error bars (paired seeds),
+    plus rainflow on the linearised model when the campaign had a linear twin (the gap between
+    the two rainflow curves is the plant nonlinearity's part) and the Volterra prediction when
+    the campaign had one (``run_campaign(volterra=k)``).
+
+    Parameters
+    ----------
+    acc : specdesign.validate.Acceptance
+        The acceptance of a design (:func:`~specdesign.validate.acceptance`).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default a new pyplot figure).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes.
+    """
     ax = _axes(ax)
     ax.plot(acc.wind_speeds, acc.predicted, "o--", label="linear prediction (Dirlik on |T|²S_W)")
     ax.errorbar(acc.wind_speeds, acc.rainflow, yerr=acc.se, fmt="s-", capsize=3,
