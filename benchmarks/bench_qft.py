@@ -38,10 +38,10 @@ def brute_force(bounds, mags_db):
     """Allowed mask (n_omega, n_phase, n_mag) by direct evaluation of every part and case."""
     ph = np.deg2rad(bounds.phases_deg)
     L0 = 10 ** (mags_db[None, :] / 20) * np.exp(1j * ph[:, None])  # (n_phase, n_mag)
-    out = np.ones((len(bounds.omegas), len(ph), len(mags_db)), bool)
+    out = np.ones((len(bounds.omega), len(ph), len(mags_db)), bool)
     for part in bounds.parts:
-        for f, w in enumerate(part.omegas):
-            i = int(np.searchsorted(bounds.omegas, w))
+        for f, w in enumerate(part.omega):
+            i = int(np.searchsorted(bounds.omega, w))
             G = L0 / part.p0[f]
             ok = np.ones(G.shape, bool)
             for c in range(part.A.shape[1]):  # one case at a time: (n_phase, n_mag) arrays
@@ -57,10 +57,10 @@ def brute_force_quadratic(bounds, mags_db):
     cheapest per-point arithmetic a grid method can use (the fairest grid competitor)."""
     ph = np.deg2rad(bounds.phases_deg)
     y = 10 ** (mags_db / 20)
-    out = np.ones((len(bounds.omegas), len(ph), len(mags_db)), bool)
+    out = np.ones((len(bounds.omega), len(ph), len(mags_db)), bool)
     for part in bounds.parts:
-        for f, w in enumerate(part.omegas):
-            i = int(np.searchsorted(bounds.omegas, w))
+        for f, w in enumerate(part.omega):
+            i = int(np.searchsorted(bounds.omega, w))
             Bp, Dp, A, C, W2 = part.B[f] / part.p0[f], part.D[f] / part.p0[f], part.A[f], part.C[f], part.W[f] ** 2
             a = np.abs(Bp) ** 2 - W2 * np.abs(Dp) ** 2
             c = np.abs(A) ** 2 - W2 * np.abs(C) ** 2

@@ -23,19 +23,32 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
+from ._deprecation import renamed_keywords
+from .bounds import Bounds, BoundsWarning, bounds, intersect
 from .controller import Controller
-from .qft import Bounds, Template, _check_grid, as_specs, evaluate
+from .freqresp import check_grid, evaluate
+from .specs import as_specs
+from .templates import Template
+
+__all__ = ["InfeasibleError", "RefineResult", "refine", "shape"]
 
 
 class InfeasibleError(ValueError):
     """No controller with the given structure meets the bounds.
 
-    ``omega`` (rad/s) and ``spec`` name the most violated design frequency and spec;
-    ``violation_db`` is by how much the best loop found misses it.
+    Parameters
+    ----------
+    message : str
+        The error message.
+    omega : float
+        The most violated design frequency, rad/s.
+    spec : str
+        The most violated spec's name.
+    violation_db : float
+        By how much the best loop found misses it, dB.
     """
 
-    def __init__(self, message, omega, spec, violation_db):
+    def __init__(self, message: str, omega: float, spec: str, violation_db: float):
         super().__init__(message)
         self.omega, self.spec, self.violation_db = omega, spec, violation_db
 
@@ -44,7 +57,7 @@ def _rows(bounds, basis):
     """Stack every (spec, frequency, case) row: a, b (row·x), c, d (row·x), W, ω, spec name."""
     a, b, c, d, W, om, name = [], [], [], [], [], [], []
     for part in bounds.parts:
-        fi = np.searchsorted(bounds.omegas, part.omegas)
+        fi = np.searchsorted(bounds.omega, part.omega)
         for k, f in enumerate(fi):
             n = part.A.shape[1]
             a.append(part.A[k])
@@ -52,15 +65,15 @@ def _rows(bounds, basis):
             c.append(part.C[k])
             d.append(part.D[k][:, None] * basis[f][None, :])
             W.append(part.W[k])
-            om.append(np.full(n, part.omegas[k]))
+            om.append(np.full(n, part.omega[k]))
             name += [part.spec.name] * n
     return (np.concatenate(a), np.vstack(b), np.concatenate(c), np.vstack(d), np.concatenate(W),
             np.concatenate(om), np.array(name))
 
 
-def _fixed_poles(poles, omegas):
+def _fixed_poles(poles, omega):
     if poles is None:
-        return np.array([-10.0 * omegas.max()] * 2, complex)
+        return np.array([-10.0 * omega.max()] * 2, complex)
     if isinstance(poles, Controller):
         return np.roots(poles.polys()[1]).astype(complex)
     p = np.atleast_1d(np.asarray(poles, complex))
@@ -69,27 +82,54 @@ def _fixed_poles(poles, omegas):
     return p
 
 
-def shape(bounds: Bounds, poles=None, *, n_zeros=None, initial=None, hf_omegas=None, margin_db=0.0, max_iter=40,
-          tol=1e-5, solver=None) -> Controller:
+@renamed_keywords(hf_omegas="hf_omega")
+def shape(bounds: Bounds, poles=None, *, n_zeros: int | None = None, initial=None, hf_omega=None,
+          margin_db: float = 0.0, max_iter: int = 40, tol: float = 1e-5, solver: str | None = None) -> Controller:
     """Shape G = N(s)/D(s) with fixed poles so that L0 = P0·G meets ``bounds``.
 
     Parameters
     ----------
-    bounds : :class:`~loopshaping.qft.Bounds` (its specs' exact inequalities are used, not
-        the phase grid).
-    poles : fixed controller poles (complex, conjugate pairs; 0 for integrators), or a
-        :class:`Controller` whose poles are kept. Default: a double real pole at
-        10 × the highest design frequency.
-    n_zeros : numerator degree, ≤ number of poles (proper); default = number of poles.
-    initial : Controller or LTI giving the first linearisation point (least-squares fitted
-        onto the structure); default: a constant gain that lifts the nominal loop 3 dB above
-        the highest lower bound at the lowest design frequency.
-    hf_omegas : rad/s grid where the largest controller gain is minimised; default 30 points
-        from 2 × to 1000 × the highest design frequency.
-    margin_db : every weight is tightened by this many dB, a cushion for the response
-        between design frequencies.
-    Returns a :class:`Controller`; raises :class:`InfeasibleError` (with the binding design
-    frequency and spec) when slack remains after ``max_iter`` iterations.
+    bounds : Bounds
+        The bounds (their specs' exact inequalities are used, not the phase grid).
+    poles : array_like or Controller, optional
+        Fixed controller poles, rad/s (complex, conjugate pairs; 0 for integrators), or a
+        :class:`~loopshaping.controller.Controller` whose poles are kept. Default: a double
+        real pole at 10 × the highest design frequency.
+    n_zeros : int, optional
+        Numerator degree, ≤ number of poles (proper); default = number of poles.
+    initial : Controller or control LTI, optional
+        The first linearisation point (least-squares fitted onto the structure); default: a
+        constant gain that lifts the nominal loop 3 dB above the highest lower bound at the
+        lowest design frequency.
+    hf_omega : array_like, optional
+        Grid (rad/s) where the largest controller gain is minimised; default 30 points from
+        2 × to 1000 × the highest design frequency. (Former keyword ``hf_omegas``: deprecated.)
+    margin_db : float
+        Every weight is tightened by this many dB, a cushion for the response between
+        design frequencies.
+    max_iter : int
+        Convex-concave iterations at most.
+    tol : float
+        Relative change of the objective that ends the iteration.
+    solver : str, optional
+        cvxpy solver name.
+
+    Returns
+    -------
+    Controller
+        The shaped controller (a gain and the factors of its zeros and poles).
+
+    Raises
+    ------
+    InfeasibleError
+        With the binding design frequency and spec, when slack remains after ``max_iter``
+        iterations.
+    TypeError
+        If ``bounds`` is not a Bounds.
+    ValueError
+        For ``n_zeros`` out of range or poles not in conjugate pairs.
+    RuntimeError
+        If a convex subproblem fails before any iterate.
     """
     try:
         import cvxpy as cp
@@ -97,7 +137,7 @@ def shape(bounds: Bounds, poles=None, *, n_zeros=None, initial=None, hf_omegas=N
         raise ImportError("loopshaping.auto.shape needs cvxpy") from e
     if not isinstance(bounds, Bounds):
         raise TypeError(f"bounds must be a loopshaping.qft.Bounds; got {type(bounds).__name__}")
-    w = bounds.omegas
+    w = bounds.omega
     p = _fixed_poles(poles, w)
     m = len(p) if n_zeros is None else int(n_zeros)
     if not 0 <= m <= len(p):
@@ -105,10 +145,10 @@ def shape(bounds: Bounds, poles=None, *, n_zeros=None, initial=None, hf_omegas=N
     den = np.real_if_close(np.poly(p)) if p.size else np.array([1.0])
     if np.iscomplexobj(den):
         raise ValueError("poles must come in complex-conjugate pairs")
-    if hf_omegas is None:
+    if hf_omega is None:
         # A grid, not one point: a lone frequency would be "minimised" by a notch on it.
-        hf_omegas = np.logspace(np.log10(2 * w.max()), np.log10(1000 * w.max()), 30)
-    hf = np.atleast_1d(np.asarray(hf_omegas, float))
+        hf_omega = np.logspace(np.log10(2 * w.max()), np.log10(1000 * w.max()), 30)
+    hf = np.atleast_1d(np.asarray(hf_omega, float))
     w_s = float(np.exp(np.mean(np.log(w))))  # numerator basis (s/w_s)^i keeps columns comparable
 
     def basis_at(om):
@@ -182,9 +222,9 @@ def shape(bounds: Bounds, poles=None, *, n_zeros=None, initial=None, hf_omegas=N
 
 def _nominal(bounds):
     """Nominal plant P0 at the design frequencies, from the parts of the bounds."""
-    p0 = np.full(len(bounds.omegas), np.nan + 0j)
+    p0 = np.full(len(bounds.omega), np.nan + 0j)
     for part in bounds.parts:
-        p0[np.searchsorted(bounds.omegas, part.omegas)] = part.p0
+        p0[np.searchsorted(bounds.omega, part.omega)] = part.p0
     return p0
 
 
@@ -192,14 +232,20 @@ def _nominal(bounds):
 class RefineResult:
     """Outcome of :func:`refine`.
 
-    Attributes
+    Parameters
     ----------
-    controller : the last shaped :class:`Controller`.
-    bounds : the :class:`~loopshaping.qft.Bounds` it was shaped against (the final design set).
-    template : the plant cases at the final design frequencies (rad/s).
-    check : :class:`~loopshaping.check.CheckResult` of ``controller`` on the dense grid.
-    added : (k,) frequencies added to the design set, rad/s, in the order they were added.
-    rounds : shaping calls made.
+    controller : Controller
+        The last shaped controller.
+    bounds : Bounds
+        The bounds it was shaped against (the final design set).
+    template : Template
+        The plant cases at the final design frequencies (rad/s).
+    check : CheckResult
+        :func:`loopshaping.check.check` of ``controller`` on the dense grid.
+    added : numpy.ndarray
+        (k,) frequencies added to the design set, rad/s, in the order they were added.
+    rounds : int
+        Shaping calls made.
     """
 
     controller: Controller
@@ -215,12 +261,13 @@ class RefineResult:
         return bool(self.check.passed)
 
 
-def refine(template: Template, specs, omega_dense, poles=None, *, max_rounds=6, margin_db=0.01, phases_deg=None,
-           **shape_kwargs) -> RefineResult:
+@renamed_keywords(omega_dense="omega", hf_omegas="hf_omega")
+def refine(template: Template, specs, omega, poles=None, *, max_rounds: int = 6, margin_db: float = 0.01,
+           phases_deg=None, **shape_kwargs) -> RefineResult:
     """:func:`shape`, check on a dense grid, add the failing frequencies, shape again.
 
     Each round shapes against the exact bounds of ``specs`` at the current design frequencies
-    (first the template's), runs :func:`loopshaping.check.check` on ``omega_dense`` over every
+    (first the template's), runs :func:`loopshaping.check.check` on ``omega`` over every
     case and, if a spec fails, adds the worst frequency of every violated range of the grid
     to the design set (bounds recomputed there from the plant cases), starting the next shape
     from the last controller. Stops when the check passes, after ``max_rounds`` shapes, or
@@ -229,22 +276,44 @@ def refine(template: Template, specs, omega_dense, poles=None, *, max_rounds=6, 
 
     Parameters
     ----------
-    template : :class:`~loopshaping.qft.Template` built from systems (the cases are
-        re-evaluated at the added frequencies); a disk radius must be the same at every
-        design frequency.
-    specs : :class:`~loopshaping.qft.Bounds` (its specs are used), a
-        :class:`~loopshaping.qft.Spec` or a list of them; weights and general-form
-        coefficients must be numbers, LTI or callables of ω.
-    omega_dense : strictly increasing grid of the check, rad/s.
-    poles, shape_kwargs : as :func:`shape` (``n_zeros``, ``initial``, ``hf_omegas``,
-        ``max_iter``, ``tol``, ``solver``).
-    margin_db : :func:`shape`'s cushion, default 0.01 dB, so that solver tolerance cannot
-        leave a bound violated by a hair at a design frequency.
-    phases_deg : phase grid of the returned bounds (charts only; the shaper uses the exact
+    template : Template
+        Built from systems (the cases are re-evaluated at the added frequencies); a disk
+        radius must be the same at every design frequency.
+    specs : Bounds or Spec or list of Spec
+        The specifications (of a Bounds, its specs); weights and general-form coefficients
+        must be numbers, LTI or callables of ω.
+    omega : array_like
+        Strictly increasing grid of the check, rad/s. (Former keyword ``omega_dense``:
+        deprecated.)
+    poles : array_like or Controller, optional
+        As :func:`shape`.
+    max_rounds : int
+        Shaping calls at most, ≥ 1.
+    margin_db : float
+        :func:`shape`'s cushion, dB, default 0.01 dB, so that solver tolerance cannot leave
+        a bound violated by a hair at a design frequency.
+    phases_deg : array_like, optional
+        Phase grid of the returned bounds, degrees (charts only; the shaper uses the exact
         inequalities).
-    Raises :class:`InfeasibleError` when a shaping round is infeasible.
+    **shape_kwargs
+        Passed to :func:`shape` (``n_zeros``, ``initial``, ``hf_omega``, ``max_iter``,
+        ``tol``, ``solver``).
+
+    Returns
+    -------
+    RefineResult
+        The last controller, its bounds, template and check; ``.passed`` tells whether the
+        check passed.
+
+    Raises
+    ------
+    InfeasibleError
+        When a shaping round is infeasible.
+    TypeError
+        If ``template`` is not a Template.
+    ValueError
+        If the template has no systems, a disk radius that varies, or ``max_rounds`` < 1.
     """
-    from . import qft
     from .check import check
 
     if not isinstance(template, Template):
@@ -259,25 +328,25 @@ def refine(template: Template, specs, omega_dense, poles=None, *, max_rounds=6, 
                              "frequencies; expand the disk into cases or use a constant radius")
         disk = float(disk[0])
     specs = as_specs(specs)
-    w_dense = _check_grid(omega_dense, "omega_dense")
+    w_dense = check_grid(omega, "omega")
     if int(max_rounds) < 1:
         raise ValueError(f"max_rounds={max_rounds} must be ≥ 1")
     if poles is None:
         # shape's default depends on the design frequencies: fix it once for every round
-        poles = _fixed_poles(None, template.omegas)
+        poles = _fixed_poles(None, template.omega)
     systems, nominal = template.systems, template.nominal
-    omegas = template.omegas
+    w_design = template.omega
     added = []
     initial = shape_kwargs.pop("initial", None)
     for rounds in range(1, int(max_rounds) + 1):
-        tmpl = Template.from_systems(systems, omegas, nominal, disk)
+        tmpl = Template.from_systems(systems, w_design, nominal, disk)
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", qft.BoundsWarning)
+            warnings.simplefilter("ignore", BoundsWarning)
             # a spec may leave some design frequencies unconstrained (band, infinite weight)
-            parts = [qft.bounds(tmpl, sp, phases_deg=phases_deg) for sp in specs if np.any(sp.in_band(omegas))]
-            b = qft.intersect(*parts)
+            parts = [bounds(tmpl, sp, phases_deg=phases_deg) for sp in specs if np.any(sp.in_band(w_design))]
+            b = intersect(*parts)
         G = shape(b, poles, initial=initial, margin_db=margin_db, **shape_kwargs)
-        res = check(G, tmpl, specs, w_dense)
+        res = check(tmpl, G, specs, w_dense)
         if res.passed or rounds == int(max_rounds):
             break
         new = []
@@ -289,11 +358,11 @@ def refine(template: Template, specs, omega_dense, poles=None, *, max_rounds=6, 
             for lo, hi in res.violated_ranges(name):
                 sel = (w_dense >= lo) & (w_dense <= hi)
                 new.append(w_dense[sel][np.argmin(m[sel])])
-        new = np.setdiff1d(np.unique(new), omegas)
-        new = new[~np.isclose(new[:, None], omegas[None, :], rtol=1e-9, atol=0).any(axis=1)] if new.size else new
+        new = np.setdiff1d(np.unique(new), w_design)
+        new = new[~np.isclose(new[:, None], w_design[None, :], rtol=1e-9, atol=0).any(axis=1)] if new.size else new
         if not new.size:
             break
         added.extend(new.tolist())
-        omegas = np.unique(np.r_[omegas, new])
+        w_design = np.unique(np.r_[w_design, new])
         initial = G
     return RefineResult(G, b, tmpl, res, np.array(added, float), rounds)

@@ -9,33 +9,49 @@ phase margins.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
+from ._deprecation import renamed_attribute, renamed_keywords
 from .controller import Controller
-from .qft import Template, _check_grid, _is_lti, as_specs, evaluate
+from .freqresp import check_grid, evaluate, is_lti
+from .specs import as_specs
+from .templates import Template
+
+__all__ = ["CheckResult", "check", "closed_loop_poles", "feedback_poles"]
 
 
 @dataclass(frozen=True, eq=False)
 class CheckResult:
     """Outcome of :func:`check`.
 
-    Attributes
+    Parameters
     ----------
-    omegas : (n,) dense grid, rad/s.
-    names : spec names, one per row of ``margins_db``.
-    margins_db : (n_specs, n) worst margin over cases, 20·log10(W/|f|) in dB (≥ 0: met);
-        NaN outside a spec's band.
-    worst_case : (n_specs, n) index of the case setting the worst margin (−1 outside band).
-    stable : (n_cases,) closed-loop stability of each case.
-    max_pole_real : (n_cases,) largest real part of the closed-loop poles, 1/s.
-    gain_margin_db : (n_cases,) gain margin nearest 0 dB over the phase crossovers (inf if none).
-    phase_margin_deg : (n_cases,) smallest distance of the loop phase from −180° at the gain
-        crossovers, degrees (inf if none).
+    omega : numpy.ndarray
+        (n,) dense grid, rad/s. (Former name ``omegas``: deprecated.)
+    names : tuple of str
+        Spec names, one per row of ``margins_db``.
+    margins_db : numpy.ndarray
+        (n_specs, n) worst margin over cases, 20·log10(W/|f|) in dB (≥ 0: met); NaN outside
+        a spec's band.
+    worst_case : numpy.ndarray
+        (n_specs, n) index of the case setting the worst margin (−1 outside band).
+    stable : numpy.ndarray
+        (n_cases,) closed-loop stability of each case.
+    max_pole_real : numpy.ndarray
+        (n_cases,) largest real part of the closed-loop poles, 1/s.
+    gain_margin_db : numpy.ndarray
+        (n_cases,) gain margin nearest 0 dB over the phase crossovers, dB (inf if none).
+    phase_margin_deg : numpy.ndarray
+        (n_cases,) smallest distance of the loop phase from −180° at the gain crossovers,
+        degrees (inf if none).
+    tol_db : float
+        Margin (dB) below 0 still counted as met (rounding).
     """
 
-    omegas: np.ndarray
+    omega: np.ndarray
     names: tuple
     margins_db: np.ndarray
     worst_case: np.ndarray
@@ -45,6 +61,8 @@ class CheckResult:
     phase_margin_deg: np.ndarray
     tol_db: float = 1e-9
 
+    omegas = renamed_attribute("omegas", "omega")
+
     @property
     def spec_passed(self) -> np.ndarray:
         """(n_specs,) each spec met on the whole grid for every case."""
@@ -53,21 +71,54 @@ class CheckResult:
 
     @property
     def passed(self) -> bool:
+        """Every spec met on the grid for every case and every closed loop stable."""
         return bool(np.all(self.spec_passed) and np.all(self.stable))
 
-    def worst(self, name):
-        """(ω in rad/s, margin in dB, case index) where spec ``name`` is closest to failing."""
+    def worst(self, name: str) -> tuple[float, float, int]:
+        """Where spec ``name`` is closest to failing.
+
+        Parameters
+        ----------
+        name : str
+            A spec name.
+
+        Returns
+        -------
+        tuple
+            ``(ω in rad/s, margin in dB, case index)``.
+
+        Raises
+        ------
+        KeyError
+            If there is no spec of that name.
+        """
         i = self._row(name)
         m = np.where(np.isnan(self.margins_db[i]), np.inf, self.margins_db[i])
         j = int(np.argmin(m))
-        return float(self.omegas[j]), float(m[j]), int(self.worst_case[i, j])
+        return float(self.omega[j]), float(m[j]), int(self.worst_case[i, j])
 
-    def violated_ranges(self, name):
-        """List of (ω_low, ω_high) rad/s intervals of the grid where spec ``name`` fails."""
+    def violated_ranges(self, name: str) -> list:
+        """Intervals of the grid where spec ``name`` fails.
+
+        Parameters
+        ----------
+        name : str
+            A spec name.
+
+        Returns
+        -------
+        list of tuple
+            ``(ω_low, ω_high)`` in rad/s, grid points at both ends included.
+
+        Raises
+        ------
+        KeyError
+            If there is no spec of that name.
+        """
         i = self._row(name)
         bad = np.nan_to_num(self.margins_db[i], nan=np.inf) < -self.tol_db
         edges = np.flatnonzero(np.diff(np.r_[0, bad.astype(int), 0]))
-        return [(float(self.omegas[a]), float(self.omegas[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
+        return [(float(self.omega[a]), float(self.omega[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
 
     def _row(self, name):
         if name not in self.names:
@@ -75,7 +126,8 @@ class CheckResult:
         return self.names.index(name)
 
     def summary(self) -> str:
-        lines = [f"check on {len(self.omegas)} frequencies {self.omegas[0]:.3g}…{self.omegas[-1]:.3g} rad/s, "
+        """Human-readable report: worst margins, violated ranges, stability, margins."""
+        lines = [f"check on {len(self.omega)} frequencies {self.omega[0]:.3g}…{self.omega[-1]:.3g} rad/s, "
                  f"{len(self.stable)} plant cases: {'PASSED' if self.passed else 'FAILED'}"]
         for name, ok in zip(self.names, self.spec_passed):
             w, m, c = self.worst(name)
@@ -100,7 +152,7 @@ def _as_tf(sys, name):
     if isinstance(sys, Controller):
         num, den = sys.polys()
         return np.asarray(num, float), np.asarray(den, float)
-    if not _is_lti(sys):
+    if not is_lti(sys):
         raise TypeError(f"{name} must be a Controller or a SISO python-control LTI; got {type(sys).__name__}")
     if sys.ninputs != 1 or sys.noutputs != 1:
         raise ValueError(f"{name} must be SISO")
@@ -108,8 +160,37 @@ def _as_tf(sys, name):
     return np.trim_zeros(tf.num[0][0], "f"), np.trim_zeros(tf.den[0][0], "f")
 
 
-def closed_loop_poles(controller, plant) -> np.ndarray:
-    """Roots of n_P·n_G + d_P·d_G: the poles of the loop with negative unit feedback."""
+def feedback_poles(plant, controller) -> np.ndarray:
+    """Poles of the loop of ``plant`` and ``controller`` with negative unit feedback.
+
+    The roots of n_P·n_G + d_P·d_G, without cancellation, so hidden unstable modes (an
+    unstable pole of P cancelled by a zero of G) are kept.
+
+    Parameters
+    ----------
+    plant : control LTI or Controller
+        SISO plant P.
+    controller : control LTI or Controller
+        SISO controller G.
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex closed-loop poles, 1/s.
+
+    Raises
+    ------
+    TypeError
+        If an argument is neither a Controller nor an LTI.
+    ValueError
+        If an argument is MIMO or the loop P·G is improper.
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> feedback_poles(ct.tf([1], [1, 0]), ct.tf([2], [1]))
+    array([-2.])
+    """
     nG, dG = _as_tf(controller, "controller")
     nP, dP = _as_tf(plant, "plant")
     num, den = np.polymul(nP, nG), np.polymul(dP, dG)
@@ -118,7 +199,27 @@ def closed_loop_poles(controller, plant) -> np.ndarray:
     return np.roots(np.polyadd(num, den))
 
 
-def _margins(L, omegas):
+def closed_loop_poles(controller, plant) -> np.ndarray:
+    """Deprecated: use :func:`feedback_poles` ``(plant, controller)``.
+
+    Parameters
+    ----------
+    controller : control LTI or Controller
+        SISO controller G.
+    plant : control LTI or Controller
+        SISO plant P.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``feedback_poles(plant, controller)``.
+    """
+    warnings.warn("loopshaping.check.closed_loop_poles(controller, plant) is deprecated, use "
+                  "loopshaping.check.feedback_poles(plant, controller)", DeprecationWarning, stacklevel=2)
+    return feedback_poles(plant, controller)
+
+
+def _margins(L, omega):
     """Per case (columns of L): gain margin nearest 0 dB and smallest phase margin, on the grid."""
     n = L.shape[1]
     gm = np.full(n, np.inf)
@@ -147,33 +248,65 @@ def _margins(L, omegas):
     return gm, pm
 
 
-def check(controller_or_tf, template_or_plants, specs, omega_dense) -> CheckResult:
+@renamed_keywords(controller_or_tf="controller", template_or_plants="plants", omega_dense="omega")
+def check(plants, controller, specs, omega) -> CheckResult:
     """Every spec on a dense grid over every case, closed-loop stability and margins.
 
     Parameters
     ----------
-    controller_or_tf : :class:`~loopshaping.controller.Controller` or SISO LTI G.
-    template_or_plants : a :class:`~loopshaping.qft.Template` built from systems, or a list
-        of SISO LTI plant cases.
-    specs : a :class:`~loopshaping.qft.Bounds` (its specs are re-evaluated), a
-        :class:`~loopshaping.qft.Spec`, or a list of them. Weights and general-form
-        coefficients must be numbers, LTI or callables of ω (arrays given only at the design
-        frequencies cannot be evaluated on the dense grid). Disk uncertainty is not applied.
-    omega_dense : strictly increasing grid, rad/s.
+    plants : Template or sequence of control LTI
+        A :class:`~loopshaping.templates.Template` built from systems, or the SISO LTI plant
+        cases. (Former keyword ``template_or_plants``; the former argument order
+        ``check(controller, plants, ...)`` is detected and works with a DeprecationWarning.)
+    controller : Controller or control LTI
+        The controller G (former keyword ``controller_or_tf``).
+    specs : Bounds or Spec or list of Spec
+        Of a Bounds its specs are re-evaluated. Weights and general-form coefficients must be
+        numbers, LTI or callables of ω (arrays given only at the design frequencies cannot be
+        evaluated on the dense grid). Disk uncertainty is not applied.
+    omega : array_like
+        Strictly increasing dense grid, rad/s (former keyword ``omega_dense``).
+
+    Returns
+    -------
+    CheckResult
+        Margins per spec and frequency, stability and margins per case.
+
+    Raises
+    ------
+    ValueError
+        For a bad grid, no plant cases, a Template without systems, or an improper loop.
+    TypeError
+        For specs or systems of the wrong type.
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> from loopshaping.specs import Spec
+    >>> res = check([ct.tf([1], [1, 1])], ct.tf([1], [1]), Spec("sensitivity", 2.0), [0.1, 1.0, 10.0])
+    >>> res.passed
+    True
     """
-    w = _check_grid(omega_dense, "omega_dense")
-    if isinstance(template_or_plants, Template):
-        if template_or_plants.systems is None:
-            raise ValueError("template_or_plants: this Template has no systems (built from responses); "
+    if isinstance(plants, Controller) or is_lti(plants):
+        # The former order check(controller, plants, ...): a controller is never a Template
+        # nor a list of plant cases, so the swap is detected reliably. stacklevel 3: the
+        # caller, above the renamed_keywords wrapper.
+        warnings.warn("check(controller, plants, specs, omega) is deprecated: pass the plant cases first, "
+                      "check(plants, controller, specs, omega)", DeprecationWarning, stacklevel=3)
+        plants, controller = controller, plants
+    w = check_grid(omega, "omega")
+    if isinstance(plants, Template):
+        if plants.systems is None:
+            raise ValueError("plants: this Template has no systems (built from responses); "
                              "pass the plant cases as LTI, they are needed off the design frequencies")
-        plants = list(template_or_plants.systems)
+        plants = list(plants.systems)
     else:
-        plants = list(template_or_plants)
+        plants = list(plants)
     if not plants:
-        raise ValueError("template_or_plants is empty")
+        raise ValueError("plants is empty")
     specs = as_specs(specs)
-    G = (controller_or_tf.response(w) if isinstance(controller_or_tf, Controller)
-         else evaluate(controller_or_tf, w, "controller_or_tf"))[:, None]
+    G = (controller.response(w) if isinstance(controller, Controller)
+         else evaluate(controller, w, "controller"))[:, None]
     P = np.stack([evaluate(p, w, f"plant {i}") for i, p in enumerate(plants)], axis=1)
     L = P * G
     margins = np.full((len(specs), len(w)), np.nan)
@@ -196,7 +329,10 @@ def check(controller_or_tf, template_or_plants, specs, omega_dense) -> CheckResu
         m = np.where(np.isnan(m), -np.inf, m)
         margins[k] = np.where(band, m.min(1), np.nan)
         worst[k] = np.where(band, m.argmin(1), -1)
-    poles = [closed_loop_poles(controller_or_tf, p) for p in plants]
+    poles = [feedback_poles(p, controller) for p in plants]
     max_re = np.array([np.max(p.real, initial=-np.inf) for p in poles])
     gm, pm = _margins(L, w)
     return CheckResult(w, tuple(sp.name for sp in specs), margins, worst, max_re < 0, max_re, gm, pm)
+
+
+CheckResult.__init__ = renamed_keywords(omegas="omega")(CheckResult.__init__)

@@ -37,6 +37,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._deprecation import renamed_keywords
+
+__all__ = [
+    "KINDS", "MAX_DEGREE", "MAX_NOTCH_ZETA", "MAX_OMEGA", "MAX_ORDER", "MIN_OMEGA", "Controller", "Element",
+    "complex_pole", "complex_zero", "differentiator", "gain", "integrator", "lead_from_phase", "lead_lag",
+    "notch", "real_pole", "real_zero",
+]
+
 _PARAMS = {
     "gain": ("k",),
     "integrator": ("order",),
@@ -65,7 +73,28 @@ MAX_DEGREE = 64
 
 @dataclass(frozen=True)
 class Element:
-    """One factor of a controller; ``params`` by name (see the module table; ω in rad/s)."""
+    """One factor of a controller; ``params`` by name (see the module table).
+
+    Parameters
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+    params : dict
+        The parameters of that kind by name (frequencies ``omega``, ``zero``, ``pole`` in
+        rad/s, damping ratios dimensionless, ``order`` an integer, ``k`` the gain).
+
+    Raises
+    ------
+    ValueError
+        For an unknown kind or a parameter out of its range (the message names it).
+    TypeError
+        For missing or unknown parameters.
+
+    Examples
+    --------
+    >>> Element("real_pole", {"omega": 2.0}).polys()
+    (array([1.]), array([0.5, 1. ]))
+    """
 
     kind: str
     params: dict = field(default_factory=dict)
@@ -108,8 +137,14 @@ class Element:
                 raise ValueError(f"{k}: {name}={p[name]!r} rad/s must have |{name}| in [{MIN_OMEGA:g}, {MAX_OMEGA:g}] rad/s")
         object.__setattr__(self, "params", p)
 
-    def polys(self):
-        """(numerator, denominator) coefficient arrays in s, highest power first."""
+    def polys(self) -> tuple[np.ndarray, np.ndarray]:
+        """Numerator and denominator coefficients in s, highest power first.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``(numerator, denominator)``.
+        """
         p, k = self.params, self.kind
         if k == "gain":
             return np.array([p["k"]]), np.array([1.0])
@@ -129,10 +164,22 @@ class Element:
         w = p["omega"]
         return np.array([1.0, 2 * p["zeta_zero"] * w, w * w]), np.array([1.0, 2 * p["zeta_pole"] * w, w * w])
 
-    def response(self, omegas) -> np.ndarray:
-        """Complex response at s = jω (ω in rad/s)."""
+    @renamed_keywords(omegas="omega")
+    def response(self, omega) -> np.ndarray:
+        """Complex response at s = jω.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s.
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex response, shape of ``omega``.
+        """
         num, den = self.polys()
-        s = 1j * np.asarray(omegas, float)
+        s = 1j * np.asarray(omega, float)
         return np.polyval(num, s) / np.polyval(den, s)
 
     def __str__(self):
@@ -140,45 +187,170 @@ class Element:
 
 
 # Factories, for readable controller definitions.
-def gain(k) -> Element:
+def gain(k: float) -> Element:
+    """A constant gain k (the only element not normalised to unit DC gain).
+
+    Parameters
+    ----------
+    k : float
+        Gain, finite and non-zero (may be negative).
+
+    Returns
+    -------
+    Element
+        The ``gain`` element.
+
+    Examples
+    --------
+    >>> gain(2.0).params
+    {'k': 2.0}
+    """
     return Element("gain", {"k": k})
 
 
-def integrator(order=1) -> Element:
+def integrator(order: int = 1) -> Element:
+    """1/s^order.
+
+    Parameters
+    ----------
+    order : int
+        Number of integrators, 1 to :data:`MAX_ORDER`.
+
+    Returns
+    -------
+    Element
+        The ``integrator`` element.
+    """
     return Element("integrator", {"order": order})
 
 
-def differentiator(order=1) -> Element:
+def differentiator(order: int = 1) -> Element:
+    """s^order.
+
+    Parameters
+    ----------
+    order : int
+        Number of differentiators, 1 to :data:`MAX_ORDER`.
+
+    Returns
+    -------
+    Element
+        The ``differentiator`` element.
+    """
     return Element("differentiator", {"order": order})
 
 
-def real_pole(omega) -> Element:
-    """1/(s/ω + 1), ω in rad/s (negative: right-half-plane pole)."""
+def real_pole(omega: float) -> Element:
+    """1/(s/ω + 1): a real pole at s = −ω, unit DC gain.
+
+    Parameters
+    ----------
+    omega : float
+        Corner frequency ω, rad/s, ≠ 0 (negative: a right-half-plane pole).
+
+    Returns
+    -------
+    Element
+        The ``real_pole`` element.
+    """
     return Element("real_pole", {"omega": omega})
 
 
-def real_zero(omega) -> Element:
-    """s/ω + 1, ω in rad/s (negative: right-half-plane zero)."""
+def real_zero(omega: float) -> Element:
+    """s/ω + 1: a real zero at s = −ω, unit DC gain.
+
+    Parameters
+    ----------
+    omega : float
+        Corner frequency ω, rad/s, ≠ 0 (negative: a right-half-plane zero).
+
+    Returns
+    -------
+    Element
+        The ``real_zero`` element.
+    """
     return Element("real_zero", {"omega": omega})
 
 
-def complex_pole(omega, zeta) -> Element:
-    """1/((s/ω)² + 2ζ s/ω + 1), ω in rad/s."""
+def complex_pole(omega: float, zeta: float) -> Element:
+    """1/((s/ω)² + 2ζ s/ω + 1): a complex pair, unit DC gain.
+
+    Parameters
+    ----------
+    omega : float
+        Natural frequency ω > 0, rad/s.
+    zeta : float
+        Damping ratio ζ, |ζ| < 1 (negative: right-half-plane pair).
+
+    Returns
+    -------
+    Element
+        The ``complex_pole`` element.
+    """
     return Element("complex_pole", {"omega": omega, "zeta": zeta})
 
 
-def complex_zero(omega, zeta) -> Element:
-    """(s/ω)² + 2ζ s/ω + 1, ω in rad/s."""
+def complex_zero(omega: float, zeta: float) -> Element:
+    """(s/ω)² + 2ζ s/ω + 1: a complex pair, unit DC gain.
+
+    Parameters
+    ----------
+    omega : float
+        Natural frequency ω > 0, rad/s.
+    zeta : float
+        Damping ratio ζ, |ζ| < 1 (negative: right-half-plane pair).
+
+    Returns
+    -------
+    Element
+        The ``complex_zero`` element.
+    """
     return Element("complex_zero", {"omega": omega, "zeta": zeta})
 
 
-def lead_lag(zero, pole) -> Element:
-    """(s/zero + 1)/(s/pole + 1): a lead when zero < pole, a lag otherwise (rad/s)."""
+def lead_lag(zero: float, pole: float) -> Element:
+    """(s/zero + 1)/(s/pole + 1): a lead when zero < pole, a lag otherwise.
+
+    Parameters
+    ----------
+    zero : float
+        Zero frequency, rad/s, > 0.
+    pole : float
+        Pole frequency, rad/s, > 0.
+
+    Returns
+    -------
+    Element
+        The ``lead_lag`` element.
+    """
     return Element("lead_lag", {"zero": zero, "pole": pole})
 
 
-def lead_from_phase(phase_deg, omega) -> Element:
-    """Lead (phase_deg > 0) or lag (< 0) with |phase| at most ±90° peaking at ω (rad/s)."""
+def lead_from_phase(phase_deg: float, omega: float) -> Element:
+    """Lead (phase_deg > 0) or lag (< 0) whose phase peaks at ω with ``phase_deg``.
+
+    Parameters
+    ----------
+    phase_deg : float
+        Peak phase, degrees, in (−90, 90) and non-zero.
+    omega : float
+        Frequency of the peak, rad/s (the geometric mean of zero and pole).
+
+    Returns
+    -------
+    Element
+        A ``lead_lag`` element.
+
+    Raises
+    ------
+    ValueError
+        If ``phase_deg`` is 0 or not within (−90, 90).
+
+    Examples
+    --------
+    >>> round(lead_from_phase(30.0, 1.0).params["pole"], 4)
+    1.7321
+    """
     if not 0 < abs(phase_deg) < 90:
         raise ValueError(f"phase_deg={phase_deg} must be within (−90, 90) degrees and non-zero")
     sin = math.sin(math.radians(abs(phase_deg)))
@@ -187,14 +359,48 @@ def lead_from_phase(phase_deg, omega) -> Element:
     return lead_lag(lo, hi) if phase_deg > 0 else lead_lag(hi, lo)
 
 
-def notch(omega, zeta_zero, zeta_pole) -> Element:
-    """(s² + 2ζ_z ω s + ω²)/(s² + 2ζ_p ω s + ω²): depth ζ_z/ζ_p at ω (rad/s)."""
+def notch(omega: float, zeta_zero: float, zeta_pole: float) -> Element:
+    """(s² + 2ζ_z ω s + ω²)/(s² + 2ζ_p ω s + ω²): depth ζ_z/ζ_p at ω.
+
+    Parameters
+    ----------
+    omega : float
+        Notch frequency ω > 0, rad/s.
+    zeta_zero : float
+        Damping ratio ζ_z of the zeros, 0 ≤ ζ_z ≤ :data:`MAX_NOTCH_ZETA`.
+    zeta_pole : float
+        Damping ratio ζ_p of the poles, 0 < ζ_p ≤ :data:`MAX_NOTCH_ZETA`.
+
+    Returns
+    -------
+    Element
+        The ``notch`` element (gain ζ_z/ζ_p at ω, i.e. 20·log10(ζ_z/ζ_p) dB).
+    """
     return Element("notch", {"omega": omega, "zeta_zero": zeta_zero, "zeta_pole": zeta_pole})
 
 
 @dataclass(frozen=True)
 class Controller:
-    """An ordered tuple of :class:`Element`; the transfer function is their product."""
+    """An ordered tuple of :class:`Element`; the transfer function is their product.
+
+    Parameters
+    ----------
+    elements : tuple of Element
+        The factors, in order.
+
+    Raises
+    ------
+    TypeError
+        If an element is not an :class:`Element`.
+    ValueError
+        If the controller has more than :data:`MAX_DEGREE` poles or zeros.
+
+    Examples
+    --------
+    >>> C = Controller((gain(10.0), integrator(), real_zero(1.0)))
+    >>> C.polys()
+    (array([10., 10.]), array([1., 0.]))
+    """
 
     elements: tuple = ()
 
@@ -210,25 +416,87 @@ class Controller:
 
     # -- editing (new objects)
     def add(self, element: Element, index: int | None = None) -> Controller:
-        """A new controller with ``element`` inserted at ``index`` (default: appended)."""
+        """A new controller with ``element`` inserted at ``index`` (default: appended).
+
+        Parameters
+        ----------
+        element : Element
+            The element to insert.
+        index : int, optional
+            Position (as ``list.insert``); None appends.
+
+        Returns
+        -------
+        Controller
+            The new controller.
+        """
         els = list(self.elements)
         els.insert(len(els) if index is None else index, element)
         return Controller(tuple(els))
 
     def replace(self, index: int, element: Element) -> Controller:
+        """A new controller with element ``index`` replaced by ``element``.
+
+        Parameters
+        ----------
+        index : int
+            Position of the element to replace.
+        element : Element
+            The new element.
+
+        Returns
+        -------
+        Controller
+            The new controller.
+
+        Raises
+        ------
+        IndexError
+            If ``index`` is out of range.
+        """
         self._check_index(index)
         els = list(self.elements)
         els[index] = element
         return Controller(tuple(els))
 
     def remove(self, index: int) -> Controller:
+        """A new controller without element ``index``.
+
+        Parameters
+        ----------
+        index : int
+            Position of the element to remove.
+
+        Returns
+        -------
+        Controller
+            The new controller.
+
+        Raises
+        ------
+        IndexError
+            If ``index`` is out of range.
+        """
         self._check_index(index)
         els = list(self.elements)
         del els[index]
         return Controller(tuple(els))
 
     def set(self, index: int, **params) -> Controller:
-        """A new controller with some parameters of element ``index`` changed."""
+        """A new controller with some parameters of element ``index`` changed.
+
+        Parameters
+        ----------
+        index : int
+            Position of the element.
+        **params
+            New parameter values by name (rad/s for frequencies).
+
+        Returns
+        -------
+        Controller
+            The new controller.
+        """
         self._check_index(index)
         e = self.elements[index]
         return self.replace(index, Element(e.kind, {**e.params, **params}))
@@ -238,8 +506,14 @@ class Controller:
             raise IndexError(f"index={index} out of range for a controller of {len(self.elements)} elements")
 
     # -- evaluation
-    def polys(self):
-        """(numerator, denominator) in s, highest power first."""
+    def polys(self) -> tuple[np.ndarray, np.ndarray]:
+        """Numerator and denominator coefficients in s, highest power first.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``(numerator, denominator)``, the products of the elements' polynomials.
+        """
         num, den = np.array([1.0]), np.array([1.0])
         for e in self.elements:
             n, d = e.polys()
@@ -247,28 +521,65 @@ class Controller:
         return num, den
 
     def tf(self):
-        """The python-control TransferFunction."""
+        """The python-control transfer function.
+
+        Returns
+        -------
+        control.TransferFunction
+            The product of the elements.
+        """
         import control as ct
 
         num, den = self.polys()
         return ct.tf(num, den)
 
-    def response(self, omegas) -> np.ndarray:
-        """Complex response at s = jω, ω in rad/s (evaluated factor by factor)."""
-        out = np.ones(np.shape(omegas), complex)
+    @renamed_keywords(omegas="omega")
+    def response(self, omega) -> np.ndarray:
+        """Complex response at s = jω, evaluated factor by factor.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s.
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex response, shape of ``omega``.
+        """
+        out = np.ones(np.shape(omega), complex)
         for e in self.elements:
-            out = out * e.response(omegas)
+            out = out * e.response(omega)
         return out
 
     @property
     def is_proper(self) -> bool:
+        """True if the numerator degree does not exceed the denominator degree."""
         num, den = self.polys()
         return len(np.trim_zeros(num, "f")) <= len(np.trim_zeros(den, "f"))
 
     # -- conversion
     @classmethod
-    def from_zpk(cls, zeros, poles, k) -> Controller:
-        """From zeros, poles (complex ones in conjugate pairs) and the gain of k·Π(s−z)/Π(s−p)."""
+    def from_zpk(cls, zeros, poles, k: float) -> Controller:
+        """From the zeros, poles and gain of k·Π(s − z)/Π(s − p).
+
+        Parameters
+        ----------
+        zeros, poles : array_like
+            Roots, rad/s (complex ones in conjugate pairs).
+        k : float
+            The leading gain k.
+
+        Returns
+        -------
+        Controller
+            A ``gain`` element followed by the normalised factors.
+
+        Raises
+        ------
+        ValueError
+            If complex roots are not in conjugate pairs or k is 0.
+        """
         elements, scale = [], float(k)
         for roots, is_zero in ((np.asarray(zeros, complex), True), (np.asarray(poles, complex), False)):
             els, f = _elements_from_roots(roots, is_zero)
@@ -280,7 +591,23 @@ class Controller:
 
     @classmethod
     def from_tf(cls, sys) -> Controller:
-        """From a SISO python-control transfer function (factored into elements)."""
+        """From a SISO python-control LTI system, factored into elements.
+
+        Parameters
+        ----------
+        sys : control LTI
+            SISO transfer function or state space.
+
+        Returns
+        -------
+        Controller
+            Its factorisation.
+
+        Raises
+        ------
+        ValueError
+            If ``sys`` is not SISO.
+        """
         import control as ct
 
         sys = ct.tf(sys)
@@ -290,11 +617,34 @@ class Controller:
         return cls.from_zpk(np.roots(num), np.roots(den), num[0] / den[0])
 
     def to_dict(self) -> dict:
+        """A JSON-ready dict ``{"version": 1, "elements": [{"kind", "params"}, ...]}``.
+
+        Returns
+        -------
+        dict
+            The controller, read back by :meth:`from_dict`.
+        """
         return {"version": _JSON_VERSION, "elements": [{"kind": e.kind, "params": dict(e.params)} for e in self.elements]}
 
     @classmethod
-    def from_dict(cls, data) -> Controller:
-        """The controller of :meth:`to_dict`; every key is checked and an error names the element index."""
+    def from_dict(cls, data: dict) -> Controller:
+        """The controller of :meth:`to_dict`; every key is checked.
+
+        Parameters
+        ----------
+        data : dict
+            As written by :meth:`to_dict`.
+
+        Returns
+        -------
+        Controller
+            The controller.
+
+        Raises
+        ------
+        ValueError
+            For unknown keys, a wrong version or an invalid element (naming its index).
+        """
         if not isinstance(data, dict) or "elements" not in data:
             raise ValueError("data must be a dict with an 'elements' list (from Controller.to_dict)")
         extra = set(data) - {"version", "elements"}
@@ -316,11 +666,34 @@ class Controller:
         return cls(tuple(out))
 
     def to_json(self, **kwargs) -> str:
-        """JSON text; floats are written with repr precision, so the round trip is exact."""
+        """JSON text; floats are written with repr precision, so the round trip is exact.
+
+        Parameters
+        ----------
+        **kwargs
+            Passed to :func:`json.dumps` (e.g. ``indent``).
+
+        Returns
+        -------
+        str
+            The JSON text of :meth:`to_dict`.
+        """
         return json.dumps(self.to_dict(), **kwargs)
 
     @classmethod
-    def from_json(cls, text) -> Controller:
+    def from_json(cls, text: str) -> Controller:
+        """The controller of :meth:`to_json`.
+
+        Parameters
+        ----------
+        text : str
+            JSON text.
+
+        Returns
+        -------
+        Controller
+            The controller (checked as by :meth:`from_dict`).
+        """
         return cls.from_dict(json.loads(text))
 
     def __str__(self):

@@ -1,4 +1,4 @@
-"""H∞ synthesis that refuses ill-posed problems before SLICOT sees them, and order reduction.
+"""H∞ synthesis that refuses ill-posed problems before SLICOT sees them.
 
 Two entry points:
 
@@ -13,12 +13,15 @@ SLICOT's H∞ routines assume (A1) (A, B2) stabilisable and (C2, A) detectable,
 (A2) D12 full column rank and D21 full row rank, (A3)/(A4) no invariant zeros of
 (A, B2, C1, D12) and (A, B1, C2, D21) on the imaginary axis. When one of them fails
 ``sb10ad`` (python-control's ``hinfsyn``) can iterate on γ without end, so every assumption
-is checked here first and a failure raises :class:`ValueError` naming the condition and a
-remedy. The γ iteration itself is a bounded bisection on ``sb10fd`` (see ``_solve``).
+is checked first (:mod:`loopshaping.wellposed`) and a failure raises :class:`ValueError`
+naming the condition and a remedy. The γ iteration itself is a bounded bisection on
+``sb10fd`` (see ``_solve``).
 
-Then :func:`reduce` (balanced truncation of the stable part, the unstable part kept
-exactly, with the H∞ norm of the error and the a-priori bound) and :func:`discretize`
-(Tustin with prewarping) make the controller implementable.
+Then :func:`~loopshaping.reduction.reduce` (balanced truncation of the stable part, the
+unstable part kept exactly, with the H∞ norm of the error and the a-priori bound) and
+:func:`~loopshaping.reduction.discretize` (Tustin with prewarping) make the controller
+implementable; they live in :mod:`loopshaping.reduction` and are re-exported here, as are
+:func:`check_well_posed` and :class:`WellPosednessWarning`.
 
 Frequencies in rad/s. Every transfer function is a python-control object.
 """
@@ -29,7 +32,10 @@ from dataclasses import dataclass, field
 
 import control as ct
 import numpy as np
-import scipy.linalg as sla
+
+from ._statespace import as_ss, check_dims, format_roots, hinf_norm, partition, slycot_routine
+from .reduction import ReductionResult, discretize, reduce
+from .wellposed import WellPosednessWarning, check_well_posed, regularized_plant, shift_axis_poles
 
 __all__ = [
     "HinfResult",
@@ -43,19 +49,6 @@ __all__ = [
 ]
 
 
-class WellPosednessWarning(UserWarning):
-    """A weight or the problem was modified (pole shifted, regularised) to make it well posed."""
-
-
-def _slycot(name):
-    # slycot is optional for the package as a whole but required here: fail loudly, late.
-    try:
-        import slycot
-    except ImportError as e:  # pragma: no cover - slycot is installed in CI
-        raise ImportError(f"loopshaping.hinf needs slycot (for {name}); pip install slycot") from e
-    return getattr(slycot, name)
-
-
 # --------------------------------------------------------------------------- results
 
 
@@ -63,7 +56,7 @@ def _slycot(name):
 class HinfResult:
     """Result of an H∞ synthesis. Unpacks as ``K, gamma = result``.
 
-    Attributes
+    Parameters
     ----------
     controller : control.StateSpace
         The controller K (sign convention of the function that produced it).
@@ -101,89 +94,6 @@ class HinfResult:
         yield self.gamma
 
 
-@dataclass(frozen=True)
-class ReductionResult:
-    """Result of :func:`reduce`. Unpacks as ``K_r, error = result``.
-
-    Attributes
-    ----------
-    controller : control.StateSpace
-        Reduced controller (same D, same unstable part as the original).
-    error_hinf : float
-        ‖K − K_r‖∞, computed (``ab13dd``) on the stable parts, where the whole error lives.
-    bound : float
-        A-priori balanced-truncation bound 2·Σ σ_i over the discarded Hankel singular
-        values of the stable part; ``error_hinf ≤ bound``.
-    hankel_singular_values : numpy.ndarray
-        Hankel singular values of the stable part, decreasing.
-    n_unstable : int
-        Number of poles with Re ≥ 0 that were kept unreduced.
-    """
-
-    controller: ct.StateSpace
-    error_hinf: float
-    bound: float
-    hankel_singular_values: np.ndarray
-    n_unstable: int
-
-    def __iter__(self):
-        yield self.controller
-        yield self.error_hinf
-
-
-# --------------------------------------------------------------------------- helpers
-
-
-def _as_ss(sys, name):
-    if isinstance(sys, (int, float, np.integer, np.floating)):
-        return ct.ss([], [], [], np.atleast_2d(float(sys)))
-    if isinstance(sys, ct.TransferFunction):
-        sys = ct.ss(sys)
-    if not isinstance(sys, ct.StateSpace):
-        raise TypeError(
-            f"{name} must be a control.StateSpace, control.TransferFunction or a number, "
-            f"got {type(sys).__name__}"
-        )
-    if not sys.isctime():
-        raise ValueError(f"{name} must be continuous-time (dt=0); discretise after synthesis")
-    return sys
-
-
-def _partition(P, n_meas, n_ctrl):
-    A, B, C, D = (np.asarray(M, dtype=float) for M in (P.A, P.B, P.C, P.D))
-    m1 = B.shape[1] - n_ctrl
-    p1 = C.shape[0] - n_meas
-    return dict(
-        A=A, B1=B[:, :m1], B2=B[:, m1:], C1=C[:p1], C2=C[p1:],
-        D11=D[:p1, :m1], D12=D[:p1, m1:], D21=D[p1:, :m1], D22=D[p1:, m1:],
-    )
-
-
-def _invariant_zeros(A, B, C, D):
-    """Finite invariant zeros of (A, B, C, D), any shape (SLICOT ab08nd + QZ)."""
-    n = A.shape[0]
-    if n == 0:
-        return np.array([], dtype=complex)
-    ab08nd = _slycot("ab08nd")
-    # SLICOT may overwrite its arguments: hand it copies.
-    out = ab08nd(n, B.shape[1], C.shape[0], A.copy(), B.copy(), C.copy(), D.copy())
-    nu = out[0]
-    if nu == 0:
-        return np.array([], dtype=complex)
-    Af, Bf = out[8][:nu, :nu], out[9][:nu, :nu]
-    z = sla.eigvals(Af, Bf)
-    return z[np.isfinite(z)].astype(complex)
-
-
-def _on_axis(values, axis_tol):
-    values = np.asarray(values, dtype=complex)
-    return values[np.abs(values.real) <= axis_tol * np.maximum(1.0, np.abs(values))]
-
-
-def _fmt(values):
-    return ", ".join(f"{v.real:+.3g}{v.imag:+.3g}j" for v in values)
-
-
 def _lower_lft(parts, K):
     """State space of F_l(P, K) with u = K·y (handles D22 ≠ 0 and a proper K)."""
     A, B1, B2, C1, C2 = parts["A"], parts["B1"], parts["B2"], parts["C1"], parts["C2"]
@@ -203,203 +113,6 @@ def _lower_lft(parts, K):
     Dcl = D11 + D12 @ Fw
     return ct.ss(Acl, Bcl, Ccl, Dcl)
 
-
-def _sigma_max(sys, w):
-    """Largest singular value of sys(jω) for each ω of w (rad/s)."""
-    r = np.asarray(ct.frequency_response(sys, w).complex)
-    r = r.reshape(sys.noutputs, sys.ninputs, len(w))
-    return np.linalg.svd(np.moveaxis(r, -1, 0), compute_uv=False)[:, 0]
-
-
-def _hinf_norm(sys):
-    """H∞ norm of a stable system: ab13dd, guarded by a pole-spanning grid search.
-
-    ab13dd (Bruinsma–Steinbuch) occasionally returns a local peak (seen on controllers
-    whose poles span eight decades); taking the larger of it and a refined grid maximum
-    removes that failure without losing ab13dd's accuracy when it is right.
-    """
-    if sys.nstates == 0:
-        return float(sla.svdvals(np.atleast_2d(sys.D))[0]) if np.size(sys.D) else 0.0
-    gpeak = float(ct.linfnorm(sys)[0])
-    mags = np.abs(np.linalg.eigvals(np.asarray(sys.A)))
-    mags = mags[mags > 0]
-    lo = np.log10(mags.min()) - 3 if mags.size else -3.0
-    hi = np.log10(mags.max()) + 3 if mags.size else 3.0
-    w = np.concatenate([[0.0], np.logspace(lo, hi, int(200 * (hi - lo)))])
-    g = _sigma_max(sys, w)
-    i = int(np.argmax(g))
-    best = g[i]
-    for _ in range(3):
-        # Zoom three times on the grid peak (±1 grid step, 201 points) to pin it down.
-        lo_w, hi_w = w[max(i - 1, 0)], w[min(i + 1, len(w) - 1)]
-        w = np.linspace(lo_w, hi_w, 201)
-        g = _sigma_max(sys, w)
-        i = int(np.argmax(g))
-        best = max(best, g[i])
-    return max(gpeak, float(best))
-
-
-def _shift_axis_poles(sys, epsilon, axis_tol):
-    """Move eigenvalues with |Re| ≤ tol to Re = −ε, leaving the others untouched.
-
-    An ordered real Schur form puts those eigenvalues in the leading block; subtracting
-    ε·I there shifts exactly them (the form is block upper-triangular).
-    Returns (shifted system, array of the moved poles).
-    """
-    A = np.asarray(sys.A, dtype=float)
-    if A.shape[0] == 0:
-        return sys, np.array([], dtype=complex)
-    poles = np.linalg.eigvals(A)
-    moved = _on_axis(poles, axis_tol)
-    if moved.size == 0:
-        return sys, moved
-    T, Z, k = sla.schur(
-        A, output="real",
-        sort=lambda re, im: abs(re) <= axis_tol * max(1.0, np.hypot(re, im)),
-    )
-    T = T.copy()
-    T[:k, :k] -= epsilon * np.eye(k)
-    shifted = ct.ss(T, Z.T @ np.asarray(sys.B), np.asarray(sys.C) @ Z, sys.D)
-    return shifted, moved
-
-
-# --------------------------------------------------------------------------- well-posedness
-
-
-def check_well_posed(generalized_plant, n_meas, n_ctrl, *, rank_tol=1e-9, axis_tol=1e-9):
-    """Check SLICOT's assumptions (A1)–(A4) on a generalized plant; raise if one fails.
-
-    Parameters
-    ----------
-    generalized_plant : control.StateSpace
-        Continuous-time plant with inputs ``[w; u]`` and outputs ``[z; y]``.
-    n_meas, n_ctrl : int
-        Number of measurements y (last outputs) and controls u (last inputs).
-    rank_tol : float
-        Relative rank tolerance: D12 counts as rank deficient when
-        σ_min(D12) ≤ rank_tol·‖[C1 D12]‖ (and likewise for D21 with ‖[B1; D21]‖).
-    axis_tol : float
-        A zero or mode s counts as on the imaginary axis when |Re s| ≤ axis_tol·max(1, |s|).
-
-    Raises
-    ------
-    ValueError
-        Naming the failed condition and a remedy.
-    """
-    P = _as_ss(generalized_plant, "generalized_plant")
-    _check_dims(P, n_meas, n_ctrl)
-    p = _partition(P, n_meas, n_ctrl)
-    A, B1, B2, C1, C2, D12, D21 = (p[k] for k in ("A", "B1", "B2", "C1", "C2", "D12", "D21"))
-    n = A.shape[0]
-
-    # (A2): rank conditions. A rank-deficient D12 is the classic "spins forever" case.
-    s12 = sla.svdvals(D12) if D12.size else np.zeros(0)
-    scale12 = max(np.linalg.norm(np.hstack([C1, D12]), 2), np.finfo(float).tiny)
-    if D12.shape[0] < D12.shape[1] or s12.size == 0 or s12.min() <= rank_tol * scale12:
-        raise ValueError(
-            f"ill-posed H∞ problem: D12 ({D12.shape[0]}×{D12.shape[1]}) is not of full column "
-            f"rank (singular values {np.array2string(s12, precision=3)}): some control input "
-            "has no direct penalty at high frequency. Remedy: add a control-effort weight "
-            "with a non-zero feed-through (w_ks in mixed_sensitivity), give a weight on T a "
-            "biproper part, or pass regularize=True to add epsilon·u to the outputs."
-        )
-    s21 = sla.svdvals(D21) if D21.size else np.zeros(0)
-    scale21 = max(np.linalg.norm(np.vstack([B1, D21]), 2), np.finfo(float).tiny)
-    if D21.shape[1] < D21.shape[0] or s21.size == 0 or s21.min() <= rank_tol * scale21:
-        raise ValueError(
-            f"ill-posed H∞ problem: D21 ({D21.shape[0]}×{D21.shape[1]}) is not of full row "
-            f"rank (singular values {np.array2string(s21, precision=3)}): some measurement is "
-            "noise-free. Remedy: add a sensor-noise input to every measurement, or pass "
-            "regularize=True to add epsilon·(noise) to the measurements."
-        )
-
-    # (A1): stabilisable / detectable by the PBH test at every closed-RHP eigenvalue.
-    if n:
-        norm_ab = max(np.linalg.norm(np.hstack([A, B2]), 2), 1.0)
-        norm_ac = max(np.linalg.norm(np.vstack([A, C2]), 2), 1.0)
-        for lam in np.linalg.eigvals(A):
-            if lam.real < -axis_tol * max(1.0, abs(lam)):
-                continue
-            M = A - lam * np.eye(n)
-            if sla.svdvals(np.hstack([M, B2])).min() <= rank_tol * norm_ab:
-                raise ValueError(
-                    f"ill-posed H∞ problem: (A, B2) is not stabilisable, the mode at "
-                    f"s = {_fmt([lam])} cannot be moved by the controls. Remedy: remove "
-                    "the mode from the weights/plant, or shift it into the left half-plane "
-                    "(weights: integrators are shifted by epsilon automatically in "
-                    "mixed_sensitivity)."
-                )
-            if sla.svdvals(np.vstack([M, C2])).min() <= rank_tol * norm_ac:
-                raise ValueError(
-                    f"ill-posed H∞ problem: (C2, A) is not detectable, the mode at "
-                    f"s = {_fmt([lam])} is not seen by the measurements. Remedy: remove the "
-                    "mode (it is usually an unobservable weight state) or shift it into the "
-                    "left half-plane."
-                )
-
-    # (A3)/(A4): invariant zeros on the imaginary axis (a pole of a weight or plant that
-    # sits on the axis and cannot be cancelled shows up here).
-    z12 = _on_axis(_invariant_zeros(A, B2, C1, D12), axis_tol)
-    if z12.size:
-        raise ValueError(
-            "ill-posed H∞ problem: (A, B2, C1, D12) has invariant zeros on the imaginary axis "
-            f"at s = {_fmt(z12)}. Typical cause: a pole on the axis (integrator) in a weight or "
-            "in the plant, or a zero of the plant on the axis. Remedy: shift the pole by a "
-            "small epsilon into the left half-plane (mixed_sensitivity does this for weights)."
-        )
-    z21 = _on_axis(_invariant_zeros(A, B1, C2, D21), axis_tol)
-    if z21.size:
-        raise ValueError(
-            "ill-posed H∞ problem: (A, B1, C2, D21) has invariant zeros on the imaginary axis "
-            f"at s = {_fmt(z21)}. Typical cause: a plant pole on the axis (integrator) that the "
-            "disturbances do not excite. Remedy: shift the pole by a small epsilon into the "
-            "left half-plane, or add a disturbance input that excites it."
-        )
-
-
-def _check_dims(P, n_meas, n_ctrl):
-    for name, v in (("n_meas", n_meas), ("n_ctrl", n_ctrl)):
-        if not isinstance(v, (int, np.integer)) or v < 1:
-            raise ValueError(f"{name}={v!r} must be a positive integer")
-    if n_meas >= P.noutputs:
-        raise ValueError(
-            f"n_meas={n_meas} must be smaller than the number of plant outputs "
-            f"({P.noutputs}): there must be at least one performance output z"
-        )
-    if n_ctrl >= P.ninputs:
-        raise ValueError(
-            f"n_ctrl={n_ctrl} must be smaller than the number of plant inputs "
-            f"({P.ninputs}): there must be at least one exogenous input w"
-        )
-
-
-def _regularized(P, n_meas, n_ctrl, epsilon, rank_tol):
-    """Append ε·u to z where D12 lacks rank and ε·noise to y where D21 lacks rank."""
-    p = _partition(P, n_meas, n_ctrl)
-    notes = []
-    A, B1, B2, C1, C2 = p["A"], p["B1"], p["B2"], p["C1"], p["C2"]
-    D11, D12, D21, D22 = p["D11"], p["D12"], p["D21"], p["D22"]
-    n = A.shape[0]
-    s12 = sla.svdvals(D12) if D12.size else np.zeros(0)
-    scale12 = max(np.linalg.norm(np.hstack([C1, D12]), 2), np.finfo(float).tiny)
-    if D12.shape[0] < D12.shape[1] or s12.size == 0 or s12.min() <= rank_tol * scale12:
-        C1 = np.vstack([C1, np.zeros((n_ctrl, n))])
-        D11 = np.vstack([D11, np.zeros((n_ctrl, D11.shape[1]))])
-        D12 = np.vstack([D12, epsilon * np.eye(n_ctrl)])
-        notes.append(f"regularised: appended {epsilon:g}·u to the performance outputs (D12)")
-    s21 = sla.svdvals(D21) if D21.size else np.zeros(0)
-    scale21 = max(np.linalg.norm(np.vstack([B1, D21]), 2), np.finfo(float).tiny)
-    if D21.shape[1] < D21.shape[0] or s21.size == 0 or s21.min() <= rank_tol * scale21:
-        B1 = np.hstack([B1, np.zeros((n, n_meas))])
-        D11 = np.hstack([D11, np.zeros((D11.shape[0], n_meas))])
-        D21 = np.hstack([D21, epsilon * np.eye(n_meas)])
-        notes.append(f"regularised: added {epsilon:g}·noise to the measurements (D21)")
-    if not notes:
-        return P, notes
-    B = np.hstack([B1, B2])
-    C = np.vstack([C1, C2])
-    D = np.block([[D11, D12], [D21, D22]])
-    return ct.ss(A, B, C, D), notes
 
 
 # --------------------------------------------------------------------------- synthesis
@@ -467,8 +180,8 @@ def synthesize(
     ValueError
         At once, before SLICOT is called, if the problem is ill posed.
     """
-    P = _as_ss(generalized_plant, "generalized_plant")
-    _check_dims(P, n_meas, n_ctrl)
+    P = as_ss(generalized_plant, "generalized_plant")
+    check_dims(P, n_meas, n_ctrl)
     if not (np.isfinite(epsilon) and epsilon > 0):
         raise ValueError(f"epsilon={epsilon!r} must be a positive number")
     if not (np.isfinite(suboptimality) and suboptimality >= 0):
@@ -492,7 +205,7 @@ def synthesize(
             )
     notes = []
     if regularize:
-        P, notes = _regularized(P, n_meas, n_ctrl, epsilon, rank_tol)
+        P, notes = regularized_plant(P, n_meas, n_ctrl, epsilon, rank_tol)
         for note in notes:
             warnings.warn(note, WellPosednessWarning, stacklevel=2)
     if decay_rate == 0:
@@ -517,11 +230,11 @@ def synthesize(
     res = _solve(P_alpha, n_meas, n_ctrl, suboptimality, gamma_tol, notes)
     Ka = res.controller
     K = ct.ss(np.asarray(Ka.A, dtype=float) - alpha * np.eye(Ka.nstates), Ka.B, Ka.C, Ka.D)
-    cl = _lower_lft(_partition(P, n_meas, n_ctrl), K)
+    cl = _lower_lft(partition(P, n_meas, n_ctrl), K)
     if cl.nstates and np.max(np.linalg.eigvals(cl.A).real) >= 0:  # pragma: no cover
         raise RuntimeError("α-shifted synthesis returned a destabilising controller")
     return HinfResult(
-        controller=K, gamma=_hinf_norm(cl), closed_loop=cl, gamma_bound=res.gamma_bound,
+        controller=K, gamma=hinf_norm(cl), closed_loop=cl, gamma_bound=res.gamma_bound,
         generalized_plant=P, notes=notes, rcond=res.rcond, decay_rate=alpha,
     )
 
@@ -533,7 +246,7 @@ def _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, notes):
     more than ten minutes on a badly scaled but well-posed turbine problem; a bisection
     here has a bounded number of steps, each a pair of Riccati equations.
     """
-    parts = _partition(P, n_meas, n_ctrl)
+    parts = partition(P, n_meas, n_ctrl)
     # SLICOT's formulas assume D22 = 0; loop-shift it out and back in:
     # y0 = y − D22·u, synthesise K0 on y0, then K = K0·(I + D22·K0)⁻¹ on y.
     D22 = parts["D22"]
@@ -544,10 +257,10 @@ def _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, notes):
     n, m, np_ = A.shape[0], B.shape[1], C.shape[0]
     # A diagonal state similarity (SLICOT tb01id) changes no transfer function but brings
     # physical models (N·m next to rad) to a scale the Riccati solvers can handle.
-    _, A, B, C, _ = _slycot("tb01id")(n, m, np_, 0.0, A.copy(), B.copy(), C.copy(), job="A")
+    _, A, B, C, _ = slycot_routine("tb01id")(n, m, np_, 0.0, A.copy(), B.copy(), C.copy(), job="A")
     Pb = ct.ss(A, B, C, np.asarray(P.D, dtype=float))
-    parts_b = _partition(Pb, n_meas, n_ctrl)
-    sb10fd = _slycot("sb10fd")
+    parts_b = partition(Pb, n_meas, n_ctrl)
+    sb10fd = slycot_routine("sb10fd")
 
     def attempt(gamma):
         # SLICOT may overwrite its arguments: hand it copies.
@@ -604,7 +317,7 @@ def _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, notes):
             raise RuntimeError(f"SLICOT sb10fd failed at γ = {gamma_bound:.6g} above γ_opt")
         sol = s_sub
     K, cl, rcond = sol
-    gamma = _hinf_norm(cl)
+    gamma = hinf_norm(cl)
     return HinfResult(
         controller=K, gamma=gamma, closed_loop=cl, gamma_bound=gamma_bound,
         generalized_plant=P, notes=notes, rcond=rcond,
@@ -661,7 +374,7 @@ def _augment(G, w_s, w_ks, w_t):
 def _weight(W, name, n_in):
     if W is None:
         return None
-    W = _as_ss(W, name)
+    W = as_ss(W, name)
     if W.ninputs == 1 and W.noutputs == 1 and n_in > 1:
         W = ct.append(*([W] * n_in))
     if W.ninputs != n_in:
@@ -728,7 +441,7 @@ def mixed_sensitivity(
         At once if the problem is ill posed (e.g. a strictly proper plant with only w_s and
         w_t: D12 is rank deficient), naming the condition and the remedy.
     """
-    G = _as_ss(plant, "plant")
+    G = as_ss(plant, "plant")
     if w_s is None and w_ks is None and w_t is None:
         raise ValueError("give at least one of w_s, w_ks, w_t")
     if not (np.isfinite(shift) and shift > 0):
@@ -739,9 +452,9 @@ def mixed_sensitivity(
     for name, W, n_in in (("w_s", w_s, ny), ("w_ks", w_ks, nu), ("w_t", w_t, ny)):
         W = _weight(W, name, n_in)
         if W is not None:
-            W, moved = _shift_axis_poles(W, shift, axis_tol)
+            W, moved = shift_axis_poles(W, shift, axis_tol)
             if moved.size:
-                note = (f"{name}: pole(s) on the imaginary axis at s = {_fmt(moved)} moved "
+                note = (f"{name}: pole(s) on the imaginary axis at s = {format_roots(moved)} moved "
                         f"left by {shift:g} rad/s to make the problem well posed")
                 notes.append(note)
                 warnings.warn(note, WellPosednessWarning, stacklevel=2)
@@ -765,139 +478,3 @@ def mixed_sensitivity(
             decay_rate=result.decay_rate,
         )
     return result
-
-
-# --------------------------------------------------------------------------- implementation
-
-
-def _stable_unstable_split(sys, axis_tol):
-    """Additive split G = G_s + G_u (+D) with G_s strictly stable, G_u the rest.
-
-    Ordered Schur form puts stable eigenvalues first; a Sylvester equation removes the
-    coupling block, giving two decoupled realisations.
-    """
-    A, B, C = (np.asarray(M, dtype=float) for M in (sys.A, sys.B, sys.C))
-    T, Z, ns = sla.schur(
-        A, output="real", sort=lambda re, im: re < -axis_tol * max(1.0, np.hypot(re, im))
-    )
-    Bt, Ct = Z.T @ B, C @ Z
-    A11, A12, A22 = T[:ns, :ns], T[:ns, ns:], T[ns:, ns:]
-    # [I X; 0 I] block-diagonalises when A11·X − X·A22 = −A12.
-    X = sla.solve_sylvester(A11, -A22, -A12) if ns and A22.size else np.zeros((ns, A22.shape[0]))
-    Bs = Bt[:ns] - X @ Bt[ns:]
-    Bu = Bt[ns:]
-    Cs = Ct[:, :ns]
-    Cu = Ct[:, ns:] + Ct[:, :ns] @ X
-    return (A11, Bs, Cs), (A22, Bu, Cu)
-
-
-def reduce(controller, order, method="balanced", *, axis_tol=1e-9):
-    """Reduce a controller's order by balanced truncation of its stable part.
-
-    The unstable (and marginal, e.g. integrator) part is kept exactly, so the error
-    lives in the stable part only and the classic bounds hold:
-    σ_{k+1} ≤ ‖K − K_r‖∞ ≤ 2·Σ_{i>k} σ_i over the stable part's Hankel singular values σ.
-
-    Parameters
-    ----------
-    controller : control LTI
-        Continuous-time controller.
-    order : int
-        Desired number of states, ≥ the number of unstable/marginal poles.
-    method : {"balanced", "singular_perturbation"}
-        Square-root balanced truncation (``ab09ad``) or balanced singular perturbation
-        approximation (``ab09nd``, matches the DC gain of the stable part; same bound).
-
-    Returns
-    -------
-    ReductionResult
-        Unpacks as ``K_r, error_hinf``.
-    """
-    K = _as_ss(controller, "controller")
-    if method not in ("balanced", "singular_perturbation"):
-        raise ValueError(f"method={method!r} must be 'balanced' or 'singular_perturbation'")
-    if not isinstance(order, (int, np.integer)) or order < 0:
-        raise ValueError(f"order={order!r} must be a non-negative integer")
-    n = K.nstates
-    if order >= n:
-        raise ValueError(f"order={order} must be smaller than the controller's {n} states")
-    (As, Bs, Cs), (Au, Bu, Cu) = _stable_unstable_split(K, axis_tol)
-    ns, nu_ = As.shape[0], Au.shape[0]
-    if order < nu_:
-        raise ValueError(
-            f"order={order} is below the {nu_} unstable or marginal poles of the controller, "
-            "which balanced truncation must keep; ask for at least that order"
-        )
-    m, p = Bs.shape[1], Cs.shape[0]
-    k = order - nu_
-    # SLICOT overwrites its array arguments in place: keep the stable part intact.
-    Gs = ct.ss(As, Bs, Cs, np.zeros((p, m))) if ns else ct.ss([], [], [], np.zeros((p, m)))
-    As, Bs, Cs = As.copy(order="F"), Bs.copy(order="F"), Cs.copy(order="F")
-    if ns == 0:
-        hsv = np.zeros(0)
-        Ar, Br, Cr, Dr_s = As, Bs, Cs, np.zeros((p, m))
-    elif method == "balanced":
-        nr, Ar, Br, Cr, hsv = _slycot("ab09ad")("C", "B", "N", ns, m, p, As, Bs, Cs, nr=k)
-        Ar, Br, Cr = Ar[:nr, :nr], Br[:nr], Cr[:, :nr]
-        Dr_s = np.zeros((p, m))
-    else:
-        Zero = np.zeros((p, m))
-        nr, Ar, Br, Cr, Dr_s, _, hsv = _slycot("ab09nd")(
-            "C", "B", "N", ns, m, p, As, Bs, Cs, Zero, nr=k
-        )
-        Ar, Br, Cr = Ar[:nr, :nr], Br[:nr], Cr[:, :nr]
-    hsv = np.asarray(hsv, dtype=float)[:ns]
-    Gsr = ct.ss(Ar, Br, Cr, Dr_s) if Ar.shape[0] else ct.ss([], [], [], Dr_s)
-    err = ct.parallel(Gs, ct.negate(Gsr)) if ns else ct.ss([], [], [], np.zeros((p, m)))
-    error = _hinf_norm(err) if ns else 0.0
-    bound = 2.0 * float(np.sum(hsv[Ar.shape[0]:])) if ns else 0.0
-    D = np.asarray(K.D, dtype=float)
-    nr_tot = nu_ + Ar.shape[0]
-    Ared = sla.block_diag(Au, Ar) if nr_tot else np.zeros((0, 0))
-    Bred = np.vstack([Bu, Br])
-    Cred = np.hstack([Cu, Cr])
-    Kr = ct.ss(Ared, Bred, Cred, D + Dr_s, inputs=K.input_labels, outputs=K.output_labels)
-    return ReductionResult(
-        controller=Kr, error_hinf=error, bound=bound, hankel_singular_values=hsv,
-        n_unstable=nu_,
-    )
-
-
-_DISCRETIZE = ("tustin", "zoh", "foh")
-
-
-def discretize(controller, dt, method="tustin", prewarp_frequency=None):
-    """Discrete-time controller for implementation at sample time ``dt`` (s).
-
-    Parameters
-    ----------
-    controller : control LTI
-        Continuous-time controller.
-    dt : float
-        Sample time in s.
-    method : {"tustin", "zoh", "foh"}
-        Discretisation rule.
-    prewarp_frequency : float, optional
-        Frequency (rad/s, below the Nyquist frequency π/dt) at which the Tustin map is
-        exact, e.g. the tower mode. Only with ``method="tustin"``.
-
-    Returns
-    -------
-    control.StateSpace
-        Discrete-time controller with ``dt`` set.
-    """
-    K = _as_ss(controller, "controller")
-    if not (isinstance(dt, (int, float, np.integer, np.floating)) and np.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt={dt!r} must be a positive sample time in seconds")
-    if method not in _DISCRETIZE:
-        raise ValueError(f"method={method!r} must be one of {_DISCRETIZE}")
-    if prewarp_frequency is not None:
-        if method != "tustin":
-            raise ValueError("prewarp_frequency only applies to method='tustin'")
-        w0 = float(prewarp_frequency)
-        if not (0 < w0 < np.pi / dt):
-            raise ValueError(
-                f"prewarp_frequency={prewarp_frequency!r} rad/s must lie in (0, π/dt = "
-                f"{np.pi / dt:.4g} rad/s)"
-            )
-    return ct.sample_system(K, dt, method=method, prewarp_frequency=prewarp_frequency)

@@ -14,9 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .bounds import Bounds
 from .controller import KINDS, Controller, Element
+from .freqresp import check_grid, evaluate
 from .nichols import draw, loop_nichols
-from .qft import Bounds, Template, _check_grid, evaluate
+from .templates import Template
+
+__all__ = ["DesignState", "Designer"]
 
 _DEFAULTS = {
     "gain": {"k": 1.0},
@@ -33,7 +37,21 @@ _DEFAULTS = {
 
 @dataclass(frozen=True, eq=False)
 class DesignState:
-    """Numbers behind one redraw: nominal loop (Nichols), bound check, closed-loop peaks."""
+    """Numbers behind one redraw: nominal loop (Nichols), bound check, closed-loop peaks.
+
+    Parameters
+    ----------
+    phase_deg : numpy.ndarray
+        (n,) nominal loop phase on the dense grid, degrees.
+    magnitude_db : numpy.ndarray
+        (n,) nominal loop magnitude, dB.
+    design_allowed : numpy.ndarray
+        (n_design,) bounds met at each design frequency.
+    worst_T_db : numpy.ndarray
+        (n,) max over cases of |L/(1+L)|, dB.
+    worst_S_db : numpy.ndarray
+        (n,) max over cases of |1/(1+L)|, dB.
+    """
 
     phase_deg: np.ndarray  # (n,) nominal loop phase on the dense grid
     magnitude_db: np.ndarray  # (n,)
@@ -47,20 +65,31 @@ class Designer:
 
     Parameters
     ----------
-    bounds : :class:`~loopshaping.qft.Bounds`.
-    plant : a :class:`~loopshaping.qft.Template` with systems (the nominal case is shaped,
+    bounds : Bounds
+        The bounds to shape against.
+    plant : Template or control LTI
+        A :class:`~loopshaping.templates.Template` with systems (the nominal case is shaped,
         all cases enter the closed-loop plot) or a SISO LTI nominal plant.
-    controller : starting :class:`Controller` (default: unit gain).
-    omega : dense grid, rad/s (default 600 points, design range ×/÷ 100).
+    controller : Controller, optional
+        Starting controller (default: unit gain).
+    omega : array_like, optional
+        Dense grid, rad/s (default 600 points, design range ×/÷ 100).
+
+    Raises
+    ------
+    TypeError
+        If ``bounds`` is not a Bounds.
+    ValueError
+        If the Template has no systems or the grid is bad.
     """
 
     def __init__(self, bounds: Bounds, plant, controller: Controller | None = None, omega=None):
         if not isinstance(bounds, Bounds):
             raise TypeError(f"bounds must be a loopshaping.qft.Bounds; got {type(bounds).__name__}")
         self.bounds = bounds
-        d = bounds.omegas
+        d = bounds.omega
         w = np.logspace(np.log10(d.min() / 100), np.log10(d.max() * 100), 600) if omega is None else omega
-        self.omega = np.unique(np.concatenate([_check_grid(w, "omega"), d]))
+        self.omega = np.unique(np.concatenate([check_grid(w, "omega"), d]))
         self._design_idx = np.searchsorted(self.omega, d)
         if isinstance(plant, Template):
             if plant.systems is None:
@@ -76,10 +105,17 @@ class Designer:
 
     # -- numbers
     def state(self) -> DesignState:
+        """The numbers of the current controller (no drawing).
+
+        Returns
+        -------
+        DesignState
+            Loop on the Nichols chart, bounds met, worst closed-loop magnitudes.
+        """
         G = self.controller.response(self.omega)
         ph, mag = loop_nichols(self._P0 * G, self.omega)
         i = self._design_idx
-        allowed = self.bounds.is_allowed(self.bounds.omegas, ph[i], mag[i])
+        allowed = self.bounds.is_allowed(self.bounds.omega, ph[i], mag[i])
         L = self._P * G[:, None]
         with np.errstate(divide="ignore"):
             T = 20 * np.log10(np.abs(L / (1 + L)).max(axis=1))
@@ -88,18 +124,75 @@ class Designer:
 
     # -- editing
     def set_controller(self, controller: Controller) -> DesignState:
+        """Replace the controller and update.
+
+        Parameters
+        ----------
+        controller : Controller
+            The new controller.
+
+        Returns
+        -------
+        DesignState
+            The new state.
+        """
         self.controller = controller
         return self.update()
 
     def set_param(self, index: int, **params) -> DesignState:
+        """Change parameters of element ``index`` and update.
+
+        Parameters
+        ----------
+        index : int
+            Element position.
+        **params
+            New parameter values (rad/s for frequencies).
+
+        Returns
+        -------
+        DesignState
+            The new state.
+        """
         return self.set_controller(self.controller.set(index, **params))
 
     def add(self, kind: str, **params) -> DesignState:
+        """Append an element of ``kind`` (default parameters unless given) and update.
+
+        Parameters
+        ----------
+        kind : str
+            One of :data:`loopshaping.controller.KINDS`.
+        **params
+            Parameters overriding the defaults.
+
+        Returns
+        -------
+        DesignState
+            The new state.
+
+        Raises
+        ------
+        ValueError
+            For an unknown kind.
+        """
         if kind not in KINDS:
             raise ValueError(f"kind={kind!r} is not one of {KINDS}")
         return self.set_controller(self.controller.add(Element(kind, {**_DEFAULTS[kind], **params})))
 
     def remove(self, index: int) -> DesignState:
+        """Remove element ``index`` and update.
+
+        Parameters
+        ----------
+        index : int
+            Element position.
+
+        Returns
+        -------
+        DesignState
+            The new state.
+        """
         return self.set_controller(self.controller.remove(index))
 
     # -- drawing
@@ -185,7 +278,7 @@ class Designer:
         return np.where(st.design_allowed, "tab:green", "tab:red")
 
     def _title(self, st):
-        bad = self.bounds.omegas[~st.design_allowed]
+        bad = self.bounds.omega[~st.design_allowed]
         head = "all bounds met" if bad.size == 0 else "bounds violated at ω = " + ", ".join(f"{w:.3g}" for w in bad)
         return f"{head}\nG = {self.controller}"
 

@@ -9,24 +9,56 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._deprecation import renamed_keywords
+from .bounds import Bounds
 from .controller import Controller
-from .qft import Bounds, Template, _check_grid, evaluate
+from .freqresp import check_grid, evaluate
+from .templates import Template
+
+__all__ = ["draw", "loop_nichols", "m_contour", "plot_templates", "template_nichols"]
 
 
-def loop_nichols(loop, omegas, phase_window=(-360.0, 0.0)):
-    """Phase (degrees, unwrapped) and magnitude (dB) of a loop on the grid ``omegas`` (rad/s).
+@renamed_keywords(omegas="omega")
+def loop_nichols(loop, omega, phase_window: tuple = (-360.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """Phase (degrees, unwrapped) and magnitude (dB) of a loop on the grid ``omega``.
 
-    ``loop`` is a SISO LTI, a :class:`Controller` or a complex response on ``omegas``. The
-    unwrapped phase is shifted by a multiple of 360° so that its first point lies in
-    ``phase_window``.
+    Parameters
+    ----------
+    loop : control LTI or Controller or array_like
+        A SISO LTI, a :class:`~loopshaping.controller.Controller` or a complex response on
+        ``omega``.
+    omega : array_like
+        Frequencies, rad/s, strictly increasing.
+    phase_window : tuple of float
+        ``(low, high)`` degrees: the unwrapped phase is shifted by a multiple of 360° so
+        that its first point lies in it.
+
+    Returns
+    -------
+    phase_deg : numpy.ndarray
+        Unwrapped phase, degrees.
+    magnitude_db : numpy.ndarray
+        Magnitude, dB.
+
+    Raises
+    ------
+    ValueError
+        For a bad grid or a response of another shape.
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> ph, mag = loop_nichols(ct.tf([1], [1, 0]), [1.0])
+    >>> float(ph[0]), float(mag[0])
+    (-90.0, 0.0)
     """
-    w = _check_grid(omegas, "omegas")
+    w = check_grid(omega, "omega")
     if isinstance(loop, Controller):
         L = loop.response(w)
     elif isinstance(loop, np.ndarray) or isinstance(loop, (list, tuple)):
         L = np.asarray(loop, complex)
         if L.shape != w.shape:
-            raise ValueError(f"loop response must have the shape of omegas {w.shape}")
+            raise ValueError(f"loop response must have the shape of omega {w.shape}")
     else:
         L = evaluate(loop, w, "loop")
     phase = np.degrees(np.unwrap(np.angle(L)))
@@ -38,11 +70,25 @@ def loop_nichols(loop, omegas, phase_window=(-360.0, 0.0)):
         return phase, 20 * np.log10(np.abs(L))
 
 
-def m_contour(m_db, phases_deg=None):
-    """Nichols curve of constant closed-loop gain |L/(1+L)| = M, M in dB.
+def m_contour(m_db: float, phases_deg=None) -> tuple[np.ndarray, np.ndarray]:
+    """Nichols curve of constant closed-loop gain |L/(1+L)| = M.
 
-    Returns (phase_deg, magnitude_db) with NaN separating the two branches. For each phase
-    φ the open-loop magnitude y solves y²(1 − M²) − 2M²cos(φ)·y − M² = 0 (closed form).
+    For each phase φ the open-loop magnitude y solves y²(1 − M²) − 2M²cos(φ)·y − M² = 0
+    (closed form).
+
+    Parameters
+    ----------
+    m_db : float
+        M, dB.
+    phases_deg : array_like, optional
+        Open-loop phases, degrees; default −359.5…−0.5 in 0.5° steps.
+
+    Returns
+    -------
+    phase_deg : numpy.ndarray
+        Phases, degrees, the two branches separated by NaN.
+    magnitude_db : numpy.ndarray
+        Open-loop magnitudes, dB (NaN where M is not reached).
     """
     phases = np.linspace(-359.5, -0.5, 719) if phases_deg is None else np.asarray(phases_deg, float)
     M2 = 10 ** (m_db / 10)
@@ -67,17 +113,38 @@ def _colours(n):
 
 
 def draw(bounds: Bounds | None, loop=None, ax=None, omega=None, m_contours_db=None,
-         xlim=(-360.0, 0.0), ylim=None, legend=True):
+         xlim: tuple = (-360.0, 0.0), ylim: tuple | None = None, legend: bool = True):
     """Nichols chart of ``bounds`` and the nominal open loop ``loop`` = L0 = P0·G.
 
     Parameters
     ----------
-    bounds : :class:`~loopshaping.qft.Bounds` or None.
-    loop : SISO LTI or complex response (then ``omega`` is its grid); drawn black, with
-        markers at the design frequencies in the bound colours.
-    omega : loop grid, rad/s (default: 2000 points spanning the design frequencies ×/÷ 100).
-    m_contours_db : closed-loop magnitudes (dB) of M-contours to draw, e.g. (1.58, 6).
-    Returns the axes.
+    bounds : Bounds or None
+        The bounds (one colour per design frequency; solid lower, dashed upper bounds).
+    loop : control LTI or Controller or numpy.ndarray, optional
+        SISO LTI, controller-shaped loop or complex response (then ``omega`` is its grid);
+        drawn black, with markers at the design frequencies in the bound colours.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw in; default a new figure.
+    omega : array_like, optional
+        Loop grid, rad/s (default: 2000 points spanning the design frequencies ×/÷ 100).
+    m_contours_db : sequence of float, optional
+        Closed-loop magnitudes (dB) of M-contours to draw, e.g. (1.58, 6).
+    xlim : tuple of float
+        Phase axis limits, degrees.
+    ylim : tuple of float, optional
+        Magnitude axis limits, dB.
+    legend : bool
+        Draw a legend.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes.
+
+    Raises
+    ------
+    TypeError
+        If ``bounds`` is neither a Bounds nor None.
     """
     import matplotlib.pyplot as plt
 
@@ -85,7 +152,7 @@ def draw(bounds: Bounds | None, loop=None, ax=None, omega=None, m_contours_db=No
         _, ax = plt.subplots(figsize=(7, 5))
     if bounds is not None and not isinstance(bounds, Bounds):
         raise TypeError(f"bounds must be a loopshaping.qft.Bounds or None; got {type(bounds).__name__}")
-    design = bounds.omegas if bounds is not None else np.array([])
+    design = bounds.omega if bounds is not None else np.array([])
     colours = _colours(len(design))
     if bounds is not None:
         lower, upper = bounds.edges()
@@ -112,7 +179,7 @@ def draw(bounds: Bounds | None, loop=None, ax=None, omega=None, m_contours_db=No
             lo = design.min() / 100 if design.size else 1e-2
             hi = design.max() * 100 if design.size else 1e3
             omega = np.logspace(np.log10(lo), np.log10(hi), 2000)
-        grid = _check_grid(omega, "omega")
+        grid = check_grid(omega, "omega")
         if isinstance(loop, np.ndarray):
             L = loop  # markers go to the nearest grid points
         else:
@@ -136,11 +203,23 @@ def draw(bounds: Bounds | None, loop=None, ax=None, omega=None, m_contours_db=No
     return ax
 
 
-def template_nichols(template: Template):
-    """Phase (degrees) and magnitude (dB) of every case, (n_omega, n_cases) each.
+def template_nichols(template: Template) -> tuple[np.ndarray, np.ndarray]:
+    """Phase and magnitude of every case of a template.
 
     Phases are taken relative to the nominal case (within ±180° of it), so a template that
     straddles a ±180° wrap is drawn in one piece.
+
+    Parameters
+    ----------
+    template : Template
+        The plant cases.
+
+    Returns
+    -------
+    phase_deg : numpy.ndarray
+        (n_omega, n_cases) phases, degrees.
+    magnitude_db : numpy.ndarray
+        (n_omega, n_cases) magnitudes, dB.
     """
     P = template.responses
     p0 = template.nominal_response[:, None]
@@ -149,8 +228,28 @@ def template_nichols(template: Template):
     return ph0 + np.degrees(np.angle(P / p0)), 20 * np.log10(np.abs(P))
 
 
-def plot_templates(template: Template, ax=None, legend=True):
-    """Templates on the Nichols plane: one colour per design frequency, nominal case boxed."""
+def plot_templates(template: Template, ax=None, legend: bool = True):
+    """Templates on the Nichols plane: one colour per design frequency, nominal case boxed.
+
+    Parameters
+    ----------
+    template : Template
+        The plant cases.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw in; default a new figure.
+    legend : bool
+        Draw a legend.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes.
+
+    Raises
+    ------
+    TypeError
+        If ``template`` is not a Template.
+    """
     import matplotlib.pyplot as plt
 
     if not isinstance(template, Template):
@@ -158,8 +257,8 @@ def plot_templates(template: Template, ax=None, legend=True):
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 5))
     ph, mag = template_nichols(template)
-    colours = _colours(len(template.omegas))
-    for i, w in enumerate(template.omegas):
+    colours = _colours(len(template.omega))
+    for i, w in enumerate(template.omega):
         ax.plot(ph[i], mag[i], ".", color=colours[i], label=f"ω = {w:.4g} rad/s")
         ax.plot(ph[i, template.nominal], mag[i, template.nominal], "s", mfc="none", mec="k", ms=8)
     ax.plot([], [], "s", mfc="none", mec="k", label="nominal case")

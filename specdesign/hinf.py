@@ -408,7 +408,7 @@ def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
         A=p_mw, B=lambda w: p_mw(w) * p_ob(w) - p_mb(w) * p_ow(w), C=1.0, D=p_ob))
     speed = qft.Spec("general", weight=_siso_tf(w_speed, "w_speed"), name="speed",
                      kind_args=dict(A=p_ow, B=0.0, C=1.0, D=p_ob))
-    return check.check(pitch_controller, [plant["gen_speed", "pitch_cmd"]], [tower, speed], omega)
+    return check.check([plant["gen_speed", "pitch_cmd"]], pitch_controller, [tower, speed], omega)
 
 
 def closed_loop(plant, controller, measurements=("gen_speed",)):

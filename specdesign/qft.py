@@ -657,8 +657,8 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
     offsets = np.atleast_1d(np.asarray(template_offsets, float))
     if offsets.ndim != 1 or not np.all(np.isfinite(offsets)):
         raise ValueError("template_offsets must be a 1-D array of finite wind-speed offsets in m/s")
-    wd = DEFAULT_DESIGN_OMEGAS.copy() if design_omegas is None else lqft._check_grid(design_omegas, "design_omegas")
-    wdense = np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omegas is None else lqft._check_grid(dense_omegas, "dense_omegas")
+    wd = DEFAULT_DESIGN_OMEGAS.copy() if design_omegas is None else lqft.check_grid(design_omegas, "design_omegas")
+    wdense = np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omegas is None else lqft.check_grid(dense_omegas, "dense_omegas")
 
     speeds, nom = _template_speeds(model, v, offsets)
     base = sp.baseline_analysis(model, v)
@@ -801,14 +801,14 @@ def _checks(prob, cb, ca, wdense):
     atd_plants = [partial_loop(P, cb, "gen_speed")["tower_top_vel", "pitch_cmd"] for P in plants]
     pitch_t = lqft.Template.from_systems(pitch_plants, prob.wd, nom)
     atd_t = lqft.Template.from_systems(atd_plants, prob.wd, nom)
-    pitch_check = lcheck(cb, pitch_t, pitch_specs, wdense)
-    atd_check = lcheck(ca, atd_t, atd_specs, wdense)
+    pitch_check = lcheck(pitch_t, cb, pitch_specs, wdense)
+    atd_check = lcheck(atd_t, ca, atd_specs, wdense)
     return pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs
 
 
 def _bounds_met(bounds, controller, template, omegas):
-    L0 = template.nominal_response * siso_response(controller, template.omegas)
-    ok = bounds.is_allowed(template.omegas, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
+    L0 = template.nominal_response * siso_response(controller, template.omega)
+    ok = bounds.is_allowed(template.omega, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
     return bool(np.all(ok))
 
 

@@ -26,7 +26,7 @@ T = qft.Template.from_systems([ct.tf([1.0], [1.0, 1.0]), ct.tf([2.0], [1.0, 1.0]
 def test_weights_of_every_form_are_checked(weight, match):
     spec = qft.Spec("sensitivity", weight)
     if match is None:
-        assert qft.bounds(T, spec).omegas.size == W.size
+        assert qft.bounds(T, spec).omega.size == W.size
     else:
         with pytest.raises(ValueError, match=match):
             qft.bounds(T, spec)

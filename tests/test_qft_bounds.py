@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from loopshaping import bounds as bounds_module
 from loopshaping import qft
 
 s = ct.tf("s")
@@ -101,7 +102,7 @@ def assert_matches_oracle(b, P_all, p0_all, fn, W_all, step_deg=5, lim=58.0):
     phases_idx = np.arange(0, len(b.phases_deg), step_deg)
     phases = b.phases_deg[phases_idx]
     mags = np.arange(-60, 60.0001, 0.1)
-    for i, w in enumerate(b.omegas):
+    for i, w in enumerate(b.omega):
         k = int(np.flatnonzero(np.isclose(OMEGAS, w))[0]) if w in OMEGAS else i
         ok = make_ok(P_all[k], p0_all[k], fn, W_all[k])
         want = [drop_slivers(t[np.abs(t) < lim], ok, ph) for t, ph in zip(oracle_transitions(ok, phases, mags), phases)]
@@ -212,7 +213,7 @@ def test_halved_gain_violates_a_bound(template, manual_bounds):
 def test_is_allowed_agrees_with_forbidden_intervals(manual_bounds):
     B, _ = manual_bounds
     rng = np.random.default_rng(0)
-    for i, w in enumerate(B.omegas):
+    for i, w in enumerate(B.omega):
         j = rng.integers(0, len(B.phases_deg), 200)
         m = rng.uniform(-40, 60, 200)
         f = B.forbidden_db[i, j]
@@ -225,28 +226,28 @@ def test_is_allowed_agrees_with_forbidden_intervals(manual_bounds):
 def test_intersection_is_and_of_parts(manual_bounds):
     B, parts = manual_bounds
     rng = np.random.default_rng(1)
-    for w in B.omegas:
+    for w in B.omega:
         ph, m = rng.uniform(-360, 0, 500), rng.uniform(-40, 60, 500)
         want = np.ones(500, bool)
         for p in parts:
-            if np.any(np.isclose(p.omegas, w)):
+            if np.any(np.isclose(p.omega, w)):
                 want &= p.is_allowed(w, ph, m)
         np.testing.assert_array_equal(B.is_allowed(w, ph, m), want)
     assert B.names == ("stability", "sensitivity", "input_disturbance")
-    np.testing.assert_array_equal(parts[1].omegas, [0.1, 5, 10])
+    np.testing.assert_array_equal(parts[1].omega, [0.1, 5, 10])
 
 
 def test_dominant_spec_sets_the_lower_bound(manual_bounds):
     B, parts = manual_bounds
     dom = B.dominant()
     total = B.lower_bound_db()
-    for i, w in enumerate(B.omegas):
+    for i, w in enumerate(B.omega):
         for j in range(0, len(B.phases_deg), 7):
             if dom[i, j] < 0:
                 assert not np.isfinite(total[i, j])
                 continue
             part = parts[dom[i, j]]
-            k = int(np.flatnonzero(np.isclose(part.omegas, w))[0])
+            k = int(np.flatnonzero(np.isclose(part.omega, w))[0])
             np.testing.assert_allclose(part.lower_bound_db()[k, j], total[i, j])
     # At 100 rad/s only the stability spec applies.
     assert set(np.unique(dom[3])) <= {-1, 0}
@@ -304,7 +305,7 @@ def test_per_case_weights_and_infinite_weights(template):
     ref = qft.bounds(sub, "input_disturbance", 0.01)
     np.testing.assert_allclose(b.lower_bound_db(), ref.lower_bound_db(), atol=1e-6)
     inf_w = np.array([0.01, 0.01, np.inf, np.inf])
-    assert list(qft.bounds(template, "input_disturbance", inf_w).omegas) == [0.1, 5.0]
+    assert list(qft.bounds(template, "input_disturbance", inf_w).omega) == [0.1, 5.0]
 
 
 def test_bad_input_names_the_argument(template):
@@ -354,7 +355,7 @@ def test_noise_bound_with_sensor_dynamics_matches_oracle(template):
 def test_interval_union_matches_a_sequential_merge(pairs):
     lo = np.array([p[0] for p in pairs])
     hi = lo + np.array([p[1] for p in pairs])
-    got_lo, got_hi = qft._merge(lo[None], hi[None])
+    got_lo, got_hi = bounds_module._merge(lo[None], hi[None])
     got = [(a, b) for a, b in zip(got_lo[0], got_hi[0]) if not np.isnan(a)]
     want = []
     for a, b in sorted((a, b) for a, b in zip(lo, hi) if b > a):
@@ -371,7 +372,7 @@ def test_bounds_do_not_depend_on_the_block_size(monkeypatch):
     k, a, b = rng.uniform(1, 10, 300), rng.uniform(1, 5, 300), rng.uniform(20, 30, 300)
     tmpl = qft.Template.from_responses(w, k / ((1j * w[:, None] + a) * (1j * w[:, None] + b)))
     ref = qft.bounds(tmpl, "stability", 1.2)
-    monkeypatch.setattr(qft, "_BLOCK", 700)  # a couple of phases per block
+    monkeypatch.setattr(bounds_module, "_BLOCK", 700)  # a couple of phases per block
     small = qft.bounds(tmpl, "stability", 1.2)
     np.testing.assert_array_equal(small.forbidden_db, ref.forbidden_db)
     assert ref.non_connected.any()  # the sort-and-merge path was exercised

@@ -59,7 +59,7 @@ def _bounds_at(bounds, template, picks):
 
     from loopshaping import qft as lqft
 
-    w = template.omegas
+    w = template.omega
     sub = np.unique([w[np.argmin(np.abs(w - p))] for p in picks])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", lqft.BoundsWarning)
