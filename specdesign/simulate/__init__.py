@@ -51,8 +51,9 @@ controller, so differences between the two are the plant's nonlinearity only.
 Layout
 ------
 - :mod:`specdesign.simulate.core`: :func:`simulate`, :class:`KernelPlant`, :func:`turbine_plant`,
-  :class:`SimulationResult`, :class:`SimulationDivergedError`, the step checks
-  (:func:`check_step`, :func:`check_loop_step`, :func:`sampled_loop_radius`).
+  :class:`SimulationResult`, :class:`SimulationDivergedError`.
+- :mod:`specdesign.simulate.checks`: the step checks (:func:`check_step`,
+  :func:`check_loop_step`, :func:`sampled_loop_radius`).
 - :mod:`specdesign.simulate.schedule`: :class:`ScheduledController`, :func:`scheduled`.
 - :mod:`specdesign.simulate.controllers`: controller preparation (:func:`as_lti`,
   :func:`discretize`, :func:`split_integrator`, :func:`split_slow`, the discrete bank).
@@ -64,19 +65,9 @@ from __future__ import annotations
 
 from ..rosco import rosco_scheduled
 from ..wind import seed_for, wind_series
+from .checks import MAX_STEP_EIGENVALUE, check_loop_step, check_step, sampled_loop_radius, warn_unstable
 from .controllers import SLOW_OMEGA, as_lti, controller_bank, discretize, is_lti_like, split_integrator, split_slow
-from .core import (
-    MAX_STEP_EIGENVALUE,
-    WIND_MEAN_TOLERANCE,
-    KernelPlant,
-    SimulationDivergedError,
-    SimulationResult,
-    check_loop_step,
-    check_step,
-    sampled_loop_radius,
-    simulate,
-    turbine_plant,
-)
+from .core import WIND_MEAN_TOLERANCE, KernelPlant, SimulationDivergedError, SimulationResult, simulate, turbine_plant
 from .kernels import KIND_LINEAR, KIND_TURBINE, NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs
 from .kernels import run_callable
 from .schedule import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController, scheduled
@@ -106,6 +97,7 @@ __all__ = [
     "SCHEDULE_FILTER_OMEGA",
     "SLOW_OMEGA",
     "FORMS",
+    "warn_unstable",
 ]
 
 # Old private names of the single-module simulate.py, still imported by callers (validate,
@@ -124,6 +116,7 @@ _FORMS = FORMS
 _NONFINITE = NONFINITE
 _KIND_TURBINE = KIND_TURBINE
 _KIND_LINEAR = KIND_LINEAR
+_warn_unstable = warn_unstable
 
 # The other private names of simulate.py (internals of the compiled loop and of simulate) have no
 # callers; they stay reachable here, by name, until the callers have switched.
@@ -133,8 +126,7 @@ _LEGACY = {
     "_turbine_outputs": ("..turbine", "outputs"),
     "_BANKS": (".controllers", "_BANKS"),
     "_make_bank": (".controllers", "_make_bank"),
-    "_RADIUS_TOL": (".core", "_RADIUS_TOL"),
-    "_warn_unstable": (".core", "_warn_unstable"),
+    "_RADIUS_TOL": (".checks", "_RADIUS_TOL"),
     "_raise_diverged": (".core", "_raise_diverged"),
     **{n: (".kernels", n) for n in ("_REBOUND", "_wind_at", "_krhs", "_kout", "_rk4", "_run_one", "_run_batch",
                                     "_step_all", "_outputs_all")},

@@ -1,5 +1,6 @@
 """The simulator's Python API: :func:`simulate`, its plant (:class:`KernelPlant`,
-:func:`turbine_plant`) and result (:class:`SimulationResult`), and the step checks.
+:func:`turbine_plant`) and result (:class:`SimulationResult`). The step checks it applies are
+in :mod:`specdesign.simulate.checks`.
 
 See :mod:`specdesign.simulate` for the conventions (signs, scheduling, anti-windup).
 """
@@ -7,36 +8,28 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._checks import positive_scalar
 from ..wind import wind_series
+from .checks import MAX_STEP_EIGENVALUE, check_step, warn_unstable
 from .controllers import controller_bank, is_lti_like
 from .kernels import NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs, run_callable
 from .schedule import ScheduledController
 
+if TYPE_CHECKING:  # pragma: no cover
+    from ..turbine import TurbineModel
+
 __all__ = [
-    "MAX_STEP_EIGENVALUE",
     "WIND_MEAN_TOLERANCE",
     "SimulationDivergedError",
     "KernelPlant",
     "turbine_plant",
     "SimulationResult",
     "simulate",
-    "check_step",
-    "sampled_loop_radius",
-    "check_loop_step",
 ]
-
-#: Largest |λ|·dt accepted, λ the fastest eigenvalue of the linearised plant: RK4 is stable up
-#: to about 2.8 and resolves a mode to a fraction of a percent per step at 1 (dt ≤ 0.32 s on
-#: the IEA 15 MW, whose pitch actuator is at 3.14 rad/s); larger steps gave NaN or wrong DELs.
-#: A bound against nonsense, not an accuracy target: the held command is a dt/2 delay, and
-#: ROSCO's tower-base DEL (13-25 m/s, 3 seeds × 600 s) moves from dt = 0.02 s by ≤ 1.0 % at
-#: dt = 0.1 s, ≤ 2.4 % at 0.2 s and ≤ 3.8 % at 0.3 s (most near rated). Besides this bound, a
-#: step at which the sampled loop is unstable is refused (:func:`sampled_loop_radius`).
-MAX_STEP_EIGENVALUE = 1.0
 
 #: Largest difference (m/s) between the mean of a given wind record and its ``wind_speeds``
 #: entry: half an IEC 2 m/s bin. The trim, the linearisation and the scheduling all use
@@ -45,8 +38,11 @@ WIND_MEAN_TOLERANCE = 1.0
 
 
 class SimulationDivergedError(RuntimeError):
-    """A run left the physically possible range (non-finite state, or an output beyond
-    :attr:`KernelPlant.output_limits`): the closed loop is unstable or the step too large."""
+    """A run left the physically possible range: the closed loop is unstable or the step too large.
+
+    Raised by :func:`simulate` for a non-finite state, or an output beyond
+    :attr:`KernelPlant.output_limits`; the message names the wind speed, seed and time.
+    """
 
 
 # ----------------------------------------------------------------------------- plant
@@ -54,19 +50,32 @@ class SimulationDivergedError(RuntimeError):
 class KernelPlant:
     """A plant given by a compiled kernel pair, as :mod:`specdesign.turbine` defines it.
 
-    rhs, outputs : ``@njit`` functions ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` and
-        ``outputs(x, wind, pitch_cmd, gen_torque, p, y)`` (SI units).
-    params : flat float64 parameter array ``p``.
-    output_names : names of ``y`` in order; must contain ``gen_speed`` (rad/s),
-        ``tower_top_vel`` (m/s) and ``pitch`` (rad).
-    trim : ``trim(wind_speed) -> (x0, pitch0 rad, gen_torque N·m)`` steady operating point.
-    rated_speed : generator-speed reference Ω_rated (rad/s).
-    linearize : optional ``linearize(wind_speed) -> control.StateSpace`` with inputs
-        (wind, pitch_cmd, gen_torque) and outputs ``output_names``, deviations from trim.
-    pitch_limits : optional (min, max) pitch command (rad): every controller's command is
-        saturated there, with anti-windup (see :func:`simulate`).
-    output_limits : dict output name → largest physically possible |y| (SI); a run whose
-        output leaves it, or turns non-finite, has diverged and :func:`simulate` raises.
+    Parameters
+    ----------
+    rhs : numba dispatcher
+        ``@njit`` ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` (SI units).
+    outputs : numba dispatcher
+        ``@njit`` ``outputs(x, wind, pitch_cmd, gen_torque, p, y)`` (SI units).
+    params : numpy.ndarray
+        Flat float64 parameter array ``p``.
+    output_names : tuple of str
+        Names of ``y`` in order; must contain ``gen_speed`` (rad/s), ``tower_top_vel`` (m/s)
+        and ``pitch`` (rad).
+    trim : callable
+        ``trim(wind_speed) -> (x0, pitch0 rad, gen_torque N·m)``, the steady operating point.
+    rated_speed : float
+        Generator-speed reference Ω_rated (rad/s).
+    linearize : callable, optional
+        ``linearize(wind_speed) -> control.StateSpace`` with inputs (wind, pitch_cmd,
+        gen_torque) and outputs ``output_names``, deviations from trim.
+    name : str, optional
+        Label of the plant.
+    pitch_limits : tuple of float, optional
+        (min, max) pitch command (rad): every controller's command is saturated there, with
+        anti-windup (see :func:`simulate`).
+    output_limits : dict, optional
+        Output name → largest physically possible |y| (SI); a run whose output leaves it, or
+        turns non-finite, has diverged and :func:`simulate` raises.
     """
 
     rhs: object
@@ -81,13 +90,49 @@ class KernelPlant:
     output_limits: dict = field(default_factory=dict)
 
     def index(self, name: str) -> int:
+        """Position of output ``name`` in ``output_names``.
+
+        Parameters
+        ----------
+        name : str
+            An output name.
+
+        Returns
+        -------
+        int
+            Its index in ``y``.
+
+        Raises
+        ------
+        ValueError
+            If the plant has no such output.
+        """
         if name not in self.output_names:
             raise ValueError(f"output {name!r} not among the plant outputs {self.output_names}")
         return self.output_names.index(name)
 
 
-def turbine_plant(model=None) -> KernelPlant:
-    """Wrap a :class:`specdesign.turbine.TurbineModel` (default: ``iea15mw()``) as a KernelPlant."""
+def turbine_plant(model: TurbineModel | KernelPlant | None = None) -> KernelPlant:
+    """Wrap a :class:`specdesign.turbine.TurbineModel` as a KernelPlant.
+
+    The plant's pitch limits are the model's; its output limits (divergence) twice the rated
+    generator speed and the tower-base moment of 10 m of tower-top deflection.
+
+    Parameters
+    ----------
+    model : TurbineModel or KernelPlant, optional
+        The model (default :func:`specdesign.turbine.iea15mw`); a KernelPlant is returned as is.
+
+    Returns
+    -------
+    KernelPlant
+        The plant on the turbine's compiled kernel.
+
+    Examples
+    --------
+    >>> turbine_plant().output_names[0]
+    'gen_speed'
+    """
     from .. import turbine
 
     if model is None:
@@ -122,12 +167,27 @@ def turbine_plant(model=None) -> KernelPlant:
 class SimulationResult:
     """Time series of a batch of runs, shaped (n_wind_speeds, n_seeds, n_samples).
 
-    time : (n,) s, from the end of the discarded transient (starts at 0).
-    wind_speeds : (W,) mean wind speeds, m/s. seeds : (S,) integer seeds (None if the wind
-    was given). outputs : dict output name → (W, S, n) array in SI, plus ``pitch_cmd`` (rad)
-    and ``wind`` (m/s, the rotor-effective wind that drove the run).
-    dt : sample spacing of ``time`` (s); sim_dt : integration step (s); linear : True if
-    the linearised plant was integrated; controller : label.
+    Index it by output name: ``result["gen_speed"]``.
+
+    Parameters
+    ----------
+    time : numpy.ndarray
+        (n,) time (s), from the end of the discarded transient (starts at 0).
+    wind_speeds : numpy.ndarray
+        (W,) mean wind speeds (m/s).
+    seeds : numpy.ndarray or None
+        (S,) integer seeds (None if the wind was given).
+    outputs : dict
+        Output name → (W, S, n) array in SI, plus ``pitch_cmd`` (rad) and ``wind`` (m/s, the
+        rotor-effective wind that drove the run).
+    dt : float
+        Sample spacing of ``time`` (s).
+    sim_dt : float
+        Integration step (s).
+    linear : bool, optional
+        True if the linearised plant was integrated.
+    controller : str, optional
+        Label of the controller.
     """
 
     time: np.ndarray
@@ -150,34 +210,51 @@ class SimulationResult:
         return float(self.time.size * self.dt)
 
 
-def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=600.0, dt=0.02,
-             record_dt=0.1, transient=60.0, wind_dt=None, turbulence_class="B", linear=False,
-             wind_rotor_radius=None, wind_mean_tol=WIND_MEAN_TOLERANCE) -> SimulationResult:
+def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration: float = 600.0, dt: float = 0.02,
+             record_dt: float = 0.1, transient: float = 60.0, wind_dt: float | None = None,
+             turbulence_class: str = "B", linear: bool = False, wind_rotor_radius: float | None = None,
+             wind_mean_tol: float = WIND_MEAN_TOLERANCE) -> SimulationResult:
     """Simulate the closed loop for every (wind speed, seed), all runs batched.
 
     Parameters
     ----------
-    plant : TurbineModel (e.g. ``turbine.iea15mw()``) or KernelPlant.
-    controller : LTI, loopshaping Controller, ScheduledController, or callable ``f(t, y)``
-        (see the module docstring for the sign convention and the callable contract).
-    wind_speeds : mean wind speeds, m/s (W of them).
-    seeds : integer seeds (S of them) for the turbulent wind; or give ``wind`` instead.
-    wind : optional (W, S, n_w) rotor-effective wind in m/s sampled every ``wind_dt`` s,
-        covering ``transient + duration``.
-    wind_dt : spacing of the wind samples, s (default ``record_dt`` when synthesised; keep it
-        a multiple of ``dt`` so the interpolated wind is smooth within each RK4 step).
-    turbulence_class : IEC NTM class of the synthesised wind. wind_rotor_radius : rotor radius
-        for the rotor-effective spectrum, m (default: the IEA 15 MW's).
-    duration : recorded length of each run, s. transient : simulated before the record
-        starts (discarded), s. dt : integration and controller step, s. record_dt : sample
-        spacing of the recorded outputs, s (a multiple of ``dt``).
-    linear : integrate the linearisation at each wind speed instead of the nonlinear model.
-    wind_mean_tol : largest |mean of a given wind record − its wind speed|, m/s (default
+    plant : TurbineModel or KernelPlant
+        The plant (e.g. ``turbine.iea15mw()``).
+    controller : control.LTI, loopshaping.controller.Controller, ScheduledController or callable
+        The pitch controller, or a callable ``f(t, y)`` (see :mod:`specdesign.simulate` for the
+        sign convention and the callable contract).
+    wind_speeds : array_like
+        Mean wind speeds (m/s), W of them.
+    seeds : array_like of int, optional
+        Integer seeds (S of them) for the turbulent wind; or give ``wind`` instead.
+    wind : array_like, optional
+        (W, S, n_w) rotor-effective wind (m/s) sampled every ``wind_dt``, covering
+        ``transient + duration``.
+    duration : float, optional
+        Recorded length of each run (s).
+    dt : float, optional
+        Integration and controller step (s).
+    record_dt : float, optional
+        Sample spacing of the recorded outputs (s), a multiple of ``dt``.
+    transient : float, optional
+        Simulated before the record starts and discarded (s).
+    wind_dt : float, optional
+        Spacing of the wind samples (s) (default ``record_dt`` when synthesised; keep it a
+        multiple of ``dt`` so the interpolated wind is smooth within each RK4 step).
+    turbulence_class : str, optional
+        IEC NTM class of the synthesised wind.
+    linear : bool, optional
+        Integrate the linearisation at each wind speed instead of the nonlinear model.
+    wind_rotor_radius : float, optional
+        Rotor radius for the rotor-effective spectrum (m) (default: the IEA 15 MW's).
+    wind_mean_tol : float, optional
+        Largest |mean of a given wind record − its wind speed| (m/s) (default
         :data:`WIND_MEAN_TOLERANCE`).
 
     Returns
     -------
-    SimulationResult with outputs (W, S, n) for every plant output, ``pitch_cmd`` and ``wind``.
+    SimulationResult
+        Outputs (W, S, n) for every plant output, ``pitch_cmd`` and ``wind``.
 
     Raises
     ------
@@ -216,6 +293,14 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
     for bit (for a PI-like controller, as for ROSCO, where its integral does not either: the
     two part only next to a limit). A callable controller's command is used as it is (the
     plant's actuator still stops at its limits; the callable sees the pitch in ``y["pitch"]``).
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw, rosco_baseline
+    >>> m = iea15mw()
+    >>> r = simulate(m, rosco_baseline(m, 19.0), [19.0], seeds=[1], duration=10.0, transient=5.0)
+    >>> r["gen_speed"].shape
+    (1, 1, 100)
     """
     plant = turbine_plant(plant) if not isinstance(plant, KernelPlant) else plant
     dt = positive_scalar(dt, "dt")
@@ -309,7 +394,7 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
     else:
         label = getattr(controller, "name", "controller")
-        _warn_unstable(plant, controller, vs, dt)
+        warn_unstable(plant, controller, vs, dt)
         sched_pitch, mats, fw, pi = controller_bank(controller, dt)
         K = sched_pitch.size
         nc = max(1, max(m[0].shape[0] for m in mats))
@@ -349,122 +434,6 @@ def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration=
         time=idx_t - idx_t[0], wind_speeds=vs, seeds=seeds, outputs=outs, dt=record_dt, sim_dt=dt,
         linear=linear, controller=str(label),
     )
-
-
-def check_step(plant, vs, dt):
-    """Reject a step the RK4 integration cannot resolve (see :data:`MAX_STEP_EIGENVALUE`)."""
-    if plant.linearize is None:
-        return
-    fastest = max(float(np.max(np.abs(np.linalg.eigvals(np.asarray(plant.linearize(v).A))), initial=0.0)) for v in vs)
-    if fastest * dt > MAX_STEP_EIGENVALUE:
-        raise ValueError(f"dt={dt:g} s is too large for this plant: its fastest mode has |λ| = {fastest:.3g} rad/s, so "
-                         f"dt must be ≤ {MAX_STEP_EIGENVALUE / fastest:.3g} s (RK4 would be inaccurate or unstable)")
-
-
-def sampled_loop_radius(plant, controller, wind_speed, dt, *, parts=None) -> float:
-    """Spectral radius of the linearised closed loop as :func:`simulate` samples it at step ``dt`` (s).
-
-    The plant's linearisation at ``wind_speed`` (m/s) advanced by one RK4 step with the pitch
-    command held, the measurements taken at the start of the step, the controller (blended at
-    the trim pitch, :func:`specdesign.closedloop.loop_parts`; ``parts``: its result, if at
-    hand) discretised by Tustin at ``dt``: the loop the compiled kernel runs, linearised. Below
-    1 the sampled loop is stable. Modes at s = 0 the wind cannot excite
-    (:func:`specdesign.closedloop.hidden_origin_poles`; z = 1 here) are left out, as the
-    continuous check leaves them out.
-    """
-    from ..closedloop import closed_loop_matrices, hidden_origin_poles, loop_parts
-
-    if parts is None:
-        parts = loop_parts(plant, controller, wind_speed)
-    G, rows, K = parts
-    A, B, C, D = (np.asarray(x, dtype=float) for x in (G.A, G.B, G.C, G.D))
-    n = A.shape[0]
-    hA = dt * A
-    phi, gam, term = np.eye(n), np.eye(n), np.eye(n)
-    for k in range(1, 5):  # RK4 on ẋ = Ax + Bu, u held: Φ = Σ_{k≤4} (hA)^k/k!, Γ = h·Σ_{k≤3} (hA)^k/(k+1)!·B
-        term = term @ hA / k
-        phi = phi + term
-        if k < 4:
-            gam = gam + term / (k + 1)
-    gam = dt * gam @ B[:, 1]
-    cm, dmu = C[rows], D[rows, 1]
-    nk = K.nstates
-    Ak, Bk, Ck, Dk = (np.asarray(x, dtype=float) for x in (K.A, K.B, K.C, K.D))
-    Ak, Bk, Ck, Dk = Ak.reshape(nk, nk), Bk.reshape(nk, 2), Ck.reshape(1, nk), Dk.reshape(1, 2)
-    if nk:  # Tustin, as control.c2d(..., "tustin") (scipy's bilinear transform) computes it
-        ima = np.eye(nk) - 0.5 * dt * Ak
-        bd = np.linalg.solve(ima, dt * Bk)
-        Ak, Bk, Ck, Dk = np.linalg.solve(ima, np.eye(nk) + 0.5 * dt * Ak), bd, np.linalg.solve(ima.T, Ck.T).T, Dk + 0.5 * Ck @ bd
-    # state [x; x_c; u_prev]: m_k = cm x_k + dmu u_{k−1}; u_k = −(Ck x_c + Dk m_k); x_c⁺ = Ak x_c + Bk m_k
-    mx = np.hstack([cm, np.zeros((2, nk)), dmu[:, None]])
-    u = -(np.hstack([np.zeros((1, n)), Ck, np.zeros((1, 1))]) + Dk @ mx)[0]
-    M = np.zeros((n + nk + 1, n + nk + 1))
-    M[:n, :n] = phi
-    M[:n] += np.outer(gam, u)
-    M[n:n + nk, n:n + nk] = Ak
-    M[n:n + nk] += Bk @ mx
-    M[-1] = u
-    z = np.linalg.eigvals(M)
-    if np.max(np.abs(z)) > 1.0 + _RADIUS_TOL:  # conserved modes, if any, sit at z = 1: drop them
-        n0 = int(np.count_nonzero(hidden_origin_poles(*closed_loop_matrices(plant, controller, wind_speed, parts=parts))))
-        if n0:
-            z = np.delete(z, np.argsort(np.abs(z - 1.0))[:n0])
-    return float(np.max(np.abs(z), initial=0.0))
-
-
-#: Tolerance on the spectral radius of the sampled loop (:func:`sampled_loop_radius`).
-_RADIUS_TOL = 1e-9
-
-
-def check_loop_step(plant, controller, v, dt, parts=None):
-    """Reject a step at which the sampled loop is unstable while the continuous one is stable
-    (the controller's hold and Tustin map add phase lag): name the largest step that is not."""
-    from ..closedloop import loop_parts
-
-    if parts is None:
-        parts = loop_parts(plant, controller, v)
-
-    def stable(h):
-        return sampled_loop_radius(plant, controller, v, h, parts=parts) <= 1.0 + _RADIUS_TOL
-
-    if stable(dt):
-        return
-    lo, hi = dt, dt
-    while lo > 1e-6 * dt and not stable(lo):
-        lo /= 2.0
-    for _ in range(40):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
-        if hi - lo <= 1e-4 * hi:
-            break
-    q = 10.0 ** (math.floor(math.log10(lo)) - 2)
-    limit = math.floor(lo / q) * q  # 3 significant digits, rounded down to a stable step
-    name = getattr(controller, "name", None) or type(controller).__name__
-    raise ValueError(f"dt={dt:g} s is too large for controller {name!r} at {v:g} m/s: the loop as simulated (the "
-                     "command held over each step, the controller discretised by Tustin) is unstable although the "
-                     f"continuous loop is stable; dt must be ≤ {limit:.3g} s (the smaller, the closer "
-                     "to the continuous loop: dt = 0.02 s by default)")
-
-
-def _warn_unstable(plant, controller, vs, dt):
-    """Warn (ClosedLoopUnstableWarning) where the linearised loop is unstable: saturations
-    may keep such a run bounded (a limit cycle between the pitch limits), but it is no result.
-    Where it is stable, reject a step ``dt`` at which the sampled loop is not (:func:`check_loop_step`)."""
-    if plant.linearize is None:
-        return
-    import warnings
-
-    from ..closedloop import ClosedLoopUnstableWarning, loop_parts, unstable_message, unstable_poles
-
-    for v in vs:
-        parts = loop_parts(plant, controller, v)
-        bad = unstable_poles(plant, controller, v, parts=parts)
-        if bad.size:
-            tail = ("; the simulation runs on the pitch limits (a limit cycle, no result) if it does not diverge"
-                    if plant.pitch_limits is not None else "; the simulated response grows without bound")
-            warnings.warn(unstable_message(controller, v, bad) + tail, ClosedLoopUnstableWarning, stacklevel=3)
-        else:
-            check_loop_step(plant, controller, v, dt, parts)
 
 
 def _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, label, linear):
