@@ -9,7 +9,8 @@ input (constant, ``rated_generator_torque``, above rated). Figures come from the
 Layout
 ------
 - :mod:`specdesign.turbine.model`: :class:`TurbineModel` (trim, linearisation, aerodynamic
-  expansion), :class:`OperatingPoint`, :class:`AeroExpansion`, :func:`iea15mw`.
+  expansion) and :func:`iea15mw`; its results :class:`OperatingPoint` and
+  :class:`AeroExpansion` in :mod:`specdesign.turbine.operating`.
 - :mod:`specdesign.turbine.kernel`: the compiled right-hand side :func:`rhs` / :func:`outputs`
   (and its parts :func:`aero_loads`, :func:`mechanics`, :func:`outputs_from`), the state,
   input and output names and the layout of the parameter array: see its docstring, "the
@@ -51,7 +52,8 @@ from .kernel import (
     outputs_from,
     rhs,
 )
-from .model import AERO_VARIABLES, LOAD_INPUT_NAMES, AeroExpansion, OperatingPoint, TurbineModel, iea15mw
+from .model import TurbineModel, iea15mw
+from .operating import AERO_VARIABLES, LOAD_INPUT_NAMES, AeroExpansion, OperatingPoint
 from .tables import DATA_DIR, HERMITE, bicubic_coefficients, read_rotor_table, read_text, uniform_step
 
 __all__ = [

@@ -75,7 +75,26 @@ HEADER_SIZE = 20
 # ----------------------------------------------------------------------------- kernel
 @njit(cache=True)
 def bicubic(p, offset, tsr, pitch):
-    """Evaluate one C2 bicubic table (coefficients at p[offset:]) at (tsr, pitch rad)."""
+    """Evaluate one C2 bicubic table (coefficients at ``p[offset:]``) at (tsr, pitch).
+
+    Outside the table the coefficient is held at its edge value.
+
+    Parameters
+    ----------
+    p : numpy.ndarray
+        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    offset : int
+        Index in ``p`` of the table's first coefficient.
+    tsr : float
+        Tip-speed ratio (-).
+    pitch : float
+        Blade pitch (rad).
+
+    Returns
+    -------
+    float
+        The coefficient (Cp or Ct, -).
+    """
     n_tsr = int(p[P_N_TSR])
     n_pitch = int(p[P_N_PITCH])
     u = (tsr - p[P_TSR0]) / p[P_DTSR]
@@ -100,8 +119,26 @@ def bicubic(p, offset, tsr, pitch):
 
 @njit(cache=True)
 def aero_loads(p, omega, v_rel, beta):
-    """(aerodynamic torque N·m, thrust N) at rotor speed ``omega`` (rad/s), wind relative to
-    the tower top ``v_rel`` (m/s) and pitch ``beta`` (rad), from the compiled Cp/Ct interpolant."""
+    """Aerodynamic torque and thrust from the compiled Cp/Ct interpolant.
+
+    Parameters
+    ----------
+    p : numpy.ndarray
+        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    omega : float
+        Rotor speed (rad/s).
+    v_rel : float
+        Wind relative to the tower top (m/s).
+    beta : float
+        Blade pitch (rad).
+
+    Returns
+    -------
+    torque : float
+        Aerodynamic torque (N·m).
+    thrust : float
+        Thrust (N).
+    """
     radius = p[P_RADIUS]
     area = np.pi * radius * radius
     # Kept positive so that a wild transient cannot divide by zero.
@@ -117,9 +154,28 @@ def aero_loads(p, omega, v_rel, beta):
 
 @njit(cache=True)
 def mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx):
-    """State derivative given the aerodynamic loads: rigid drivetrain, first tower fore-aft
-    mode, pitch actuator with rate and position limits (written into ``dx``). Shared by
-    :func:`rhs` and by kernels that replace only the aerodynamics."""
+    """State derivative given the aerodynamic loads, written into ``dx``.
+
+    Rigid drivetrain, first tower fore-aft mode, pitch actuator with rate and position limits.
+    Shared by :func:`rhs` and by kernels that replace only the aerodynamics.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State, float64[5] (:data:`STATE_NAMES`, SI).
+    aero_torque : float
+        Aerodynamic torque (N·m).
+    thrust : float
+        Thrust (N).
+    pitch_cmd : float
+        Collective pitch demand (rad).
+    gen_torque : float
+        Generator torque on the rotor shaft (N·m).
+    p : numpy.ndarray
+        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    dx : numpy.ndarray
+        Output: float64[5], the state derivative (written).
+    """
     beta = x[3]
     beta_rate = x[4]
     qd = x[2]
@@ -144,8 +200,23 @@ def mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx):
 def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
     """State derivative of the reduced IEA 15 MW model, written into ``dx``.
 
-    See the module docstring, section "Kernel interface", for the state vector, units and
-    the layout of the parameter array ``p`` (from :meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    See the module docstring for the state vector, units and the layout of the parameter
+    array ``p``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State, float64[5] (:data:`STATE_NAMES`, SI).
+    wind : float
+        Rotor-effective wind speed (m/s).
+    pitch_cmd : float
+        Collective pitch demand (rad).
+    gen_torque : float
+        Generator torque on the rotor shaft (N·m).
+    p : numpy.ndarray
+        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    dx : numpy.ndarray
+        Output: float64[5], the state derivative (written).
     """
     # The rotor sees the wind relative to the moving tower top.
     aero_torque, thrust = aero_loads(p, x[0], wind - x[2], x[3])
@@ -154,7 +225,21 @@ def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
 
 @njit(cache=True)
 def outputs_from(x, dx, gen_torque, p, y):
-    """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``."""
+    """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State, float64[5] (:data:`STATE_NAMES`, SI).
+    dx : numpy.ndarray
+        Its derivative, float64[5].
+    gen_torque : float
+        Generator torque on the rotor shaft (N·m).
+    p : numpy.ndarray
+        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    y : numpy.ndarray
+        Output: float64[6], the outputs (written, SI).
+    """
     y[0] = x[0]
     y[1] = p[P_MY_PER_M] * x[1]
     y[2] = dx[2]
@@ -167,8 +252,21 @@ def outputs_from(x, dx, gen_torque, p, y):
 def outputs(x, wind, pitch_cmd, gen_torque, p, y):
     """Outputs of the reduced model in the order of :data:`OUTPUT_NAMES`, written into ``y``.
 
-    Same arguments as :func:`rhs`; ``y`` is float64[6]: gen_speed (rad/s), tower_base_my
-    (N·m), tower_top_acc (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical).
+    Parameters
+    ----------
+    x : numpy.ndarray
+        State, float64[5] (:data:`STATE_NAMES`, SI).
+    wind : float
+        Rotor-effective wind speed (m/s).
+    pitch_cmd : float
+        Collective pitch demand (rad).
+    gen_torque : float
+        Generator torque on the rotor shaft (N·m).
+    p : numpy.ndarray
+        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    y : numpy.ndarray
+        Output: float64[6], written: gen_speed (rad/s), tower_base_my (N·m), tower_top_acc
+        (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical).
     """
     dx = np.empty(5)
     rhs(x, wind, pitch_cmd, gen_torque, p, dx)

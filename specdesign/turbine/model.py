@@ -1,4 +1,4 @@
-"""The embedded IEA 15 MW reduced-order model: trim and linearisation (ROSCO: :mod:`specdesign.rosco`).
+"""The reduced-order turbine model: trim, linearisation, aerodynamic expansion; the IEA 15 MW.
 
 The model: rigid-drivetrain rotor (aerodynamic torque from Cp(λ, β), thrust from Ct(λ, β)),
 first tower fore-aft mode driven by thrust with the rotor seeing the relative wind U − ẋ_top,
@@ -8,17 +8,22 @@ input (constant, ``rated_generator_torque``, above rated). Figures come from the
 
 The state, input and output vectors and the compiled kernel are those of
 :mod:`specdesign.turbine.kernel`; the data and the table preparation are in
-:mod:`specdesign.turbine.tables`.
+:mod:`specdesign.turbine.tables`; the model's results (:class:`OperatingPoint`,
+:class:`AeroExpansion`) in :mod:`specdesign.turbine.operating`.
 """
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._checks import positive_scalar
+
+if TYPE_CHECKING:  # pragma: no cover
+    import control
 from .kernel import (
     HEADER_SIZE,
     INPUT_NAMES,
@@ -50,87 +55,64 @@ from .kernel import (
     outputs_from,
     rhs,
 )
+from .operating import LOAD_INPUT_NAMES, AeroExpansion, OperatingPoint
 from .tables import bicubic_coefficients, read_rotor_table, read_text, uniform_step
 
-__all__ = ["LOAD_INPUT_NAMES", "AERO_VARIABLES", "OperatingPoint", "AeroExpansion", "TurbineModel", "iea15mw"]
-
-#: Extra inputs of ``linearize(..., load_inputs=True)``: disturbances added to the aerodynamic
-#: torque (N·m) and thrust (N).
-LOAD_INPUT_NAMES = ("aero_torque", "thrust")
-#: Arguments of the aerodynamic loads that :class:`AeroExpansion` expands in.
-AERO_VARIABLES = ("rotor_speed", "relative_wind", "pitch")
-
-# ----------------------------------------------------------------------------- results
-@dataclass(frozen=True)
-class OperatingPoint:
-    """A steady operating point (trim) of the reduced model.
-
-    wind_speed (m/s), rotor_speed (rad/s), pitch (rad), gen_torque (N·m), x (state vector,
-    :data:`STATE_NAMES`), thrust (N), aero_power (W, mechanical), power (W, electrical),
-    tsr (-), cp (-), ct (-).
-    """
-
-    wind_speed: float
-    rotor_speed: float
-    pitch: float
-    gen_torque: float
-    x: np.ndarray
-    thrust: float
-    aero_power: float
-    power: float
-    tsr: float
-    cp: float
-    ct: float
-
-    @property
-    def u(self) -> np.ndarray:
-        """Input vector (wind m/s, pitch_cmd rad, gen_torque N·m) at the trim."""
-        return np.array([self.wind_speed, self.pitch, self.gen_torque])
-
-
-@dataclass(frozen=True, eq=False)  # array fields: compare by identity
-class AeroExpansion:
-    """Taylor expansion of the aerodynamic loads about a trim, to third order.
-
-    The loads (aerodynamic torque N·m, thrust N) are functions of z = (rotor speed rad/s, wind
-    relative to the tower top m/s, pitch rad) (:data:`AERO_VARIABLES`). ``point`` (3,) is z at
-    the trim of ``wind_speed`` (m/s) and ``loads`` (2,) the loads there; ``gradient`` (2, 3),
-    ``hessian`` (2, 3, 3) and ``third`` (2, 3, 3, 3) are their first, second and third
-    partial derivatives in z (SI units of load per unit of each variable), by central
-    differences of the compiled interpolant with steps ``steps`` (3,).
-    """
-
-    wind_speed: float
-    point: np.ndarray
-    loads: np.ndarray
-    gradient: np.ndarray
-    hessian: np.ndarray
-    third: np.ndarray
-    steps: np.ndarray
-
-    def evaluate(self, dz, order: int = 3) -> np.ndarray:
-        """Load change (2, ...) predicted by the Taylor polynomial of ``order`` (1-3) for the
-        deviations ``dz`` (3, ...) from ``point`` (same units as :data:`AERO_VARIABLES`)."""
-        dz = np.asarray(dz, dtype=float)
-        if dz.ndim < 1 or dz.shape[0] != 3:
-            raise ValueError(f"dz must have shape (3, ...) ordered as {AERO_VARIABLES}, got {dz.shape}")
-        if order not in (1, 2, 3):
-            raise ValueError(f"order={order!r} must be 1, 2 or 3")
-        out = np.einsum("ki,i...->k...", self.gradient, dz)
-        if order >= 2:
-            out = out + 0.5 * np.einsum("kij,i...,j...->k...", self.hessian, dz, dz)
-        if order == 3:
-            out = out + np.einsum("kijl,i...,j...,l...->k...", self.third, dz, dz, dz) / 6.0
-        return out
+__all__ = ["TurbineModel", "iea15mw"]
 
 
 @dataclass(frozen=True)
 class TurbineModel:
     """Reduced-order turbine: rotor + rigid drivetrain + tower fore-aft mode + pitch actuator.
 
-    All fields SI (rad, rad/s, N·m, kg, N/m). Build the IEA 15 MW with :func:`iea15mw`.
-    ``tsr_grid`` (-), ``pitch_grid`` (rad) and the (n_tsr, n_pitch) ``cp_table``, ``ct_table``
-    are the rotor performance tables.
+    Build the IEA 15 MW with :func:`iea15mw`.
+
+    Parameters
+    ----------
+    name : str
+        Label of the turbine.
+    air_density : float
+        Air density (kg/m³).
+    rotor_radius : float
+        Rotor radius (m).
+    drivetrain_inertia : float
+        Rotor and drivetrain inertia on the rotor shaft (kg·m²).
+    tower_modal_mass : float
+        Modal mass of the first tower fore-aft mode (kg).
+    tower_modal_stiffness : float
+        Its modal stiffness (N/m).
+    tower_damping_ratio : float
+        Its damping ratio (-).
+    tower_base_moment_per_m : float
+        Tower-base fore-aft moment per metre of tower-top deflection (N·m/m).
+    actuator_omega : float
+        Pitch-actuator natural frequency (rad/s).
+    actuator_zeta : float
+        Pitch-actuator damping ratio (-).
+    pitch_rate_limit : float
+        Pitch rate limit (rad/s).
+    pitch_min : float
+        Lower pitch limit (rad).
+    pitch_max : float
+        Upper pitch limit (rad).
+    generator_efficiency : float
+        Generator efficiency (-).
+    rated_rotor_speed : float
+        Rated rotor (= generator) speed (rad/s).
+    rated_generator_torque : float
+        Rated generator torque on the rotor shaft (N·m).
+    rated_power : float
+        Rated electrical power (W).
+    tsr_grid : numpy.ndarray
+        (n_tsr,) uniform tip-speed-ratio grid of the rotor tables (-).
+    pitch_grid : numpy.ndarray
+        (n_pitch,) uniform pitch grid of the rotor tables (rad).
+    cp_table : numpy.ndarray
+        (n_tsr, n_pitch) power coefficients (-).
+    ct_table : numpy.ndarray
+        (n_tsr, n_pitch) thrust coefficients (-).
+    wind_range : tuple of float, optional
+        (low, high) mean wind speeds (m/s) where the above-rated model is valid.
     """
 
     name: str
@@ -195,11 +177,30 @@ class TurbineModel:
         return p
 
     def kernel_params(self) -> np.ndarray:
-        """Flat float64 parameter array for :func:`rhs` / :func:`outputs` (a fresh copy)."""
+        """Flat float64 parameter array of the compiled kernel (a fresh copy).
+
+        Returns
+        -------
+        numpy.ndarray
+            The ``p`` of :func:`specdesign.turbine.rhs` / :func:`specdesign.turbine.outputs`.
+        """
         return self._params.copy()
 
     def rotor_coefficients(self, tsr, pitch):
-        """(Cp, Ct) of the compiled interpolant at tip-speed ratio ``tsr`` and ``pitch`` (rad)."""
+        """(Cp, Ct) of the compiled interpolant.
+
+        Parameters
+        ----------
+        tsr : array_like
+            Tip-speed ratio (-).
+        pitch : array_like
+            Blade pitch (rad), broadcast with ``tsr``.
+
+        Returns
+        -------
+        cp, ct : numpy.ndarray
+            Power and thrust coefficients (-), of the broadcast shape.
+        """
         p = self._params
         n_cells = (self.tsr_grid.size - 1) * (self.pitch_grid.size - 1) * 16
         tsr, pitch = np.broadcast_arrays(np.asarray(tsr, float), np.asarray(pitch, float))
@@ -209,15 +210,58 @@ class TurbineModel:
 
     # -- numpy wrappers -------------------------------------------------------------------
     def derivatives(self, x, wind, pitch_cmd, gen_torque) -> np.ndarray:
-        """ẋ of the compiled :func:`rhs` for state ``x`` (see :data:`STATE_NAMES`), wind (m/s),
-        pitch_cmd (rad) and gen_torque (N·m)."""
+        """ẋ of the compiled :func:`specdesign.turbine.rhs`.
+
+        Parameters
+        ----------
+        x : array_like
+            State, shape (5,) (:data:`STATE_NAMES`, SI).
+        wind : float
+            Rotor-effective wind speed (m/s).
+        pitch_cmd : float
+            Collective pitch demand (rad).
+        gen_torque : float
+            Generator torque (N·m).
+
+        Returns
+        -------
+        numpy.ndarray
+            (5,) state derivative (SI per second).
+
+        Raises
+        ------
+        ValueError
+            If ``x`` is not of shape (5,).
+        """
         x = self._state(x)
         dx = np.empty(5)
         rhs(x, float(wind), float(pitch_cmd), float(gen_torque), self._params, dx)
         return dx
 
     def evaluate_outputs(self, x, wind, pitch_cmd, gen_torque) -> np.ndarray:
-        """Outputs (:data:`OUTPUT_NAMES`, SI) of the compiled :func:`outputs`."""
+        """Outputs of the compiled :func:`specdesign.turbine.outputs`.
+
+        Parameters
+        ----------
+        x : array_like
+            State, shape (5,) (:data:`STATE_NAMES`, SI).
+        wind : float
+            Rotor-effective wind speed (m/s).
+        pitch_cmd : float
+            Collective pitch demand (rad).
+        gen_torque : float
+            Generator torque (N·m).
+
+        Returns
+        -------
+        numpy.ndarray
+            (6,) outputs (:data:`OUTPUT_NAMES`, SI).
+
+        Raises
+        ------
+        ValueError
+            If ``x`` is not of shape (5,).
+        """
         x = self._state(x)
         y = np.empty(len(OUTPUT_NAMES))
         outputs(x, float(wind), float(pitch_cmd), float(gen_torque), self._params, y)
@@ -232,9 +276,22 @@ class TurbineModel:
 
     # -- trim and linearisation -------------------------------------------------------------
     def check_wind_speed(self, wind_speed) -> float:
-        """``wind_speed`` (m/s) as a float, checked to be within ``wind_range``.
+        """``wind_speed`` as a float, checked to be within ``wind_range``.
 
-        Raises ValueError outside the above-rated range where the model is valid.
+        Parameters
+        ----------
+        wind_speed : float
+            Mean wind speed (m/s).
+
+        Returns
+        -------
+        float
+            The wind speed (m/s).
+
+        Raises
+        ------
+        ValueError
+            Outside the above-rated range where the model is valid.
         """
         v = positive_scalar(wind_speed, "wind_speed")
         lo, hi = self.wind_range
@@ -252,11 +309,32 @@ class TurbineModel:
         return self.derivatives(x, wind, pitch, 0.0)[0] * self.drivetrain_inertia
 
     def trim(self, wind_speed) -> OperatingPoint:
-        """Steady operating point above rated: rated rotor speed, rated generator torque, the
-        pitch (rad) that balances aerodynamic and generator torque, tower at static deflection.
+        """Steady operating point above rated.
 
-        Raises ValueError outside ``wind_range`` (m/s) or when the wind is below rated (no
-        pitch ≥ ``pitch_min`` balances the torque).
+        Rated rotor speed, rated generator torque, the pitch that balances aerodynamic and
+        generator torque, tower at static deflection.
+
+        Parameters
+        ----------
+        wind_speed : float
+            Mean wind speed (m/s), within ``wind_range``.
+
+        Returns
+        -------
+        OperatingPoint
+            The trim.
+
+        Raises
+        ------
+        ValueError
+            Outside ``wind_range`` or when the wind is below rated (no pitch ≥ ``pitch_min``
+            balances the torque).
+
+        Examples
+        --------
+        >>> op = iea15mw().trim(19.0)
+        >>> bool(0.2 < op.pitch < 0.3)
+        True
         """
         from scipy.optimize import brentq
 
@@ -303,11 +381,22 @@ class TurbineModel:
             ct=ct,
         )
 
-    def jacobians(self, op: OperatingPoint):
-        """(A, B, C, D) of :func:`rhs`/:func:`outputs` at ``op`` by central differences.
+    def jacobians(self, op: OperatingPoint) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Jacobians of the compiled kernel at ``op`` by central differences.
 
         Steps are small enough (≤ 1e-5 in scaled units) that the actuator saturations stay
         inactive, large enough that round-off stays far below the 1e-6 relative level.
+
+        Parameters
+        ----------
+        op : OperatingPoint
+            The trim to linearise about.
+
+        Returns
+        -------
+        A, B, C, D : numpy.ndarray
+            (5, 5), (5, 3), (6, 5), (6, 3) matrices of :func:`specdesign.turbine.rhs` /
+            :func:`specdesign.turbine.outputs` in (state, input) (SI).
         """
         x0 = np.array(op.x, dtype=float)
         u0 = op.u
@@ -333,21 +422,48 @@ class TurbineModel:
         return A, B, C, D
 
     def rated_wind_speed(self) -> float:
-        """Lowest wind speed (m/s) at which rated torque is reached at rated speed and minimum pitch."""
+        """Lowest wind speed at which rated torque is reached at rated speed and minimum pitch.
+
+        Returns
+        -------
+        float
+            The rated wind speed (m/s).
+        """
         from scipy.optimize import brentq
 
         omega, torque = self.rated_rotor_speed, self.rated_generator_torque
         return float(brentq(lambda v: self._aero_torque(v, omega, self.pitch_min) - torque, 5.0, 20.0, xtol=1e-10))
 
-    def linearize(self, wind_speed, *, load_inputs: bool = False):
-        """Linear model at the trim for ``wind_speed`` (m/s, 11-25): a ``control.StateSpace``
-        with inputs ``wind`` (m/s), ``pitch_cmd`` (rad), ``gen_torque`` (N·m), outputs
+    def linearize(self, wind_speed, *, load_inputs: bool = False) -> control.StateSpace:
+        """Linear model at the trim for ``wind_speed``.
+
+        Inputs ``wind`` (m/s), ``pitch_cmd`` (rad), ``gen_torque`` (N·m), outputs
         :data:`OUTPUT_NAMES` (SI) and states :data:`STATE_NAMES`, all deviations from the trim.
         Index it by name: ``sys['gen_speed', 'wind']``.
 
-        load_inputs : also take :data:`LOAD_INPUT_NAMES`, disturbances added to the
-            aerodynamic torque (N·m) and thrust (N): the inputs through which the higher-order
-            aerodynamic terms of :meth:`aero_expansion` act (:func:`specdesign.validate.volterra_response`).
+        Parameters
+        ----------
+        wind_speed : float
+            Mean wind speed (m/s), within ``wind_range`` (11-25).
+        load_inputs : bool, optional
+            Also take :data:`LOAD_INPUT_NAMES`, disturbances added to the aerodynamic torque
+            (N·m) and thrust (N): the inputs through which the higher-order aerodynamic terms
+            of :meth:`aero_expansion` act (the Volterra prediction of :mod:`specdesign.validate`).
+
+        Returns
+        -------
+        control.StateSpace
+            The linear model, named ``<name>@<v>mps``.
+
+        Raises
+        ------
+        ValueError
+            Outside ``wind_range``.
+
+        Examples
+        --------
+        >>> iea15mw().linearize(19.0).nstates
+        5
         """
         import control
 
@@ -390,12 +506,28 @@ class TurbineModel:
         return z0, np.array(aero_loads(self._params, z0[0], z0[1], z0[2]))
 
     def aero_expansion(self, wind_speed, *, steps=(2e-3, 2e-2, 2e-3)) -> AeroExpansion:
-        """Third-order Taylor expansion of (aerodynamic torque, thrust) about the trim of
-        ``wind_speed`` (m/s) in (rotor speed, relative wind, pitch): :class:`AeroExpansion`.
+        """Third-order Taylor expansion of (aerodynamic torque, thrust) about a trim.
 
-        steps : central-difference steps (rad/s, m/s, rad), small against the excursions in
-        turbulence (≈ 0.05 rad/s, 1.5 m/s, 0.03 rad at class B) and large enough that
-        round-off stays ≤ 1e-6 of the third derivatives.
+        In (rotor speed, relative wind, pitch) (:data:`AERO_VARIABLES`).
+
+        Parameters
+        ----------
+        wind_speed : float
+            Mean wind speed of the trim (m/s).
+        steps : tuple of float, optional
+            Central-difference steps (rad/s, m/s, rad), small against the excursions in
+            turbulence (≈ 0.05 rad/s, 1.5 m/s, 0.03 rad at class B) and large enough that
+            round-off stays ≤ 1e-6 of the third derivatives.
+
+        Returns
+        -------
+        AeroExpansion
+            The expansion.
+
+        Raises
+        ------
+        ValueError
+            Outside ``wind_range`` or for steps that are not three positive numbers.
         """
         op = self.trim(wind_speed)
         z0, loads0 = self._aero_point(op)
@@ -431,6 +563,16 @@ def iea15mw() -> TurbineModel:
     Tower: first fore-aft mode of the finite-element model with gravity (modal mass and
     stiffness, 1.081 rad/s), 1 % damping, tower-base moment at z = 15 m per metre of
     tower-top deflection. Generator efficiency 0.95756 (electrical power = η·T·Ω).
+
+    Returns
+    -------
+    TurbineModel
+        The IEA 15 MW reduced model.
+
+    Examples
+    --------
+    >>> iea15mw().name
+    'IEA-15-240-RWT'
     """
     par = json.loads(read_text("parameters.json"))
     tsr, pitch_deg, cp, ct = read_rotor_table()

@@ -17,11 +17,45 @@ DATA_DIR = "data/iea15mw"
 
 
 def read_text(name: str) -> str:
+    """Text of a file of the shipped IEA 15 MW data (package data, also from an installed wheel).
+
+    Parameters
+    ----------
+    name : str
+        File name inside ``specdesign/data/iea15mw``.
+
+    Returns
+    -------
+    str
+        The file's text.
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no such file.
+
+    Examples
+    --------
+    >>> "air_density_kg_m3" in read_text("parameters.json")
+    True
+    """
     return resources.files("specdesign").joinpath(f"{DATA_DIR}/{name}").read_text()
 
 
-def read_rotor_table():
-    """Parse the ROSCO-format Cp/Ct/Cq text table: pitch (deg), TSR, and (n_tsr, n_pitch) blocks."""
+def read_rotor_table() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Parse the shipped ROSCO-format Cp/Ct/Cq text table (``Cp_Ct_Cq.IEA15MW.txt``).
+
+    Returns
+    -------
+    tsr : numpy.ndarray
+        (n_tsr,) tip-speed ratios (-).
+    pitch : numpy.ndarray
+        (n_pitch,) blade pitch (deg).
+    cp : numpy.ndarray
+        (n_tsr, n_pitch) power coefficients (-).
+    ct : numpy.ndarray
+        (n_tsr, n_pitch) thrust coefficients (-).
+    """
     lines = read_text("Cp_Ct_Cq.IEA15MW.txt").splitlines()
     pitch = tsr = None
     blocks = {}
@@ -47,25 +81,61 @@ def read_rotor_table():
     return tsr, pitch, blocks["po"], blocks["th"]
 
 
-def uniform_step(grid, name):
+def uniform_step(grid, name: str) -> float:
+    """The spacing of a uniform grid (the compiled interpolant needs uniform axes).
+
+    Parameters
+    ----------
+    grid : numpy.ndarray
+        1-D increasing grid.
+    name : str
+        Name of the axis, for the error message.
+
+    Returns
+    -------
+    float
+        The step, in the units of ``grid``.
+
+    Raises
+    ------
+    ValueError
+        If the grid is not uniform.
+    """
     step = np.diff(grid)
     if not np.allclose(step, step[0], rtol=1e-9, atol=1e-12):
         raise ValueError(f"the {name} axis of the rotor table must be uniform for the compiled interpolant")
     return float(step[0])
 
 
-# Hermite basis: for a cubic on [0, 1] with values f0, f1 and slopes d0, d1, the monomial
-# coefficients are H @ [f0, f1, d0, d1].
+#: Hermite basis: for a cubic on [0, 1] with values f0, f1 and slopes d0, d1, the monomial
+#: coefficients are HERMITE @ [f0, f1, d0, d1].
 HERMITE = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [-3.0, 3.0, -2.0, -1.0], [2.0, -2.0, 1.0, 1.0]])
 
 
-def bicubic_coefficients(tsr, pitch_rad, table):
-    """Per-cell bicubic coefficients a[i, j, k, l] (f = Σ a_kl u^k v^l) reproducing the
-    interpolating tensor-product cubic spline of ``table`` (scipy RectBivariateSpline, s=0).
+def bicubic_coefficients(tsr, pitch_rad, table) -> tuple[np.ndarray, object]:
+    """Per-cell bicubic coefficients reproducing the interpolating cubic spline of ``table``.
 
-    Within each cell that spline is one bicubic polynomial, fixed by f, f_u, f_v, f_uv at the
-    four corners; Hermite patches built from those corner values reproduce it exactly, so the
-    compiled kernel evaluates the same C2 surface scipy fits.
+    The coefficients a[i, j, k, l] (f = Σ a_kl u^k v^l in cell (i, j), u and v in [0, 1])
+    reproduce the interpolating tensor-product cubic spline of ``table`` (scipy
+    RectBivariateSpline, s=0). Within each cell that spline is one bicubic polynomial, fixed by
+    f, f_u, f_v, f_uv at the four corners; Hermite patches built from those corner values
+    reproduce it exactly, so the compiled kernel evaluates the same C2 surface scipy fits.
+
+    Parameters
+    ----------
+    tsr : numpy.ndarray
+        (n_tsr,) uniform tip-speed-ratio grid (-).
+    pitch_rad : numpy.ndarray
+        (n_pitch,) uniform pitch grid (rad).
+    table : numpy.ndarray
+        (n_tsr, n_pitch) coefficient table (Cp or Ct, -).
+
+    Returns
+    -------
+    coefficients : numpy.ndarray
+        (n_tsr − 1, n_pitch − 1, 4, 4) patch coefficients.
+    spline : scipy.interpolate.RectBivariateSpline
+        The spline they reproduce.
     """
     from scipy.interpolate import RectBivariateSpline
 
