@@ -22,6 +22,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_keywords
 from .bounds import Bounds, BoundsWarning, bounds, intersect
@@ -83,8 +84,9 @@ def _fixed_poles(poles, omega):
 
 
 @renamed_keywords(hf_omegas="hf_omega")
-def shape(bounds: Bounds, poles=None, *, n_zeros: int | None = None, initial=None, hf_omega=None,
-          margin_db: float = 0.0, max_iter: int = 40, tol: float = 1e-5, solver: str | None = None) -> Controller:
+def shape(bounds: Bounds, poles: object = None, *, n_zeros: int | None = None, initial: object = None,
+          hf_omega: ArrayLike | None = None, margin_db: float = 0.0, max_iter: int = 40, tol: float = 1e-5,
+          solver: str | None = None) -> Controller:
     """Shape G = N(s)/D(s) with fixed poles so that L0 = P0·G meets ``bounds``.
 
     Parameters
@@ -262,8 +264,9 @@ class RefineResult:
 
 
 @renamed_keywords(omega_dense="omega", hf_omegas="hf_omega")
-def refine(template: Template, specs, omega, poles=None, *, max_rounds: int = 6, margin_db: float = 0.01,
-           phases_deg=None, **shape_kwargs) -> RefineResult:
+def refine(template: Template, specs: "Bounds | Spec | Sequence[Spec]", omega: ArrayLike, poles: object = None, *,
+           max_rounds: int = 6, margin_db: float = 0.01, phases_deg: ArrayLike | None = None,
+           **shape_kwargs) -> RefineResult:
     """:func:`shape`, check on a dense grid, add the failing frequencies, shape again.
 
     Each round shapes against the exact bounds of ``specs`` at the current design frequencies

@@ -23,6 +23,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_attribute, renamed_keywords
 from .freqresp import DEFAULT_PHASES_DEG, check_phases, grid_indices
@@ -198,8 +199,8 @@ class _Part:
         return np.all(lhs <= rhs * (1 + rtol) + 1e-300, axis=-1)
 
 
-def bounds(template: Template, kind: str | Spec, weight=None, phases_deg=None, *, band: tuple | None = None,
-           name: str | None = None, n_disk: int = 24, **kind_args) -> Bounds:
+def bounds(template: Template, kind: str | Spec, weight: object = None, phases_deg: ArrayLike | None = None, *,
+           band: tuple | None = None, name: str | None = None, n_disk: int = 24, **kind_args) -> Bounds:
     """Exact QFT bounds of one specification at the template's design frequencies.
 
     Parameters

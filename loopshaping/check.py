@@ -13,6 +13,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_attribute, renamed_keywords
 from .controller import Controller
@@ -160,7 +161,7 @@ def _as_tf(sys, name):
     return np.trim_zeros(tf.num[0][0], "f"), np.trim_zeros(tf.den[0][0], "f")
 
 
-def feedback_poles(plant, controller) -> np.ndarray:
+def feedback_poles(plant: "Controller | control.LTI", controller: "Controller | control.LTI") -> np.ndarray:
     """Poles of the loop of ``plant`` and ``controller`` with negative unit feedback.
 
     The roots of n_P·n_G + d_P·d_G, without cancellation, so hidden unstable modes (an
@@ -199,7 +200,7 @@ def feedback_poles(plant, controller) -> np.ndarray:
     return np.roots(np.polyadd(num, den))
 
 
-def closed_loop_poles(controller, plant) -> np.ndarray:
+def closed_loop_poles(controller: "Controller | control.LTI", plant: "Controller | control.LTI") -> np.ndarray:
     """Deprecated: use :func:`feedback_poles` ``(plant, controller)``.
 
     Parameters
@@ -249,7 +250,9 @@ def _margins(L, omega):
 
 
 @renamed_keywords(controller_or_tf="controller", template_or_plants="plants", omega_dense="omega")
-def check(plants, controller, specs, omega) -> CheckResult:
+def check(plants: "Template | Sequence[control.LTI]", controller: "Controller | control.LTI",
+          specs: "Bounds | Spec | Sequence[Spec]",
+          omega: ArrayLike) -> CheckResult:
     """Every spec on a dense grid over every case, closed-loop stability and margins.
 
     Parameters

@@ -36,6 +36,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_keywords
 
@@ -165,7 +166,7 @@ class Element:
         return np.array([1.0, 2 * p["zeta_zero"] * w, w * w]), np.array([1.0, 2 * p["zeta_pole"] * w, w * w])
 
     @renamed_keywords(omegas="omega")
-    def response(self, omega) -> np.ndarray:
+    def response(self, omega: ArrayLike) -> np.ndarray:
         """Complex response at s = jω.
 
         Parameters
@@ -534,7 +535,7 @@ class Controller:
         return ct.tf(num, den)
 
     @renamed_keywords(omegas="omega")
-    def response(self, omega) -> np.ndarray:
+    def response(self, omega: ArrayLike) -> np.ndarray:
         """Complex response at s = jω, evaluated factor by factor.
 
         Parameters

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numbers
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_keywords
 
@@ -48,7 +49,7 @@ def is_lti(obj: object) -> bool:
     return isinstance(obj, ct.LTI)
 
 
-def as_siso(sys, name: str = "system", *, proper: bool = True):
+def as_siso(sys: object, name: str = "system", *, proper: bool = True) -> "control.TransferFunction | control.StateSpace":
     """Make ``sys`` a SISO continuous-time python-control LTI, or raise naming ``name``.
 
     The one helper for "this argument must be a SISO LTI" checks. Contract:
@@ -117,7 +118,7 @@ def as_siso(sys, name: str = "system", *, proper: bool = True):
 
 
 @renamed_keywords(omegas="omega")
-def evaluate(obj, omega, name: str = "system") -> np.ndarray:
+def evaluate(obj: object, omega: ArrayLike, name: str = "system") -> np.ndarray:
     """Complex response of ``obj`` at s = jω.
 
     Parameters
@@ -173,7 +174,7 @@ def evaluate(obj, omega, name: str = "system") -> np.ndarray:
     raise TypeError(f"{name} must be a number, a SISO LTI system or a callable of ω; got {type(obj).__name__}")
 
 
-def check_grid(omega, name: str = "omega") -> np.ndarray:
+def check_grid(omega: ArrayLike, name: str = "omega") -> np.ndarray:
     """Validate a frequency grid: non-empty, 1-D, finite, > 0 and strictly increasing.
 
     Parameters
@@ -208,7 +209,7 @@ def check_grid(omega, name: str = "omega") -> np.ndarray:
     return w
 
 
-def check_phases(phases_deg=None, name: str = "phases_deg") -> np.ndarray:
+def check_phases(phases_deg: ArrayLike | None = None, name: str = "phases_deg") -> np.ndarray:
     """Validate a phase grid in degrees; None gives :data:`DEFAULT_PHASES_DEG`.
 
     Parameters
@@ -241,7 +242,7 @@ def check_phases(phases_deg=None, name: str = "phases_deg") -> np.ndarray:
     return p
 
 
-def grid_indices(grid, values, name: str = "omega") -> np.ndarray:
+def grid_indices(grid: np.ndarray, values: ArrayLike, name: str = "omega") -> np.ndarray:
     """Indices of ``values`` in the sorted frequency grid ``grid`` (equal up to 1e-9 relative).
 
     Parameters

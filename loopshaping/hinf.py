@@ -119,19 +119,19 @@ def _lower_lft(parts, K):
 
 
 def synthesize(
-    generalized_plant,
-    n_meas,
-    n_ctrl,
+    generalized_plant: ct.StateSpace | ct.TransferFunction,
+    n_meas: int,
+    n_ctrl: int,
     *,
-    regularize=False,
-    epsilon=1e-3,
-    suboptimality=0.0,
-    gamma_tol=1e-4,
-    rank_tol=1e-9,
-    axis_tol=1e-9,
-    decay_rate=0.0,
-    decay_states=None,
-):
+    regularize: bool = False,
+    epsilon: float = 1e-3,
+    suboptimality: float = 0.0,
+    gamma_tol: float = 1e-4,
+    rank_tol: float = 1e-9,
+    axis_tol: float = 1e-9,
+    decay_rate: float = 0.0,
+    decay_states: np.ndarray | None = None,
+) -> HinfResult:
     """γ-optimal H∞ controller for a general plant, closed by ``u = K·y``.
 
     Parameters
@@ -386,20 +386,20 @@ def _weight(W, name, n_in):
 
 
 def mixed_sensitivity(
-    plant,
-    w_s=None,
-    w_ks=None,
-    w_t=None,
+    plant: ct.StateSpace | ct.TransferFunction,
+    w_s: ct.LTI | float | None = None,
+    w_ks: ct.LTI | float | None = None,
+    w_t: ct.LTI | float | None = None,
     *,
-    regularize=False,
-    epsilon=1e-3,
-    shift=1e-4,
-    suboptimality=0.0,
-    gamma_tol=1e-4,
-    rank_tol=1e-9,
-    axis_tol=1e-9,
-    decay_rate=0.0,
-):
+    regularize: bool = False,
+    epsilon: float = 1e-3,
+    shift: float = 1e-4,
+    suboptimality: float = 0.0,
+    gamma_tol: float = 1e-4,
+    rank_tol: float = 1e-9,
+    axis_tol: float = 1e-9,
+    decay_rate: float = 0.0,
+) -> HinfResult:
     """Mixed-sensitivity H∞ design: minimise ‖[W_S·S; W_KS·K·S; W_T·T]‖∞.
 
     Feedback is negative, ``u = K·(r − y)``: ``L = G·K``, ``S = (I + L)⁻¹``, ``T = L·S``

@@ -8,6 +8,7 @@ solid = lower bound (the loop must pass above), dashed = upper bound (must pass 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_keywords
 from .bounds import Bounds
@@ -19,7 +20,7 @@ __all__ = ["draw", "loop_nichols", "m_contour", "plot_templates", "template_nich
 
 
 @renamed_keywords(omegas="omega")
-def loop_nichols(loop, omega, phase_window: tuple = (-360.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+def loop_nichols(loop: object, omega: ArrayLike, phase_window: tuple = (-360.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """Phase (degrees, unwrapped) and magnitude (dB) of a loop on the grid ``omega``.
 
     Parameters
@@ -70,7 +71,7 @@ def loop_nichols(loop, omega, phase_window: tuple = (-360.0, 0.0)) -> tuple[np.n
         return phase, 20 * np.log10(np.abs(L))
 
 
-def m_contour(m_db: float, phases_deg=None) -> tuple[np.ndarray, np.ndarray]:
+def m_contour(m_db: float, phases_deg: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Nichols curve of constant closed-loop gain |L/(1+L)| = M.
 
     For each phase φ the open-loop magnitude y solves y²(1 − M²) − 2M²cos(φ)·y − M² = 0
@@ -112,8 +113,9 @@ def _colours(n):
     return [cmap(i if n <= 10 else i / max(n - 1, 1)) for i in range(n)]
 
 
-def draw(bounds: Bounds | None, loop=None, ax=None, omega=None, m_contours_db=None,
-         xlim: tuple = (-360.0, 0.0), ylim: tuple | None = None, legend: bool = True):
+def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes | None" = None,
+         omega: ArrayLike | None = None, m_contours_db: ArrayLike | None = None, xlim: tuple = (-360.0, 0.0),
+         ylim: tuple | None = None, legend: bool = True) -> "matplotlib.axes.Axes":
     """Nichols chart of ``bounds`` and the nominal open loop ``loop`` = L0 = P0·G.
 
     Parameters
@@ -228,7 +230,8 @@ def template_nichols(template: Template) -> tuple[np.ndarray, np.ndarray]:
     return ph0 + np.degrees(np.angle(P / p0)), 20 * np.log10(np.abs(P))
 
 
-def plot_templates(template: Template, ax=None, legend: bool = True):
+def plot_templates(template: Template, ax: "matplotlib.axes.Axes | None" = None,
+                   legend: bool = True) -> "matplotlib.axes.Axes":
     """Templates on the Nichols plane: one colour per design frequency, nominal case boxed.
 
     Parameters

@@ -71,7 +71,8 @@ def _stable_unstable_split(sys, axis_tol):
     return (A11, Bs, Cs), (A22, Bu, Cu)
 
 
-def reduce(controller, order, method="balanced", *, axis_tol=1e-9):
+def reduce(controller: ct.StateSpace | ct.TransferFunction, order: int, method: str = "balanced", *,
+           axis_tol: float = 1e-9) -> ReductionResult:
     """Reduce a controller's order by balanced truncation of its stable part.
 
     The unstable (and marginal, e.g. integrator) part is kept exactly, so the error
@@ -149,7 +150,8 @@ def reduce(controller, order, method="balanced", *, axis_tol=1e-9):
 _DISCRETIZE = ("tustin", "zoh", "foh")
 
 
-def discretize(controller, dt, method="tustin", prewarp_frequency=None):
+def discretize(controller: ct.StateSpace | ct.TransferFunction, dt: float, method: str = "tustin",
+               prewarp_frequency: float | None = None) -> ct.StateSpace:
     """Discrete-time controller for implementation at sample time ``dt`` (s).
 
     Parameters

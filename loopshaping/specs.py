@@ -14,6 +14,7 @@ import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_keywords
 from .freqresp import evaluate, is_lti
@@ -111,7 +112,7 @@ class Spec:
             object.__setattr__(self, "name", self.kind)
 
     @renamed_keywords(omegas="omega")
-    def in_band(self, omega) -> np.ndarray:
+    def in_band(self, omega: ArrayLike) -> np.ndarray:
         """Where the spec applies.
 
         Parameters
@@ -130,7 +131,7 @@ class Spec:
         return (omega >= self.band[0]) & (omega <= self.band[1])
 
     @renamed_keywords(omegas="omega")
-    def weights(self, omega, n_cases, design=None) -> np.ndarray:
+    def weights(self, omega: ArrayLike, n_cases: int, design: ArrayLike | None = None) -> np.ndarray:
         """|W| at ``omega``; for tracking, the allowed ratio.
 
         Parameters
@@ -197,7 +198,7 @@ class Spec:
         return w
 
     @renamed_keywords(omegas="omega")
-    def coefficients(self, omega, plants, design=None):
+    def coefficients(self, omega: ArrayLike, plants: np.ndarray, design: ArrayLike | None = None) -> tuple:
         """General-form coefficients A, B, C, D at ``omega`` for the plant responses ``plants``.
 
         Parameters
@@ -283,7 +284,7 @@ def _static_gain(sys):
     return None
 
 
-def as_specs(specs) -> list:
+def as_specs(specs: "Bounds | Spec | Iterable[Spec]") -> list:
     """A Bounds (its specs), one Spec, or an iterable of Spec → a non-empty list of Spec.
 
     Parameters

@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import itertools
 import numbers
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_attribute, renamed_keywords
 from .freqresp import check_grid, evaluate, grid_indices
@@ -131,7 +133,7 @@ class Template:
         return np.concatenate([self.responses, ring.reshape(len(self.omega), -1)], axis=1)
 
     @renamed_keywords(omegas="omega")
-    def at(self, omega) -> Template:
+    def at(self, omega: ArrayLike) -> Template:
         """The template restricted to some of its design frequencies.
 
         Parameters
@@ -157,7 +159,7 @@ class Template:
     # -- constructors
     @classmethod
     @renamed_keywords(omegas="omega")
-    def from_responses(cls, omega, responses, nominal=0, disk_radius=None) -> Template:
+    def from_responses(cls, omega: ArrayLike, responses: ArrayLike, nominal: int = 0, disk_radius: ArrayLike | None = None) -> Template:
         """From frequency responses.
 
         Parameters
@@ -180,7 +182,7 @@ class Template:
 
     @classmethod
     @renamed_keywords(omegas="omega")
-    def from_systems(cls, systems, omega, nominal=0, disk_radius=None) -> Template:
+    def from_systems(cls, systems: Sequence, omega: ArrayLike, nominal: int = 0, disk_radius: ArrayLike | None = None) -> Template:
         """From SISO python-control LTI plant cases, evaluated at ``omega``.
 
         Parameters
@@ -214,8 +216,9 @@ class Template:
 
     @classmethod
     @renamed_keywords(omegas="omega")
-    def from_parameter_grid(cls, fn, ranges, omega, n=10, edges_only=False, nominal=None,
-                            disk_radius=None) -> Template:
+    def from_parameter_grid(cls, fn: Callable, ranges: dict, omega: ArrayLike, n: int | dict = 10,
+                            edges_only: bool = False, nominal: dict | None = None,
+                            disk_radius: ArrayLike | None = None) -> Template:
         """Grid a parameter box: ``fn(**params) -> LTI``, ``ranges = {name: (low, high)}``.
 
         ``n`` points per parameter (an int or ``{name: n}``), linearly spaced. With
@@ -287,7 +290,8 @@ class Template:
 
     @classmethod
     @renamed_keywords(omegas="omega")
-    def from_operating_points(cls, systems, omega, nominal=0, n_between=0, disk_radius=None) -> Template:
+    def from_operating_points(cls, systems: Sequence, omega: ArrayLike, nominal: int = 0, n_between: int = 0,
+                              disk_radius: ArrayLike | None = None) -> Template:
         """From linear models at neighbouring operating points (ordered, e.g. by wind speed).
 
         ``n_between`` extra cases are inserted between consecutive points as convex

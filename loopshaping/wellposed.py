@@ -50,7 +50,7 @@ def _on_axis(values, axis_tol):
 
 
 
-def shift_axis_poles(sys, epsilon: float, axis_tol: float) -> tuple:
+def shift_axis_poles(sys: ct.StateSpace, epsilon: float, axis_tol: float) -> tuple:
     """Move eigenvalues with |Re| ≤ tol to Re = −ε, leaving the others untouched.
 
     An ordered real Schur form puts those eigenvalues in the leading block; subtracting
@@ -90,7 +90,8 @@ def shift_axis_poles(sys, epsilon: float, axis_tol: float) -> tuple:
 
 
 
-def check_well_posed(generalized_plant, n_meas, n_ctrl, *, rank_tol=1e-9, axis_tol=1e-9):
+def check_well_posed(generalized_plant: ct.StateSpace | ct.TransferFunction, n_meas: int, n_ctrl: int, *,
+                     rank_tol: float = 1e-9, axis_tol: float = 1e-9) -> None:
     """Check SLICOT's assumptions (A1)–(A4) on a generalized plant; raise if one fails.
 
     Parameters
@@ -181,7 +182,7 @@ def check_well_posed(generalized_plant, n_meas, n_ctrl, *, rank_tol=1e-9, axis_t
         )
 
 
-def regularized_plant(P, n_meas: int, n_ctrl: int, epsilon: float, rank_tol: float) -> tuple:
+def regularized_plant(P: ct.StateSpace, n_meas: int, n_ctrl: int, epsilon: float, rank_tol: float) -> tuple:
     """Append ε·u to z where D12 lacks rank and ε·noise to y where D21 lacks rank.
 
     Parameters
