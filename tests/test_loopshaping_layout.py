@@ -139,3 +139,12 @@ def test_internal_callers_use_no_deprecated_form():
         from loopshaping.nichols import loop_nichols
 
         loop_nichols(1 / (s + 1), np.logspace(-1, 1, 5))
+
+
+def test_hf_omegas_and_omega_dense_keywords_are_deprecated():
+    from loopshaping import auto
+
+    with pytest.warns(DeprecationWarning, match="'hf_omega'"), pytest.raises(TypeError, match="Bounds"):
+        auto.shape("not bounds", hf_omegas=[100.0])
+    with pytest.warns(DeprecationWarning, match="'omega'"), pytest.raises(TypeError, match="Template"):
+        auto.refine("not a template", [], omega_dense=[1.0])
