@@ -31,9 +31,10 @@ predicts from the linear ρ's and ROSCO's measured nonlinear/linear DEL ratio g_
 Seeds are 1000, 1001, … (``--seeds`` of them): disjoint from the 0..199 used by the tests and
 benchmarks/acceptance.py, so this is an independent sample.
 
-The cost changes are experiments, not library features: they patch ``qft._Problem.cost``
-(a private method, with the private helpers ``qft._polys`` and ``_Problem._t``) inside a
-context manager that restores it, and nothing outside this script sees them.
+The cost changes are experiments, not library features: they patch
+``TuningProblem.objective`` (:mod:`specdesign.qft.tuner`, with ``controller_polys`` of
+:mod:`specdesign.qft.structure` and the private ``TuningProblem._t``) inside a context manager
+that restores it, and nothing outside this script sees them.
 
 Run:   python benchmarks/nonlinearity_designs.py                 # 60 seeds, 15 19 25 m/s (≈ 7 min, 2 cores)
        python benchmarks/nonlinearity_designs.py --quick         # 8 seeds, 19 m/s, smoke test (≈ 1 min)
@@ -49,6 +50,8 @@ import warnings
 import numpy as np
 
 from specdesign import qft, validate
+from specdesign.qft.structure import controller_polys
+from specdesign.qft.tuner import TuningProblem
 from specdesign.closedloop import siso_response
 from specdesign.simulate import scheduled
 from specdesign.turbine import iea15mw, rosco_baseline
@@ -64,26 +67,26 @@ SEED0 = 1000
 def extra_cost(term):
     """Add ``term(problem, x)`` to the QFT tuner's objective while the block runs.
 
-    Both the exploration's penalty cost and the polish use ``_Problem.objective``; the cost's
+    Both the exploration's penalty cost and the polish use ``TuningProblem.objective``; the cost's
     barrier values (≥ 1e10: unstable or not evaluable) come before the objective, so the extra
     term can never trade stability for anything.
     """
-    orig = qft._Problem.objective
+    orig = TuningProblem.objective
 
     def objective(self, x):
         extra = term(self, x)
         return float(orig(self, x) + extra) if np.isfinite(extra) else 1e12
 
-    qft._Problem.objective = objective
+    TuningProblem.objective = objective
     try:
         yield
     finally:
-        qft._Problem.objective = orig
+        TuningProblem.objective = orig
 
 
 def _tuner_rho(prob, x):
     """(ρ_total, ρ_low) of the candidate x on the tuner's grid, nominal plant (linear, |T|²S_W)."""
-    nb, db, na, da = qft._polys(x)
+    nb, db, na, da = controller_polys(x)
     s = 1j * prob.wf[:, None]
     c = np.polyval(nb, s) / np.polyval(db, s)
     k = np.polyval(na, s) / np.polyval(da, s)
@@ -120,7 +123,7 @@ def dc_gain_cost(w=100.0, omegas=(0.005, 0.01, 0.02, 0.03)):
     om = np.asarray(omegas, float)
 
     def term(prob, x):
-        nb, db, _, _ = qft._polys(x)
+        nb, db, _, _ = controller_polys(x)
         c = np.polyval(nb, 1j * om) / np.polyval(db, 1j * om)
         return w * float(np.sum(np.log(np.abs(c / siso_response(prob.rosco[prob.nom], om))) ** 2))
     return term

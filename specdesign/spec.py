@@ -8,23 +8,34 @@ change follows as DEL ratio = damage ratio^(1/m), reported beside it.
 
 Units: ω in rad/s, depths in dB (positive = attenuation), PSDs one-sided per rad/s.
 
-Typical use::
+Typical use:
 
-    base = baseline_analysis(model, 19.0)             # T_{MyT,w}, S_W, ΔD%(ω) at 19 m/s
-    res = shape_to_target(base, 15.0)                  # notches promising 15 % less damage
-    res.specification.tf()                             # W_MyT(s)
+>>> from specdesign.spec import baseline_analysis, shape_to_target
+>>> from specdesign.turbine import iea15mw
+>>> base = baseline_analysis(iea15mw(), 19.0)    # T_{MyT,w}, S_W, ΔD%(ω) at 19 m/s
+>>> res = shape_to_target(base, 15.0)            # notches promising 15 % less damage
+>>> w_myt = res.specification.tf()               # W_MyT(s)
 """
 from __future__ import annotations
 
+import math
 import warnings
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
 
 import control as ct
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import spectral
 from ._checks import as_omega, as_psd, positive_scalar
 from .closedloop import siso_response
+
+if TYPE_CHECKING:
+    from loopshaping.controller import Controller, Element
+
+    from .turbine import TurbineModel
 
 __all__ = [
     "Notch",
@@ -37,10 +48,13 @@ __all__ = [
     "ShapingResult",
     "baseline_analysis",
     "baseline_from_response",
-    "evaluate",
+    "promise_of",
     "shape_to_target",
     "speed_specification",
     "specification_table",
+    "DesignSpecifications",
+    "design_specifications",
+    "from_element",
 ]
 
 
@@ -60,6 +74,19 @@ class Notch:
     width : float
         Damping ratio ζ_p of the pole pair (dimensionless, 0 < width ≤ 2): the relative
         bandwidth of the notch; 0.1 is narrow, 0.7 wide. Unity gain at DC and at ∞.
+
+    Raises
+    ------
+    ValueError
+        If ``omega_n`` is not positive and finite, ``depth_db`` is not finite, or ``width``
+        is outside (0, 2].
+
+    Examples
+    --------
+    >>> from specdesign.spec import Notch
+    >>> n = Notch(1.0, 6.0, 0.2)         # 6 dB deep at 1 rad/s
+    >>> print(f"{n.zeta_zero:.4f} {abs(n.response([1.0])[0]):.4f}")
+    0.1002 0.5012
     """
 
     omega_n: float
@@ -75,34 +102,131 @@ class Notch:
 
     @property
     def zeta_zero(self) -> float:
+        """Damping ratio ζ_z = ζ_p·10^(−depth/20) of the zero pair (-)."""
         return self.width * 10 ** (-self.depth_db / 20)
 
     def tf(self) -> ct.TransferFunction:
+        """The notch N(s) as a transfer function.
+
+        Returns
+        -------
+        control.TransferFunction
+            N(s), dimensionless, s in rad/s.
+        """
         w = self.omega_n
         return ct.tf([1, 2 * self.zeta_zero * w, w * w], [1, 2 * self.width * w, w * w])
 
-    def response(self, omega: np.ndarray) -> np.ndarray:
+    def response(self, omega: ArrayLike) -> np.ndarray:
+        """N(jω) on a frequency grid.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s (any shape).
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex N(jω) (-), shaped like ``omega``.
+        """
         s = 1j * np.asarray(omega, dtype=float)
         w = self.omega_n
         return (s * s + 2 * self.zeta_zero * w * s + w * w) / (s * s + 2 * self.width * w * s + w * w)
 
+    def to_elements(self) -> tuple[Element, ...]:
+        """The same factor as :mod:`loopshaping.controller` elements: one ``notch``.
+
+        Returns
+        -------
+        tuple of loopshaping.controller.Element
+            One ``notch(omega_n, zeta_zero, width)``.
+        """
+        from loopshaping import controller as lc
+
+        return (lc.notch(self.omega_n, self.zeta_zero, self.width),)
+
 
 @dataclass(frozen=True)
 class Gain:
-    """Constant gain in dB (negative attenuates everywhere)."""
+    """Constant gain in dB (negative attenuates everywhere).
+
+    Parameters
+    ----------
+    gain_db : float
+        The gain, dB of the linear factor 10^(gain_db/20).
+
+    Examples
+    --------
+    >>> from specdesign.spec import Gain
+    >>> Gain(-6.0).response([0.1, 1.0]).real.round(3)
+    array([0.501, 0.501])
+    """
 
     gain_db: float
 
     def tf(self) -> ct.TransferFunction:
+        """The gain as a static transfer function.
+
+        Returns
+        -------
+        control.TransferFunction
+            10^(gain_db/20) (-).
+        """
         return ct.tf([10 ** (self.gain_db / 20)], [1])
 
-    def response(self, omega):
+    def response(self, omega: ArrayLike) -> np.ndarray:
+        """The gain's response on a frequency grid.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s (any shape).
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex 10^(gain_db/20) (-), shaped like ``omega``.
+        """
         return np.full(np.shape(omega), 10 ** (self.gain_db / 20), dtype=complex)
+
+    def to_elements(self) -> tuple[Element, ...]:
+        """The same factor as :mod:`loopshaping.controller` elements: one ``gain`` (linear).
+
+        Returns
+        -------
+        tuple of loopshaping.controller.Element
+            One ``gain(10^(gain_db/20))``.
+        """
+        from loopshaping import controller as lc
+
+        return (lc.gain(10 ** (self.gain_db / 20)),)
 
 
 @dataclass(frozen=True)
 class LeadLag:
-    """(1 + s/ω_z) / (1 + s/ω_p): lead if ω_z < ω_p, lag otherwise. Frequencies in rad/s."""
+    """Lead-lag (1 + s/ω_z) / (1 + s/ω_p): lead if ω_z < ω_p, lag otherwise.
+
+    Unity gain at DC, ω_p/ω_z at high frequency.
+
+    Parameters
+    ----------
+    omega_zero : float
+        Zero frequency ω_z, rad/s (> 0).
+    omega_pole : float
+        Pole frequency ω_p, rad/s (> 0).
+
+    Raises
+    ------
+    ValueError
+        If a frequency is not positive and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.spec import LeadLag
+    >>> np.abs(LeadLag(1.0, 10.0).response([0.0, 1e3])).round(2)   # +20 dB at high ω
+    array([ 1., 10.])
+    """
 
     omega_zero: float
     omega_pole: float
@@ -111,17 +235,68 @@ class LeadLag:
         positive_scalar(self.omega_zero, "LeadLag.omega_zero (rad/s)")
         positive_scalar(self.omega_pole, "LeadLag.omega_pole (rad/s)")
 
-    def tf(self):
+    def tf(self) -> ct.TransferFunction:
+        """The lead-lag as a transfer function.
+
+        Returns
+        -------
+        control.TransferFunction
+            (1 + s/ω_z) / (1 + s/ω_p) (-).
+        """
         return ct.tf([1 / self.omega_zero, 1], [1 / self.omega_pole, 1])
 
-    def response(self, omega):
+    def response(self, omega: ArrayLike) -> np.ndarray:
+        """The lead-lag's response on a frequency grid.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s (any shape).
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex (1 + jω/ω_z) / (1 + jω/ω_p) (-), shaped like ``omega``.
+        """
         s = 1j * np.asarray(omega, dtype=float)
         return (1 + s / self.omega_zero) / (1 + s / self.omega_pole)
+
+    def to_elements(self) -> tuple[Element, ...]:
+        """The same factor as :mod:`loopshaping.controller` elements: one ``lead_lag``.
+
+        Returns
+        -------
+        tuple of loopshaping.controller.Element
+            One ``lead_lag(omega_zero, omega_pole)``.
+        """
+        from loopshaping import controller as lc
+
+        return (lc.lead_lag(self.omega_zero, self.omega_pole),)
 
 
 @dataclass(frozen=True)
 class LowPass:
-    """Second-order low-pass ω_c² / (s² + 2ζ ω_c s + ω_c²), ω_c in rad/s."""
+    """Second-order low-pass ω_c² / (s² + 2ζ ω_c s + ω_c²), unity gain at DC.
+
+    Parameters
+    ----------
+    omega_c : float
+        Corner (natural) frequency ω_c, rad/s (> 0).
+    zeta : float
+        Damping ratio ζ of the pole pair (-, > 0).
+
+    Raises
+    ------
+    ValueError
+        If ``omega_c`` or ``zeta`` is not positive and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.spec import LowPass
+    >>> np.abs(LowPass(2.0, 0.7).response([0.0, 2.0])).round(4)   # 1/(2ζ) at ω_c
+    array([1.    , 0.7143])
+    """
 
     omega_c: float
     zeta: float = 0.7
@@ -130,25 +305,129 @@ class LowPass:
         positive_scalar(self.omega_c, "LowPass.omega_c (rad/s)")
         positive_scalar(self.zeta, "LowPass.zeta")
 
-    def tf(self):
+    def tf(self) -> ct.TransferFunction:
+        """The low-pass as a transfer function.
+
+        Returns
+        -------
+        control.TransferFunction
+            ω_c² / (s² + 2ζ ω_c s + ω_c²) (-).
+        """
         w = self.omega_c
         return ct.tf([w * w], [1, 2 * self.zeta * w, w * w])
 
-    def response(self, omega):
+    def response(self, omega: ArrayLike) -> np.ndarray:
+        """The low-pass's response on a frequency grid.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s (any shape).
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex response (-), shaped like ``omega``.
+        """
         s = 1j * np.asarray(omega, dtype=float)
         w = self.omega_c
         return w * w / (s * s + 2 * self.zeta * w * s + w * w)
+
+    def to_elements(self) -> tuple[Element, ...]:
+        """The same factor as :mod:`loopshaping.controller` elements, unity gain at DC.
+
+        Returns
+        -------
+        tuple of loopshaping.controller.Element
+            A ``complex_pole`` (ζ < 1) or two ``real_pole`` at ω_c(ζ ± √(ζ² − 1)) (ζ ≥ 1).
+        """
+        from loopshaping import controller as lc
+
+        if self.zeta < 1:
+            return (lc.complex_pole(self.omega_c, self.zeta),)
+        r = math.sqrt(self.zeta ** 2 - 1)
+        return (lc.real_pole(self.omega_c * (self.zeta - r)), lc.real_pole(self.omega_c * (self.zeta + r)))
 
 
 _ELEMENTS = (Notch, Gain, LeadLag, LowPass)
 
 
+def from_element(element: Element) -> Gain | LeadLag | Notch | LowPass:
+    """The shaping element equal to one :class:`loopshaping.controller.Element`.
+
+    Parameters
+    ----------
+    element : loopshaping.controller.Element
+        A ``gain`` (> 0), ``lead_lag``, ``notch`` (ζ_z ≤ ζ_p: an attenuation) or
+        ``complex_pole`` (a unity-DC-gain low-pass).
+
+    Returns
+    -------
+    Gain, LeadLag, Notch or LowPass
+        The specification element with the same frequency response.
+
+    Raises
+    ------
+    TypeError
+        If ``element`` is not a :class:`loopshaping.controller.Element`.
+    ValueError
+        For an element with no specification counterpart (integrators, differentiators,
+        real or right-half-plane poles and zeros, a negative gain): a specification is a
+        stable, minimum-phase reshaping of the baseline.
+
+    Examples
+    --------
+    >>> from loopshaping import controller as lc
+    >>> from specdesign.spec import from_element
+    >>> from_element(lc.notch(1.0, 0.05, 0.2))       # ζ_z/ζ_p = 1/4: 12 dB deep
+    Notch(omega_n=1.0, depth_db=12.041199826559248, width=0.2)
+    """
+    from loopshaping.controller import Element
+
+    if not isinstance(element, Element):
+        raise TypeError(f"element must be a loopshaping.controller.Element, got {type(element).__name__}")
+    k, p = element.kind, element.params
+    if k == "gain" and p["k"] > 0:
+        return Gain(20 * math.log10(p["k"]))
+    if k == "lead_lag":
+        return LeadLag(p["zero"], p["pole"])
+    if k == "notch" and 0 < p["zeta_zero"] <= p["zeta_pole"] <= 2:
+        return Notch(p["omega"], -20 * math.log10(p["zeta_zero"] / p["zeta_pole"]), p["zeta_pole"])
+    if k == "complex_pole" and p["zeta"] > 0:
+        return LowPass(p["omega"], p["zeta"])
+    raise ValueError(f"a loopshaping {element} has no specification element: a specification takes positive gains, "
+                     "lead-lags, notches (0 < ζ_z ≤ ζ_p ≤ 2) and stable complex poles (low-pass)")
+
+
 @dataclass(frozen=True)
 class Specification:
-    """W_y(s) = baseline(s) × Π elements(s).
+    """A specification W_y(s) = baseline(s) × Π elements(s).
 
-    ``baseline`` is the closed-loop map wind → y of the baseline controller (a SISO
-    python-control LTI); ``elements`` a tuple of shaping elements (:class:`Notch`, ...).
+    Parameters
+    ----------
+    baseline : control.LTI
+        The closed-loop map wind (m/s) → y of the baseline controller: a SISO, proper,
+        stable python-control LTI, in output units per m/s (e.g. ``closed_loop(...)[y, "wind"]``).
+    elements : tuple
+        Shaping elements (:class:`Notch`, :class:`Gain`, :class:`LeadLag`, :class:`LowPass`),
+        dimensionless factors.
+    name : str
+        Name of the specification (e.g. ``W_tower_base_my``).
+
+    Raises
+    ------
+    TypeError
+        If ``baseline`` is not an LTI system, or an element is not a shaping element.
+    ValueError
+        If ``baseline`` is not SISO, is improper, or is unstable.
+
+    Examples
+    --------
+    >>> import control
+    >>> from specdesign.spec import Notch, Specification
+    >>> w = Specification(control.tf([1.0], [1.0, 1.0]), (Notch(1.0, 6.0, 0.2),))
+    >>> print(f"{abs(w.response([1.0])[0]):.4f}")       # |1/(j+1)| × 10^(-6/20)
+    0.3544
     """
 
     baseline: object
@@ -166,32 +445,121 @@ class Specification:
             if not isinstance(e, _ELEMENTS):
                 raise TypeError(f"elements[{i}] must be one of {[c.__name__ for c in _ELEMENTS]}, got {type(e).__name__}")
 
-    def shaping(self, omega) -> np.ndarray:
-        """Product of the elements' responses on ω (rad/s), complex."""
+    def shaping(self, omega: ArrayLike) -> np.ndarray:
+        """Product of the elements' responses, W_y/baseline, on a frequency grid.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s.
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex Π elements(jω) (-), shaped like ``omega``.
+        """
         out = np.ones(np.shape(omega), dtype=complex)
         for e in self.elements:
             out = out * e.response(omega)
         return out
 
-    def response(self, omega) -> np.ndarray:
-        """W_y(jω) on the grid ω (rad/s), complex."""
+    def response(self, omega: ArrayLike) -> np.ndarray:
+        """W_y(jω) on a frequency grid.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s.
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex W_y(jω), output units per m/s, shaped like ``omega``.
+        """
         omega = np.asarray(omega, dtype=float)
         return siso_response(self.baseline, omega, "baseline") * self.shaping(omega)
 
-    def magnitude(self, omega) -> np.ndarray:
+    def magnitude(self, omega: ArrayLike) -> np.ndarray:
+        """|W_y(jω)| on a frequency grid.
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s.
+
+        Returns
+        -------
+        numpy.ndarray
+            |W_y(jω)|, output units per m/s (linear, not dB).
+        """
         return np.abs(self.response(omega))
 
     def tf(self) -> ct.TransferFunction:
-        """W_y(s) as a transfer function (minimal realisation of the product)."""
+        """W_y(s) as a transfer function (minimal realisation of the product).
+
+        Returns
+        -------
+        control.TransferFunction
+            W_y(s), output units per m/s.
+        """
         w = ct.tf(self.baseline)
         for e in self.elements:
             w = w * e.tf()
         return ct.minreal(w, verbose=False)
 
-    def add(self, element) -> "Specification":
+    def add(self, element: Notch | Gain | LeadLag | LowPass) -> "Specification":
+        """A copy with one more shaping element.
+
+        Parameters
+        ----------
+        element : Notch, Gain, LeadLag or LowPass
+            The element appended to :attr:`elements`.
+
+        Returns
+        -------
+        Specification
+            The new specification (this one is unchanged).
+
+        Raises
+        ------
+        TypeError
+            If ``element`` is not a shaping element.
+        """
         return replace(self, elements=self.elements + (element,))
 
-    def with_elements(self, elements) -> "Specification":
+    def shaping_controller(self) -> Controller:
+        """The shaping Π elements(s) as a :class:`loopshaping.controller.Controller`.
+
+        That is the vocabulary a controller is edited in (gains, lead-lags, notches, poles),
+        so a specification and a controller can be shaped, plotted and saved alike.
+
+        Returns
+        -------
+        loopshaping.controller.Controller
+            The elements' product (-), without the baseline.
+        """
+        from loopshaping.controller import Controller
+
+        return Controller(tuple(x for e in self.elements for x in e.to_elements()))
+
+    def with_elements(self, elements: Iterable) -> "Specification":
+        """A copy with the shaping elements replaced.
+
+        Parameters
+        ----------
+        elements : iterable
+            The new shaping elements (:class:`Notch`, :class:`Gain`, ...).
+
+        Returns
+        -------
+        Specification
+            The new specification (this one is unchanged).
+
+        Raises
+        ------
+        TypeError
+            If an element is not a shaping element.
+        """
         return replace(self, elements=tuple(elements))
 
 
@@ -213,10 +581,37 @@ def _check_proper_stable(sys, name):
 class Baseline:
     """The baseline loop seen by one output: everything Eq. (7) and Eq. (10) need.
 
-    omega (rad/s), t_response = T_{y,w}(jω), s_wind = S_W(ω) (one-sided, (m/s)²/(rad/s)),
-    psd = |T|² S_W, damage_rate (1/s, S-N with S_ref = 1 in the output's units),
-    sensitivity = ΔD%(ω) per 1 % reduction of S_y at each grid point (computed with a finite
-    step ``reduction``), m (Wöhler exponent, range-based S-N), method (damage method name).
+    Made by :func:`baseline_analysis` or :func:`baseline_from_response`.
+
+    Parameters
+    ----------
+    omega : numpy.ndarray
+        Frequency grid, rad/s.
+    t_response : numpy.ndarray
+        Complex T_{y,w}(jω) on ``omega``, output units per m/s.
+    s_wind : numpy.ndarray
+        Wind PSD S_W(ω), one-sided, (m/s)² per rad/s.
+    psd : numpy.ndarray
+        Output PSD |T|² S_W, one-sided, output units² per rad/s.
+    damage_rate : float
+        Damage rate, 1/s (S-N curve with S_ref = 1 in the output's units).
+    sensitivity : numpy.ndarray
+        ΔD%(ω): % damage change per 1 % reduction of S_y at each grid point (computed with a
+        finite step ``reduction``).
+    m : float
+        Wöhler exponent (-), range-based S-N curve.
+    method : str
+        Damage method name (:func:`specdesign.spectral.damage_rate`).
+    reduction : float
+        Finite relative step of the sensitivity (-; 0.01 is 1 %).
+    system : control.LTI, optional
+        T_{y,w}(s) as a system, when known (needed for a :class:`Specification`).
+    output : str
+        Name of the output y.
+    wind_speed : float
+        Operating point, m/s (nan when unknown).
+    extras : dict
+        Free-form extra data.
     """
 
     omega: np.ndarray
@@ -235,12 +630,60 @@ class Baseline:
 
     @property
     def del_1hz(self) -> float:
-        """DEL at 1 Hz of the baseline output, in the output's units."""
+        """DEL at 1 Hz of the baseline output, a range in the output's units (N·m for MyT)."""
         return float(self.damage_rate ** (1.0 / self.m))
 
 
-def baseline_from_response(omega, t_response, s_wind, m=4.0, *, method="dirlik", reduction=0.01, system=None, output="", wind_speed=float("nan")) -> Baseline:
-    """Baseline from a closed-loop frequency response T(jω) and an input spectrum S_W(ω)."""
+def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, s_wind: ArrayLike, m: float = 4.0, *,
+                           method: str = "dirlik", reduction: float = 0.01, system: ct.LTI | None = None,
+                           output: str = "", wind_speed: float = float("nan")) -> Baseline:
+    """Baseline from a closed-loop frequency response T(jω) and an input spectrum S_W(ω).
+
+    Parameters
+    ----------
+    omega : array_like
+        Frequencies, rad/s: 1-D, increasing, non-negative.
+    t_response : array_like
+        Complex T_{y,w}(jω) on ``omega``, output units per m/s.
+    s_wind : array_like
+        One-sided wind PSD S_W on ``omega``, (m/s)² per rad/s.
+    m : float
+        Wöhler exponent (-), range-based S-N curve.
+    method : str
+        Damage method (:func:`specdesign.spectral.damage_rate`).
+    reduction : float
+        Finite relative step of ΔD% (-); the result is rescaled to "per 1 %" (Eq. 10).
+    system : control.LTI, optional
+        T_{y,w}(s) as a system, kept in :attr:`Baseline.system`.
+    output : str
+        Name of the output y.
+    wind_speed : float
+        Operating point, m/s (informative).
+
+    Returns
+    -------
+    Baseline
+        T, S_W, S_y = |T|² S_W, the damage rate and ΔD%(ω).
+
+    Raises
+    ------
+    TypeError
+        If ``omega`` or ``s_wind`` is complex.
+    ValueError
+        If ``omega`` is not a valid grid, ``t_response`` or ``s_wind`` does not match it,
+        ``s_wind`` is negative or non-finite, or the output spectrum carries no damage.
+
+    Examples
+    --------
+    A lightly damped mode at 1 rad/s driven by white wind:
+
+    >>> import numpy as np
+    >>> from specdesign.spec import baseline_from_response
+    >>> omega = np.linspace(0.0, 2.0, 201)                         # rad/s
+    >>> base = baseline_from_response(omega, 1 / (1 - omega**2 + 0.2j * omega), np.ones_like(omega))
+    >>> print(f"{base.del_1hz:.3f}")
+    5.758
+    """
     omega = as_omega(omega)
     t_response = np.asarray(t_response, dtype=complex)
     if t_response.shape != omega.shape:
@@ -256,15 +699,74 @@ def baseline_from_response(omega, t_response, s_wind, m=4.0, *, method="dirlik",
 
 
 def default_omega(n: int = 400, lo: float = 0.01, hi: float = 10.0) -> np.ndarray:
-    """Log-spaced design grid in rad/s (covers the wind band, the tower mode and 3P)."""
+    """Log-spaced design grid in rad/s (covers the wind band, the tower mode and 3P).
+
+    Parameters
+    ----------
+    n : int
+        Number of points.
+    lo : float
+        First frequency, rad/s.
+    hi : float
+        Last frequency, rad/s.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``n`` log-spaced frequencies from ``lo`` to ``hi``, rad/s.
+    """
     return np.logspace(np.log10(lo), np.log10(hi), n)
 
 
-def baseline_analysis(model, wind_speed, output="tower_base_my", *, m=4.0, omega=None, controller=None, turbulence_class="B", method="dirlik", reduction=0.01) -> Baseline:
-    """ΔD%(ω) of the baseline closed loop of ``model`` at ``wind_speed`` (m/s) for ``output``.
+def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tower_base_my", *, m: float = 4.0,
+                      omega: ArrayLike | None = None, controller: ct.LTI | None = None, turbulence_class: str = "B",
+                      method: str = "dirlik", reduction: float = 0.01) -> Baseline:
+    """ΔD%(ω) of the baseline closed loop of ``model`` at ``wind_speed`` for ``output``.
 
     The baseline controller is ROSCO's PI (tower damping off) unless ``controller`` is given;
     the disturbance is the rotor-effective wind spectrum (IEC NTM ``turbulence_class``).
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine (its ``linearize`` and ``rotor_radius``).
+    wind_speed : float
+        Operating point, m/s.
+    output : str
+        Plant output y (``tower_base_my``, N·m, by default; ``gen_speed``, rad/s, ...).
+    m : float
+        Wöhler exponent (-), range-based S-N curve.
+    omega : array_like, optional
+        Frequency grid, rad/s, positive (default :func:`default_omega`: 400 points, 0.01-10).
+    controller : control.LTI, optional
+        Pitch controller C_β (rad per rad/s, β = −C_β·Ω_g); default ROSCO's PI
+        (:func:`specdesign.rosco.rosco_baseline`).
+    turbulence_class : str
+        IEC turbulence class of the wind spectrum ("A", "B", "C", ...).
+    method : str
+        Damage method (:func:`specdesign.spectral.damage_rate`).
+    reduction : float
+        Finite relative step of ΔD% (-).
+
+    Returns
+    -------
+    Baseline
+        The baseline loop's T_{y,w}, S_W, S_y, damage rate and ΔD%(ω), with the closed-loop
+        system in :attr:`Baseline.system`.
+
+    Raises
+    ------
+    ValueError
+        If ``omega`` is not a valid positive grid, ``output`` is not a plant output, or the
+        output spectrum carries no damage.
+
+    Examples
+    --------
+    >>> from specdesign.spec import baseline_analysis
+    >>> from specdesign.turbine import iea15mw
+    >>> base = baseline_analysis(iea15mw(), 19.0)
+    >>> print(f"{base.output}: DEL {base.del_1hz / 1e6:.1f} MN·m, ΣΔD% = {base.sensitivity.sum():.2f}")
+    tower_base_my: DEL 32.2 MN·m, ΣΔD% = 2.00
     """
     from . import closedloop, turbine, wind
 
@@ -282,8 +784,18 @@ def baseline_analysis(model, wind_speed, output="tower_base_my", *, m=4.0, omega
 class Promise:
     """What a specification promises against its baseline (all in %, positive = less fatigue).
 
-    ``predicted_damage``: Eq. (10), linear in the spectral change; ``exact_damage``: Dirlik
-    on |W|² S_W; the DEL reductions follow from DEL ratio = damage ratio^(1/m).
+    The DEL reductions follow from DEL ratio = damage ratio^(1/m).
+
+    Parameters
+    ----------
+    predicted_damage : float
+        Damage reduction by Eq. (10), linear in the spectral change, %.
+    exact_damage : float
+        Damage reduction by the damage method (Dirlik) on |W|² S_W, %.
+    predicted_del : float
+        DEL reduction from ``predicted_damage``, %.
+    exact_del : float
+        DEL reduction from ``exact_damage``, %.
     """
 
     predicted_damage: float
@@ -293,15 +805,40 @@ class Promise:
 
     @property
     def linearisation_error(self) -> float:
-        """Eq. (10) minus exact, percentage points of damage."""
+        """Eq. (10) minus exact damage reduction, percentage points."""
         return self.predicted_damage - self.exact_damage
 
 
-def evaluate(spec_or_shaping, base: Baseline) -> Promise:
+def promise_of(spec_or_shaping: Specification | ArrayLike, base: Baseline) -> Promise:
     """Promised fatigue reduction of a specification (or a shaping response) vs ``base``.
 
-    ``spec_or_shaping`` is a :class:`Specification` (W_y on ``base.omega``) or a complex /
-    real array of the shaping |W_y|/|T| on the baseline grid.
+    Parameters
+    ----------
+    spec_or_shaping : Specification or array_like
+        A :class:`Specification` (evaluated on ``base.omega``), or a complex / real array of
+        the shaping W_y/T (-) on the baseline grid.
+    base : Baseline
+        The baseline (:func:`baseline_analysis`).
+
+    Returns
+    -------
+    Promise
+        Damage and DEL reductions, % (Eq. 10 and exact).
+
+    Raises
+    ------
+    ValueError
+        If a notch of the specification lies outside the baseline grid, or the shaping array
+        does not have the grid's shape.
+
+    Examples
+    --------
+    >>> from specdesign.spec import Notch, baseline_analysis, promise_of
+    >>> from specdesign.turbine import iea15mw
+    >>> base = baseline_analysis(iea15mw(), 19.0)
+    >>> p = promise_of(Notch(1.0, 6.0, 0.2).response(base.omega), base)
+    >>> print(f"damage −{p.exact_damage:.1f} % (Eq. 10: −{p.predicted_damage:.1f} %), DEL −{p.exact_del:.2f} %")
+    damage −28.4 % (Eq. 10: −30.1 %), DEL −8.01 %
     """
     if isinstance(spec_or_shaping, Specification):
         for e in spec_or_shaping.elements:
@@ -335,9 +872,22 @@ def _promise(base: Baseline, ratio: np.ndarray) -> Promise:
 class ShapingResult:
     """Outcome of :func:`shape_to_target`.
 
-    ``specification`` (None when no system is attached to the baseline), ``notches``,
-    ``promise`` (exact and Eq. 10), ``target`` and ``quantity`` ("damage" or "del"),
-    ``success`` and a human-readable ``message`` saying why not when it failed.
+    Parameters
+    ----------
+    notches : tuple of Notch
+        The notches placed.
+    promise : Promise
+        Their promise against the baseline (exact and Eq. 10), %.
+    target : float
+        The requested reduction, %.
+    quantity : {"damage", "del"}
+        What the target is a reduction of.
+    success : bool
+        Whether the target was reached (within the tolerance).
+    message : str
+        Human-readable outcome, saying why not when it failed.
+    specification : Specification or None
+        Baseline × notches; None when no system is attached to the baseline.
     """
 
     notches: tuple
@@ -350,6 +900,7 @@ class ShapingResult:
 
     @property
     def reached(self) -> float:
+        """The exact reduction reached of ``quantity`` (damage or DEL), %."""
         return self.promise.exact_damage if self.quantity == "damage" else self.promise.exact_del
 
 
@@ -362,8 +913,15 @@ def _notch_mag2(omega, params):
     return np.prod(np.abs(n) ** 2, axis=0)
 
 
-def shape_to_target(base: Baseline, target_reduction: float, *, quantity="damage", keep_below=0.6, n_notches=None, max_notches=3, max_depth_db=30.0, width_range=(0.05, 0.8), tolerance=0.5) -> ShapingResult:
+def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", keep_below: float = 0.6,
+                    n_notches: int | None = None, max_notches: int = 3, max_depth_db: float = 30.0,
+                    width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5) -> ShapingResult:
     """Place and size notches where ΔD% is largest above ``keep_below`` to reach a target.
+
+    The problem solved (scipy SLSQP, exact Dirlik in the constraint): minimise the mean
+    squared log-magnitude change of the specification, Σ_k w_k (20 log10 |N(jω_k)|)², with
+    w_k = 1 above ``keep_below`` and 100 below, subject to reduction ≥ target. Notch centres
+    are seeded at the largest ΔD% peaks above ``keep_below``.
 
     Parameters
     ----------
@@ -378,12 +936,43 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity="damage
         alone (their effect below it is penalised heavily and the notch centres stay above).
     n_notches : int, optional
         Fixed number of notches; by default 1, 2, ... up to ``max_notches`` until reached.
+    max_notches : int
+        Most notches tried (and most candidate centres seeded).
+    max_depth_db : float
+        Deepest notch allowed, dB.
+    width_range : (float, float)
+        Bounds of the notch width ζ_p (-).
     tolerance : float
         Accepted shortfall, percentage points.
 
-    The problem solved (scipy SLSQP, exact Dirlik in the constraint): minimise the mean
-    squared log-magnitude change of the specification, Σ_k w_k (20 log10 |N(jω_k)|)², with
-    w_k = 1 above ``keep_below`` and 100 below, subject to reduction ≥ target.
+    Returns
+    -------
+    ShapingResult
+        The notches, their promise, whether the target was reached and the specification
+        (baseline × notches, when the baseline has a system).
+
+    Raises
+    ------
+    TypeError
+        If ``base`` is not a :class:`Baseline`.
+    ValueError
+        If ``quantity`` is unknown, ``target_reduction`` is not in (0, 100), ``keep_below``
+        lies outside the grid, or no grid frequency lies above ``keep_below``.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the target cannot be reached (the result then has ``success=False`` and says why).
+
+    Examples
+    --------
+    >>> from specdesign.spec import baseline_analysis, shape_to_target
+    >>> from specdesign.turbine import iea15mw
+    >>> res = shape_to_target(baseline_analysis(iea15mw(), 19.0), 15.0)
+    >>> res.message
+    'reached 15.00 % damage reduction (target 15.00 %) with 1 notch(es)'
+    >>> print(f"{res.notches[0].omega_n:.2f} rad/s")
+    1.02 rad/s
     """
     from scipy.optimize import minimize
 
@@ -468,8 +1057,33 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity="damage
     return ShapingResult(notches, promise, t, quantity, bool(success), message, spec)
 
 
-def speed_specification(model, wind_speed, *, margin_db=0.0, controller=None):
-    """Generator-speed specification: the baseline's T_{Ω,w}, optionally relaxed by ``margin_db``."""
+def speed_specification(model: TurbineModel, wind_speed: float, *, margin_db: float = 0.0,
+                        controller: ct.LTI | None = None) -> Specification:
+    """Generator-speed specification: the baseline's T_{Ω,w}, optionally relaxed by ``margin_db``.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    margin_db : float
+        Relaxation, dB (a :class:`Gain`; 0 for none).
+    controller : control.LTI, optional
+        Baseline pitch controller C_β (rad per rad/s); default ROSCO's PI.
+
+    Returns
+    -------
+    Specification
+        W_Ω = T_{Ω,w}·10^(margin_db/20), (rad/s) per (m/s), named ``W_gen_speed``.
+
+    Examples
+    --------
+    >>> from specdesign.spec import speed_specification
+    >>> from specdesign.turbine import iea15mw
+    >>> speed_specification(iea15mw(), 19.0, margin_db=3.0).elements
+    (Gain(gain_db=3.0),)
+    """
     from . import closedloop, turbine
 
     plant = model.linearize(wind_speed)
@@ -479,11 +1093,29 @@ def speed_specification(model, wind_speed, *, margin_db=0.0, controller=None):
     return Specification(cl["gen_speed", "wind"], elements, name="W_gen_speed")
 
 
-def specification_table(model, wind_speeds=(15, 17, 19, 21, 23, 25), target_reduction=15.0, **kwargs):
+def specification_table(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
+                        target_reduction: float = 15.0, **kwargs: Any) -> list[dict]:
     """The "Specifications" row of the paper's Table 3: promised reduction per wind speed.
 
-    Returns a list of dicts (wind_speed m/s, notches, promised damage and DEL reduction %,
-    Eq. 10 prediction %, success) — one per wind speed.
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speeds : sequence of float
+        Operating points, m/s.
+    target_reduction : float
+        Damage (or DEL) reduction the notches should promise, %.
+    **kwargs : dict, optional
+        :func:`shape_to_target` options (``quantity``, ``keep_below``, ``n_notches``,
+        ``max_notches``, ``max_depth_db``, ``width_range``, ``tolerance``); the rest go to
+        :func:`baseline_analysis`.
+
+    Returns
+    -------
+    list of dict
+        One per wind speed: ``wind_speed`` (m/s), ``notches``, ``promised_damage_pct`` and
+        ``promised_del_pct`` (exact, %), ``eq10_damage_pct`` (%), ``success`` and the
+        :class:`ShapingResult` as ``result``. Shortfall warnings are suppressed: see ``success``.
     """
     rows = []
     shape_kw = {k: kwargs.pop(k) for k in list(kwargs) if k in ("quantity", "keep_below", "n_notches", "max_notches", "max_depth_db", "width_range", "tolerance")}
@@ -504,3 +1136,106 @@ def specification_table(model, wind_speeds=(15, 17, 19, 21, 23, 25), target_redu
             }
         )
     return rows
+
+
+@dataclass(frozen=True)
+class DesignSpecifications:
+    """The specifications a controller design at one operating point is given.
+
+    Made by :func:`design_specifications`.
+
+    Parameters
+    ----------
+    base : Baseline
+        ROSCO's loop at the operating point (T_{MyT,w}, S_W, ΔD%).
+    shaping : ShapingResult
+        The notches of :func:`shape_to_target` and their promise (the unrelaxed notch
+        specification, what the paper's Table 3 lists).
+    tower : Specification
+        W_MyT: the notch specification × the high-frequency relaxation (two leads).
+    speed : Specification
+        W_Ω: ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``.
+    """
+
+    base: Baseline
+    shaping: ShapingResult
+    tower: Specification
+    speed: Specification
+
+
+def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
+                          spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
+                          keep_below: float = 0.6, m: float = 4.0,
+                          omega: ArrayLike | None = None) -> DesignSpecifications:
+    """The tower-load and generator-speed specifications that QFT and H∞ designs are given.
+
+    Tower load: W_MyT = T^ROSCO_{MyT,w} × the notches of :func:`shape_to_target`
+    (``spec_reduction`` % damage, notches above ``keep_below`` rad/s) × two leads
+    (1 + s/ω_r)/(1 + s/(ω_r·10^(tower_relax_db/40))), ω_r = ``tower_relax_omega``: the spec is
+    relaxed by ``tower_relax_db`` at high frequency, where ΔD% is negligible. Generator speed:
+    W_Ω = T^ROSCO_{Ω,w}·10^(speed_relax_db/20) (:func:`speed_specification`).
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    speed_relax_db : float
+        Relaxation of the generator-speed specification, dB (≥ 0).
+    spec_reduction : float
+        Damage reduction the notches promise, %.
+    tower_relax_db : float
+        High-frequency relaxation of the tower specification, dB (≥ 0; 0 for none).
+    tower_relax_omega : float
+        Corner of the relaxation, rad/s.
+    keep_below : float
+        No notch below this frequency, rad/s.
+    m : float
+        Wöhler exponent of the tower-base S-N curve (-).
+    omega : array_like, optional
+        Frequency grid of the baseline analysis, rad/s (default :func:`default_omega`).
+
+    Returns
+    -------
+    DesignSpecifications
+        The baseline, the shaping and both specifications.
+
+    Raises
+    ------
+    ValueError
+        For a negative or non-finite relaxation or a non-positive corner frequency.
+
+    Examples
+    --------
+    >>> from specdesign.spec import design_specifications
+    >>> from specdesign.turbine import iea15mw
+    >>> ds = design_specifications(iea15mw(), 19.0)
+    >>> ds.tower.name, len(ds.tower.elements), ds.speed.elements
+    ('W_tower_base_my', 3, (Gain(gain_db=4.5),))
+    """
+    for k, v in (("speed_relax_db", speed_relax_db), ("tower_relax_db", tower_relax_db)):
+        if not (np.isfinite(v) and v >= 0):
+            raise ValueError(f"{k}={v!r} must be a finite relaxation ≥ 0 dB")
+    positive_scalar(tower_relax_omega, "tower_relax_omega")
+    v = float(wind_speed)
+    base = baseline_analysis(model, v, m=m, omega=omega)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        shaping = shape_to_target(base, spec_reduction, keep_below=keep_below)
+    relax = ()
+    if tower_relax_db > 0:
+        half = tower_relax_db / 2
+        relax = (LeadLag(tower_relax_omega, tower_relax_omega * 10 ** (half / 20)),) * 2
+    tower = Specification(base.system, tuple(shaping.notches) + relax, name="W_tower_base_my")
+    speed = speed_specification(model, v, margin_db=float(speed_relax_db))
+    return DesignSpecifications(base, shaping, tower, speed)
+
+
+def __getattr__(name):
+    # spec.evaluate was renamed: loopshaping.qft.evaluate is a frequency response, this a promise
+    if name == "evaluate":
+        warnings.warn("specdesign.spec.evaluate is deprecated; use specdesign.spec.promise_of", DeprecationWarning,
+                      stacklevel=2)
+        return promise_of
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

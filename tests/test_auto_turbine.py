@@ -34,27 +34,27 @@ def design(model):
 @pytest.fixture(scope="module")
 def shaped(design):
     poles = np.roots(design.pitch_controller.den[0][0])
-    return auto.refine(design.pitch_template, design.pitch_bounds, design.dense_omegas, poles, n_zeros=3,
+    return auto.refine(design.pitch_template, design.pitch_bounds, design.dense_omega, poles, n_zeros=3,
                        initial=design.pitch_controller, margin_db=0.01)
 
 
 def _met(bounds, template, controller):
-    L0 = template.nominal_response * controller.response(template.omegas)
-    return bounds.is_allowed(template.omegas, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
+    L0 = template.nominal_response * controller.response(template.omega)
+    return bounds.is_allowed(template.omega, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
 
 
 def test_auto_shaped_pitch_controller_meets_every_bound_at_the_design_frequencies(design, shaped):
     ok = _met(design.pitch_bounds, design.pitch_template, shaped.controller)
-    assert ok.all(), design.pitch_template.omegas[~ok]
+    assert ok.all(), design.pitch_template.omega[~ok]
     ok = _met(shaped.bounds, shaped.template, shaped.controller)  # with the added frequencies
-    assert ok.all(), shaped.template.omegas[~ok]
-    assert set(design.design_omegas) <= set(shaped.template.omegas)
+    assert ok.all(), shaped.template.omega[~ok]
+    assert set(design.design_omega) <= set(shaped.template.omega)
 
 
 def test_auto_shaped_pitch_controller_passes_the_dense_check(design, shaped):
     assert shaped.passed, shaped.check.summary()
     # independently of refine's own check, on the design's dense grid and specs
-    res = check(shaped.controller, design.pitch_template, design.pitch_bounds, design.dense_omegas)
+    res = check(design.pitch_template, shaped.controller, design.pitch_bounds, design.dense_omega)
     assert res.passed, res.summary()
     assert res.stable.all()
     assert set(res.names) == {"speed", "tower", "margin", "actuator_margin"}

@@ -117,9 +117,9 @@ def design(model):
 def test_design_meets_its_bounds_at_the_design_frequencies(design):
     for bounds, c, tmpl in ((design.pitch_bounds, design.pitch_controller, design.pitch_template),
                             (design.atd_bounds, design.atd_controller, design.atd_template)):
-        L0 = tmpl.nominal_response * np.asarray(c(1j * tmpl.omegas)).ravel()
-        ok = bounds.is_allowed(tmpl.omegas, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
-        assert ok.all(), tmpl.omegas[~ok]
+        L0 = tmpl.nominal_response * np.asarray(c(1j * tmpl.omega)).ravel()
+        ok = bounds.is_allowed(tmpl.omega, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
+        assert ok.all(), tmpl.omega[~ok]
         assert not bounds.empty.any()
     assert design.bounds_met
 
@@ -129,7 +129,7 @@ def test_design_passes_the_dense_check_over_all_cases(design):
     assert design.atd_check.passed, design.atd_check.summary()
     assert design.pitch_check.stable.all() and design.atd_check.stable.all()
     assert set(design.pitch_check.names) >= {"speed", "tower", "margin"}
-    assert len(design.template_speeds) == 5 and design.dense_omegas.size >= 500
+    assert len(design.template_speeds) == 5 and design.dense_omega.size >= 500
 
 
 def test_every_case_is_stable_in_the_full_interconnection(model, design):
@@ -141,7 +141,7 @@ def test_every_case_is_stable_in_the_full_interconnection(model, design):
 def test_specs_hold_on_a_dense_grid_recomputed_by_interconnect(model, design):
     """Independent of the general form: T from control.interconnect vs the ROSCO loop, on the
     check's grid (QFT guarantees the specs where they are checked)."""
-    w = design.dense_omegas
+    w = design.dense_omega
     relax = 10 ** (design.options["speed_relax_db"] / 20)
     shaping = np.abs(design.tower_spec.shaping(w))
     for v in design.template_speeds:

@@ -75,7 +75,7 @@ def test_eq10_agrees_for_small_changes_and_departs_for_large(base19):
     errors = []
     for depth in (0.2, 1.0, 6.0, 20.0):
         shaping = spec.Notch(1.05, depth, 0.3).response(w)
-        p = spec.evaluate(shaping, base19)
+        p = spec.promise_of(shaping, base19)
         # exact, computed independently with spectral.exact_change on the modified PSD
         ch = spectral.exact_change(w, base19.psd, base19.psd * np.abs(shaping) ** 2, base19.m)
         assert p.exact_damage == pytest.approx(float(ch.damage_reduction), rel=1e-10)
@@ -87,7 +87,7 @@ def test_eq10_agrees_for_small_changes_and_departs_for_large(base19):
 
 
 def test_del_reduction_is_damage_ratio_to_one_over_m(base19):
-    p = spec.evaluate(spec.Notch(1.05, 10.0, 0.3).response(base19.omega), base19)
+    p = spec.promise_of(spec.Notch(1.05, 10.0, 0.3).response(base19.omega), base19)
     assert 1 - p.exact_del / 100 == pytest.approx((1 - p.exact_damage / 100) ** (1 / base19.m), rel=1e-12)
 
 
@@ -138,7 +138,7 @@ def test_bad_inputs(base19):
     with pytest.raises(ValueError, match="not stable"):
         spec.Specification(ct.tf([1], [1, -1]))
     with pytest.raises(ValueError, match="outside the baseline grid"):
-        spec.evaluate(spec.Specification(base19.system, (spec.Notch(50.0, 6.0, 0.3),)), base19)
+        spec.promise_of(spec.Specification(base19.system, (spec.Notch(50.0, 6.0, 0.3),)), base19)
     with pytest.raises(ValueError, match="keep_below"):
         spec.shape_to_target(base19, 10.0, keep_below=100.0)
     with pytest.raises(ValueError, match="s_wind"):
@@ -160,3 +160,37 @@ def test_specification_table_rows(model):
     for r in rows:
         assert r["success"]
         assert abs(r["promised_damage_pct"] - 15.0) <= 0.5
+
+
+# ----------------------------------------------------------------------------- one vocabulary with loopshaping
+@pytest.mark.parametrize("element", [spec.Notch(1.1, 12.0, 0.3), spec.Gain(-3.0), spec.LeadLag(0.5, 2.0),
+                                     spec.LowPass(2.0, 0.7), spec.LowPass(2.0, 1.5)])
+def test_spec_elements_are_loopshaping_elements(element):
+    # The same factor in both vocabularies: responses equal on a grid through the tower mode
+    # (independent evaluations: the spec's own formula vs loopshaping's polynomials).
+    from loopshaping.controller import Controller
+
+    w = np.logspace(-2, 1.5, 300)
+    got = Controller(element.to_elements()).response(w)
+    np.testing.assert_allclose(got, element.response(w), rtol=1e-12)
+    if len(element.to_elements()) == 1:  # and back, to the same record
+        back = spec.from_element(element.to_elements()[0])
+        assert type(back) is type(element)
+        np.testing.assert_allclose(back.response(w), element.response(w), rtol=1e-12)
+
+
+def test_specification_shaping_as_a_controller(model):
+    base = spec.baseline_analysis(model, 19.0)
+    s = spec.Specification(base.system, (spec.Notch(1.1, 10.0, 0.4), spec.LeadLag(1.3, 2.6)), name="W")
+    w = np.logspace(-2, 1, 200)
+    np.testing.assert_allclose(s.shaping_controller().response(w), s.shaping(w), rtol=1e-12)
+
+
+def test_elements_without_a_specification_counterpart_are_refused():
+    from loopshaping import controller as lc
+
+    for e in (lc.integrator(1), lc.real_zero(-1.0), lc.gain(-2.0), lc.notch(1.0, 0.5, 0.1)):
+        with pytest.raises(ValueError, match="has no specification element"):
+            spec.from_element(e)
+    with pytest.raises(TypeError, match="loopshaping.controller.Element"):
+        spec.from_element(spec.Gain(1.0))

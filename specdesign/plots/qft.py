@@ -1,17 +1,46 @@
-"""QFT design figures: the paper's Fig. 7 analogue (Bode magnitudes ROSCO vs spec vs QFT)."""
+"""QFT design figures: the paper's Fig. 7 analogue (Bode magnitudes ROSCO vs spec vs QFT)
+and its Figs. 5-6 analogue (Nichols charts with the bounds).
+
+Magnitudes in dB, phases in degrees, ω in rad/s.
+"""
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
 import numpy as np
+from numpy.typing import ArrayLike
 
-__all__ = ["plot_design_bode"]
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ..qft import QFTDesign
+    from ..turbine import TurbineModel
+
+__all__ = ["plot_design_bode", "plot_design_nichols"]
 
 
-def plot_design_bode(design, model=None, omega=None, axes=None):
+def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega: ArrayLike | None = None,
+                     axes: Sequence[Axes] | None = None) -> Figure:
     """|T_{Ω,w}| and |T_{MyT,w}| of ROSCO, the specifications and the QFT design (dB).
 
-    ``design`` is a :class:`specdesign.qft.QFTDesign` made on ``model`` (default the embedded
-    IEA 15 MW); ``omega`` the grid in rad/s (default 0.01-10 rad/s). Returns the figure (two
-    stacked axes, shared ω axis).
+    Parameters
+    ----------
+    design : specdesign.qft.QFTDesign
+        The QFT design (its controllers, specifications and closed loop).
+    model : specdesign.turbine.TurbineModel, optional
+        The turbine the design was made on (default the embedded IEA 15 MW), for ROSCO's loop.
+    omega : array_like, optional
+        Frequency grid, rad/s (default 800 log-spaced points, 0.01-10 rad/s).
+    axes : sequence of matplotlib.axes.Axes, optional
+        Two stacked axes (generator speed, tower-base moment); default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure (two stacked axes, shared ω axis): |T| in dB re 1 (rad/s)/(m/s) and
+        re 1 N·m/(m/s).
     """
     import matplotlib.pyplot as plt
 
@@ -39,7 +68,7 @@ def plot_design_bode(design, model=None, omega=None, axes=None):
             ax.semilogx(w, db(design.shaping.specification.response(w)), "C3", label="specification: ROSCO × notches")
             ax.semilogx(w, db(design.tower_spec.response(w)), "C3--", label="spec used for the bounds (relaxed at high ω)")
         ax.semilogx(w, db(closedloop.frequency_response(design.closed_loop, w, out)), "C1", lw=2, label="QFT: $C_\\beta$ + ATD")
-        wd = design.design_omegas[(design.design_omegas >= w[0]) & (design.design_omegas <= w[-1])]
+        wd = design.design_omega[(design.design_omega >= w[0]) & (design.design_omega <= w[-1])]
         ax.semilogx(wd, db(closedloop.frequency_response(design.closed_loop, wd, out)), "o", color="C4", ms=4,
                     label="design frequencies")
         ax.set_ylabel(f"|T| (dB re 1 {unit})")
@@ -66,10 +95,28 @@ def _bounds_at(bounds, template, picks):
         return lqft.intersect(*[lqft.bounds(template.at(sub), s) for s in bounds.specs])
 
 
-def plot_design_nichols(design, picks=(0.01, 0.05, 0.1, 0.3, 0.6, 1.0, 1.5, 3.0), axes=None):
-    """Nichols charts (dB vs degrees) of the pitch loop C_β·P'_{Ω,β} (ATD closed) and of the
-    ATD loop C_atd·P''_{z,β} (pitch loop closed), with their bounds at the design frequencies
-    nearest to ``picks`` (rad/s): the paper's Figs. 5-6 analogue. Returns the figure."""
+def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05, 0.1, 0.3, 0.6, 1.0, 1.5, 3.0),
+                        axes: Sequence[Axes] | None = None) -> Figure:
+    """Nichols charts of both QFT loops with their bounds: the paper's Figs. 5-6 analogue.
+
+    Left: the pitch loop C_β·P'_{Ω,β} (ATD closed); right: the ATD loop C_atd·P''_{z,β}
+    (pitch loop closed); magnitude in dB vs phase in degrees, nominal plant case, with the
+    bounds at the design frequencies nearest to ``picks``.
+
+    Parameters
+    ----------
+    design : specdesign.qft.QFTDesign
+        The QFT design (its templates, bounds and controllers).
+    picks : sequence of float
+        Frequencies, rad/s, whose nearest template frequencies get their bounds drawn.
+    axes : sequence of matplotlib.axes.Axes, optional
+        Two axes side by side (pitch loop, ATD loop); default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure.
+    """
     import matplotlib.pyplot as plt
 
     from loopshaping import nichols

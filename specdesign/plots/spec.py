@@ -1,19 +1,60 @@
-"""Specification figures and the interactive notch explorer (results in, axes out)."""
+"""Specification figures and the interactive notch explorer (results in, axes out).
+
+Magnitudes in dB (of the output per m/s, times a display ``scale``), ω in rad/s.
+"""
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
-from ..spec import Baseline, Notch, evaluate
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..spec import Baseline, Notch, promise_of
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ..spec import Promise, Specification
 
 __all__ = ["plot_specification", "NotchExplorer"]
 
 
-def plot_specification(base: Baseline, specification=None, *, shaping=None, ax=None, scale=1e-3, unit="kN·m/(m/s)"):
+def plot_specification(base: Baseline, specification: Specification | None = None, *, shaping: ArrayLike | None = None,
+                       ax: Axes | None = None, scale: float = 1e-3, unit: str = "kN·m/(m/s)") -> Axes:
     """Bode magnitude of the baseline T_{y,w} and the specification W_y on the baseline grid.
 
-    ``specification`` is a :class:`specdesign.spec.Specification`, or pass ``shaping`` (the
-    complex or real |W/T| on ``base.omega``). Magnitudes in dB of ``scale`` × (output/wind),
-    ω in rad/s on a log axis.
+    Magnitudes in dB of ``scale`` × (output/wind), ω in rad/s on a log axis.
+
+    Parameters
+    ----------
+    base : specdesign.spec.Baseline
+        The baseline (:func:`specdesign.spec.baseline_analysis`): its grid and T_{y,w}.
+    specification : specdesign.spec.Specification, optional
+        The specification W_y to draw over the baseline.
+    shaping : array_like, optional
+        Instead of ``specification``: the complex or real shaping W/T on ``base.omega`` (-).
+        Ignored when ``specification`` is given.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default a new pyplot figure).
+    scale : float
+        Display factor of the magnitudes (1e-3: N·m → kN·m).
+    unit : str
+        Unit of ``scale`` × output per m/s, for the axis label.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes.
+
+    Examples
+    --------
+    >>> from specdesign.plots.spec import plot_specification
+    >>> from specdesign.spec import baseline_analysis, shape_to_target
+    >>> from specdesign.turbine import iea15mw
+    >>> base = baseline_analysis(iea15mw(), 19.0)
+    >>> ax = plot_specification(base, shape_to_target(base, 15.0).specification)
+    >>> len(ax.get_lines())
+    2
     """
     import matplotlib.pyplot as plt
 
@@ -40,9 +81,38 @@ class NotchExplorer:
     promise (Eq. 10 and exact Dirlik) and refreshes the figure's line and title; it is the
     slider callback, and is timed in ``benchmarks/bench_spec.py``. ``widget()`` returns the
     ipywidgets box (needs ipywidgets; ``%matplotlib widget`` for live redraw in Jupyter).
+    The figure has two axes: the magnitudes (:func:`plot_specification`) and ΔD%(ω).
+
+    Parameters
+    ----------
+    base : specdesign.spec.Baseline
+        The baseline (:func:`specdesign.spec.baseline_analysis`).
+    notch : specdesign.spec.Notch, optional
+        Initial notch (default 6 dB deep, width 0.2, at 1.05 rad/s).
+    scale : float
+        Display factor of the magnitudes (1e-3: N·m → kN·m).
+
+    Attributes
+    ----------
+    notch : specdesign.spec.Notch
+        The current notch.
+    promise : specdesign.spec.Promise
+        Its promise against ``base``, %.
+    fig : matplotlib.figure.Figure
+        The figure.
+
+    Examples
+    --------
+    >>> from specdesign.plots.spec import NotchExplorer
+    >>> from specdesign.spec import baseline_analysis
+    >>> from specdesign.turbine import iea15mw
+    >>> explorer = NotchExplorer(baseline_analysis(iea15mw(), 19.0))
+    >>> p = explorer.update(1.0, 6.0, 0.2, redraw=False)
+    >>> print(f"damage −{p.exact_damage:.1f} %")
+    damage −28.4 %
     """
 
-    def __init__(self, base: Baseline, notch: Notch | None = None, *, scale=1e-3):
+    def __init__(self, base: Baseline, notch: Notch | None = None, *, scale: float = 1e-3):
         import matplotlib.pyplot as plt
 
         self.base = base
@@ -60,10 +130,33 @@ class NotchExplorer:
         self.promise = None
         self.update(self.notch.omega_n, self.notch.depth_db, self.notch.width)
 
-    def update(self, omega_n, depth_db, width, *, redraw=True):
+    def update(self, omega_n: float, depth_db: float, width: float, *, redraw: bool = True) -> Promise:
+        """Move the notch: recompute its promise and refresh the line, marker and title.
+
+        Parameters
+        ----------
+        omega_n : float
+            Centre frequency, rad/s.
+        depth_db : float
+            Depth, dB (> 0 attenuates).
+        width : float
+            Pole damping ratio ζ_p (-, 0 < width ≤ 2).
+        redraw : bool
+            Ask the canvas to redraw (``draw_idle``).
+
+        Returns
+        -------
+        specdesign.spec.Promise
+            The notch's promise against the baseline, %.
+
+        Raises
+        ------
+        ValueError
+            If the notch parameters are invalid (:class:`specdesign.spec.Notch`).
+        """
         self.notch = Notch(float(omega_n), float(depth_db), float(width))
         shaping = self.notch.response(self.base.omega)
-        self.promise = evaluate(shaping, self.base)
+        self.promise = promise_of(shaping, self.base)
         self.line.set_ydata(self._t_db + 20 * np.log10(np.abs(shaping)))
         self.marker.set_xdata([omega_n, omega_n])
         p = self.promise
@@ -74,7 +167,14 @@ class NotchExplorer:
             self.fig.canvas.draw_idle()
         return self.promise
 
-    def widget(self):
+    def widget(self) -> Any:
+        """Sliders for ω_n, depth and width wired to :meth:`update`.
+
+        Returns
+        -------
+        ipywidgets.interactive
+            The widget box (needs ipywidgets; ``%matplotlib widget`` for live redraw in Jupyter).
+        """
         import ipywidgets as widgets
 
         w = self.base.omega

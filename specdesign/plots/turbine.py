@@ -5,7 +5,16 @@ axes out; magnitudes in dB only here.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
 import numpy as np
+from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ..closedloop import LoopMaps
 
 __all__ = ["plot_open_vs_baseline", "plot_fatigue_origin"]
 
@@ -25,11 +34,42 @@ def _db(x):
     return 20 * np.log10(np.maximum(np.abs(x), 1e-300))
 
 
-def plot_open_vs_baseline(maps, axes=None, *, label="ROSCO"):
+def plot_open_vs_baseline(maps: LoopMaps, axes: Sequence[Axes] | None = None, *, label: str = "ROSCO") -> np.ndarray:
     """Fig. 1 analogue: |T_{Ω,w}|, |T_{MyT,w}| open loop vs closed loop, and |C_β|, in dB vs ω.
 
-    maps: a :class:`specdesign.closedloop.LoopMaps`. axes: three matplotlib Axes or None.
-    Returns the array of three Axes.
+    Parameters
+    ----------
+    maps : specdesign.closedloop.LoopMaps
+        The maps (:func:`specdesign.closedloop.loop_maps`): ω in rad/s, T_{Ω,w} in
+        (rad/s)/(m/s), T_{MyT,w} in N·m/(m/s), C_β in rad/(rad/s).
+    axes : sequence of matplotlib.axes.Axes, optional
+        Three stacked axes; default a new figure.
+    label : str
+        Name of the controller in the legends.
+
+    Returns
+    -------
+    numpy.ndarray
+        The three Axes.
+
+    Raises
+    ------
+    TypeError
+        If ``maps`` is not a :class:`~specdesign.closedloop.LoopMaps`.
+    ValueError
+        If ``axes`` does not hold three axes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.closedloop import loop_maps
+    >>> from specdesign.plots.turbine import plot_open_vs_baseline
+    >>> from specdesign.rosco import rosco_baseline
+    >>> from specdesign.turbine import iea15mw
+    >>> model = iea15mw()
+    >>> maps = loop_maps(model.linearize(19.0), rosco_baseline(model, 19.0), np.logspace(-2, 1, 200))
+    >>> plot_open_vs_baseline(maps).shape
+    (3,)
     """
     from ..closedloop import LoopMaps
 
@@ -52,12 +92,44 @@ def plot_open_vs_baseline(maps, axes=None, *, label="ROSCO"):
     return ax
 
 
-def plot_fatigue_origin(omega, t_tower, psd, delta_d, axes=None, *, m=None):
+def plot_fatigue_origin(omega: ArrayLike, t_tower: ArrayLike, psd: ArrayLike, delta_d: ArrayLike,
+                        axes: Sequence[Axes] | None = None, *, m: float | None = None) -> np.ndarray:
     """Fig. 3 analogue: |T_{MyT,w}| (dB), S_MyT ((MN·m)² per rad/s, log) and ΔD%(ω).
 
-    omega (rad/s); t_tower: complex T_{MyT,w} on omega (N·m per m/s); psd: S_MyT on omega
-    ((N·m)² per rad/s); delta_d: ΔD% per grid point from :func:`specdesign.spectral.sensitivity`.
-    m: Wöhler exponent for the legend. Returns the array of three Axes.
+    Parameters
+    ----------
+    omega : array_like
+        Frequency grid, rad/s.
+    t_tower : array_like
+        Complex T_{MyT,w} on ``omega``, N·m per m/s.
+    psd : array_like
+        One-sided S_MyT on ``omega``, (N·m)² per rad/s (drawn in (MN·m)² per rad/s).
+    delta_d : array_like
+        ΔD% per grid point (:func:`specdesign.spectral.sensitivity`), %.
+    axes : sequence of matplotlib.axes.Axes, optional
+        Three stacked axes; default a new figure.
+    m : float, optional
+        Wöhler exponent (-), for the legend.
+
+    Returns
+    -------
+    numpy.ndarray
+        The three Axes.
+
+    Raises
+    ------
+    ValueError
+        If ``t_tower``, ``psd`` or ``delta_d`` does not have the shape of ``omega``, or
+        ``axes`` does not hold three axes.
+
+    Examples
+    --------
+    >>> from specdesign.plots.turbine import plot_fatigue_origin
+    >>> from specdesign.spec import baseline_analysis
+    >>> from specdesign.turbine import iea15mw
+    >>> b = baseline_analysis(iea15mw(), 19.0)
+    >>> plot_fatigue_origin(b.omega, b.t_response, b.psd, b.sensitivity, m=b.m).shape
+    (3,)
     """
     w = np.asarray(omega, float)
     for name, arr in (("t_tower", t_tower), ("psd", psd), ("delta_d", delta_d)):

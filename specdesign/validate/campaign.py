@@ -12,7 +12,7 @@ import numpy as np
 
 from .._checks import positive_scalar
 from ..closedloop import unstable_poles
-from ._loop import check_loop_step, check_step, has_linear_form
+from ._loop import has_linear_form
 from ._point import SPECTRA, campaign_point
 from .indicators import INDICATORS
 from .stats import PairedChange, paired_change
@@ -194,7 +194,7 @@ def check_plant_step(model, wind_speeds, dt: float) -> None:
         ``dt`` is too large for the fastest mode of the linearised plant at some wind speed
         (the message gives the largest step it allows).
     """
-    from ..simulate import turbine_plant
+    from ..simulate import check_step, turbine_plant
 
     check_step(turbine_plant(model), np.asarray(wind_speeds, float), dt)
 
@@ -223,7 +223,7 @@ def check_campaign_step(model, controllers: Mapping, wind_speeds, dt: float) -> 
         ``dt`` is not positive, too large for the plant (:func:`check_plant_step`), or one at
         which a controller's sampled loop is unstable (naming the controller).
     """
-    from ..simulate import turbine_plant
+    from ..simulate import check_loop_step, check_step, turbine_plant
 
     dt = positive_scalar(dt, "dt")
     plant = turbine_plant(model)

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
-from ..closedloop import t_output_wind, unstable_message, unstable_poles
-from ._loop import local_response, rotor_radius
+from ..closedloop import local_response, t_output_wind, unstable_message, unstable_poles
+from ._loop import rotor_radius
 
 __all__ = ["closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction"]
 
@@ -47,7 +47,7 @@ def closed_loop_response(model, controller, wind_speed: float, omega, output: st
     # by position: a user KernelPlant's linearisation need not carry signal names
     P = {(o, u): G[names.index(o), j] for o in {output, "gen_speed", "tower_top_vel"}
          for j, u in enumerate(("wind", "pitch_cmd"))}
-    cb, ca = local_response(controller, model, wind_speed, 1j * w)
+    cb, ca = local_response(model, controller, wind_speed, 1j * w)
     return t_output_wind(P, cb, w, output, atd_controller=ca, atd_measurement="tower_top_vel")
 
 

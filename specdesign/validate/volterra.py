@@ -8,8 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
-from ..closedloop import t_output_wind
-from ._loop import has_linear_form, local_response, rotor_radius
+from ..closedloop import local_response, t_output_wind
+from ._loop import has_linear_form, rotor_radius
 from .stats import pool
 
 __all__ = ["volterra_response", "VolterraPrediction", "volterra_prediction"]
@@ -89,7 +89,7 @@ def volterra_response(model, controller, wind_speed: float, wind, dt: float, *, 
     plant = model.linearize(v, load_inputs=True)
     G = np.asarray(plant(1j * om, squeeze=False))
     names, ins = list(plant.output_labels), list(plant.input_labels)
-    cb, ca = local_response(controller, model, v, 1j * om)
+    cb, ca = local_response(model, controller, v, 1j * om)
     need = tuple(dict.fromkeys(_AERO_OUTPUTS + outs))
 
     def loop(u):  # closed-loop responses of ``need`` to input u, on the rfft grid

@@ -1,0 +1,61 @@
+"""H∞ pitch control with the fatigue-based specifications as weights.
+
+Modules: :mod:`~specdesign.hinf.weights` (W⁻¹ of a specification), :mod:`~specdesign.hinf.plant`
+(the generalized plant), :mod:`~specdesign.hinf.design` (:func:`design_hinf` and its result); the
+synthesis, well-posedness checks and reduction are :mod:`loopshaping.hinf`'s.
+
+The specifications of :mod:`specdesign.spec` are upper bounds on closed-loop maps from the
+rotor-effective wind: |T_{MyT,w}(jω)| ≤ |W_MyT(jω)| (tower-base load, the baseline reshaped by
+notches) and |T_{Ω,w}(jω)| ≤ |W_Ω(jω)| (generator speed, the baseline's T_{Ω,w}); by default
+:func:`design_hinf` takes them as :func:`specdesign.qft.design_qft` does (:func:`qft_specifications`:
+the tower spec relaxed above ≈ 1.3 rad/s, the speed spec relaxed by QFT's dB ladder), so H∞ and
+QFT are compared on the same specifications. Dividing each
+output by its specification gives performance outputs whose H∞ norm is ≤ 1 exactly when
+the specification is met, so the generalized plant at one operating point is
+
+    inputs  [wind (m/s); noise on each measurement; pitch_cmd (rad)]
+    outputs [z_tower = W_MyT⁻¹·MyT; z_speed = W_Ω⁻¹·Ω_g; z_pitch = w_pitch·β; y = measurements]
+
+with W⁻¹ made a stable, proper weight (:func:`inverse_weight`). The performance outputs form
+one column (one wind input), so γ bounds the root-sum-square of the ratios: γ ≤ 1 means
+every specification is met, and γ ≈ √2 is what two specifications met with equality give.
+
+Sign convention of the workbench: β = −C_β·Ω_g − C_atd·v_tt. SLICOT closes u = K·y, so
+[C_β, C_atd] = −K.
+"""
+from __future__ import annotations
+
+import warnings
+
+from ..closedloop import closed_loop_mimo, refine_grid
+from .design import DEFAULT_DECAY_RATE, QFT_SPEED_RELAX_DB, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
+from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
+from .weights import DEFAULT_MIN_DAMPING, inverse_weight, siso_weight
+
+__all__ = [
+    "GeneralizedPlant",
+    "HinfDesign",
+    "QFT_SPEED_RELAX_DB",
+    "design_hinf",
+    "generalized_plant",
+    "inverse_weight",
+    "qft_specifications",
+    "siso_weight",
+    "DEFAULT_NOISE",
+    "DEFAULT_MIN_DAMPING",
+    "DEFAULT_DECAY_RATE",
+    "DEFAULT_INTEGRAL_CORNER",
+    "TOWER_BAND",
+]
+
+_MOVED = {"closed_loop": ("closed_loop_mimo", closed_loop_mimo), "assessment_grid": ("refine_grid", refine_grid)}
+
+
+def __getattr__(name):
+    # names that moved to specdesign.closedloop (issue 13: one home per closed-loop construction)
+    if name in _MOVED:
+        new, obj = _MOVED[name]
+        warnings.warn(f"specdesign.hinf.{name} is deprecated; use specdesign.closedloop.{new}", DeprecationWarning,
+                      stacklevel=2)
+        return obj
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

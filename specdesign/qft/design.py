@@ -1,0 +1,442 @@
+"""The automatic QFT design at one operating point and over a schedule (see :mod:`specdesign.qft`)."""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import control as ct
+import numpy as np
+
+from .._checks import positive_scalar
+from ..closedloop import (check_stability, close_responses, closed_loop, general_coefficients, lightly_damped,
+                          partial_loop, plant_responses, siso_response)
+from .structure import controllers, from_vector, rosco_start
+from .tuner import TuningProblem, tune
+
+__all__ = ["QFTDesign", "design_qft", "design_schedule", "design_table", "format_table", "DEFAULT_DESIGN_OMEGA"]
+
+
+#: Default QFT design frequencies, rad/s: the wind band, the tower mode (~1.06 rad/s) and
+#: the actuator band.
+DEFAULT_DESIGN_OMEGA = np.unique(np.r_[0.005, 0.007, np.logspace(-2, 1, 37), 0.9, 0.95, 1.0, 1.03, 1.05, 1.07, 1.1, 1.15, 1.2])
+
+
+# ----------------------------------------------------------------------------- result
+@dataclass(frozen=True, eq=False)
+class QFTDesign:
+    """One operating point's QFT design (frozen). All changes are designed vs ROSCO (ATD off),
+    in %, positive = increase; reductions are positive = less.
+
+    pitch_controller, atd_controller : python-control TFs (β_cmd = −C_β·Ω_g − C_atd·ẋ_top).
+    baseline_controller : ROSCO's PI at the same speed.
+    template_speeds : wind speeds of the plant cases (m/s); nominal at ``wind_speed``.
+    design_omega : QFT design frequencies, rad/s.
+    pitch_bounds / atd_bounds : :class:`loopshaping.qft.Bounds` on L0 = C_β·P'_{Ω,β} (ATD
+        closed) and on L0 = C_atd·P''_{z,β} (pitch loop closed); ``*_template`` their templates.
+    pitch_check / atd_check : :class:`loopshaping.check.CheckResult` on ``dense_omega``.
+    bounds_met : every bound met at every design frequency (nominal loop, exact).
+    all_stable : the full interconnection is stable for every plant case.
+    del_reduction, damage_reduction : predicted tower-base DEL (1 Hz, m = 4) and damage
+        reduction, Dirlik on |T|²S_W, nominal case.
+    promise : :class:`specdesign.spec.Promise` of the (relaxed) tower specification.
+    gen_speed_sd_change, pitch_sd_change, pitch_rate_sd_change : SD changes, %.
+    gain_margin_db, phase_margin_deg : nominal pitch loop C_β·P'_{Ω,β} (ATD closed).
+    atd_gain_margin_db, atd_phase_margin_deg : nominal ATD loop C_atd·P''_{z,β}.
+    actuator_peak_sensitivity : max over ω and cases of |1/(1 + C_β P_{Ω,β} + C_atd P_{z,β})|.
+    """
+
+    wind_speed: float
+    pitch_controller: object
+    atd_controller: object
+    baseline_controller: object
+    template_speeds: tuple
+    design_omega: np.ndarray
+    dense_omega: np.ndarray
+    tower_spec: object
+    speed_spec: object
+    shaping: object
+    promise: object
+    pitch_template: object
+    atd_template: object
+    pitch_bounds: object
+    atd_bounds: object
+    pitch_check: object
+    atd_check: object
+    closed_loop: object
+    baseline: object
+    bounds_met: bool
+    all_stable: bool
+    del_reduction: float
+    damage_reduction: float
+    gen_speed_sd_change: float
+    pitch_sd_change: float
+    pitch_rate_sd_change: float
+    pitch_rate_sd: float
+    gain_margin_db: float
+    phase_margin_deg: float
+    atd_gain_margin_db: float
+    atd_phase_margin_deg: float
+    actuator_peak_sensitivity: float
+    target_reduction: float
+    success: bool
+    message: str
+    parameters: dict = field(default_factory=dict)
+    options: dict = field(default_factory=dict)
+
+    @property
+    def design_omegas(self) -> np.ndarray:
+        """Deprecated name of :attr:`design_omega`."""
+        warnings.warn("QFTDesign.design_omegas is deprecated, use QFTDesign.design_omega", DeprecationWarning, stacklevel=2)
+        return self.design_omega
+
+    @property
+    def dense_omegas(self) -> np.ndarray:
+        """Deprecated name of :attr:`dense_omega`."""
+        warnings.warn("QFTDesign.dense_omegas is deprecated, use QFTDesign.dense_omega", DeprecationWarning, stacklevel=2)
+        return self.dense_omega
+
+    @property
+    def n_states(self) -> int:
+        """Total controller order (pitch + ATD states)."""
+        return int(ct.ss(self.pitch_controller).nstates + ct.ss(self.atd_controller).nstates)
+
+    @property
+    def is_proper(self) -> bool:
+        def proper(tf):
+            return len(np.trim_zeros(tf.num[0][0], "f")) <= len(np.trim_zeros(tf.den[0][0], "f"))
+
+        return proper(self.pitch_controller) and proper(self.atd_controller)
+
+    def row(self) -> dict:
+        """One row of :func:`design_table`."""
+        return {
+            "wind_speed": self.wind_speed,
+            "notch_promise_del_pct": self.shaping.promise.exact_del,
+            "notch_promise_damage_pct": self.shaping.promise.exact_damage,
+            "promised_del_pct": self.promise.exact_del,
+            "promised_damage_pct": self.promise.exact_damage,
+            "predicted_del_pct": self.del_reduction,
+            "predicted_damage_pct": self.damage_reduction,
+            "gen_speed_sd_change_pct": self.gen_speed_sd_change,
+            "pitch_sd_change_pct": self.pitch_sd_change,
+            "pitch_rate_sd_change_pct": self.pitch_rate_sd_change,
+            "gain_margin_db": self.gain_margin_db,
+            "phase_margin_deg": self.phase_margin_deg,
+            "atd_gain_margin_db": self.atd_gain_margin_db,
+            "atd_phase_margin_deg": self.atd_phase_margin_deg,
+            "bounds_met": self.bounds_met,
+            "dense_check_passed": bool(self.pitch_check.passed and self.atd_check.passed),
+            "all_stable": self.all_stable,
+            "n_states": self.n_states,
+        }
+
+    def summary(self) -> str:
+        r = self.row()
+        return (f"QFT design at {self.wind_speed:g} m/s: tower DEL reduced {r['predicted_del_pct']:.1f} % "
+                f"(notch spec promises {r['notch_promise_del_pct']:.1f} %, relaxed spec {r['promised_del_pct']:.1f} %), "
+                f"gen-speed SD {r['gen_speed_sd_change_pct']:+.1f} %, "
+                f"pitch SD {r['pitch_sd_change_pct']:+.1f} %, pitch-rate SD {r['pitch_rate_sd_change_pct']:+.1f} %; "
+                f"pitch loop GM {r['gain_margin_db']:.1f} dB PM {r['phase_margin_deg']:.1f}°, ATD loop GM "
+                f"{r['atd_gain_margin_db']:.1f} dB PM {r['atd_phase_margin_deg']:.1f}°; bounds met: {self.bounds_met}, "
+                f"dense check: {r['dense_check_passed']}, all {len(self.template_speeds)} cases stable: {self.all_stable}; "
+                f"{self.message}")
+
+
+def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01)):
+    """|p|·spread for lightly damped (ζ < zeta_max) poles and zeros of every case's ROSCO
+    closed-loop maps wind → gen_speed and wind → tower_base_my, inside 0.005-20 rad/s."""
+
+    if not enabled:
+        return np.zeros(0)
+    out = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for P, c in zip(prob.plants, prob.rosco):
+            cl = closed_loop(P, c, warn=False)
+            for y in ("gen_speed", "tower_base_my"):
+                sys = cl[y, "wind"]
+                for r in lightly_damped(np.r_[ct.poles(sys), ct.zeros(sys)], zeta_max):
+                    if r.imag > 0:
+                        out.extend(abs(r) * np.asarray(spread))
+    w = np.asarray(out)
+    return np.unique(w[(w >= 0.005) & (w <= 20.0)])
+
+
+def _template_speeds(model, v, offsets):
+    lo, hi = model.wind_range
+    speeds = sorted({float(np.clip(v + o, lo, hi)) for o in offsets} | {v})
+    return tuple(speeds), speeds.index(v)
+
+
+def _callable(fn, key):
+    def f(omega):
+        return fn(np.asarray(omega, float))[key]
+
+    return f
+
+
+def design_qft(model, wind_speed, target_reduction=25.0, *, speed_relax_db=(3.0, 4.5, 6.0, 8.0), **kwargs) -> QFTDesign:
+    """QFT design of C_β and C_atd at ``wind_speed`` (m/s) against the fatigue-based specs.
+
+    Parameters
+    ----------
+    model : :class:`specdesign.turbine.TurbineModel` (e.g. ``turbine.iea15mw()``).
+    wind_speed : operating point, m/s (above rated, inside ``model.wind_range``).
+    target_reduction : predicted tower-base DEL reduction (1 Hz, m = 4) vs ROSCO to reach, %.
+    spec_reduction : damage reduction (%) the notch-shaped tower specification promises
+        (:func:`specdesign.spec.shape_to_target`, notches above ``keep_below`` rad/s).
+    template_offsets : wind-speed offsets (m/s) of the neighbouring operating points.
+    design_omega : QFT design frequencies, rad/s (default :data:`DEFAULT_DESIGN_OMEGA`).
+    dense_omega : grid of the final check, rad/s (default 600 points, 0.005-20 rad/s).
+    speed_relax_db : relaxation of the generator-speed spec in dB (≥ 0), or an increasing
+        sequence tried in turn (default 3, 4.5, 6, 8 dB): the design with the smallest
+        relaxation that meets every spec is returned (else the last attempt, with a warning).
+    tower_relax_db, tower_relax_omega : the tower spec is relaxed by this many dB above about
+        this frequency (rad/s), where ΔD% is negligible (0 to disable).
+    max_sensitivity : bound on |1/(1+L)| for both loops and at the actuator (> 1).
+    min_decay : required closed-loop decay rate, 1/s (poles left of −min_decay).
+    keep_below : protected band of the notch specification, rad/s (power regulation).
+    refine : rounds adding the dense check's failing frequencies to the design set.
+    maxfev : function evaluations per tuning round.
+
+    Returns a :class:`QFTDesign`; ``success`` is False (with a message, and a RuntimeWarning)
+    when the target, a bound, the dense check or stability is not met.
+    """
+    for old_name in ("design_omegas", "dense_omegas"):  # renamed: one name for frequency grids, omega
+        if old_name in kwargs:
+            new_name = old_name[:-1]
+            warnings.warn(f"design_qft({old_name}=...) is deprecated, use {new_name}=", DeprecationWarning, stacklevel=2)
+            if new_name in kwargs:
+                raise TypeError(f"design_qft got both {old_name}= and {new_name}=")
+            kwargs[new_name] = kwargs.pop(old_name)
+    ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
+    if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
+    design = None
+    for k, relax in enumerate(ladder):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            design = _design_single(model, wind_speed, target_reduction, speed_relax_db=float(relax), **kwargs)
+        if design.success:
+            return design
+    warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {ladder[-1]:g} dB): {design.message}",
+                  RuntimeWarning, stacklevel=2)
+    return design
+
+
+def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=15.0, template_offsets=(-1.0, -0.5, 0.5, 1.0),
+                   design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
+                   max_sensitivity=1.9, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
+    """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
+    from loopshaping import qft as lqft
+
+    from .. import spec as sp
+    from .. import turbine
+
+    if not isinstance(model, turbine.TurbineModel):
+        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()), got {type(model).__name__}")
+    v = model._check_wind(wind_speed)
+    t = float(target_reduction)
+    if not 0 < t < 100:
+        raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
+    for name, val in (("speed_relax_db", speed_relax_db), ("tower_relax_db", tower_relax_db)):
+        if not (np.isfinite(val) and val >= 0):
+            raise ValueError(f"{name}={val!r} must be a finite relaxation ≥ 0 dB")
+    positive_scalar(tower_relax_omega, "tower_relax_omega")
+    if not max_sensitivity > 1:
+        raise ValueError(f"max_sensitivity={max_sensitivity!r} must be > 1 (|1/(1+L)| bound)")
+    positive_scalar(min_decay, "min_decay")
+    offsets = np.atleast_1d(np.asarray(template_offsets, float))
+    if offsets.ndim != 1 or not np.all(np.isfinite(offsets)):
+        raise ValueError("template_offsets must be a 1-D array of finite wind-speed offsets in m/s")
+    wd = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
+    wdense = np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None else lqft.check_grid(dense_omega, "dense_omega")
+
+    speeds, nom = _template_speeds(model, v, offsets)
+    specs = sp.design_specifications(model, v, speed_relax_db=speed_relax_db, spec_reduction=spec_reduction,
+                                     tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
+                                     keep_below=keep_below)
+    base, shaping, tower_spec, speed_spec = specs.base, specs.shaping, specs.tower, specs.speed
+    promise = sp.promise_of(tower_spec, base)
+
+    prob = TuningProblem(model, v, speeds, nom, wd, tower_spec.shaping, speed_relax_db, max_sensitivity, base)
+    # Sharp features of the specs (the lightly damped tower-mode poles and zeros of every case's
+    # ROSCO loop) are design frequencies and dense-check points too: a bound that holds on
+    # both sides of a narrow dip of W can still fail inside it.
+    sharp = _sharp_frequencies(prob, design_omega is None)
+    if sharp.size:
+        prob.set_design(np.unique(np.r_[prob.wd, sharp]))
+        wdense = np.unique(np.r_[wdense, sharp[(sharp >= wdense[0]) & (sharp <= wdense[-1])]])
+    x = rosco_start(prob.rosco[nom])
+    rounds = 0
+    while True:
+        x, feasible = tune(prob, x, t, min_decay, maxfev)
+        cb, ca = controllers(x, v)
+        pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = _checks(prob, cb, ca, wdense)
+        bad = [w for chk in (pitch_check, atd_check) for name in chk.names for w in [chk.worst(name)] if w[1] < 0]
+        # more design frequencies cannot rescue a design that already fails on the ones it has
+        if not bad or not feasible or rounds >= refine:
+            break
+        new = np.unique(np.r_[prob.wd, [w[0] for w in bad]])
+        if new.size == prob.wd.size:
+            break
+        prob.set_design(new)
+        rounds += 1
+
+    # exact bounds on the final design frequencies, for the Nichols charts and the bound check
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", lqft.BoundsWarning)
+        pitch_bounds = lqft.intersect(*[lqft.bounds(pitch_t, s_) for s_ in pitch_specs])
+        atd_bounds = lqft.intersect(*[lqft.bounds(atd_t, s_) for s_ in atd_specs])
+    bounds_met = _bounds_met(pitch_bounds, cb, pitch_t, prob.wd) and _bounds_met(atd_bounds, ca, atd_t, prob.wd)
+
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        stable = [check_stability(closed_loop(P, cb, ca, warn=False), tol=0.0) for P in prob.plants]
+        cl = closed_loop(prob.plants[nom], cb, ca, warn=False)
+    all_stable = bool(np.all(stable))
+    red, dred, gs, ps, rate = prob.performance(x)
+    Rdense = plant_responses(prob.plants, wdense, ("gen_speed", "tower_top_vel"))
+    cdn, kdn = siso_response(cb, wdense)[:, None], siso_response(ca, wdense)[:, None]
+    peak_in = float(np.max(1 / np.abs(1 + cdn * Rdense[("gen_speed", "pitch_cmd")] + kdn * Rdense[("tower_top_vel", "pitch_cmd")])))
+    nomp = pitch_t.nominal
+    problems = []
+    if red < t - 0.5:
+        problems.append(f"DEL reduction {red:.1f} % below the target {t:g} %")
+    if not bounds_met:
+        problems.append("a bound is violated at a design frequency")
+    if not pitch_check.passed:
+        problems.append("dense check of the pitch loop failed: " + pitch_check.summary().replace("\n", "; "))
+    if not atd_check.passed:
+        problems.append("dense check of the ATD loop failed: " + atd_check.summary().replace("\n", "; "))
+    if not all_stable:
+        problems.append(f"unstable closed loops at {[speeds[i] for i, s_ in enumerate(stable) if not s_]} m/s")
+    success = not problems
+    message = "all specifications met" if success else "; ".join(problems)
+    if not success:
+        warnings.warn(f"design_qft at {v:g} m/s: {message}", RuntimeWarning, stacklevel=2)
+    return QFTDesign(
+        wind_speed=v, pitch_controller=cb, atd_controller=ca, baseline_controller=prob.rosco[nom],
+        template_speeds=speeds, design_omega=prob.wd.copy(), dense_omega=wdense, tower_spec=tower_spec,
+        speed_spec=speed_spec, shaping=shaping, promise=promise, pitch_template=pitch_t, atd_template=atd_t,
+        pitch_bounds=pitch_bounds, atd_bounds=atd_bounds, pitch_check=pitch_check, atd_check=atd_check, closed_loop=cl,
+        baseline=base, bounds_met=bool(bounds_met), all_stable=all_stable, del_reduction=float(red),
+        damage_reduction=float(dred), gen_speed_sd_change=100 * (gs - 1), pitch_sd_change=100 * (ps - 1),
+        pitch_rate_sd_change=100 * (rate - 1), pitch_rate_sd=float(rate * prob.sd0["pitch_rate"]),
+        gain_margin_db=float(pitch_check.gain_margin_db[nomp]), phase_margin_deg=float(pitch_check.phase_margin_deg[nomp]),
+        atd_gain_margin_db=float(atd_check.gain_margin_db[nomp]), atd_phase_margin_deg=float(atd_check.phase_margin_deg[nomp]),
+        actuator_peak_sensitivity=peak_in, target_reduction=t, success=success, message=message, parameters=from_vector(x),
+        options=dict(spec_reduction=spec_reduction, template_offsets=tuple(offsets), speed_relax_db=speed_relax_db,
+                     tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega, max_sensitivity=max_sensitivity,
+                     min_decay=min_decay, refine_rounds=rounds),
+    )
+
+
+def _checks(prob, cb, ca, wdense):
+    """Templates, specs (general form, callables of ω) and dense checks of both loops."""
+    from loopshaping import qft as lqft
+    from loopshaping.check import check as lcheck
+
+    plants, nom = prob.plants, prob.nom
+
+    def data(omega):
+        w = np.asarray(omega, float)
+        R = plant_responses(plants, w, ("gen_speed", "tower_base_my", "tower_top_vel"))
+        c, k = siso_response(cb, w)[:, None], siso_response(ca, w)[:, None]
+        W_speed, W_tower = prob.weights(w)
+        Rp = close_responses(R, k, "tower_top_vel", ("gen_speed", "tower_base_my"))  # ATD closed: C_β's plant
+        Ra = close_responses(R, c, "gen_speed", ("tower_top_vel", "tower_base_my", "gen_speed"))  # pitch closed: ATD's plant
+        out = {"W_speed": W_speed, "W_tower": W_tower}
+        for tag, RR, meas in (("p", Rp, "gen_speed"), ("a", Ra, "tower_top_vel")):
+            for y in ("gen_speed", "tower_base_my"):
+                A, B, C, D = general_coefficients(RR, y, meas)
+                out.update({f"{tag}{y}A": A, f"{tag}{y}B": B, f"{tag}{y}C": C, f"{tag}{y}D": D})
+        out["pin_A"] = 1 / (1 + k * R[("tower_top_vel", "pitch_cmd")])
+        out["zero"] = np.zeros_like(out["pin_A"])
+        out["one"] = np.ones_like(out["pin_A"])
+        out["pin_D"] = Rp[("gen_speed", "pitch_cmd")]
+        return out
+
+    cache = {}
+
+    def fn(w):
+        key = w.tobytes()
+        if key not in cache:
+            cache[key] = data(w)
+        return cache[key]
+
+    def general(tag, y, weight, name):
+        return lqft.Spec("general", _callable(fn, weight), name=name,
+                         kind_args={k: _callable(fn, f"{tag}{y}{k}") for k in "ABCD"})
+
+    pitch_specs = [
+        general("p", "gen_speed", "W_speed", "speed"),
+        general("p", "tower_base_my", "W_tower", "tower"),
+        lqft.Spec("sensitivity", prob.ms, name="margin"),
+        lqft.Spec("general", prob.ms, name="actuator_margin",
+                  kind_args={"A": _callable(fn, "pin_A"), "B": _callable(fn, "zero"), "C": _callable(fn, "one"),
+                             "D": _callable(fn, "pin_D")}),
+    ]
+    atd_specs = [
+        general("a", "gen_speed", "W_speed", "speed"),
+        general("a", "tower_base_my", "W_tower", "tower"),
+        lqft.Spec("sensitivity", prob.ms, name="margin"),
+    ]
+    pitch_plants = [partial_loop(P, ca, "tower_top_vel")["gen_speed", "pitch_cmd"] for P in plants]
+    atd_plants = [partial_loop(P, cb, "gen_speed")["tower_top_vel", "pitch_cmd"] for P in plants]
+    pitch_t = lqft.Template.from_systems(pitch_plants, prob.wd, nom)
+    atd_t = lqft.Template.from_systems(atd_plants, prob.wd, nom)
+    pitch_check = lcheck(pitch_t, cb, pitch_specs, wdense)
+    atd_check = lcheck(atd_t, ca, atd_specs, wdense)
+    return pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs
+
+
+def _bounds_met(bounds, controller, template, omega):
+    L0 = template.nominal_response * siso_response(controller, template.omega)
+    ok = bounds.is_allowed(template.omega, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
+    return bool(np.all(ok))
+
+
+def design_schedule(model, wind_speeds=(15, 17, 19, 21, 23, 25), target_reduction=25.0, **kwargs) -> tuple:
+    """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
+
+    ``target_reduction`` is a number or one value per wind speed; other keywords go to
+    :func:`design_qft`.
+    """
+    vs = np.atleast_1d(np.asarray(wind_speeds, float))
+    if vs.ndim != 1 or vs.size == 0:
+        raise ValueError("wind_speeds must be a non-empty 1-D sequence of wind speeds in m/s")
+    targets = np.broadcast_to(np.asarray(target_reduction, float), vs.shape)
+    return tuple(design_qft(model, float(v), float(tr), **kwargs) for v, tr in zip(vs, targets))
+
+
+def design_table(designs) -> list:
+    """Rows (dicts) of the per-wind-speed table: promised vs predicted reduction, SD changes, margins."""
+    designs = list(designs)
+    if not all(isinstance(d, QFTDesign) for d in designs):
+        raise TypeError("designs must be QFTDesign objects (from design_qft / design_schedule)")
+    return [d.row() for d in designs]
+
+
+def format_table(rows) -> str:
+    """Markdown table of :func:`design_table` rows (reductions and changes in %, margins in dB/deg)."""
+    head = ("| v [m/s] | notch-spec promise DEL [%] | relaxed-spec promise DEL [%] | predicted DEL red. [%] | predicted damage red. [%] | gen-speed SD [%] "
+            "| pitch SD [%] | pitch-rate SD [%] | GM pitch [dB] | PM pitch [deg] | GM ATD [dB] | PM ATD [deg] "
+            "| bounds | dense check | stable | states |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        lines.append(
+            f"| {r['wind_speed']:g} | {r['notch_promise_del_pct']:.1f} | {r['promised_del_pct']:.1f} | {r['predicted_del_pct']:.1f} | {r['predicted_damage_pct']:.1f} "
+            f"| {r['gen_speed_sd_change_pct']:+.1f} | {r['pitch_sd_change_pct']:+.1f} | {r['pitch_rate_sd_change_pct']:+.1f} "
+            f"| {r['gain_margin_db']:.1f} | {r['phase_margin_deg']:.1f} | {r['atd_gain_margin_db']:.1f} "
+            f"| {r['atd_phase_margin_deg']:.1f} | {'yes' if r['bounds_met'] else 'NO'} | {'pass' if r['dense_check_passed'] else 'FAIL'} "
+            f"| {'yes' if r['all_stable'] else 'NO'} | {r['n_states']} |")
+    return "\n".join(lines)
+
+
+def __getattr__(name):
+    if name == "DEFAULT_DESIGN_OMEGAS":  # renamed: one name for frequency grids, omega
+        warnings.warn("DEFAULT_DESIGN_OMEGAS is deprecated, use DEFAULT_DESIGN_OMEGA", DeprecationWarning, stacklevel=2)
+        return DEFAULT_DESIGN_OMEGA
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

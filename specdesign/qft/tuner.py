@@ -1,0 +1,235 @@
+"""The tuning problem of the automatic QFT design: objective, constraints, and the tuner.
+
+Everything the tuning evaluates is precomputed on the design and analysis grids
+(:class:`TuningProblem`); :func:`tune` explores with Powell on exterior penalties, polishes
+with SLSQP to KKT points, and keeps the best candidate by a total order (feasible first, then
+the smaller objective), so the design does not jump when the data move by round-off.
+"""
+from __future__ import annotations
+
+import warnings
+
+import control as ct
+import numpy as np
+
+from ..closedloop import closed_map, plant_responses, siso_response
+from .structure import controller_polys, vector_bounds
+
+__all__ = ["TuningProblem", "tune", "FEASIBLE_TOL", "STABILITY_SAFETY_DB", "PERFORMANCE_SAFETY_DB", "DC_SAFETY_DB"]
+
+#: Safety margins (dB) on the bounds while tuning: the stability specs, the performance specs
+#: above 0.05 rad/s, and below it (where the specs meet ROSCO's loop at DC).
+STABILITY_SAFETY_DB = 0.1
+PERFORMANCE_SAFETY_DB = 0.02
+DC_SAFETY_DB = 0.005
+
+
+class TuningProblem:
+    """Everything the tuning evaluates, precomputed on the design and analysis grids."""
+
+    def __init__(self, model, v, speeds, nominal, design_omega, tower_shaping, speed_relax_db, max_sensitivity,
+                 base):
+        from .. import turbine
+
+        self.v, self.speeds, self.nom = v, speeds, nominal
+        self.plants = [model.linearize(s) for s in speeds]
+        self.rosco = [turbine.rosco_baseline(model, s) for s in speeds]
+        self.tower_shaping = tower_shaping  # callable ω → complex shaping (notches × relaxation)
+        self.speed_gain = 10 ** (speed_relax_db / 20)
+        self.ms = max_sensitivity
+        self.base = base
+        self.wf, self.S = base.omega, base.s_wind
+        self.Rf = plant_responses(self.plants, self.wf)
+        self.pss = []
+        for P in self.plants:
+            p = ct.ss(P)[["gen_speed", "tower_top_vel"], "pitch_cmd"]
+            if np.any(np.asarray(p.D) != 0):
+                raise ValueError("the plant has a direct feedthrough pitch → measurement; not supported")
+            self.pss.append((np.asarray(p.A), np.asarray(p.B), np.asarray(p.C)))
+        c0 = siso_response(self.rosco[nominal], self.wf)[:, None]
+        T0 = {y: self._t(self.Rf, c0, 0.0, y)[:, nominal] for y in ("tower_base_my", "gen_speed", "pitch")}
+        from .. import spectral
+
+        self.d0 = float(spectral.damage_rate(self.wf, np.abs(T0["tower_base_my"]) ** 2 * self.S, base.m, method=base.method))
+        self.sd0 = {"gen_speed": self._sd(T0["gen_speed"]), "pitch": self._sd(T0["pitch"]),
+                    "pitch_rate": self._sd(T0["pitch"] * 1j * self.wf)}
+        self.set_design(design_omega)
+
+    # closed-loop maps from responses (every case at once)
+    @staticmethod
+    def _t(R, c, k, y):
+        return closed_map(R, c, k, y)
+
+    def _sd(self, t):
+        return float(np.sqrt(np.trapezoid(np.abs(t) ** 2 * self.S, self.wf)))
+
+    def weights(self, omega):
+        """(W_Ω, W_MyT), each (n_omega, n_cases) magnitudes at ω (rad/s)."""
+        R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"))
+        c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
+        w_speed = np.abs(self._t(R, c, 0.0, "gen_speed")) * self.speed_gain
+        w_tower = np.abs(self._t(R, c, 0.0, "tower_base_my")) * np.abs(self.tower_shaping(omega))[:, None]
+        return w_speed, w_tower
+
+    def set_design(self, omega):
+        self.wd = np.asarray(omega, float)
+        self.Rd = plant_responses(self.plants, self.wd, ("gen_speed", "tower_base_my", "tower_top_vel"))
+        self.WO, self.WM = self.weights(self.wd)
+
+    def margins(self, x):
+        """Per-spec margins in dB on the design grid, (n_specs, n_omega, n_cases)."""
+        nb, db, na, da = controller_polys(x)
+        s = 1j * self.wd[:, None]
+        c = np.polyval(nb, s) / np.polyval(db, s)
+        k = np.polyval(na, s) / np.polyval(da, s)
+        R = self.Rd
+        to = self._t(R, c, k, "gen_speed")
+        tm = self._t(R, c, k, "tower_base_my")
+        ob, zb = R[("gen_speed", "pitch_cmd")], R[("tower_top_vel", "pitch_cmd")]
+        d = 1 + c * ob + k * zb
+        with np.errstate(divide="ignore"):
+            return np.stack([
+                20 * np.log10(self.WO / np.abs(to)),
+                20 * np.log10(self.WM / np.abs(tm)),
+                20 * np.log10(self.ms * np.abs(d) / np.abs(1 + k * zb)),  # pitch loop, ATD closed
+                20 * np.log10(self.ms * np.abs(d) / np.abs(1 + c * ob)),  # ATD loop, pitch closed
+                20 * np.log10(self.ms * np.abs(d)),  # at the actuator
+            ])
+
+    def max_real(self, x):
+        """Largest closed-loop pole real part (1/s) per case, full interconnection."""
+        from scipy.signal import tf2ss
+
+        nb, db, na, da = controller_polys(x)
+        A1, B1, C1, D1 = tf2ss(nb, db)
+        A2, B2, C2, D2 = tf2ss(na, da)
+        n1, n2 = A1.shape[0], A2.shape[0]
+        out = []
+        for A, B, C in self.pss:
+            n = A.shape[0]
+            M = np.zeros((n + n1 + n2,) * 2)
+            M[:n, :n] = A - B @ (D1 @ C[0:1] + D2 @ C[1:2])
+            M[:n, n:n + n1] = -B @ C1
+            M[:n, n + n1:] = -B @ C2
+            M[n:n + n1, :n] = B1 @ C[0:1]
+            M[n:n + n1, n:n + n1] = A1
+            M[n + n1:, :n] = B2 @ C[1:2]
+            M[n + n1:, n + n1:] = A2
+            out.append(np.linalg.eigvals(M).real.max())
+        return np.array(out)
+
+    def performance(self, x):
+        """(DEL reduction %, damage reduction %, SD ratios gen speed, pitch, pitch rate) nominal."""
+        from .. import spectral
+
+        key = np.asarray(x, float).tobytes()
+        if getattr(self, "_perf_key", None) == key:  # the objective and the constraints ask for the same x
+            return self._perf
+        nb, db, na, da = controller_polys(x)
+        s = 1j * self.wf[:, None]
+        c = np.polyval(nb, s) / np.polyval(db, s)
+        k = np.polyval(na, s) / np.polyval(da, s)
+        tm = self._t(self.Rf, c, k, "tower_base_my")[:, self.nom]
+        tp = self._t(self.Rf, c, k, "pitch")[:, self.nom]
+        to = self._t(self.Rf, c, k, "gen_speed")[:, self.nom]
+        d = float(spectral.damage_rate(self.wf, np.abs(tm) ** 2 * self.S, self.base.m, method=self.base.method))
+        ratio = d / self.d0
+        self._perf_key, self._perf = key, (
+            100 * (1 - ratio ** (1 / self.base.m)), 100 * (1 - ratio), self._sd(to) / self.sd0["gen_speed"],
+            self._sd(tp) / self.sd0["pitch"], self._sd(tp * 1j * self.wf) / self.sd0["pitch_rate"])
+        return self._perf
+
+    def objective(self, x):
+        """The tuning objective: (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)², nominal case."""
+        _, _, gs, _, rate = self.performance(x)
+        return float(rate**2 + 0.1 * gs**2)
+
+    def _safety(self):
+        # the performance specs touch their weights at ω → 0 (integral action: every design
+        # reaches the same DC response), so only the margin specs get a full safety margin
+        return np.where(self.wd >= 0.05, PERFORMANCE_SAFETY_DB, DC_SAFETY_DB)[None, :, None]
+
+    def constraints(self, x, target, min_decay):
+        """Every requirement as one vector that is ≥ 0 when met: bound margins (dB) less their
+        safety margin per spec, frequency and case; DEL reduction − target (pp); decay margin
+        −(max Re p + min_decay) per case (1/s)."""
+        g = self.margins(x)
+        return np.r_[(g[:2] - self._safety()).ravel(), (g[2:] - STABILITY_SAFETY_DB).ravel(), self.performance(x)[0] - target,
+                     -(self.max_real(x) + min_decay)]
+
+    def cost(self, x, target, min_decay, weight=1e3):
+        """Exterior-penalty cost of the exploration: objective + 10·(target − reduction)₊²
+        + weight·Σ(bound violation, dB)²; a barrier (≥ 1e10) for decay-rate violations."""
+        try:
+            g = self.margins(x)
+            red = self.performance(x)[0]
+            mr = self.max_real(x)
+        except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+            return 1e12
+        if not (np.all(np.isfinite(g)) and np.isfinite(red) and np.all(np.isfinite(mr))):
+            return 1e12
+        viol = np.sum(np.minimum(g[:2] - self._safety(), 0.0) ** 2) + np.sum(np.minimum(g[2:] - STABILITY_SAFETY_DB, 0.0) ** 2)
+        excess = np.sum(np.maximum(mr + min_decay, 0.0))
+        if excess > 0:  # a barrier: never trade stability for anything
+            return float(1e10 * (1 + excess))
+        return float(self.objective(x) + 10 * max(target - red, 0.0) ** 2 + weight * viol)
+
+
+#: Largest constraint violation a polished candidate may keep and still count as feasible
+#: (dB for bounds, pp for the DEL target, 1/s for the decay rate): SLSQP's own tolerance.
+FEASIBLE_TOL = 1e-6
+
+
+def tune(prob, x0, target, min_decay, maxfev):
+    """Tune from ``x0``: explore, polish, and keep the best candidate by a total order.
+
+    Returns (x, feasible): the chosen parameters and whether they meet every constraint.
+
+    Powell on the penalty cost explores (a derivative-free search that gets past the kinks of
+    the bounds from an infeasible start) but stops wherever its line searches happen to end,
+    so its end point moves with round-off. Each candidate is therefore polished by SLSQP on the
+    constrained problem (objective subject to :meth:`TuningProblem.constraints` ≥ 0) to a KKT point,
+    which moves continuously with the data. Candidates: the polished Powell end point, the
+    polished start, and the unpolished Powell end point. The order that picks one is total:
+    feasible (every constraint ≥ −1e-6) before infeasible; among feasible ones the smaller
+    objective; among infeasible ones the smaller penalty cost; ties by candidate order.
+    """
+    from scipy.optimize import minimize
+
+    lo, hi = vector_bounds()
+    box = list(zip(lo, hi))
+    x = x0
+    # exterior penalty method: the bound violations cost more and more (continuation)
+    for weight in (1e3, 1e5, 1e7):
+        with np.errstate(all="ignore"):
+            res = minimize(prob.cost, x, args=(target, min_decay, weight), method="Powell", bounds=box,
+                           options={"maxfev": int(maxfev), "xtol": 1e-4, "ftol": 1e-8})
+        if np.all(np.isfinite(res.x)) and res.fun <= prob.cost(x, target, min_decay, weight):
+            x = np.clip(res.x, lo, hi)
+
+    def polish(start):
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                r = minimize(prob.objective, start, method="SLSQP", bounds=box,
+                             constraints=[{"type": "ineq", "fun": prob.constraints, "args": (target, min_decay)}],
+                             options={"maxiter": 300, "ftol": 1e-10})
+            except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+                return None
+        return np.clip(r.x, lo, hi) if np.all(np.isfinite(r.x)) else None
+
+    candidates = [c for c in (polish(x), polish(np.asarray(x0, float)), x) if c is not None]
+
+    def key(c):
+        with np.errstate(all="ignore"):
+            try:
+                g = prob.constraints(c, target, min_decay)
+                if np.all(np.isfinite(g)) and g.min() >= -FEASIBLE_TOL:
+                    return (0, prob.objective(c))
+                return (1, prob.cost(c, target, min_decay, 1e7))
+            except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+                return (2, 0.0)
+
+    keys = [key(c) for c in candidates]
+    best = min(range(len(candidates)), key=lambda i: (keys[i], i))
+    return candidates[best], keys[best][0] == 0
