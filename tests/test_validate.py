@@ -410,7 +410,7 @@ def test_no_module_chooses_a_matplotlib_backend():
     assert not offenders, offenders
 
 
-@pytest.mark.parametrize("module", ["specdesign.validate.stats", "specdesign.validate.indicators",
+@pytest.mark.parametrize("module", ["specdesign.validate.stats", "specdesign.validate.metrics",
                                     "specdesign.validate.prediction", "specdesign.validate.volterra",
                                     "specdesign.validate.campaign", "specdesign.validate.tables", "specdesign.cli",
                                     "specdesign.openfast.series", "specdesign.openfast.outputs",

@@ -5,7 +5,7 @@ and the user's OpenFAST outputs (:func:`specdesign.openfast.series_from_openfast
 
 Modules, in the order they build on each other:
 
-- :mod:`~specdesign.validate.indicators`: per-run indicators (the paper's four, plus pitch
+- :mod:`~specdesign.validate.metrics`: per-run indicators (the paper's four, plus pitch
   rate): tower-base DEL by rainflow (a range, N·m, 1 Hz convention, Wöhler exponent m = 4 by
   default), generator-speed SD (rad/s), mean electrical power (W), pitch SD (rad) and
   pitch-rate SD (rad/s).
@@ -39,7 +39,7 @@ from __future__ import annotations
 from ..closedloop import closed_loop_poles  # noqa: F401  (reachable here as before; not part of __all__)
 from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
 from .campaign import Campaign, check_campaign_step, check_plant_step, concat_campaigns, run_campaign, seeds_from
-from .indicators import INDICATORS, Indicators, indicators
+from .metrics import INDICATORS, Indicators, indicators
 from .prediction import LinearPrediction, closed_loop_response, linear_prediction, prediction_grid
 from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, weibull_weights,
                     welch_psd)

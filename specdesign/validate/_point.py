@@ -9,7 +9,7 @@ import numpy as np
 
 from ..closedloop import unstable_message, unstable_poles
 from ._loop import has_linear_form, rotor_radius
-from .indicators import INDICATORS, indicators
+from .metrics import INDICATORS, indicators
 from .prediction import closed_loop_response, linear_prediction, prediction_grid
 from .stats import welch_psd
 from .volterra import volterra_response

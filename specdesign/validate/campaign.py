@@ -14,7 +14,7 @@ from .._checks import positive_scalar
 from ..closedloop import unstable_poles
 from ._loop import has_linear_form
 from ._point import SPECTRA, campaign_point
-from .indicators import INDICATORS
+from .metrics import INDICATORS
 from .stats import PairedChange, paired_change
 
 __all__ = ["Campaign", "run_campaign", "concat_campaigns", "seeds_from", "check_plant_step", "check_campaign_step"]

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
-from .indicators import INDICATORS
+from .metrics import INDICATORS
 
 __all__ = ["WEIBULL_K", "WEIBULL_A", "weibull_weights", "welch_psd", "pool", "resampled_se", "PairedChange",
            "paired_change"]
@@ -124,7 +124,7 @@ def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
     Parameters
     ----------
     indicator : str
-        One of :data:`~specdesign.validate.indicators.INDICATORS`.
+        One of :data:`~specdesign.validate.metrics.INDICATORS`.
     x : numpy.ndarray
         Per-seed values (the indicator's unit), seeds along ``axis``.
     m : float
@@ -203,7 +203,7 @@ class PairedChange:
     Parameters
     ----------
     indicator : str
-        The indicator compared (:data:`~specdesign.validate.indicators.INDICATORS`).
+        The indicator compared (:data:`~specdesign.validate.metrics.INDICATORS`).
     wind_speeds : numpy.ndarray
         (W,) wind speeds (m/s), or 0..W−1 when none were given.
     change : numpy.ndarray
@@ -240,7 +240,7 @@ def paired_change(designed, baseline, indicator: str = "tower_del", *, m: float 
         (W, S) per-run values on the same seeds (seed j of both saw the same wind), in the
         indicator's unit; a 1-D array is one wind speed.
     indicator : str, default "tower_del"
-        One of :data:`~specdesign.validate.indicators.INDICATORS`.
+        One of :data:`~specdesign.validate.metrics.INDICATORS`.
     m : float, default 4.0
         Wöhler exponent (for the DEL).
     wind_speeds : array_like, optional
