@@ -589,7 +589,7 @@ class Baseline:
         Frequency grid, rad/s.
     t_response : numpy.ndarray
         Complex T_{y,w}(jω) on ``omega``, output units per m/s.
-    s_wind : numpy.ndarray
+    wind_psd : numpy.ndarray
         Wind PSD S_W(ω), one-sided, (m/s)² per rad/s.
     psd : numpy.ndarray
         Output PSD |T|² S_W, one-sided, output units² per rad/s.
@@ -616,7 +616,7 @@ class Baseline:
 
     omega: np.ndarray
     t_response: np.ndarray
-    s_wind: np.ndarray
+    wind_psd: np.ndarray
     psd: np.ndarray
     damage_rate: float
     sensitivity: np.ndarray
@@ -629,12 +629,18 @@ class Baseline:
     extras: dict = field(default_factory=dict)
 
     @property
+    def s_wind(self) -> np.ndarray:
+        """Deprecated name of :attr:`wind_psd` (one name for the wind PSD)."""
+        warnings.warn("Baseline.s_wind is deprecated, use Baseline.wind_psd", DeprecationWarning, stacklevel=2)
+        return self.wind_psd
+
+    @property
     def del_1hz(self) -> float:
         """DEL at 1 Hz of the baseline output, a range in the output's units (N·m for MyT)."""
         return float(self.damage_rate ** (1.0 / self.m))
 
 
-def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, s_wind: ArrayLike, m: float = 4.0, *,
+def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, wind_psd: ArrayLike, m: float = 4.0, *,
                            method: str = "dirlik", reduction: float = 0.01, system: ct.LTI | None = None,
                            output: str = "", wind_speed: float = float("nan")) -> Baseline:
     """Baseline from a closed-loop frequency response T(jω) and an input spectrum S_W(ω).
@@ -645,7 +651,7 @@ def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, s_wind: Arra
         Frequencies, rad/s: 1-D, increasing, non-negative.
     t_response : array_like
         Complex T_{y,w}(jω) on ``omega``, output units per m/s.
-    s_wind : array_like
+    wind_psd : array_like
         One-sided wind PSD S_W on ``omega``, (m/s)² per rad/s.
     m : float
         Wöhler exponent (-), range-based S-N curve.
@@ -668,10 +674,10 @@ def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, s_wind: Arra
     Raises
     ------
     TypeError
-        If ``omega`` or ``s_wind`` is complex.
+        If ``omega`` or ``wind_psd`` is complex.
     ValueError
-        If ``omega`` is not a valid grid, ``t_response`` or ``s_wind`` does not match it,
-        ``s_wind`` is negative or non-finite, or the output spectrum carries no damage.
+        If ``omega`` is not a valid grid, ``t_response`` or ``wind_psd`` does not match it,
+        ``wind_psd`` is negative or non-finite, or the output spectrum carries no damage.
 
     Examples
     --------
@@ -688,14 +694,14 @@ def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, s_wind: Arra
     t_response = np.asarray(t_response, dtype=complex)
     if t_response.shape != omega.shape:
         raise ValueError(f"t_response must have the shape of omega {omega.shape}, got {t_response.shape}")
-    s_wind = as_psd(s_wind, omega.size, "s_wind")
-    psd = np.abs(t_response) ** 2 * s_wind
+    wind_psd = as_psd(wind_psd, omega.size, "wind_psd")
+    psd = np.abs(t_response) ** 2 * wind_psd
     d0 = float(spectral.damage_rate(omega, psd, m, method=method))
     if not d0 > 0:
         raise ValueError("the baseline output spectrum carries no damage (all-zero PSD); check the output and the wind spectrum")
     # Eq. (10) reads ΔD% as "per 1 % reduction"; a different finite step is rescaled to it.
     sens = spectral.sensitivity(omega, psd, m, reduction=reduction, method=method) * (0.01 / reduction)
-    return Baseline(omega, t_response, s_wind, psd, d0, np.asarray(sens), float(m), method, float(reduction), system, output, float(wind_speed))
+    return Baseline(omega, t_response, wind_psd, psd, d0, np.asarray(sens), float(m), method, float(reduction), system, output, float(wind_speed))
 
 
 def default_omega(n: int = 400, lo: float = 0.01, hi: float = 10.0) -> np.ndarray:

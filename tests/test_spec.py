@@ -64,7 +64,7 @@ def test_baseline_matches_closed_loop_formula(model, base19):
     c = fr(C)
     t = (pyw + c * (pyw * pob - pyb * pow_)) / (1 + c * pob)
     assert np.allclose(base19.t_response, t, rtol=1e-8)
-    assert base19.psd == pytest.approx(np.abs(t) ** 2 * base19.s_wind, rel=1e-10)
+    assert base19.psd == pytest.approx(np.abs(t) ** 2 * base19.wind_psd, rel=1e-10)
     # ΔD% sums to m/2 for small steps (damage is homogeneous of degree m/2 in S)
     assert base19.sensitivity.sum() == pytest.approx(base19.m / 2, rel=2e-2)
 
@@ -141,8 +141,8 @@ def test_bad_inputs(base19):
         spec.promise_of(spec.Specification(base19.system, (spec.Notch(50.0, 6.0, 0.3),)), base19)
     with pytest.raises(ValueError, match="keep_below"):
         spec.shape_to_target(base19, 10.0, keep_below=100.0)
-    with pytest.raises(ValueError, match="s_wind"):
-        spec.baseline_from_response(base19.omega, base19.t_response, -base19.s_wind)
+    with pytest.raises(ValueError, match="wind_psd"):
+        spec.baseline_from_response(base19.omega, base19.t_response, -base19.wind_psd)
 
 
 def test_speed_specification_margin(model):

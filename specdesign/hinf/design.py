@@ -373,12 +373,12 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, 
     notch_excess = float(20 * np.log10(at_mode / np.abs(np.asarray(Wn(1j * wt_mode)))))
     t_speed0 = closedloop.frequency_response(cl0, omega, "gen_speed")
     speed_excess0 = float(np.max(20 * np.log10(np.abs(t_speed) / np.abs(t_speed0))))
-    s_wind = wind.rotor_effective_spectrum(omega, v, model.rotor_radius)
+    wind_psd = wind.rotor_effective_spectrum(omega, v, model.rotor_radius)
     t_tower0 = closedloop.frequency_response(cl0, omega, "tower_base_my")
-    del0 = float(spectral.del_spectral(omega, np.abs(t_tower0) ** 2 * s_wind, m))
-    del1 = float(spectral.del_spectral(omega, np.abs(t_tower) ** 2 * s_wind, m))
+    del0 = float(spectral.del_spectral(omega, np.abs(t_tower0) ** 2 * wind_psd, m))
+    del1 = float(spectral.del_spectral(omega, np.abs(t_tower) ** 2 * wind_psd, m))
     t_pitch0 = closedloop.frequency_response(cl0, omega, "pitch_cmd")
-    std = lambda t: float(np.sqrt(np.trapezoid(np.abs(t) ** 2 * s_wind, omega)))  # noqa: E731
+    std = lambda t: float(np.sqrt(np.trapezoid(np.abs(t) ** 2 * wind_psd, omega)))  # noqa: E731
     # Loop at the actuator, L_u = Σ C_i·P_{y_i,β}; its peak sensitivity max |1/(1 + L_u)|.
     Kj = np.asarray(ct.frequency_response(K, omega).complex).reshape(1, len(measurements), -1)[0]
     L_u = -sum(Kj[i] * closedloop.frequency_response(plant, omega, y, "pitch_cmd")

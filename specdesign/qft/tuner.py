@@ -38,7 +38,7 @@ class TuningProblem:
         self.speed_gain = 10 ** (speed_relax_db / 20)
         self.ms = max_sensitivity
         self.base = base
-        self.wf, self.S = base.omega, base.s_wind
+        self.wf, self.S = base.omega, base.wind_psd
         self.Rf = plant_responses(self.plants, self.wf)
         self.pss = []
         for P in self.plants:
