@@ -142,9 +142,23 @@ class LinearizationData:
     def to_statespace(self, inputs=None, outputs=None):
         """``control.StateSpace`` with the selected signals.
 
-        inputs / outputs: None (all), a list of description substrings (each must match one
-        description; an exact description always wins) or a dict {signal name: substring} to
-        rename, e.g. ``{"wind": "horizontal wind speed", "pitch_cmd": "collective blade-pitch"}``.
+        Parameters
+        ----------
+        inputs, outputs : None, list of str or dict
+            None (all), a list of description substrings (each must match one description; an
+            exact description always wins) or a dict {signal name: substring} to rename, e.g.
+            ``{"wind": "horizontal wind speed", "pitch_cmd": "collective blade-pitch"}``.
+
+        Returns
+        -------
+        control.StateSpace
+            The linearisation restricted to the selected inputs and outputs, signals named by
+            their (renamed) descriptions, states ``x0, x1, ...``; units as in the file.
+
+        Raises
+        ------
+        ValueError
+            If a substring matches no description or several.
         """
         import control
 

@@ -55,7 +55,22 @@ def plot_range_histogram(cycles: Cycles, omega, psd, ax=None, *, bins: int = 60,
 def plot_sensitivity(omega, dd, ax=None, *, label: str = "ΔD%(ω)"):
     """Damage sensitivity ΔD%(ω) (Eq. 7: % damage change for a 1 % PSD reduction) on a log ω axis.
 
-    ``omega`` in rad/s, ``dd`` of shape (n,) or (k, n) (one line per row). Returns the axes.
+    Parameters
+    ----------
+    omega : array_like
+        Frequency grid, rad/s.
+    dd : array_like
+        ΔD%(ω) in % (:func:`specdesign.spectral.sensitivity`), shape (n,) or (k, n): one line
+        per row.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+    label : str
+        Legend label (suffixed by the row index when ``dd`` has several rows).
+
+    Returns
+    -------
+    matplotlib Axes
+        The axes drawn on.
     """
     w = np.asarray(omega, dtype=float)
     d = np.atleast_2d(np.asarray(dd, dtype=float))
