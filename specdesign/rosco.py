@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._checks import positive_scalar
 from .turbine import TurbineModel, iea15mw
@@ -88,7 +89,7 @@ class RoscoSchedule:
     omega_pc: float
     zeta_pc: float
 
-    def gains(self, wind_speeds) -> tuple[np.ndarray, np.ndarray]:
+    def gains(self, wind_speeds: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(Kp, Ki) at ``wind_speeds`` from the straight-line fits, in ROSCO's sign.
 
         The same pole placement as ``Kp``, ``Ki``, with A and B_β from their straight-line
@@ -163,7 +164,7 @@ def first_order_rotor_model(model: TurbineModel, wind_speed: float) -> tuple[flo
     return op.pitch, A[0, 0], A[0, 3], B[0, 0]
 
 
-def rosco_gain_schedule(model: TurbineModel, wind_speeds=None, *, omega_pc: float = 0.2,
+def rosco_gain_schedule(model: TurbineModel, wind_speeds: ArrayLike | None = None, *, omega_pc: float = 0.2,
                         zeta_pc: float = 1.0) -> RoscoSchedule:
     """ROSCO's pitch PI schedule by pole placement on the first-order rotor model.
 
@@ -301,7 +302,7 @@ def rosco_baseline(model: TurbineModel, wind_speed: float, *, omega_pc: float = 
     return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=f"ROSCO_PI@{v:g}mps".replace(".", "p"))
 
 
-def rosco_scheduled(model: TurbineModel | None = None, wind_speeds=None, *, name: str = "ROSCO",
+def rosco_scheduled(model: TurbineModel | None = None, wind_speeds: ArrayLike | None = None, *, name: str = "ROSCO",
                     form: str = "gains") -> ScheduledController:
     """The ROSCO baseline PI (tower damping off) with its gain schedule on filtered pitch.
 

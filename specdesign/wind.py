@@ -14,7 +14,10 @@ All spectra are one-sided and per rad/s (∫₀^∞ S(ω) dω = variance, (m/s)�
 from __future__ import annotations
 
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._checks import as_omega, positive_scalar
 
@@ -41,7 +44,7 @@ def _sigma(mean_speed, turbulence_class):
     return TURBULENCE_CLASSES[turbulence_class] * (0.75 * mean_speed + 5.6)
 
 
-def kaimal_spectrum(omega, mean_speed: float, turbulence_class: str = "B") -> np.ndarray:
+def kaimal_spectrum(omega: ArrayLike, mean_speed: float, turbulence_class: str = "B") -> np.ndarray:
     """One-sided Kaimal spectrum of the longitudinal wind at a point, ((m/s)² per rad/s).
 
     S(ω) = S_f(ω/2π)/(2π), S_f(f) = 4σ²(L/U)/(1 + 6fL/U)^{5/3} (per Hz), σ = I_ref(0.75U + 5.6)
@@ -80,7 +83,7 @@ def kaimal_spectrum(omega, mean_speed: float, turbulence_class: str = "B") -> np
     return s_f / (2 * np.pi)
 
 
-def disc_coherence(omega, mean_speed: float, rotor_radius: float) -> np.ndarray:
+def disc_coherence(omega: ArrayLike, mean_speed: float, rotor_radius: float) -> np.ndarray:
     """Rotor-disc average γ(ω) of the IEC exponential coherence (dimensionless, ≤ 1).
 
     γ = ∫₀^{2R} exp(−12 √((f r/U)² + (0.12 r/L_c)²)) p_R(r) dr, f = ω/2π, with
@@ -120,7 +123,7 @@ def disc_coherence(omega, mean_speed: float, rotor_radius: float) -> np.ndarray:
     return coh @ weights
 
 
-def rotor_effective_spectrum(omega, mean_speed: float, rotor_radius: float,
+def rotor_effective_spectrum(omega: ArrayLike, mean_speed: float, rotor_radius: float,
                              turbulence_class: str = "B") -> np.ndarray:
     """One-sided PSD of the rotor-effective wind speed ((m/s)² per rad/s): Kaimal × γ(ω).
 
@@ -171,7 +174,7 @@ def _seeds(seeds):
     return out
 
 
-def synthesize(spectrum_or_callable, duration: float, dt: float, seeds, *,
+def synthesize(spectrum_or_callable: Callable | tuple, duration: float, dt: float, seeds: int | Sequence[int], *,
                random_amplitude: bool = True) -> np.ndarray:
     """Zero-mean Gaussian series with a one-sided PSD, shape (n_seeds, n_samples).
 
@@ -278,7 +281,7 @@ def seed_for(wind_speed: float, seed: int) -> int:
     return int(seed) * 1000 + int(round(10.0 * float(wind_speed)))
 
 
-def wind_series(rotor_radius: float, wind_speeds, seeds, duration: float, dt: float,
+def wind_series(rotor_radius: float, wind_speeds: Sequence[float], seeds: Sequence[int], duration: float, dt: float,
                 turbulence_class: str = "B") -> np.ndarray:
     """Rotor-effective wind records: the mean plus turbulence, one per (wind speed, seed).
 

@@ -5,6 +5,7 @@ unstable, is refused before any run (:func:`specdesign.simulate.simulate` applie
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -24,7 +25,7 @@ __all__ = ["MAX_STEP_EIGENVALUE", "check_step", "sampled_loop_radius", "check_lo
 MAX_STEP_EIGENVALUE = 1.0
 
 
-def check_step(plant: KernelPlant, wind_speeds, dt: float) -> None:
+def check_step(plant: KernelPlant, wind_speeds: Sequence[float], dt: float) -> None:
     """Reject a step the RK4 integration cannot resolve (see :data:`MAX_STEP_EIGENVALUE`).
 
     Parameters
@@ -56,7 +57,8 @@ def check_step(plant: KernelPlant, wind_speeds, dt: float) -> None:
                          f"dt must be ≤ {MAX_STEP_EIGENVALUE / fastest:.3g} s (RK4 would be inaccurate or unstable)")
 
 
-def sampled_loop_radius(plant: KernelPlant, controller, wind_speed: float, dt: float, *, parts=None) -> float:
+def sampled_loop_radius(plant: KernelPlant, controller: object, wind_speed: float, dt: float, *,
+                        parts: tuple | None = None) -> float:
     """Spectral radius of the linearised closed loop as the simulator samples it at step ``dt``.
 
     The plant's linearisation at ``wind_speed`` advanced by one RK4 step with the pitch
@@ -136,7 +138,8 @@ def sampled_loop_radius(plant: KernelPlant, controller, wind_speed: float, dt: f
 _RADIUS_TOL = 1e-9
 
 
-def check_loop_step(plant: KernelPlant, controller, wind_speed: float, dt: float, parts=None) -> None:
+def check_loop_step(plant: KernelPlant, controller: object, wind_speed: float, dt: float,
+                    parts: tuple | None = None) -> None:
     """Reject a step at which the sampled loop is unstable while the continuous one is stable.
 
     The controller's hold and Tustin map add phase lag (:func:`sampled_loop_radius`); the
@@ -189,7 +192,7 @@ def check_loop_step(plant: KernelPlant, controller, wind_speed: float, dt: float
                      "to the continuous loop: dt = 0.02 s by default)")
 
 
-def warn_unstable(plant: KernelPlant, controller, wind_speeds, dt: float) -> None:
+def warn_unstable(plant: KernelPlant, controller: object, wind_speeds: Sequence[float], dt: float) -> None:
     """Warn where the linearised loop is unstable; where it is stable, check the step.
 
     Saturations may keep a run of an unstable loop bounded (a limit cycle between the pitch

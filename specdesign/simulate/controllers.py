@@ -26,7 +26,7 @@ __all__ = [
 ]
 
 
-def is_lti_like(c) -> bool:
+def is_lti_like(c: object) -> bool:
     """Whether ``c`` is an LTI controller the simulator takes as one (not a callable).
 
     Parameters
@@ -44,7 +44,7 @@ def is_lti_like(c) -> bool:
 
     return isinstance(c, control.LTI) or (hasattr(c, "tf") and callable(getattr(c, "tf")))
 
-def as_lti(c, name: str) -> control.LTI:
+def as_lti(c: object, name: str) -> control.LTI:
     """``c`` as a continuous SISO python-control system, checked.
 
     Parameters
@@ -79,7 +79,7 @@ def as_lti(c, name: str) -> control.LTI:
     return c
 
 
-def discretize(controller, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def discretize(controller: object, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Tustin discretisation of a SISO continuous controller at step ``dt``.
 
     Parameters
@@ -126,7 +126,7 @@ def discretize(controller, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarra
             np.array([float(np.squeeze(d.D))]))
 
 
-def split_integrator(controller) -> tuple[float, control.LTI]:
+def split_integrator(controller: object) -> tuple[float, control.LTI]:
     """(r, C_r): C(s) = r/s + C_r(s) for a SISO controller with one pole at s = 0.
 
     The simulator runs r/s as a separate integrator (trapezoid rule = Tustin, so the sum is
@@ -181,7 +181,7 @@ def split_integrator(controller) -> tuple[float, control.LTI]:
 SLOW_OMEGA = 0.1
 
 
-def split_slow(controller, omega: float = SLOW_OMEGA) -> tuple[control.StateSpace | None, control.LTI]:
+def split_slow(controller: object, omega: float = SLOW_OMEGA) -> tuple[control.StateSpace | None, control.LTI]:
     """(C_s or None, C_f): C = C_s + C_f, C_s the modes of ``controller`` slower than ``omega``.
 
     C_s holds the modes of ``controller`` (no pole at 0, e.g. C_r of :func:`split_integrator`)
@@ -228,7 +228,7 @@ def split_slow(controller, omega: float = SLOW_OMEGA) -> tuple[control.StateSpac
 _BANKS: dict = {}
 
 
-def controller_bank(controller, dt: float) -> tuple:
+def controller_bank(controller: object, dt: float) -> tuple:
     """Discrete arrays of one controller (K local 2-input controllers) and its filter corner.
 
     Memoised per (controller object, dt): a campaign simulates the same controllers at

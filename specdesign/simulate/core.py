@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 from ..wind import wind_series
@@ -210,7 +211,8 @@ class SimulationResult:
         return float(self.time.size * self.dt)
 
 
-def simulate(plant, controller, wind_speeds, *, seeds=None, wind=None, duration: float = 600.0, dt: float = 0.02,
+def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds: ArrayLike, *,
+             seeds: ArrayLike | None = None, wind: ArrayLike | None = None, duration: float = 600.0, dt: float = 0.02,
              record_dt: float = 0.1, transient: float = 60.0, wind_dt: float | None = None,
              turbulence_class: str = "B", linear: bool = False, wind_rotor_radius: float | None = None,
              wind_mean_tol: float = WIND_MEAN_TOLERANCE) -> SimulationResult:

@@ -17,9 +17,15 @@ by :func:`specdesign.simulate.simulate`; nothing is meant to be called directly 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit, prange
+from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:  # pragma: no cover
+    import control
 
 from ..turbine import outputs as _turbine_outputs
 from ..turbine import rhs as _turbine_rhs
@@ -39,7 +45,7 @@ __all__ = [
 # ----------------------------------------------------------------------------- linear kernel
 # Parameter layout of the linear kernel: [nx, ny, u0(3), y0(ny), A, B(nx×3), C(ny×nx), D(ny×3)]
 @njit(cache=True)
-def linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
+def linear_rhs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.ndarray, dx: np.ndarray) -> None:
     """State derivative of the linear plant, ẋ = A x + B (u − u0), written into ``dx``.
 
     Parameters
@@ -72,7 +78,7 @@ def linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx):
 
 
 @njit(cache=True)
-def linear_outputs(x, wind, pitch_cmd, gen_torque, p, y):
+def linear_outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.ndarray, y: np.ndarray) -> None:
     """Outputs of the linear plant, y = y0 + C x + D (u − u0) (SI), written into ``y``.
 
     Parameters
@@ -104,7 +110,7 @@ def linear_outputs(x, wind, pitch_cmd, gen_torque, p, y):
         y[i] = s
 
 
-def linear_plant_params(sys, u0, y0) -> np.ndarray:
+def linear_plant_params(sys: control.StateSpace, u0: ArrayLike, y0: ArrayLike) -> np.ndarray:
     """Flat parameter array of the linear kernel (:func:`linear_rhs`, :func:`linear_outputs`).
 
     Layout: [nx, ny, u0(3), y0(ny), A, B(nx×3), C(ny×nx), D(ny×3)], matrices flattened in C order.
@@ -377,7 +383,7 @@ def _outputs_all(kind, P, X, W, wdt, t, bcmd, torque, Y):
 _REBOUND = {}
 
 
-def compiled_for(rhs, outfn) -> tuple:
+def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
     """The compiled loop functions for a kernel pair.
 
     The turbine and linear kernels use the cached module functions. Any other pair gets
@@ -425,8 +431,10 @@ def compiled_for(rhs, outfn) -> tuple:
     return _REBOUND[key]
 
 
-def run_callable(fn, step_all, outputs_all, kind, P, X0, Wr, wdt, dt, nsteps, rec_every, torque, beta0, ny, Y, names,
-                 lim_idx, lim_val, status) -> None:
+def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: int, P: np.ndarray, X0: np.ndarray,
+                 Wr: np.ndarray, wdt: float, dt: float, nsteps: int, rec_every: int, torque: np.ndarray,
+                 beta0: np.ndarray, ny: int, Y: np.ndarray, names: Sequence[str], lim_idx: np.ndarray,
+                 lim_val: np.ndarray, status: np.ndarray) -> None:
     """Run a batch with a Python controller ``fn(t, y) -> pitch_cmd`` (the slow path).
 
     ``fn`` is called once per step with ``y`` a dict of the outputs, each an array over all

@@ -8,9 +8,11 @@ speed. See :mod:`specdesign.simulate` for how the simulator runs them and
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 from .controllers import as_lti
@@ -144,8 +146,9 @@ class ScheduledController:
         return self.pitch[k], (None if self.atd is None else self.atd[k])
 
     @classmethod
-    def gain_scheduled_pi(cls, schedule_pitch, kp, ki, error_filter, *, atd=None,
-                          filter_omega=SCHEDULE_FILTER_OMEGA, name="PI", pitch_limits=None) -> "ScheduledController":
+    def gain_scheduled_pi(cls, schedule_pitch: ArrayLike, kp: ArrayLike, ki: ArrayLike, error_filter: object, *,
+                          atd: Sequence | None = None, filter_omega: float = SCHEDULE_FILTER_OMEGA, name: str = "PI",
+                          pitch_limits: tuple[float, float] | None = None) -> ScheduledController:
         """ROSCO-form gain-scheduled PI: u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_ref − Ω_g).
 
         Parameters
@@ -199,7 +202,7 @@ class ScheduledController:
                    form="gains", kp=kp, ki=ki, error_filter=f, pitch_limits=pitch_limits)
 
 
-def scheduled(model, pitch: dict, atd: dict | None = None, *, filter_omega: float = SCHEDULE_FILTER_OMEGA,
+def scheduled(model: object, pitch: dict, atd: dict | None = None, *, filter_omega: float = SCHEDULE_FILTER_OMEGA,
               name: str = "designed") -> ScheduledController:
     """Build an output-blended ScheduledController from controllers designed per wind speed.
 

@@ -74,7 +74,7 @@ HEADER_SIZE = 20
 
 # ----------------------------------------------------------------------------- kernel
 @njit(cache=True)
-def bicubic(p, offset, tsr, pitch):
+def bicubic(p: np.ndarray, offset: int, tsr: float, pitch: float) -> float:
     """Evaluate one C2 bicubic table (coefficients at ``p[offset:]``) at (tsr, pitch).
 
     Outside the table the coefficient is held at its edge value.
@@ -118,7 +118,7 @@ def bicubic(p, offset, tsr, pitch):
 
 
 @njit(cache=True)
-def aero_loads(p, omega, v_rel, beta):
+def aero_loads(p: np.ndarray, omega: float, v_rel: float, beta: float) -> tuple[float, float]:
     """Aerodynamic torque and thrust from the compiled Cp/Ct interpolant.
 
     Parameters
@@ -153,7 +153,8 @@ def aero_loads(p, omega, v_rel, beta):
 
 
 @njit(cache=True)
-def mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx):
+def mechanics(x: np.ndarray, aero_torque: float, thrust: float, pitch_cmd: float, gen_torque: float, p: np.ndarray,
+              dx: np.ndarray) -> None:
     """State derivative given the aerodynamic loads, written into ``dx``.
 
     Rigid drivetrain, first tower fore-aft mode, pitch actuator with rate and position limits.
@@ -197,7 +198,7 @@ def mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx):
 
 
 @njit(cache=True)
-def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
+def rhs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.ndarray, dx: np.ndarray) -> None:
     """State derivative of the reduced IEA 15 MW model, written into ``dx``.
 
     See the module docstring for the state vector, units and the layout of the parameter
@@ -224,7 +225,7 @@ def rhs(x, wind, pitch_cmd, gen_torque, p, dx):
 
 
 @njit(cache=True)
-def outputs_from(x, dx, gen_torque, p, y):
+def outputs_from(x: np.ndarray, dx: np.ndarray, gen_torque: float, p: np.ndarray, y: np.ndarray) -> None:
     """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``.
 
     Parameters
@@ -249,7 +250,7 @@ def outputs_from(x, dx, gen_torque, p, y):
 
 
 @njit(cache=True)
-def outputs(x, wind, pitch_cmd, gen_torque, p, y):
+def outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.ndarray, y: np.ndarray) -> None:
     """Outputs of the reduced model in the order of :data:`OUTPUT_NAMES`, written into ``y``.
 
     Parameters

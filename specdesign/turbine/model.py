@@ -19,6 +19,7 @@ from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 
@@ -186,7 +187,7 @@ class TurbineModel:
         """
         return self._params.copy()
 
-    def rotor_coefficients(self, tsr, pitch):
+    def rotor_coefficients(self, tsr: ArrayLike, pitch: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(Cp, Ct) of the compiled interpolant.
 
         Parameters
@@ -209,7 +210,7 @@ class TurbineModel:
         return cp, ct
 
     # -- numpy wrappers -------------------------------------------------------------------
-    def derivatives(self, x, wind, pitch_cmd, gen_torque) -> np.ndarray:
+    def derivatives(self, x: ArrayLike, wind: float, pitch_cmd: float, gen_torque: float) -> np.ndarray:
         """ẋ of the compiled :func:`specdesign.turbine.rhs`.
 
         Parameters
@@ -238,7 +239,7 @@ class TurbineModel:
         rhs(x, float(wind), float(pitch_cmd), float(gen_torque), self._params, dx)
         return dx
 
-    def evaluate_outputs(self, x, wind, pitch_cmd, gen_torque) -> np.ndarray:
+    def evaluate_outputs(self, x: ArrayLike, wind: float, pitch_cmd: float, gen_torque: float) -> np.ndarray:
         """Outputs of the compiled :func:`specdesign.turbine.outputs`.
 
         Parameters
@@ -275,7 +276,7 @@ class TurbineModel:
         return x
 
     # -- trim and linearisation -------------------------------------------------------------
-    def check_wind_speed(self, wind_speed) -> float:
+    def check_wind_speed(self, wind_speed: float) -> float:
         """``wind_speed`` as a float, checked to be within ``wind_range``.
 
         Parameters
@@ -308,7 +309,7 @@ class TurbineModel:
         x = np.array([omega, 0.0, 0.0, pitch, 0.0])
         return self.derivatives(x, wind, pitch, 0.0)[0] * self.drivetrain_inertia
 
-    def trim(self, wind_speed) -> OperatingPoint:
+    def trim(self, wind_speed: float) -> OperatingPoint:
         """Steady operating point above rated.
 
         Rated rotor speed, rated generator torque, the pitch that balances aerodynamic and
@@ -434,7 +435,7 @@ class TurbineModel:
         omega, torque = self.rated_rotor_speed, self.rated_generator_torque
         return float(brentq(lambda v: self._aero_torque(v, omega, self.pitch_min) - torque, 5.0, 20.0, xtol=1e-10))
 
-    def linearize(self, wind_speed, *, load_inputs: bool = False) -> control.StateSpace:
+    def linearize(self, wind_speed: float, *, load_inputs: bool = False) -> control.StateSpace:
         """Linear model at the trim for ``wind_speed``.
 
         Inputs ``wind`` (m/s), ``pitch_cmd`` (rad), ``gen_torque`` (N·m), outputs
@@ -505,7 +506,7 @@ class TurbineModel:
         z0 = np.array([op.rotor_speed, op.wind_speed, op.pitch])
         return z0, np.array(aero_loads(self._params, z0[0], z0[1], z0[2]))
 
-    def aero_expansion(self, wind_speed, *, steps=(2e-3, 2e-2, 2e-3)) -> AeroExpansion:
+    def aero_expansion(self, wind_speed: float, *, steps: tuple[float, float, float] = (2e-3, 2e-2, 2e-3)) -> AeroExpansion:
         """Third-order Taylor expansion of (aerodynamic torque, thrust) about a trim.
 
         In (rotor speed, relative wind, pitch) (:data:`AERO_VARIABLES`).

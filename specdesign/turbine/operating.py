@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["LOAD_INPUT_NAMES", "AERO_VARIABLES", "OperatingPoint", "AeroExpansion"]
 
@@ -97,7 +98,7 @@ class AeroExpansion:
     third: np.ndarray
     steps: np.ndarray
 
-    def evaluate(self, dz, order: int = 3) -> np.ndarray:
+    def evaluate(self, dz: ArrayLike, order: int = 3) -> np.ndarray:
         """Load change predicted by the Taylor polynomial of ``order`` for deviations ``dz``.
 
         Parameters

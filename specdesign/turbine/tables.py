@@ -81,7 +81,7 @@ def read_rotor_table() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     return tsr, pitch, blocks["po"], blocks["th"]
 
 
-def uniform_step(grid, name: str) -> float:
+def uniform_step(grid: np.ndarray, name: str) -> float:
     """The spacing of a uniform grid (the compiled interpolant needs uniform axes).
 
     Parameters
@@ -112,7 +112,7 @@ def uniform_step(grid, name: str) -> float:
 HERMITE = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [-3.0, 3.0, -2.0, -1.0], [2.0, -2.0, 1.0, 1.0]])
 
 
-def bicubic_coefficients(tsr, pitch_rad, table) -> tuple[np.ndarray, object]:
+def bicubic_coefficients(tsr: np.ndarray, pitch_rad: np.ndarray, table: np.ndarray) -> tuple[np.ndarray, object]:
     """Per-cell bicubic coefficients reproducing the interpolating cubic spline of ``table``.
 
     The coefficients a[i, j, k, l] (f = Σ a_kl u^k v^l in cell (i, j), u and v in [0, 1])
