@@ -413,9 +413,14 @@ class Bounds:
         return out
 
     def lower_bound_db(self) -> np.ndarray:
-        """(n_omega, n_phase) top of the highest finite forbidden interval (−inf if none), dB.
+        """Top of the highest finite forbidden interval at each design frequency and phase.
 
         Above it L0 meets every spec; it is the solid curve toolbox users read first.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n_omega, n_phase), dB of |L0| (−inf where no spec forbids anything).
         """
         lower, _ = self.edges()
         with warnings.catch_warnings():
@@ -424,9 +429,13 @@ class Bounds:
         return top
 
     def dominant(self) -> np.ndarray:
-        """(n_omega, n_phase) index into ``parts`` of the spec setting :meth:`lower_bound_db`.
+        """Which spec sets :meth:`lower_bound_db` at each design frequency and phase.
 
-        −1 where no spec puts a lower bound there.
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n_omega, n_phase), integer index into ``parts``; −1 where no spec puts a
+            lower bound there.
         """
         total = self.lower_bound_db()
         out = np.full(total.shape, -1)

@@ -127,7 +127,14 @@ class CheckResult:
         return self.names.index(name)
 
     def summary(self) -> str:
-        """Human-readable report: worst margins, violated ranges, stability, margins."""
+        """Human-readable report: worst margins, violated ranges, stability, margins.
+
+        Returns
+        -------
+        str
+            One line per spec (worst margin in dB, its frequency in rad/s and plant case), then
+            stability and the nominal gain and phase margins.
+        """
         lines = [f"check on {len(self.omega)} frequencies {self.omega[0]:.3g}…{self.omega[-1]:.3g} rad/s, "
                  f"{len(self.stable)} plant cases: {'PASSED' if self.passed else 'FAILED'}"]
         for name, ok in zip(self.names, self.spec_passed):

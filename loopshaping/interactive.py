@@ -197,11 +197,19 @@ class Designer:
 
     # -- drawing
     def draw(self, live=None):
-        """Build the figure (Nichols chart + closed-loop magnitudes); returns it.
+        """Build the figure (Nichols chart + closed-loop magnitudes).
 
-        ``live``: redraw edits by blitting (only the loop, markers and closed-loop lines are
-        re-rendered). Default: on with the ipympl backend. Blitted artists are skipped by
-        ``savefig`` and static inline display, hence off elsewhere.
+        Parameters
+        ----------
+        live : bool, optional
+            Redraw edits by blitting (only the loop, markers and closed-loop lines are
+            re-rendered). Default: on with the ipympl backend. Blitted artists are skipped by
+            ``savefig`` and static inline display, hence off elsewhere.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The designer's figure (also kept as ``self.figure``).
         """
         import matplotlib
         import matplotlib.pyplot as plt
@@ -249,8 +257,16 @@ class Designer:
     def update(self, redraw=True) -> DesignState:
         """Recompute and push the new data into the existing artists (no figure rebuild).
 
-        ``redraw=False`` skips asking the canvas to redraw (a non-interactive canvas such as
-        Agg renders synchronously on request).
+        Parameters
+        ----------
+        redraw : bool
+            Ask the canvas to redraw; False skips it (a non-interactive canvas such as Agg
+            renders synchronously on request).
+
+        Returns
+        -------
+        DesignState
+            The numbers behind this redraw (nominal loop, bound check, closed-loop peaks).
         """
         st = self.state()
         if self.figure is not None:
@@ -284,7 +300,18 @@ class Designer:
 
     # -- widgets
     def widget(self):
-        """ipywidgets UI: element list, parameter sliders, add/remove, and the figure."""
+        """ipywidgets UI: element list, parameter sliders, add/remove, and the figure.
+
+        Returns
+        -------
+        ipywidgets.Widget
+            A box holding the controls and the figure's canvas, ready to display.
+
+        Raises
+        ------
+        ImportError
+            Without ipywidgets.
+        """
         try:
             import ipywidgets as ipw
         except ImportError as e:

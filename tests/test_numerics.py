@@ -11,13 +11,11 @@ Where the expected numbers come from (each test says which):
 - independent references that cannot overflow: Decimal arithmetic (50 digits) for Σ n S^m,
   the narrow-band closed form in logarithms (math.lgamma), and FLife at unit scale.
 
-The last test checks the documentation of both modules (issue 13): numpydoc docstrings on
-every public function and class, and examples that run.
+(The documentation of both modules, numpydoc docstrings and examples that run, is checked
+with every other module's in tests/test_docstrings.py.)
 """
 from __future__ import annotations
 
-import doctest
-import inspect
 import math
 import warnings
 from decimal import Decimal, localcontext
@@ -217,23 +215,3 @@ def test_complex_input_is_a_type_error_naming_the_argument(name, call):
     # even a zero imaginary part: the caller probably passed T where |T|² belongs
     with pytest.raises(TypeError, match=f"^{name} is complex"):
         call()
-
-
-@pytest.mark.parametrize("module", [spectral, fatigue], ids=lambda m: m.__name__)
-def test_public_api_is_documented_and_its_examples_run(module):
-    """numpydoc: no missing docstring (GL08), undocumented (PR01) or unknown (PR02) parameter,
-    or missing Returns (RT01) on a public function, class, method or property; doctests pass."""
-    validate = pytest.importorskip("numpydoc.validate").validate
-    names = []
-    for name in module.__all__:
-        obj = getattr(module, name)
-        if inspect.isfunction(obj) or inspect.isclass(obj):
-            names.append(f"{module.__name__}.{name}")
-        if inspect.isclass(obj):
-            names += [f"{module.__name__}.{name}.{k}" for k, v in vars(obj).items()
-                      if not k.startswith("_") and (inspect.isfunction(v) or isinstance(v, property))]
-    bad = {n: codes for n in names
-           if (codes := [c for c, _ in validate(n)["errors"] if c in ("GL08", "PR01", "PR02", "RT01")])}
-    assert not bad, bad
-    result = doctest.testmod(module)
-    assert result.attempted > 0 and result.failed == 0, result
