@@ -117,6 +117,16 @@ def test_every_public_module_declares_all():
     assert not missing, f"public modules without __all__: {missing}"
 
 
+def test_every_name_in_all_exists():
+    import importlib
+
+    absent = [f"{modname}.{n}" for path, modname in _modules()
+              if not any(p.startswith("_") and p != "__init__" for p in modname.split("."))
+              for n in getattr(importlib.import_module(modname.removesuffix(".__init__")), "__all__", ())
+              if not hasattr(importlib.import_module(modname.removesuffix(".__init__")), n)]
+    assert not absent, absent
+
+
 def test_no_module_chooses_the_matplotlib_backend():
     # the command line chooses it once (specdesign.cli); a library module that calls
     # matplotlib.use would override a notebook's widget backend
