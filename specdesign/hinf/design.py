@@ -1,18 +1,34 @@
 """H∞ design of the pitch (and ATD) controller at one operating point on the fatigue-based
-specifications, with reduction, discretisation and an assessment on a refined grid."""
+specifications, with reduction, discretisation and an assessment on a refined grid.
+
+Units: ω in rad/s, wind speed in m/s, pitch in rad, generator speed in rad/s, tower-base
+moment in N·m, reductions in %, relaxations and excesses in dB, decay rates in 1/s. Sign
+convention of the workbench: β = −C_β·Ω_g − C_atd·ẋ_top; the synthesis closes u = K·y, so
+[C_β, C_atd] = −K.
+"""
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
 import control as ct
 import numpy as np
+from numpy.typing import ArrayLike
 
 from loopshaping import hinf as lhinf
 
 from ..closedloop import closed_loop_mimo, refine_grid
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
+
+if TYPE_CHECKING:
+    from loopshaping.check import CheckResult
+    from loopshaping.reduction import ReductionResult
+
+    from ..spec import Specification
+    from ..turbine import TurbineModel
 
 __all__ = ['HinfDesign', 'QFT_SPEED_RELAX_DB', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
 
@@ -26,46 +42,100 @@ TOWER_BAND = 0.1
 class HinfDesign:
     """Outcome of :func:`design_hinf` at one operating point (units: rad/s, N·m, rad, %).
 
-    ``pitch_controller`` C_β (gen_speed → pitch) and ``atd_controller`` C_atd (or None), in the
-    workbench sign β = −C_β·Ω_g − C_atd·v, as minimal SISO systems for frequency-domain use
-    (implement the 1×2 ``controller`` itself: see :func:`specdesign.closedloop.closed_loop_mimo`);
-    ``controller`` the reduced K (u = K·y) and
-    ``full_controller`` the synthesised one; ``gamma`` of the full-order design; ``reduction``
-    (:class:`loopshaping.hinf.ReductionResult`); ``w_tower``, ``w_speed`` the specifications;
-    ``promised_del_reduction`` (the specification's exact Dirlik promise, %) and
-    ``predicted_del_reduction`` (Dirlik on the reduced controller's closed loop, %);
-    ``speed_excess_db`` max over the grid of 20·log10(|T_Ω,w|/|W_Ω|) (≤ 0 means met);
-    ``tower_excess_db`` the same for MyT at ``tower_mode`` (rad/s) and
-    ``tower_band_excess_db`` its max over ``tower_mode``·(1 ± :data:`TOWER_BAND`);
-    ``zeta_min`` the least damping ratio of the reduced loop's oscillatory poles, at
-    ``zeta_min_frequency`` (|p|, rad/s), ``max_pole_real`` its largest Re p (1/s);
-    ``peak_sensitivity`` max |1/(1 + L_u)| at the actuator, L_u = Σ C_i·P_{y_i,β};
-    ``decay_rate`` the α of the synthesis;
-    ``discrete_controller`` K sampled at ``dt`` (Tustin prewarped at the tower mode) or None;
-    ``pitch_std``/``pitch_std_baseline`` pitch-command standard deviation (rad) from the
-    linear model; ``omega`` the assessment grid (:func:`specdesign.closedloop.refine_grid`) on which every
-    frequency-domain number here is computed, DELs included; ``check`` the :func:`loopshaping.check.check` of the
-    reduced pitch controller against both specifications in QFT's general form (specs
-    "tower" and "speed", margins in dB, stability, gain/phase margins; None with ATD, whose
-    1×2 loop that SISO check does not cover); ``notes``;
-    ``specs`` which specifications were the weights ("qft", "qft_design", "rosco", "custom")
-    and ``speed_relax_db`` the relaxation of ROSCO's T_{Ω,w} in the speed spec (dB; nan for
-    custom specs); ``notch_spec`` the unrelaxed notch specification (ROSCO × notches of
-    :func:`specdesign.spec.shape_to_target`; ``w_tower`` for custom specs),
-    ``notch_promised_del_reduction`` its promise (%), ``tower_notch_excess_db`` the tower
-    excess against it at ``tower_mode`` (stricter than ``tower_excess_db`` when ``w_tower``
-    is relaxed); ``speed_excess_baseline_db`` max 20·log10(|T_Ω,w|/|T^ROSCO_Ω,w|), the speed
-    excess over ROSCO's unrelaxed response (what a relaxed speed spec gives away).
+    Every frequency-domain number is computed on ``omega``, the assessment grid
+    (:func:`specdesign.closedloop.refine_grid`), DELs included.
+
+    Parameters
+    ----------
+    pitch_controller : control.StateSpace
+        C_β, generator speed (rad/s) → pitch (rad), in the workbench sign
+        β = −C_β·Ω_g − C_atd·v, as a minimal SISO system for frequency-domain use (implement
+        the 1×2 ``controller`` itself: see :func:`specdesign.closedloop.closed_loop_mimo`).
+    atd_controller : control.StateSpace or None
+        C_atd, tower-top velocity (m/s) → pitch (rad), same sign and use; None without ATD.
+    controller : control.StateSpace
+        The reduced K (u = K·y, y the measurements), ``order`` states.
+    full_controller : control.StateSpace
+        The synthesised full-order K (times the integrator F when one is built in).
+    gamma : float
+        The γ of the full-order design (-): the H∞ norm of the weighted closed loop
+        (see :mod:`specdesign.hinf`).
+    reduction : loopshaping.hinf.ReductionResult
+        The controller reduction (reduced K, its H∞ error and bound, Hankel singular values).
+    w_tower : specdesign.spec.Specification or control.LTI
+        The tower-load specification W_MyT used as the weight, N·m per m/s.
+    w_speed : specdesign.spec.Specification or control.LTI
+        The generator-speed specification W_Ω used as the weight, rad/s per m/s.
+    promised_del_reduction : float
+        The tower specification's exact (Dirlik) promise, %.
+    predicted_del_reduction : float
+        Dirlik on the reduced controller's closed loop vs ROSCO's, tower-base DEL, %.
+    speed_excess_db : float
+        Maximum over the grid of 20·log10(|T_Ω,w|/|W_Ω|), dB (≤ 0 means met).
+    tower_excess_db : float
+        The same for MyT at ``tower_mode``, dB.
+    tower_mode : float
+        Frequency of the least-damped open-loop pole pair (the tower mode), rad/s.
+    pitch_std : float
+        Pitch-command standard deviation from the linear model, rad.
+    pitch_std_baseline : float
+        The same with ROSCO, rad.
+    omega : numpy.ndarray
+        The assessment grid, rad/s.
+    check : loopshaping.check.CheckResult or None
+        :func:`loopshaping.check.check` of the reduced pitch controller against both
+        specifications in QFT's general form (specs "tower" and "speed", margins in dB,
+        stability, gain/phase margins); None with ATD, whose 1×2 loop that SISO check does
+        not cover.
+    discrete_controller : control.StateSpace or None
+        K sampled at ``dt`` (Tustin prewarped at the tower mode), or None.
+    notes : tuple of str
+        Notes of the weights, the synthesis and the relaxation ladder.
+    zeta_min : float
+        The least damping ratio of the reduced loop's oscillatory poles (-; 1 when none).
+    zeta_min_frequency : float
+        Its |p|, rad/s (nan when none).
+    peak_sensitivity : float
+        Peak |1/(1 + L_u)| at the actuator, L_u = Σ C_i·P_{y_i,β} (-).
+    max_pole_real : float
+        The reduced loop's largest pole real part Re p, 1/s.
+    decay_rate : float
+        The α of the synthesis, 1/s.
+    tower_band_excess_db : float
+        Maximum of the tower excess over ``tower_mode``·(1 ± :data:`TOWER_BAND`), dB.
+    specs : str
+        Which specifications were the weights: "qft", "qft_design", "rosco" or "custom".
+    speed_relax_db : float
+        The relaxation of ROSCO's T_{Ω,w} in the speed spec, dB (nan for custom specs).
+    notch_spec : specdesign.spec.Specification or control.LTI
+        The unrelaxed notch specification (ROSCO × notches of
+        :func:`specdesign.spec.shape_to_target`; ``w_tower`` for custom specs).
+    notch_promised_del_reduction : float
+        Its promise, %.
+    tower_notch_excess_db : float
+        The tower excess against it at ``tower_mode``, dB (stricter than
+        ``tower_excess_db`` when ``w_tower`` is relaxed).
+    speed_excess_baseline_db : float
+        Maximum of 20·log10(|T_Ω,w|/|T^ROSCO_Ω,w|), dB: the speed excess over ROSCO's unrelaxed
+        response (what a relaxed speed spec gives away).
+
+    Examples
+    --------
+    >>> from specdesign import turbine
+    >>> from specdesign.hinf import design_hinf
+    >>> d = design_hinf(turbine.iea15mw(), 19.0)  # doctest: +SKIP
+    >>> d.specs, d.speed_relax_db, d.controller.nstates  # doctest: +SKIP
+    ('qft', 4.5, 8)
     """
 
     pitch_controller: ct.StateSpace
-    atd_controller: object
+    atd_controller: ct.StateSpace | None
     controller: ct.StateSpace
     full_controller: ct.StateSpace
     gamma: float
-    reduction: object
-    w_tower: object
-    w_speed: object
+    reduction: ReductionResult
+    w_tower: Specification | ct.LTI
+    w_speed: Specification | ct.LTI
     promised_del_reduction: float
     predicted_del_reduction: float
     speed_excess_db: float
@@ -74,9 +144,9 @@ class HinfDesign:
     pitch_std: float
     pitch_std_baseline: float
     omega: np.ndarray
-    check: object
-    discrete_controller: object
-    notes: tuple
+    check: CheckResult | None
+    discrete_controller: ct.StateSpace | None
+    notes: tuple[str, ...]
     zeta_min: float
     zeta_min_frequency: float
     peak_sensitivity: float
@@ -85,7 +155,7 @@ class HinfDesign:
     tower_band_excess_db: float
     specs: str = "custom"
     speed_relax_db: float = float("nan")
-    notch_spec: object = None
+    notch_spec: Specification | ct.LTI | None = None
     notch_promised_del_reduction: float = float("nan")
     tower_notch_excess_db: float = float("nan")
     speed_excess_baseline_db: float = float("nan")
@@ -125,8 +195,10 @@ def _is_design(obj) -> bool:
     return all(hasattr(obj, k) for k in ("tower_spec", "speed_spec", "shaping", "options"))
 
 
-def qft_specifications(model, wind_speed, *, speed_relax_db=4.5, spec_reduction=15.0, tower_relax_db=6.0,
-                       tower_relax_omega=1.3, keep_below=0.6, m=4.0, omega=None):
+def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
+                       spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
+                       keep_below: float = 0.6, m: float = 4.0,
+                       omega: ArrayLike | None = None) -> tuple[Specification, Specification, Specification]:
     """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
 
     Tower load: W_MyT = T^ROSCO_{MyT,w} × the notches of :func:`specdesign.spec.shape_to_target`
@@ -135,13 +207,53 @@ def qft_specifications(model, wind_speed, *, speed_relax_db=4.5, spec_reduction=
     spec is relaxed by ``tower_relax_db`` at high frequency, where ΔD% is negligible (the
     leads already lift it by ≈ 1.9 dB at the tower mode, 1.06 rad/s, with the defaults).
     Generator speed: W_Ω = T^ROSCO_{Ω,w}·10^(speed_relax_db/20), ROSCO's dip at the tower
-    mode (a ζ = 0.01 zero pair) kept.
+    mode (a ζ = 0.01 zero pair) kept. Built by :func:`specdesign.spec.design_specifications`.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    speed_relax_db : float
+        Relaxation of the generator-speed specification, dB (≥ 0).
+    spec_reduction : float
+        Damage reduction the notches promise, %.
+    tower_relax_db : float
+        High-frequency relaxation of the tower specification, dB (≥ 0; 0 for none).
+    tower_relax_omega : float
+        Corner ω_r of the relaxation, rad/s.
+    keep_below : float
+        No notch below this frequency, rad/s.
+    m : float
+        Wöhler exponent of the tower-base S-N curve (-).
+    omega : array_like, optional
+        Frequency grid of the baseline analysis, rad/s (default
+        :func:`specdesign.spec.default_omega`).
 
     Returns
     -------
-    (Specification, Specification, Specification)
-        ``(tower_spec, speed_spec, notch_spec)``: the two specs QFT is given and the
-        unrelaxed notch spec whose promise :func:`specdesign.spec.shape_to_target` reports.
+    tower_spec : specdesign.spec.Specification
+        W_MyT, N·m per m/s: the notch spec × the relaxation.
+    speed_spec : specdesign.spec.Specification
+        W_Ω, rad/s per m/s.
+    notch_spec : specdesign.spec.Specification
+        The unrelaxed notch spec whose promise :func:`specdesign.spec.shape_to_target` reports.
+
+    Raises
+    ------
+    ValueError
+        If no notch specification reaches ``spec_reduction`` at this wind speed, a relaxation
+        is negative or not finite, ``tower_relax_omega`` is not positive, or ``wind_speed`` is
+        outside ``model.wind_range``.
+
+    Examples
+    --------
+    >>> from specdesign import turbine
+    >>> from specdesign.hinf import qft_specifications
+    >>> tower, speed, notch = qft_specifications(turbine.iea15mw(), 19.0)  # doctest: +SKIP
+    >>> speed.elements  # doctest: +SKIP
+    (Gain(gain_db=4.5),)
     """
     from .. import spec
 
@@ -159,29 +271,29 @@ QFT_SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
 
 
 def design_hinf(
-    model,
-    wind_speed,
+    model: TurbineModel,
+    wind_speed: float,
     *,
-    specs="qft",
-    target_reduction=15.0,
-    measurements=("gen_speed", "tower_top_vel"),
-    order=8,
-    w_tower=None,
-    w_speed=None,
-    w_pitch=None,
-    speed_relax_db=QFT_SPEED_RELAX_DB,
-    tower_relax_db=6.0,
-    tower_relax_omega=1.3,
-    m=4.0,
-    omega=None,
-    suboptimality=0.05,
-    reduction_method="balanced",
-    dt=None,
-    min_damping=DEFAULT_MIN_DAMPING,
-    decay_rate=DEFAULT_DECAY_RATE,
-    integral_corner=None,
-    **plant_options,
-):
+    specs: str | Any = "qft",
+    target_reduction: float = 15.0,
+    measurements: Sequence[str] = ("gen_speed", "tower_top_vel"),
+    order: int = 8,
+    w_tower: Specification | ct.LTI | None = None,
+    w_speed: Specification | ct.LTI | None = None,
+    w_pitch: ct.LTI | float | None = None,
+    speed_relax_db: float | Sequence[float] = QFT_SPEED_RELAX_DB,
+    tower_relax_db: float = 6.0,
+    tower_relax_omega: float = 1.3,
+    m: float = 4.0,
+    omega: ArrayLike | None = None,
+    suboptimality: float = 0.05,
+    reduction_method: str = "balanced",
+    dt: float | None = None,
+    min_damping: float = DEFAULT_MIN_DAMPING,
+    decay_rate: float = DEFAULT_DECAY_RATE,
+    integral_corner: float | None = None,
+    **plant_options: Any,
+) -> HinfDesign:
     """Design, reduce and assess an H∞ pitch (and optional ATD) controller at one wind speed.
 
     Every frequency-domain number is computed on :func:`specdesign.closedloop.refine_grid`: ``omega`` refined
@@ -194,7 +306,7 @@ def design_hinf(
     model : specdesign.turbine.TurbineModel
         E.g. :func:`specdesign.turbine.iea15mw`.
     wind_speed : float
-        m/s, above rated.
+        Operating point, m/s, above rated.
     specs : "qft", "rosco" or specdesign.qft.QFTDesign
         Which specifications are the weights (``w_tower``/``w_speed``, when given, override).
         ``"qft"`` (default): those of :func:`specdesign.qft.design_qft`
@@ -219,8 +331,12 @@ def design_hinf(
         Explicit specifications (override ``specs``).
     w_pitch : optional
         Pitch-activity weight, see :func:`generalized_plant`.
-    speed_relax_db, tower_relax_db, tower_relax_omega : float (dB, dB, rad/s)
-        See ``specs="qft"``.
+    speed_relax_db : float or sequence of float
+        Relaxation(s) of ROSCO's T_{Ω,w} in the speed spec, dB (≥ 0); see ``specs="qft"``.
+    tower_relax_db : float
+        High-frequency relaxation of the tower spec, dB; see ``specs="qft"``.
+    tower_relax_omega : float
+        Corner of that relaxation, rad/s; see ``specs="qft"``.
     m : float
         Wöhler exponent of the tower-base DEL (S-N curve on ranges).
     omega : array, optional
@@ -239,16 +355,51 @@ def design_hinf(
         assessment uses the true specification, dip included.
         Without it (0) the synthesis copies the dip into a closed-loop pole pair of ζ ≈ 0.003.
     decay_rate : float
-        α (1/s) of an α-shifted synthesis (:func:`loopshaping.hinf.synthesize`) on the
+        The α (1/s) of an α-shifted synthesis (:func:`loopshaping.hinf.synthesize`) on the
         turbine's states and the integrator F (weights, in series, unshifted): every pole of
         the loop with the full-order controller has Re < −α (reduction may move them; the
         reduced loop's poles are reported in ``zeta_min`` and ``max_pole_real``).
     integral_corner : float, optional
-        ω_i (rad/s) of the integrator F(s) = (1 + s/ω_i)/s built into the plant
+        Corner ω_i (rad/s) of the integrator F(s) = (1 + s/ω_i)/s built into the plant
         (:func:`generalized_plant`). Default: 0.1 rad/s when ``decay_rate`` > 0 (without it
         the shift would move the controller's integral action to −α), none otherwise.
     **plant_options
         ``noise``, ``noise_band``, ``rolloff``, ``shift`` for :func:`generalized_plant`.
+
+    Returns
+    -------
+    HinfDesign
+        The reduced design and its assessment; with a ladder of ``speed_relax_db`` the
+        smallest relaxation met (else the last one, said in ``notes``).
+
+    Raises
+    ------
+    ValueError
+        If ``specs`` is not "qft", "rosco" or a design record; ``speed_relax_db`` is not a
+        relaxation ≥ 0 dB or a sequence of them; no notch specification reaches
+        ``target_reduction``; ``wind_speed`` is outside ``model.wind_range``; or a weight,
+        the generalized plant, the synthesis or the reduction rejects its arguments
+        (:func:`inverse_weight`, :func:`generalized_plant`, :func:`loopshaping.hinf.synthesize`,
+        :func:`loopshaping.hinf.reduce`).
+    RuntimeError
+        If the reduced controller of the last relaxation tried does not stabilise the
+        turbine (raise ``order``).
+    TypeError
+        If a weight is not an LTI system or a number, or ``plant_options`` has an unknown key.
+
+    Warns
+    -----
+    specdesign.closedloop.ClosedLoopUnstableWarning
+        When a reduced controller does not stabilise the turbine (before the RuntimeError, or
+        before the next relaxation is tried).
+
+    Examples
+    --------
+    >>> from specdesign import turbine
+    >>> from specdesign.hinf import design_hinf
+    >>> d = design_hinf(turbine.iea15mw(), 19.0)  # doctest: +SKIP
+    >>> d.speed_excess_db <= 0 and d.tower_band_excess_db <= 0  # doctest: +SKIP
+    True
     """
     from .. import spec
 

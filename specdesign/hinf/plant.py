@@ -1,14 +1,24 @@
-"""The generalized plant of the H∞ pitch design at one operating point (see :mod:`specdesign.hinf`)."""
+"""The generalized plant of the H∞ pitch design at one operating point (see :mod:`specdesign.hinf`).
+
+Units: wind in m/s, pitch in rad, generator speed in rad/s, tower-base moment in N·m,
+frequencies in rad/s; the performance outputs z are the outputs divided by their
+specifications (dimensionless).
+"""
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import control as ct
 import numpy as np
 
 from ..closedloop import named_siso
 from .weights import inverse_weight, siso_weight
+
+if TYPE_CHECKING:
+    from ..spec import Specification
 
 __all__ = ['DEFAULT_NOISE', 'DEFAULT_INTEGRAL_CORNER', 'GeneralizedPlant', 'generalized_plant']
 
@@ -22,41 +32,58 @@ DEFAULT_INTEGRAL_CORNER = 0.1
 
 @dataclass(frozen=True)
 class GeneralizedPlant:
-    """Generalized plant for :func:`loopshaping.hinf.synthesize`.
+    """Generalized plant for :func:`loopshaping.hinf.synthesize`, made by :func:`generalized_plant`.
 
-    ``system``: inputs ``['wind', 'noise_<meas>'..., 'pitch_cmd']``, outputs
-    ``['z_tower', 'z_speed', 'z_pitch', 'y_<meas>'...]``; ``n_meas``, ``n_ctrl`` (= 1);
-    ``measurements`` (names); ``inverse_weights`` {'tower', 'speed', 'pitch'} → LTI; ``notes``;
-    ``input_filter`` F(s) = (1 + s/ω_i)/s when built with ``integral_corner`` (the control
-    input is then ``pitch_u`` and the turbine's controller is F·K), else None;
-    ``n_plant_states``: the first states of ``system`` are the turbine's (and F's), the rest
-    are weights in series.
+    Parameters
+    ----------
+    system : control.StateSpace
+        Inputs ``['wind', 'noise_<meas>'..., 'pitch_cmd']`` (m/s, measurement units, rad; the
+        last input is ``pitch_u`` with an ``input_filter``), outputs ``['z_tower', 'z_speed',
+        'z_pitch', 'y_<meas>'...]`` (performance outputs, dimensionless, then the noisy
+        measurements in their units).
+    n_meas : int
+        Number of measurements (the last outputs).
+    n_ctrl : int
+        Number of control inputs (the last inputs), 1.
+    measurements : tuple of str
+        Names of the measured plant outputs.
+    inverse_weights : dict
+        ``'tower'``, ``'speed'``, ``'pitch'`` → the LTI weights on the outputs: W_MyT⁻¹
+        (m/s per N·m), W_Ω⁻¹ (m/s per rad/s) and the pitch weight (1/rad).
+    notes : tuple of str
+        What was modified in the weights (:func:`inverse_weight`) and the integrator note.
+    input_filter : control.StateSpace or None
+        F(s) = (1 + s/ω_i)/s when built with ``integral_corner`` (the control input is then
+        ``pitch_u`` and the turbine's controller is F·K), else None.
+    n_plant_states : int
+        The first states of ``system`` are the turbine's (and F's), the rest are weights in
+        series.
     """
 
     system: ct.StateSpace
     n_meas: int
     n_ctrl: int
-    measurements: tuple
-    inverse_weights: dict
-    notes: tuple
-    input_filter: object = None
+    measurements: tuple[str, ...]
+    inverse_weights: dict[str, ct.StateSpace]
+    notes: tuple[str, ...]
+    input_filter: ct.StateSpace | None = None
     n_plant_states: int = 0
 
 
 def generalized_plant(
-    plant,
-    w_tower,
-    w_speed,
-    w_pitch=None,
-    measurements=("gen_speed",),
+    plant: ct.StateSpace,
+    w_tower: Specification | ct.LTI,
+    w_speed: Specification | ct.LTI,
+    w_pitch: ct.LTI | float | None = None,
+    measurements: Sequence[str] = ("gen_speed",),
     *,
-    noise=None,
-    noise_band=(1e-3, 1.0),
-    rolloff=10.0,
-    shift=1e-3,
-    min_damping=0.0,
-    integral_corner=None,
-):
+    noise: Mapping[str, float] | None = None,
+    noise_band: tuple[float, float] = (1e-3, 1.0),
+    rolloff: float = 10.0,
+    shift: float = 1e-3,
+    min_damping: float = 0.0,
+    integral_corner: float | None = None,
+) -> GeneralizedPlant:
     """The generalized plant at one operating point (see the module docstring).
 
     Parameters
@@ -80,13 +107,49 @@ def generalized_plant(
         with integral action a measurement offset at DC would pass to Ω_g and meet the
         speed weight's near-infinite low-frequency gain, so the noise is kept out of DC
         (a > 0 keeps its zero off the imaginary axis).
-    rolloff, shift, min_damping : float
-        Passed to :func:`inverse_weight` (rad/s; damping ratio).
+    rolloff : float
+        Passed to :func:`inverse_weight`, rad/s.
+    shift : float
+        Passed to :func:`inverse_weight`, rad/s.
+    min_damping : float
+        Passed to :func:`inverse_weight`, damping ratio (-).
     integral_corner : float, optional
-        ω_i (rad/s): put F(s) = (1 + s/ω_i)/s in front of the pitch input, so the control
+        Corner ω_i (rad/s): put F(s) = (1 + s/ω_i)/s in front of the pitch input, so the control
         input becomes ``pitch_u`` and the controller F·K has exact integral action (needed by
         an α-shifted synthesis, which would otherwise move the controller's integrator to −α).
         The pitch weight stays on ``pitch_cmd``.
+
+    Returns
+    -------
+    GeneralizedPlant
+        The interconnection and what :func:`loopshaping.hinf.synthesize` needs to know.
+
+    Raises
+    ------
+    TypeError
+        If ``plant`` is not a ``control.StateSpace``, or a weight is not an LTI system or a
+        number.
+    ValueError
+        If ``measurements`` is empty or has duplicates; the plant lacks ``wind``,
+        ``pitch_cmd``, ``gen_speed``, ``tower_base_my`` or a measurement; a measurement has
+        no positive noise level; ``noise_band`` is not 0 < a < b; ``integral_corner`` is not
+        a positive frequency; or a specification cannot be inverted (:func:`inverse_weight`).
+
+    Examples
+    --------
+    A first-order stand-in for the turbine (use :meth:`specdesign.turbine.TurbineModel.linearize`):
+
+    >>> import control as ct
+    >>> from specdesign.hinf import generalized_plant
+    >>> P = ct.ss([[-1.0]], [[1.0, -2.0]], [[1.0], [1e6]], [[0.0, 0.0], [0.0, 0.0]],
+    ...           inputs=["wind", "pitch_cmd"], outputs=["gen_speed", "tower_base_my"])
+    >>> gp = generalized_plant(P, ct.tf(1e6, [1, 1]), ct.tf(1, [1, 1]))
+    >>> gp.system.input_labels
+    ['wind', 'noise_gen_speed', 'pitch_cmd']
+    >>> gp.system.output_labels
+    ['z_tower', 'z_speed', 'z_pitch', 'y_gen_speed']
+    >>> gp.n_meas, gp.n_ctrl, gp.n_plant_states
+    (1, 1, 1)
     """
     if not isinstance(plant, ct.StateSpace):
         raise TypeError(f"plant must be a named control.StateSpace, got {type(plant).__name__}")

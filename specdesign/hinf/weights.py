@@ -1,9 +1,19 @@
 """Weights of the H∞ design: W⁻¹ of a fatigue-based specification as a stable, proper, minimum-phase
-system (:func:`inverse_weight`), and the one conversion of a specification or weight to a SISO LTI."""
+system (:func:`inverse_weight`), and the one conversion of a specification or weight to a SISO LTI.
+
+Units: frequencies in rad/s; a specification W is in output units per m/s of rotor-effective
+wind (N·m per m/s for the tower-base moment, rad/s per m/s for the generator speed), W⁻¹ in
+m/s per output unit.
+"""
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import control as ct
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..spec import Specification
 
 __all__ = ['DEFAULT_MIN_DAMPING', 'siso_weight', 'inverse_weight']
 
@@ -11,9 +21,39 @@ __all__ = ['DEFAULT_MIN_DAMPING', 'siso_weight', 'inverse_weight']
 DEFAULT_MIN_DAMPING = 0.05
 
 
-def siso_weight(sys, name):
-    """``sys`` (a :class:`specdesign.spec.Specification` or a SISO continuous-time LTI) as a
-    TransferFunction; TypeError/ValueError name ``name``."""
+def siso_weight(sys: Specification | ct.LTI | float, name: str) -> ct.TransferFunction:
+    """A specification or weight as a SISO continuous-time transfer function.
+
+    ``sys`` (a :class:`specdesign.spec.Specification` or a SISO continuous-time LTI) as a
+    TransferFunction; TypeError/ValueError name ``name``.
+
+    Parameters
+    ----------
+    sys : specdesign.spec.Specification, control.LTI or float
+        The specification (its :meth:`~specdesign.spec.Specification.tf`), a SISO
+        continuous-time system or a constant gain (output units per input unit).
+    name : str
+        Name of the argument, used in the error messages.
+
+    Returns
+    -------
+    control.TransferFunction
+        ``sys`` as a SISO transfer function (proper or not).
+
+    Raises
+    ------
+    TypeError
+        If ``sys`` is neither a specification, an LTI system nor a number.
+    ValueError
+        If ``sys`` is not SISO or is discrete-time.
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> from specdesign.hinf import siso_weight
+    >>> siso_weight(ct.ss(-1.0, 1.0, 1.0, 0.0), "w_pitch").den[0][0]
+    array([1., 1.])
+    """
     from loopshaping.freqresp import as_siso
 
     from ..spec import Specification
@@ -45,7 +85,8 @@ def _cascade(zeros, poles, gain):
     return sys
 
 
-def inverse_weight(specification, *, rolloff=10.0, shift=1e-3, min_damping=0.0, name="specification"):
+def inverse_weight(specification: Specification | ct.LTI, *, rolloff: float = 10.0, shift: float = 1e-3,
+                   min_damping: float = 0.0, name: str = "specification") -> tuple[ct.StateSpace, tuple[str, ...]]:
     """A stable, proper, minimum-phase W⁻¹ with |W⁻¹(jω)| = 1/|W(jω)| below ``rolloff``.
 
     Zeros of W in the right half-plane are reflected (same magnitude on the jω axis), zeros
@@ -57,19 +98,45 @@ def inverse_weight(specification, *, rolloff=10.0, shift=1e-3, min_damping=0.0, 
     ----------
     specification : specdesign.spec.Specification or SISO LTI
         W(s), stable and proper (output units per m/s of wind).
-    rolloff, shift : float
-        rad/s.
+    rolloff : float
+        Frequency of the poles that compensate W's relative degree, rad/s (> 0).
+    shift : float
+        Distance the zeros of W on the imaginary axis are moved into the left half-plane,
+        rad/s (> 0).
     min_damping : float
         Zeros of W with damping ratio below this (a narrow dip of the specification, such
         as the one ROSCO's T_{Ω,w} has at the tower mode) are given this damping at the same
         |z|: W⁻¹ then caps its resonant peak there (relaxes the weight in that narrow band)
         instead of asking the synthesis to track a 40 dB spike, which it does by copying the
         dip into a lightly damped closed-loop pole pair. 0 keeps every zero.
+    name : str
+        Name of the specification in the notes and the error messages.
 
     Returns
     -------
-    (control.StateSpace, tuple of str)
-        W⁻¹ (m/s of wind per output unit) and notes on what was modified.
+    inverse : control.StateSpace
+        W⁻¹ (m/s of wind per output unit), a cascade of second-order sections.
+    notes : tuple of str
+        Notes on what was modified (reflected, shifted or damped zeros, roll-off).
+
+    Raises
+    ------
+    TypeError
+        If ``specification`` is neither a specification nor an LTI system.
+    ValueError
+        If W is not SISO, is discrete-time, identically zero, unstable (a pole with
+        Re ≥ 0) or improper; if ``rolloff`` or ``shift`` is not a positive frequency; or if
+        ``min_damping`` is not in [0, 1).
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> from specdesign.hinf import inverse_weight
+    >>> inv, notes = inverse_weight(ct.tf([2.0, 0.0], [1.0, 1.0]), name="w_speed")  # W = 2s/(s + 1)
+    >>> notes
+    ('w_speed: 1 zero(s) on the imaginary axis moved to Re = −0.001 rad/s',)
+    >>> round(abs(complex(inv(1j))), 4)  # 1/|W(j·1)| = 0.7071
+    0.7071
     """
     W = siso_weight(specification, name)
     for k, v in (("rolloff", rolloff), ("shift", shift)):

@@ -1,8 +1,15 @@
-"""The automatic QFT design at one operating point and over a schedule (see :mod:`specdesign.qft`)."""
+"""The automatic QFT design at one operating point and over a schedule (see :mod:`specdesign.qft`).
+
+Units: ω in rad/s, wind speeds in m/s, reductions and standard-deviation changes in %
+(reductions positive = less, changes positive = more), relaxations and gain margins in dB,
+phase margins in degrees, decay rates in 1/s; β = −C_β·Ω_g − C_atd·ẋ_top.
+"""
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import control as ct
 import numpy as np
@@ -12,6 +19,14 @@ from ..closedloop import (check_stability, close_responses, closed_loop, general
                           partial_loop, plant_responses, siso_response)
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
+
+if TYPE_CHECKING:
+    from loopshaping.bounds import Bounds
+    from loopshaping.check import CheckResult
+    from loopshaping.templates import Template
+
+    from ..spec import Baseline, Promise, ShapingResult, Specification
+    from ..turbine import TurbineModel
 
 __all__ = ["QFTDesign", "design_qft", "design_schedule", "design_table", "format_table", "DEFAULT_DESIGN_OMEGA"]
 
@@ -24,46 +39,120 @@ DEFAULT_DESIGN_OMEGA = np.unique(np.r_[0.005, 0.007, np.logspace(-2, 1, 37), 0.9
 # ----------------------------------------------------------------------------- result
 @dataclass(frozen=True, eq=False)
 class QFTDesign:
-    """One operating point's QFT design (frozen). All changes are designed vs ROSCO (ATD off),
-    in %, positive = increase; reductions are positive = less.
+    """One operating point's QFT design (frozen), made by :func:`design_qft`.
 
-    pitch_controller, atd_controller : python-control TFs (β_cmd = −C_β·Ω_g − C_atd·ẋ_top).
-    baseline_controller : ROSCO's PI at the same speed.
-    template_speeds : wind speeds of the plant cases (m/s); nominal at ``wind_speed``.
-    design_omega : QFT design frequencies, rad/s.
-    pitch_bounds / atd_bounds : :class:`loopshaping.qft.Bounds` on L0 = C_β·P'_{Ω,β} (ATD
-        closed) and on L0 = C_atd·P''_{z,β} (pitch loop closed); ``*_template`` their templates.
-    pitch_check / atd_check : :class:`loopshaping.check.CheckResult` on ``dense_omega``.
-    bounds_met : every bound met at every design frequency (nominal loop, exact).
-    all_stable : the full interconnection is stable for every plant case.
-    del_reduction, damage_reduction : predicted tower-base DEL (1 Hz, m = 4) and damage
-        reduction, Dirlik on |T|²S_W, nominal case.
-    promise : :class:`specdesign.spec.Promise` of the (relaxed) tower specification.
-    gen_speed_sd_change, pitch_sd_change, pitch_rate_sd_change : SD changes, %.
-    gain_margin_db, phase_margin_deg : nominal pitch loop C_β·P'_{Ω,β} (ATD closed).
-    atd_gain_margin_db, atd_phase_margin_deg : nominal ATD loop C_atd·P''_{z,β}.
-    actuator_peak_sensitivity : max over ω and cases of |1/(1 + C_β P_{Ω,β} + C_atd P_{z,β})|.
+    All changes are designed vs ROSCO (ATD off), in %, positive = increase; reductions are
+    positive = less. The controllers are in the workbench sign β_cmd = −C_β·Ω_g − C_atd·ẋ_top.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Operating point, m/s.
+    pitch_controller : control.TransferFunction
+        C_β, generator speed (rad/s) → pitch command (rad).
+    atd_controller : control.TransferFunction
+        C_atd, tower-top fore-aft velocity ẋ_top (m/s) → pitch command (rad).
+    baseline_controller : control.TransferFunction
+        ROSCO's PI (with its speed filter) at the same speed, rad/s → rad.
+    template_speeds : tuple of float
+        Wind speeds of the plant cases, m/s; nominal at ``wind_speed``.
+    design_omega : numpy.ndarray
+        QFT design frequencies, rad/s (the final set, refinements included).
+    dense_omega : numpy.ndarray
+        Grid of the dense check, rad/s.
+    tower_spec : specdesign.spec.Specification
+        The (relaxed) tower-load specification W_MyT, N·m per m/s.
+    speed_spec : specdesign.spec.Specification
+        The generator-speed specification W_Ω (ROSCO's T_{Ω,w} relaxed by the
+        ``speed_relax_db`` that worked), rad/s per m/s.
+    shaping : specdesign.spec.ShapingResult
+        The notches of :func:`specdesign.spec.shape_to_target` and the unrelaxed notch
+        specification's promise (``shaping.promise``, what the paper's Table 3 lists).
+    promise : specdesign.spec.Promise
+        Promise of the (relaxed) tower specification, %.
+    pitch_template : loopshaping.qft.Template
+        Template of P'_{Ω,β} (ATD closed) on ``design_omega``.
+    atd_template : loopshaping.qft.Template
+        Template of P''_{z,β} (pitch loop closed) on ``design_omega``.
+    pitch_bounds : loopshaping.qft.Bounds
+        Bounds on L0 = C_β·P'_{Ω,β} (ATD closed), exact for the final controllers.
+    atd_bounds : loopshaping.qft.Bounds
+        Bounds on L0 = C_atd·P''_{z,β} (pitch loop closed).
+    pitch_check : loopshaping.check.CheckResult
+        Dense check of the pitch loop on ``dense_omega``, every case.
+    atd_check : loopshaping.check.CheckResult
+        Dense check of the ATD loop on ``dense_omega``, every case.
+    closed_loop : control.StateSpace
+        Nominal plant with both loops closed (:func:`specdesign.closedloop.closed_loop`).
+    baseline : specdesign.spec.Baseline
+        ROSCO's nominal loop as seen by the tower-base moment (T_{MyT,w}, S_W, ΔD%).
+    bounds_met : bool
+        Every bound met at every design frequency (nominal loop, exact).
+    all_stable : bool
+        The full interconnection is stable for every plant case.
+    del_reduction : float
+        Predicted tower-base DEL reduction (1 Hz, m = 4), Dirlik on |T|²S_W, nominal case, %.
+    damage_reduction : float
+        Predicted tower-base damage reduction, same method, %.
+    gen_speed_sd_change : float
+        Change of the generator-speed standard deviation, %.
+    pitch_sd_change : float
+        Change of the pitch standard deviation, %.
+    pitch_rate_sd_change : float
+        Change of the pitch-rate standard deviation, %.
+    pitch_rate_sd : float
+        Pitch-rate standard deviation of the design, rad/s (linear, nominal case).
+    gain_margin_db : float
+        Gain margin of the nominal pitch loop C_β·P'_{Ω,β} (ATD closed), dB.
+    phase_margin_deg : float
+        Phase margin of the same loop, degrees.
+    atd_gain_margin_db : float
+        Gain margin of the nominal ATD loop C_atd·P''_{z,β} (pitch loop closed), dB.
+    atd_phase_margin_deg : float
+        Phase margin of the same loop, degrees.
+    actuator_peak_sensitivity : float
+        Maximum over ω and cases of |1/(1 + C_β P_{Ω,β} + C_atd P_{z,β})| (-).
+    target_reduction : float
+        The requested tower-base DEL reduction, %.
+    success : bool
+        Every specification met: target (within 0.5 pp), bounds, dense checks, stability.
+    message : str
+        ``"all specifications met"`` or what failed.
+    parameters : dict of str to float
+        The tuned parameters (:func:`specdesign.qft.structure.from_vector`).
+    options : dict
+        The options the design was made with (``spec_reduction``, ``template_offsets``,
+        ``speed_relax_db``, ``tower_relax_db``, ``tower_relax_omega``, ``max_sensitivity``,
+        ``min_decay``) and ``refine_rounds``.
+
+    Examples
+    --------
+    >>> from specdesign import turbine
+    >>> from specdesign.qft import design_qft
+    >>> d = design_qft(turbine.iea15mw(), 19.0)  # doctest: +SKIP
+    >>> d.success, d.n_states, d.is_proper  # doctest: +SKIP
+    (True, 6, True)
     """
 
     wind_speed: float
-    pitch_controller: object
-    atd_controller: object
-    baseline_controller: object
-    template_speeds: tuple
+    pitch_controller: ct.TransferFunction
+    atd_controller: ct.TransferFunction
+    baseline_controller: ct.TransferFunction
+    template_speeds: tuple[float, ...]
     design_omega: np.ndarray
     dense_omega: np.ndarray
-    tower_spec: object
-    speed_spec: object
-    shaping: object
-    promise: object
-    pitch_template: object
-    atd_template: object
-    pitch_bounds: object
-    atd_bounds: object
-    pitch_check: object
-    atd_check: object
-    closed_loop: object
-    baseline: object
+    tower_spec: Specification
+    speed_spec: Specification
+    shaping: ShapingResult
+    promise: Promise
+    pitch_template: Template
+    atd_template: Template
+    pitch_bounds: Bounds
+    atd_bounds: Bounds
+    pitch_check: CheckResult
+    atd_check: CheckResult
+    closed_loop: ct.StateSpace
+    baseline: Baseline
     bounds_met: bool
     all_stable: bool
     del_reduction: float
@@ -80,18 +169,30 @@ class QFTDesign:
     target_reduction: float
     success: bool
     message: str
-    parameters: dict = field(default_factory=dict)
-    options: dict = field(default_factory=dict)
+    parameters: dict[str, float] = field(default_factory=dict)
+    options: dict[str, Any] = field(default_factory=dict)
 
     @property
     def design_omegas(self) -> np.ndarray:
-        """Deprecated name of :attr:`design_omega`."""
+        """Deprecated name of :attr:`design_omega`.
+
+        Warns
+        -----
+        DeprecationWarning
+            Always: use :attr:`design_omega`.
+        """
         warnings.warn("QFTDesign.design_omegas is deprecated, use QFTDesign.design_omega", DeprecationWarning, stacklevel=2)
         return self.design_omega
 
     @property
     def dense_omegas(self) -> np.ndarray:
-        """Deprecated name of :attr:`dense_omega`."""
+        """Deprecated name of :attr:`dense_omega`.
+
+        Warns
+        -----
+        DeprecationWarning
+            Always: use :attr:`dense_omega`.
+        """
         warnings.warn("QFTDesign.dense_omegas is deprecated, use QFTDesign.dense_omega", DeprecationWarning, stacklevel=2)
         return self.dense_omega
 
@@ -102,13 +203,27 @@ class QFTDesign:
 
     @property
     def is_proper(self) -> bool:
+        """Both controllers are proper (numerator degree ≤ denominator degree)."""
+
         def proper(tf):
             return len(np.trim_zeros(tf.num[0][0], "f")) <= len(np.trim_zeros(tf.den[0][0], "f"))
 
         return proper(self.pitch_controller) and proper(self.atd_controller)
 
-    def row(self) -> dict:
-        """One row of :func:`design_table`."""
+    def row(self) -> dict[str, Any]:
+        """One row of :func:`design_table`.
+
+        Returns
+        -------
+        dict
+            ``wind_speed`` (m/s); the promises of the notch and of the relaxed specification
+            (``notch_promise_del_pct``, ``notch_promise_damage_pct``, ``promised_del_pct``,
+            ``promised_damage_pct``) and the predicted reductions (``predicted_del_pct``,
+            ``predicted_damage_pct``), %; the SD changes (``*_sd_change_pct``), %; the margins
+            (``gain_margin_db``, ``phase_margin_deg``, ``atd_gain_margin_db``,
+            ``atd_phase_margin_deg``); ``bounds_met``, ``dense_check_passed``, ``all_stable``
+            (bool) and ``n_states``.
+        """
         return {
             "wind_speed": self.wind_speed,
             "notch_promise_del_pct": self.shaping.promise.exact_del,
@@ -131,6 +246,13 @@ class QFTDesign:
         }
 
     def summary(self) -> str:
+        """One-paragraph summary: reductions, SD changes, margins, checks and the message.
+
+        Returns
+        -------
+        str
+            The summary (reductions and changes in %, margins in dB and degrees).
+        """
         r = self.row()
         return (f"QFT design at {self.wind_speed:g} m/s: tower DEL reduced {r['predicted_del_pct']:.1f} % "
                 f"(notch spec promises {r['notch_promise_del_pct']:.1f} %, relaxed spec {r['promised_del_pct']:.1f} %), "
@@ -175,32 +297,86 @@ def _callable(fn, key):
     return f
 
 
-def design_qft(model, wind_speed, target_reduction=25.0, *, speed_relax_db=(3.0, 4.5, 6.0, 8.0), **kwargs) -> QFTDesign:
+def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
+               speed_relax_db: float | Sequence[float] = (3.0, 4.5, 6.0, 8.0), **kwargs: Any) -> QFTDesign:
     """QFT design of C_β and C_atd at ``wind_speed`` (m/s) against the fatigue-based specs.
+
+    The automatic procedure of :mod:`specdesign.qft`: fixed structures started from ROSCO,
+    tuned against the bounds of every plant case, checked on a dense grid (5-60 s).
 
     Parameters
     ----------
-    model : :class:`specdesign.turbine.TurbineModel` (e.g. ``turbine.iea15mw()``).
-    wind_speed : operating point, m/s (above rated, inside ``model.wind_range``).
-    target_reduction : predicted tower-base DEL reduction (1 Hz, m = 4) vs ROSCO to reach, %.
-    spec_reduction : damage reduction (%) the notch-shaped tower specification promises
-        (:func:`specdesign.spec.shape_to_target`, notches above ``keep_below`` rad/s).
-    template_offsets : wind-speed offsets (m/s) of the neighbouring operating points.
-    design_omega : QFT design frequencies, rad/s (default :data:`DEFAULT_DESIGN_OMEGA`).
-    dense_omega : grid of the final check, rad/s (default 600 points, 0.005-20 rad/s).
-    speed_relax_db : relaxation of the generator-speed spec in dB (≥ 0), or an increasing
-        sequence tried in turn (default 3, 4.5, 6, 8 dB): the design with the smallest
-        relaxation that meets every spec is returned (else the last attempt, with a warning).
-    tower_relax_db, tower_relax_omega : the tower spec is relaxed by this many dB above about
-        this frequency (rad/s), where ΔD% is negligible (0 to disable).
-    max_sensitivity : bound on |1/(1+L)| for both loops and at the actuator (> 1).
-    min_decay : required closed-loop decay rate, 1/s (poles left of −min_decay).
-    keep_below : protected band of the notch specification, rad/s (power regulation).
-    refine : rounds adding the dense check's failing frequencies to the design set.
-    maxfev : function evaluations per tuning round.
+    model : specdesign.turbine.TurbineModel
+        The turbine, e.g. ``turbine.iea15mw()``.
+    wind_speed : float
+        Operating point, m/s (above rated, inside ``model.wind_range``).
+    target_reduction : float
+        Predicted tower-base DEL reduction (1 Hz, m = 4) vs ROSCO to reach, % (0-100).
+    speed_relax_db : float or sequence of float
+        Relaxation of the generator-speed spec in dB (≥ 0), or an increasing sequence tried
+        in turn (default 3, 4.5, 6, 8 dB): the design with the smallest relaxation that meets
+        every spec is returned (else the last attempt, with a warning).
+    **kwargs
+        Options of each design attempt (keyword only):
 
-    Returns a :class:`QFTDesign`; ``success`` is False (with a message, and a RuntimeWarning)
-    when the target, a bound, the dense check or stability is not met.
+        spec_reduction : float, default 15.0
+            Damage reduction (%) the notch-shaped tower specification promises
+            (:func:`specdesign.spec.shape_to_target`, notches above ``keep_below`` rad/s).
+        template_offsets : sequence of float, default (-1, -0.5, 0.5, 1)
+            Wind-speed offsets (m/s) of the neighbouring operating points (clipped to
+            ``model.wind_range``).
+        design_omega : array_like, optional
+            QFT design frequencies, rad/s (default :data:`DEFAULT_DESIGN_OMEGA` plus the
+            tower-mode features of ROSCO's loops).
+        dense_omega : array_like, optional
+            Grid of the final check, rad/s (default 600 points, 0.005-20 rad/s).
+        tower_relax_db, tower_relax_omega : float, default 6.0 dB, 1.3 rad/s
+            The tower spec is relaxed by this many dB above about this frequency (rad/s),
+            where ΔD% is negligible (0 dB to disable).
+        max_sensitivity : float, default 1.9
+            Bound on |1/(1+L)| for both loops and at the actuator (> 1).
+        min_decay : float, default 0.02
+            Required closed-loop decay rate, 1/s (poles left of −min_decay).
+        keep_below : float, default 0.6
+            Protected band of the notch specification, rad/s (power regulation).
+        refine : int, default 2
+            Rounds adding the dense check's failing frequencies to the design set.
+        maxfev : int, default 3000
+            Function evaluations per tuning round.
+
+    Returns
+    -------
+    QFTDesign
+        The design; ``success`` is False (with a message, and a RuntimeWarning) when the
+        target, a bound, the dense check or stability is not met.
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is not a :class:`specdesign.turbine.TurbineModel`, an option is unknown,
+        or both a deprecated and a current keyword (``design_omegas=``/``design_omega=``,
+        ``dense_omegas=``/``dense_omega=``) are given.
+    ValueError
+        If ``wind_speed`` is outside ``model.wind_range``; ``target_reduction`` is not
+        strictly between 0 and 100 %; a relaxation is negative or not finite;
+        ``tower_relax_omega`` or ``min_decay`` is not positive; ``max_sensitivity`` ≤ 1;
+        ``template_offsets`` is not a 1-D array of finite offsets; or a frequency grid is
+        invalid.
+
+    Warns
+    -----
+    RuntimeWarning
+        When no relaxation of ``speed_relax_db`` gives a design that meets every
+        specification (the last attempt is returned, ``success`` False).
+    DeprecationWarning
+        For the old keywords ``design_omegas=`` and ``dense_omegas=``.
+
+    Examples
+    --------
+    >>> from specdesign import turbine
+    >>> from specdesign.qft import design_qft
+    >>> d = design_qft(turbine.iea15mw(), 19.0)  # doctest: +SKIP
+    >>> print(d.summary())  # doctest: +SKIP
     """
     for old_name in ("design_omegas", "dense_omegas"):  # renamed: one name for frequency grids, omega
         if old_name in kwargs:
@@ -235,7 +411,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
 
     if not isinstance(model, turbine.TurbineModel):
         raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()), got {type(model).__name__}")
-    v = model._check_wind(wind_speed)
+    v = model.check_wind_speed(wind_speed)
     t = float(target_reduction)
     if not 0 < t < 100:
         raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
@@ -398,11 +574,45 @@ def _bounds_met(bounds, controller, template, omega):
     return bool(np.all(ok))
 
 
-def design_schedule(model, wind_speeds=(15, 17, 19, 21, 23, 25), target_reduction=25.0, **kwargs) -> tuple:
+def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
+                    target_reduction: float | Sequence[float] = 25.0, **kwargs: Any) -> tuple[QFTDesign, ...]:
     """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
 
-    ``target_reduction`` is a number or one value per wind speed; other keywords go to
-    :func:`design_qft`.
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speeds : sequence of float
+        Operating points, m/s.
+    target_reduction : float or sequence of float
+        Tower-base DEL reduction to reach, %: one number, or one value per wind speed.
+    **kwargs
+        Other keywords go to :func:`design_qft`.
+
+    Returns
+    -------
+    tuple of QFTDesign
+        One design per wind speed, in the order of ``wind_speeds``.
+
+    Raises
+    ------
+    ValueError
+        If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` does not
+        broadcast to it, or :func:`design_qft` raises.
+    TypeError
+        As :func:`design_qft`.
+
+    Warns
+    -----
+    RuntimeWarning
+        As :func:`design_qft`, for each wind speed whose design does not meet every spec.
+
+    Examples
+    --------
+    >>> from specdesign import turbine
+    >>> from specdesign.qft import design_schedule, design_table, format_table
+    >>> designs = design_schedule(turbine.iea15mw(), (15, 19, 23))  # doctest: +SKIP
+    >>> print(format_table(design_table(designs)))  # doctest: +SKIP
     """
     vs = np.atleast_1d(np.asarray(wind_speeds, float))
     if vs.ndim != 1 or vs.size == 0:
@@ -411,16 +621,62 @@ def design_schedule(model, wind_speeds=(15, 17, 19, 21, 23, 25), target_reductio
     return tuple(design_qft(model, float(v), float(tr), **kwargs) for v, tr in zip(vs, targets))
 
 
-def design_table(designs) -> list:
-    """Rows (dicts) of the per-wind-speed table: promised vs predicted reduction, SD changes, margins."""
+def design_table(designs: Iterable[QFTDesign]) -> list[dict[str, Any]]:
+    """Rows (dicts) of the per-wind-speed table: promised vs predicted reduction, SD changes, margins.
+
+    Parameters
+    ----------
+    designs : iterable of QFTDesign
+        Designs, e.g. from :func:`design_schedule`.
+
+    Returns
+    -------
+    list of dict
+        :meth:`QFTDesign.row` of each design (reductions and changes in %, margins in dB and
+        degrees, wind speed in m/s).
+
+    Raises
+    ------
+    TypeError
+        If an element is not a :class:`QFTDesign`.
+
+    Examples
+    --------
+    >>> from specdesign.qft import design_table
+    >>> design_table([])
+    []
+    """
     designs = list(designs)
     if not all(isinstance(d, QFTDesign) for d in designs):
         raise TypeError("designs must be QFTDesign objects (from design_qft / design_schedule)")
     return [d.row() for d in designs]
 
 
-def format_table(rows) -> str:
-    """Markdown table of :func:`design_table` rows (reductions and changes in %, margins in dB/deg)."""
+def format_table(rows: Iterable[dict[str, Any]]) -> str:
+    """Markdown table of :func:`design_table` rows (reductions and changes in %, margins in dB/deg).
+
+    Parameters
+    ----------
+    rows : iterable of dict
+        Rows of :func:`design_table` (:meth:`QFTDesign.row`).
+
+    Returns
+    -------
+    str
+        A Markdown table, one line per row after the header and the separator.
+
+    Raises
+    ------
+    KeyError
+        If a row lacks a key of :meth:`QFTDesign.row`.
+
+    Examples
+    --------
+    >>> from specdesign.qft import format_table
+    >>> table = format_table([])  # the header and the separator line
+    >>> len(table.splitlines()), table.splitlines()[0].split(" | ")[:2]
+    (2, ['| v [m/s]', 'notch-spec promise DEL [%]'])
+    """
     head = ("| v [m/s] | notch-spec promise DEL [%] | relaxed-spec promise DEL [%] | predicted DEL red. [%] | predicted damage red. [%] | gen-speed SD [%] "
             "| pitch SD [%] | pitch-rate SD [%] | GM pitch [dB] | PM pitch [deg] | GM ATD [dB] | PM ATD [deg] "
             "| bounds | dense check | stable | states |")

@@ -6,34 +6,116 @@
 
 The tuner works on a vector x of the 11 parameters, frequencies and gains in logarithms
 (:data:`LOG_SCALED`), inside [:data:`LOWER`, :data:`UPPER`] (rad/s, -, and |k| in rad per rad/s).
+
+Parameter units: ``k`` rad per rad/s (pitch per generator speed), ``k_atd`` rad per m/s (pitch
+per tower-top velocity), ``z``, ``omega_*``, ``z_atd``, ``p_atd`` rad/s, ``zeta_*`` damping
+ratios (-). The sign convention is the workbench's, β = −C_β·Ω_g − C_atd·ẋ_top, so both gains
+are negative; the vector holds their magnitudes.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import control as ct
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["PARAMETER_NAMES", "LOG_SCALED", "LOWER", "UPPER", "to_vector", "from_vector", "controller_polys",
            "controllers", "rosco_start", "vector_bounds"]
 
+#: Names of the 11 parameters, in the order of the vector x.
 PARAMETER_NAMES = ("k", "z", "omega_n", "zeta_n", "omega_d", "zeta_d", "omega_f", "zeta_f", "k_atd", "z_atd", "p_atd")
+#: Which entries of x are logarithms (frequencies and gain magnitudes) rather than the value (damping ratios).
 LOG_SCALED = np.array([True, True, True, False, True, False, True, False, True, True, True])
+#: Lower and upper limits of the parameters (values, not logarithms; |k| and |k_atd| for the gains).
 LOWER = np.array([1e-3, 0.01, 0.05, 0.1, 0.05, 0.3, 0.3, 0.3, 1e-4, 0.05, 0.02])
 UPPER = np.array([10.0, 5.0, 10.0, 1.5, 5.0, 1.5, 5.0, 1.2, 2.0, 20.0, 20.0])
 
 
-def to_vector(params):
+def to_vector(params: Mapping[str, float]) -> np.ndarray:
+    """Pack controller parameters into the tuner's vector x.
+
+    Parameters
+    ----------
+    params : mapping of str to float
+        Every name of :data:`PARAMETER_NAMES`: gains ``k`` (rad per rad/s) and ``k_atd``
+        (rad per m/s), of either sign (their magnitudes are used), frequencies in rad/s and
+        damping ratios (-).
+
+    Returns
+    -------
+    numpy.ndarray
+        The vector x, shape (11,): natural logarithms of the :data:`LOG_SCALED` entries, the others as given.
+
+    Raises
+    ------
+    KeyError
+        If a name of :data:`PARAMETER_NAMES` is missing from ``params``.
+
+    Examples
+    --------
+    >>> from specdesign.qft.structure import from_vector, to_vector
+    >>> p = dict(k=-0.1, z=0.4, omega_n=1.0, zeta_n=0.7, omega_d=1.0, zeta_d=0.7, omega_f=1.0,
+    ...          zeta_f=0.7, k_atd=-0.02, z_atd=4.0, p_atd=0.3)
+    >>> round(from_vector(to_vector(p))["k"], 12)
+    -0.1
+    """
     p = np.array([abs(params[n]) if n in ("k", "k_atd") else params[n] for n in PARAMETER_NAMES], float)
     return np.where(LOG_SCALED, np.log(p), p)
 
 
-def from_vector(x):
+def from_vector(x: ArrayLike) -> dict[str, float]:
+    """Unpack the tuner's vector x into named controller parameters.
+
+    Parameters
+    ----------
+    x : array_like
+        Parameter vector, shape (11,), as made by :func:`to_vector`.
+
+    Returns
+    -------
+    dict of str to float
+        :data:`PARAMETER_NAMES` → value; the gains ``k`` (rad per rad/s) and ``k_atd`` (rad
+        per m/s) negative (β = −C_β·Ω_g − C_atd·ẋ_top), frequencies in rad/s, damping ratios (-).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.qft.structure import from_vector
+    >>> p = from_vector(np.zeros(11))
+    >>> p["k"], p["zeta_n"], p["z_atd"]
+    (-1.0, 0.0, 1.0)
+    """
     p = np.where(LOG_SCALED, np.exp(x), x)
     out = dict(zip(PARAMETER_NAMES, map(float, p)))
     out["k"], out["k_atd"] = -out["k"], -out["k_atd"]
     return out
 
 
-def controller_polys(x):
+def controller_polys(x: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Numerator and denominator polynomials of C_β and C_atd for a parameter vector.
+
+    Parameters
+    ----------
+    x : array_like
+        Parameter vector, shape (11,) (:func:`to_vector`).
+
+    Returns
+    -------
+    nb, db : numpy.ndarray
+        Coefficients (descending powers of s) of C_β = nb/db, generator speed (rad/s) → pitch
+        (rad): degree 3 over degree 5 (integrator, notch-like pair, two low-pass pairs).
+    na, da : numpy.ndarray
+        Coefficients of C_atd = na/da, tower-top velocity (m/s) → pitch (rad): the lead-lag
+        k_a·(s/z_a + 1)/(s/p_a + 1).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.qft.structure import controller_polys
+    >>> [len(c) for c in controller_polys(np.zeros(11))]
+    [4, 6, 2, 2]
+    """
     p = from_vector(x)
     wn, wd, wf = p["omega_n"], p["omega_d"], p["omega_f"]
     nb = p["k"] * np.polymul([1.0, p["z"]], np.array([1.0, 2 * p["zeta_n"] * wn, wn * wn]) / wn**2) * wd**2 * wf**2
@@ -43,7 +125,32 @@ def controller_polys(x):
     return nb, db, na, da
 
 
-def controllers(x, v):
+def controllers(x: ArrayLike, v: float) -> tuple[ct.TransferFunction, ct.TransferFunction]:
+    """The two controllers of a parameter vector as named python-control transfer functions.
+
+    Parameters
+    ----------
+    x : array_like
+        Parameter vector, shape (11,) (:func:`to_vector`).
+    v : float
+        Wind speed of the design, m/s (only used in the systems' names).
+
+    Returns
+    -------
+    cb : control.TransferFunction
+        C_β, input ``gen_speed`` (rad/s), output ``pitch_cmd`` (rad), named ``QFT_pitch@<v>mps``.
+    ca : control.TransferFunction
+        C_atd, input ``tower_top_vel`` (m/s), output ``pitch_cmd`` (rad), named ``QFT_ATD@<v>mps``.
+        Both in the workbench sign β = −C_β·Ω_g − C_atd·ẋ_top.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.qft.structure import controllers
+    >>> cb, ca = controllers(np.zeros(11), 19.0)
+    >>> cb.name, ca.name, ca.input_labels
+    ('QFT_pitch@19mps', 'QFT_ATD@19mps', ['tower_top_vel'])
+    """
     nb, db, na, da = controller_polys(x)
     tag = f"{v:g}mps".replace(".", "p")
     cb = ct.tf(nb, db, inputs="gen_speed", outputs="pitch_cmd", name=f"QFT_pitch@{tag}")
@@ -51,8 +158,36 @@ def controllers(x, v):
     return cb, ca
 
 
-def rosco_start(rosco):
-    """Parameters reproducing ROSCO's C = (Kp + Ki/s)·ω_f²/(s² + 2ζω_f s + ω_f²), weak ATD."""
+def rosco_start(rosco: ct.TransferFunction) -> np.ndarray:
+    """Parameters reproducing ROSCO's C = (Kp + Ki/s)·ω_f²/(s² + 2ζω_f s + ω_f²), weak ATD.
+
+    The tuner's start: the PI and the speed filter of ROSCO, the notch-like pair and the
+    first low-pass pair cancelling (ω_n = ω_d = 1 rad/s, ζ = 0.7), and a weak ATD
+    (k_a = −0.02 rad per m/s, z_a = 4 rad/s, p_a = 0.3 rad/s). When ROSCO's fitted Kp is
+    positive (a right-half-plane PI zero, at high wind speeds) the start keeps its Ki with a
+    PI zero at 0.2 rad/s instead. The vector is clipped to :func:`vector_bounds`.
+
+    Parameters
+    ----------
+    rosco : control.TransferFunction
+        ROSCO's SISO controller, generator speed (rad/s) → pitch (rad), in the workbench sign
+        (negative gains), e.g. :func:`specdesign.turbine.rosco_baseline`: numerator
+        (Kp·s + Ki)·ω_f², denominator s·(s² + 2ζω_f s + ω_f²).
+
+    Returns
+    -------
+    numpy.ndarray
+        Parameter vector x, shape (11,) (:func:`from_vector` names it).
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> from specdesign.qft.structure import from_vector, rosco_start
+    >>> rosco = ct.tf([-0.113, -0.04409], [1, 1.411, 1.016, 0])  # ROSCO at 19 m/s
+    >>> p = from_vector(rosco_start(rosco))
+    >>> round(p["k"], 4), round(p["z"], 4), round(p["omega_f"], 3)
+    (-0.1112, 0.3902, 1.008)
+    """
     num, den = np.asarray(rosco.num[0][0], float), np.asarray(rosco.den[0][0], float)
     wf2 = den[-2]
     kp, ki = num[-2] / wf2, num[-1] / wf2
@@ -67,5 +202,21 @@ def rosco_start(rosco):
     return np.clip(to_vector(start), vector_bounds()[0], vector_bounds()[1])
 
 
-def vector_bounds():
+def vector_bounds() -> tuple[np.ndarray, np.ndarray]:
+    """Box limits of the parameter vector x (:data:`LOWER`, :data:`UPPER` in x's scaling).
+
+    Returns
+    -------
+    lower, upper : numpy.ndarray
+        Shape (11,) each: logarithms of the limits for the :data:`LOG_SCALED` entries, the
+        limits themselves for the damping ratios.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.qft.structure import vector_bounds
+    >>> lower, upper = vector_bounds()
+    >>> lower.shape, bool(np.all(lower < upper))
+    ((11,), True)
+    """
     return np.where(LOG_SCALED, np.log(LOWER), LOWER), np.where(LOG_SCALED, np.log(UPPER), UPPER)

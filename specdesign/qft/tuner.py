@@ -4,16 +4,27 @@ Everything the tuning evaluates is precomputed on the design and analysis grids
 (:class:`TuningProblem`); :func:`tune` explores with Powell on exterior penalties, polishes
 with SLSQP to KKT points, and keeps the best candidate by a total order (feasible first, then
 the smaller objective), so the design does not jump when the data move by round-off.
+
+Units: ω in rad/s, wind speeds in m/s, DEL and damage reductions in % (positive = less),
+bound margins and safety margins in dB, decay rates in 1/s; the parameter vector x is
+:mod:`specdesign.qft.structure`'s.
 """
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import control as ct
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..closedloop import closed_map, plant_responses, siso_response
 from .structure import controller_polys, vector_bounds
+
+if TYPE_CHECKING:
+    from ..spec import Baseline
+    from ..turbine import TurbineModel
 
 __all__ = ["TuningProblem", "tune", "FEASIBLE_TOL", "STABILITY_SAFETY_DB", "PERFORMANCE_SAFETY_DB", "DC_SAFETY_DB"]
 
@@ -25,10 +36,73 @@ DC_SAFETY_DB = 0.005
 
 
 class TuningProblem:
-    """Everything the tuning evaluates, precomputed on the design and analysis grids."""
+    """Everything the tuning evaluates, precomputed on the design and analysis grids.
 
-    def __init__(self, model, v, speeds, nominal, design_omega, tower_shaping, speed_relax_db, max_sensitivity,
-                 base):
+    The plant cases are the linear models at ``speeds``; the specifications are, per case,
+    |T_{Ω,w}| ≤ |T^ROSCO_{Ω,w}|·10^(speed_relax_db/20), |T_{MyT,w}| ≤ |T^ROSCO_{MyT,w}|·|tower_shaping|
+    and |1/(1 + L)| ≤ ``max_sensitivity`` on each loop with the other closed and at the actuator.
+    The performance (DEL, damage, standard deviations) is the nominal case's on the baseline's
+    grid ``base.omega`` with its wind PSD.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine (linearised at every speed of ``speeds``).
+    v : float
+        Nominal wind speed, m/s.
+    speeds : sequence of float
+        Wind speeds of the plant cases (templates), m/s, including ``v``.
+    nominal : int
+        Index of the nominal case in ``speeds``.
+    design_omega : array_like
+        Design frequencies, rad/s.
+    tower_shaping : callable
+        Maps ω (rad/s) to the complex shaping of ROSCO's T_{MyT,w} (notches × relaxation), e.g. the
+        tower :class:`specdesign.spec.Specification`'s ``shaping``.
+    speed_relax_db : float
+        Relaxation of the generator-speed specification, dB.
+    max_sensitivity : float
+        Bound on |1/(1 + L)| (-, > 1).
+    base : specdesign.spec.Baseline
+        ROSCO's nominal loop (grid ``omega`` in rad/s, ``wind_psd`` in (m/s)² per rad/s,
+        Wöhler exponent ``m`` and damage method).
+
+    Attributes
+    ----------
+    plants, rosco : list
+        Linear plant and ROSCO controller per case.
+    wd : numpy.ndarray
+        Current design frequencies, rad/s (:meth:`set_design`).
+    WO, WM : numpy.ndarray
+        |W_Ω| and |W_MyT| on ``wd``, shape (n_omega, n_cases).
+    d0 : float
+        ROSCO's nominal tower-base damage rate, 1/s.
+    sd0 : dict
+        ROSCO's nominal standard deviations: ``gen_speed`` (rad/s), ``pitch`` (rad),
+        ``pitch_rate`` (rad/s).
+
+    Raises
+    ------
+    ValueError
+        If a plant has a direct feedthrough from the pitch command to a measurement, or a
+        speed is outside ``model.wind_range``.
+
+    Examples
+    --------
+    >>> from specdesign import spec, turbine
+    >>> from specdesign.qft import DEFAULT_DESIGN_OMEGA
+    >>> from specdesign.qft.structure import rosco_start
+    >>> model = turbine.iea15mw()  # doctest: +SKIP
+    >>> d = spec.design_specifications(model, 19.0, speed_relax_db=3.0)  # doctest: +SKIP
+    >>> prob = TuningProblem(model, 19.0, (18.0, 19.0, 20.0), 1, DEFAULT_DESIGN_OMEGA,
+    ...                      d.tower.shaping, 3.0, 1.9, d.base)  # doctest: +SKIP
+    >>> prob.margins(rosco_start(prob.rosco[1])).shape  # doctest: +SKIP
+    (5, 47, 3)
+    """
+
+    def __init__(self, model: TurbineModel, v: float, speeds: Sequence[float], nominal: int, design_omega: ArrayLike,
+                 tower_shaping: Callable[[np.ndarray], np.ndarray], speed_relax_db: float, max_sensitivity: float,
+                 base: Baseline) -> None:
         from .. import turbine
 
         self.v, self.speeds, self.nom = v, speeds, nominal
@@ -63,21 +137,54 @@ class TuningProblem:
     def _sd(self, t):
         return float(np.sqrt(np.trapezoid(np.abs(t) ** 2 * self.S, self.wf)))
 
-    def weights(self, omega):
-        """(W_Ω, W_MyT), each (n_omega, n_cases) magnitudes at ω (rad/s)."""
+    def weights(self, omega: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(W_Ω, W_MyT), each (n_omega, n_cases) magnitudes at ω (rad/s).
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies, rad/s.
+
+        Returns
+        -------
+        w_speed : numpy.ndarray
+            |W_Ω| = |T^ROSCO_{Ω,w}|·10^(speed_relax_db/20) per case, rad/s per m/s.
+        w_tower : numpy.ndarray
+            |W_MyT| = |T^ROSCO_{MyT,w}|·|tower_shaping| per case, N·m per m/s.
+        """
         R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"))
         c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
         w_speed = np.abs(self._t(R, c, 0.0, "gen_speed")) * self.speed_gain
         w_tower = np.abs(self._t(R, c, 0.0, "tower_base_my")) * np.abs(self.tower_shaping(omega))[:, None]
         return w_speed, w_tower
 
-    def set_design(self, omega):
+    def set_design(self, omega: ArrayLike) -> None:
+        """Set the design frequencies and precompute the plant responses and weights on them.
+
+        Parameters
+        ----------
+        omega : array_like
+            New design frequencies, rad/s (replaces ``wd``, ``Rd``, ``WO``, ``WM``).
+        """
         self.wd = np.asarray(omega, float)
         self.Rd = plant_responses(self.plants, self.wd, ("gen_speed", "tower_base_my", "tower_top_vel"))
         self.WO, self.WM = self.weights(self.wd)
 
-    def margins(self, x):
-        """Per-spec margins in dB on the design grid, (n_specs, n_omega, n_cases)."""
+    def margins(self, x: ArrayLike) -> np.ndarray:
+        """Per-spec margins in dB on the design grid, (n_specs, n_omega, n_cases).
+
+        Parameters
+        ----------
+        x : array_like
+            Parameter vector (:mod:`specdesign.qft.structure`).
+
+        Returns
+        -------
+        numpy.ndarray
+            20·log10(bound/|map|), dB (≥ 0 where met), shape (5, n_omega, n_cases), in the
+            order: generator speed, tower load, pitch-loop margin (ATD closed), ATD-loop
+            margin (pitch loop closed), margin at the actuator.
+        """
         nb, db, na, da = controller_polys(x)
         s = 1j * self.wd[:, None]
         c = np.polyval(nb, s) / np.polyval(db, s)
@@ -96,8 +203,20 @@ class TuningProblem:
                 20 * np.log10(self.ms * np.abs(d)),  # at the actuator
             ])
 
-    def max_real(self, x):
-        """Largest closed-loop pole real part (1/s) per case, full interconnection."""
+    def max_real(self, x: ArrayLike) -> np.ndarray:
+        """Largest closed-loop pole real part (1/s) per case, full interconnection.
+
+        Parameters
+        ----------
+        x : array_like
+            Parameter vector (:mod:`specdesign.qft.structure`).
+
+        Returns
+        -------
+        numpy.ndarray
+            Largest Re p of the plant with both loops closed, 1/s, one per case (< −``min_decay``
+            is required).
+        """
         from scipy.signal import tf2ss
 
         nb, db, na, da = controller_polys(x)
@@ -118,8 +237,23 @@ class TuningProblem:
             out.append(np.linalg.eigvals(M).real.max())
         return np.array(out)
 
-    def performance(self, x):
-        """(DEL reduction %, damage reduction %, SD ratios gen speed, pitch, pitch rate) nominal."""
+    def performance(self, x: ArrayLike) -> tuple[float, float, float, float, float]:
+        """(DEL reduction %, damage reduction %, SD ratios gen speed, pitch, pitch rate) nominal.
+
+        Dirlik (the baseline's damage method) on |T_{MyT,w}|² S_W of the nominal case, against
+        ROSCO's; the last result is cached (the objective and the constraints ask for the same x).
+
+        Parameters
+        ----------
+        x : array_like
+            Parameter vector (:mod:`specdesign.qft.structure`).
+
+        Returns
+        -------
+        tuple of float
+            Tower-base DEL reduction (%), damage reduction (%), and the ratios σ/σ_ROSCO (-) of
+            generator speed, pitch and pitch rate.
+        """
         from .. import spectral
 
         key = np.asarray(x, float).tobytes()
@@ -139,8 +273,19 @@ class TuningProblem:
             self._sd(tp) / self.sd0["pitch"], self._sd(tp * 1j * self.wf) / self.sd0["pitch_rate"])
         return self._perf
 
-    def objective(self, x):
-        """The tuning objective: (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)², nominal case."""
+    def objective(self, x: ArrayLike) -> float:
+        """The tuning objective: (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)², nominal case.
+
+        Parameters
+        ----------
+        x : array_like
+            Parameter vector (:mod:`specdesign.qft.structure`).
+
+        Returns
+        -------
+        float
+            The objective (-); 1.1 for ROSCO's own standard deviations.
+        """
         _, _, gs, _, rate = self.performance(x)
         return float(rate**2 + 0.1 * gs**2)
 
@@ -149,17 +294,55 @@ class TuningProblem:
         # reaches the same DC response), so only the margin specs get a full safety margin
         return np.where(self.wd >= 0.05, PERFORMANCE_SAFETY_DB, DC_SAFETY_DB)[None, :, None]
 
-    def constraints(self, x, target, min_decay):
-        """Every requirement as one vector that is ≥ 0 when met: bound margins (dB) less their
-        safety margin per spec, frequency and case; DEL reduction − target (pp); decay margin
-        −(max Re p + min_decay) per case (1/s)."""
+    def constraints(self, x: ArrayLike, target: float, min_decay: float) -> np.ndarray:
+        """Every requirement as one vector that is ≥ 0 when met.
+
+        Bound margins (dB) less their safety margin per spec, frequency and case; DEL reduction
+        − target (pp); decay margin −(max Re p + min_decay) per case (1/s).
+
+        Parameters
+        ----------
+        x : array_like
+            Parameter vector (:mod:`specdesign.qft.structure`).
+        target : float
+            Required tower-base DEL reduction, %.
+        min_decay : float
+            Required decay rate, 1/s (poles left of −``min_decay``).
+
+        Returns
+        -------
+        numpy.ndarray
+            1-D: the 5·n_omega·n_cases bound margins (dB, less :data:`PERFORMANCE_SAFETY_DB` /
+            :data:`DC_SAFETY_DB` on the performance specs and :data:`STABILITY_SAFETY_DB` on the
+            margin specs), the DEL margin (pp) and the n_cases decay margins (1/s).
+        """
         g = self.margins(x)
         return np.r_[(g[:2] - self._safety()).ravel(), (g[2:] - STABILITY_SAFETY_DB).ravel(), self.performance(x)[0] - target,
                      -(self.max_real(x) + min_decay)]
 
-    def cost(self, x, target, min_decay, weight=1e3):
-        """Exterior-penalty cost of the exploration: objective + 10·(target − reduction)₊²
-        + weight·Σ(bound violation, dB)²; a barrier (≥ 1e10) for decay-rate violations."""
+    def cost(self, x: ArrayLike, target: float, min_decay: float, weight: float = 1e3) -> float:
+        """Exterior-penalty cost of the exploration.
+
+        objective + 10·(target − reduction)₊² + weight·Σ(bound violation, dB)²; a barrier
+        (≥ 1e10) for decay-rate violations.
+
+        Parameters
+        ----------
+        x : array_like
+            Parameter vector (:mod:`specdesign.qft.structure`).
+        target : float
+            Required tower-base DEL reduction, %.
+        min_decay : float
+            Required decay rate, 1/s.
+        weight : float
+            Penalty weight per dB² of bound violation (after the safety margins).
+
+        Returns
+        -------
+        float
+            The cost (-); 1e12 when x cannot be evaluated (non-finite responses, a failed
+            eigenvalue computation), 1e10·(1 + Σ excess) when a pole is right of −``min_decay``.
+        """
         try:
             g = self.margins(x)
             red = self.performance(x)[0]
@@ -180,10 +363,8 @@ class TuningProblem:
 FEASIBLE_TOL = 1e-6
 
 
-def tune(prob, x0, target, min_decay, maxfev):
+def tune(prob: TuningProblem, x0: ArrayLike, target: float, min_decay: float, maxfev: int) -> tuple[np.ndarray, bool]:
     """Tune from ``x0``: explore, polish, and keep the best candidate by a total order.
-
-    Returns (x, feasible): the chosen parameters and whether they meet every constraint.
 
     Powell on the penalty cost explores (a derivative-free search that gets past the kinks of
     the bounds from an infeasible start) but stops wherever its line searches happen to end,
@@ -193,6 +374,34 @@ def tune(prob, x0, target, min_decay, maxfev):
     polished start, and the unpolished Powell end point. The order that picks one is total:
     feasible (every constraint ≥ −1e-6) before infeasible; among feasible ones the smaller
     objective; among infeasible ones the smaller penalty cost; ties by candidate order.
+
+    Parameters
+    ----------
+    prob : TuningProblem
+        The precomputed problem.
+    x0 : array_like
+        Start parameter vector, e.g. :func:`specdesign.qft.structure.rosco_start`.
+    target : float
+        Required tower-base DEL reduction, %.
+    min_decay : float
+        Required closed-loop decay rate, 1/s.
+    maxfev : int
+        Function evaluations per Powell run (three runs: penalty weights 1e3, 1e5, 1e7).
+
+    Returns
+    -------
+    x : numpy.ndarray
+        The chosen parameter vector, inside :func:`specdesign.qft.structure.vector_bounds`.
+    feasible : bool
+        Whether ``x`` meets every constraint (each ≥ −:data:`FEASIBLE_TOL`).
+
+    Examples
+    --------
+    >>> from specdesign.qft.structure import from_vector, rosco_start
+    >>> # prob: a TuningProblem (see its example)
+    >>> x, feasible = tune(prob, rosco_start(prob.rosco[1]), 25.0, 0.02, 3000)  # doctest: +SKIP
+    >>> from_vector(x)["k"] < 0  # doctest: +SKIP
+    True
     """
     from scipy.optimize import minimize
 
