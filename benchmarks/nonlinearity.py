@@ -174,7 +174,7 @@ def rosco_integral_scheduled(model, v, dt=DT, wind_speeds=None, filter_omega=0.1
     the filtered pitch command β_f (first-order, ``filter_omega`` rad/s), as
     :func:`specdesign.simulate.rosco_scheduled` uses, but scheduled *inside* the integral
     instead of by output blending. The integrator starts at the trim pitch of ``v``."""
-    from specdesign.simulate import discretize
+    from specdesign.simulate import tustin_matrices
 
     if wind_speeds is None:
         wind_speeds = np.arange(11.0, 25.5, 1.0)
@@ -184,7 +184,7 @@ def rosco_integral_scheduled(model, v, dt=DT, wind_speeds=None, filter_omega=0.1
     kp = (2 * sched.zeta_pc * sched.omega_pc + a) / b
     ki = sched.omega_pc**2 / b
     bs = np.array([model.trim(s).pitch for s in wind_speeds])
-    Af, Bf, Cf, Df = discretize(tb.speed_filter(), dt)
+    Af, Bf, Cf, Df = tustin_matrices(tb.speed_filter(), dt)
     beta0, om_ref = model.trim(v).pitch, model.rated_rotor_speed
     a_f = 1.0 - np.exp(-filter_omega * dt)
     st = {}

@@ -104,6 +104,10 @@ def test_bad_input_is_named(model, plant):
         qft.design_qft(model, 19.0, max_sensitivity=0.9)
     with pytest.raises(TypeError, match="plant"):
         qft.general_form("not a plant", OMEGA)
+    with pytest.raises(TypeError, match=r"unknown option\(s\) \['max_sensitivty'\].*'max_sensitivity'"):
+        qft.design_qft(model, 19.0, max_sensitivty=1.5)  # a typo is named, not an internal function's TypeError
+    with pytest.raises(ValueError, match="speed_relax_db.*must increase"):
+        qft.design_qft(model, 19.0, speed_relax_db=(6.0, 3.0))
 
 
 # ----------------------------------------------------------------------------- the 19 m/s design

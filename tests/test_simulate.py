@@ -411,7 +411,7 @@ def test_bad_arguments():
     with pytest.raises(ValueError, match="wind covers"):
         sm.simulate(osc_plant(), c, [1.0], wind=wind, wind_dt=0.1, duration=50.0, transient=0)
     with pytest.raises(ValueError, match="improper"):
-        sm.discretize(control.tf([1.0, 0.0], [1.0]), 0.01)
+        sm.tustin_matrices(control.tf([1.0, 0.0], [1.0]), 0.01)
     with pytest.raises(ValueError, match="seeds"):
         sm.simulate(osc_plant(), c, [1.0], duration=5.0)
     with pytest.raises(ValueError, match="schedule_pitch"):

@@ -385,11 +385,19 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             if new_name in kwargs:
                 raise TypeError(f"design_qft got both {old_name}= and {new_name}=")
             kwargs[new_name] = kwargs.pop(old_name)
+    import inspect
+
+    options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
+    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
+    if unknown:  # named here, not as a TypeError of an internal function
+        raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
     if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
+    if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
     design = None
-    for k, relax in enumerate(ladder):
+    for relax in ladder:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             design = _design_single(model, wind_speed, target_reduction, speed_relax_db=float(relax), **kwargs)

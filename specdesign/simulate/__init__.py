@@ -56,7 +56,7 @@ Layout
   :func:`check_loop_step`, :func:`sampled_loop_radius`).
 - :mod:`specdesign.simulate.schedule`: :class:`ScheduledController`, :func:`scheduled`.
 - :mod:`specdesign.simulate.controllers`: controller preparation (:func:`as_lti`,
-  :func:`discretize`, :func:`split_integrator`, :func:`split_slow`, the discrete bank).
+  :func:`tustin_matrices`, :func:`split_integrator`, :func:`split_slow`, the discrete bank).
 - :mod:`specdesign.simulate.kernels`: the numba kernels (the compiled loop, the linear plant).
 - :func:`rosco_scheduled` lives in :mod:`specdesign.rosco`, :func:`wind_series` and
   :func:`seed_for` in :mod:`specdesign.wind`; both are re-exported here.
@@ -66,10 +66,9 @@ from __future__ import annotations
 from ..rosco import rosco_scheduled
 from ..wind import seed_for, wind_series
 from .checks import MAX_STEP_EIGENVALUE, check_loop_step, check_step, sampled_loop_radius, warn_unstable
-from .controllers import SLOW_OMEGA, as_lti, controller_bank, discretize, is_lti_like, split_integrator, split_slow
+from .controllers import SLOW_OMEGA, as_lti, is_lti_like, split_integrator, split_slow, tustin_matrices
 from .core import WIND_MEAN_TOLERANCE, KernelPlant, SimulationDivergedError, SimulationResult, simulate, turbine_plant
-from .kernels import KIND_LINEAR, KIND_TURBINE, NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs
-from .kernels import run_callable
+from .kernels import linear_plant_params
 from .schedule import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController, scheduled
 
 __all__ = [
@@ -80,7 +79,7 @@ __all__ = [
     "turbine_plant",
     "scheduled",
     "rosco_scheduled",
-    "discretize",
+    "tustin_matrices",
     "split_integrator",
     "split_slow",
     "sampled_loop_radius",
@@ -100,43 +99,11 @@ __all__ = [
     "warn_unstable",
 ]
 
-# Old private names of the single-module simulate.py, still imported by callers (validate,
-# closedloop): plain aliases of the public names.
-# TODO(issue 13): remove once callers switch
-_as_lti = as_lti
-_is_lti_like = is_lti_like
-_check_step = check_step
-_check_loop_step = check_loop_step
-_compiled_for = compiled_for
-_lin_rhs = linear_rhs
-_lin_outputs = linear_outputs
-_bank = controller_bank
-_run_callable = run_callable
-_FORMS = FORMS
-_NONFINITE = NONFINITE
-_KIND_TURBINE = KIND_TURBINE
-_KIND_LINEAR = KIND_LINEAR
-_warn_unstable = warn_unstable
-
-# The other private names of simulate.py (internals of the compiled loop and of simulate) have no
-# callers; they stay reachable here, by name, until the callers have switched.
-# TODO(issue 13): remove once callers switch
-_LEGACY = {
-    "_turbine_rhs": ("..turbine", "rhs"),
-    "_turbine_outputs": ("..turbine", "outputs"),
-    "_BANKS": (".controllers", "_BANKS"),
-    "_make_bank": (".controllers", "_make_bank"),
-    "_RADIUS_TOL": (".checks", "_RADIUS_TOL"),
-    "_raise_diverged": (".core", "_raise_diverged"),
-    **{n: (".kernels", n) for n in ("_REBOUND", "_wind_at", "_krhs", "_kout", "_rk4", "_run_one", "_run_batch",
-                                    "_step_all", "_outputs_all")},
-}
-
-
 def __getattr__(name):
-    if name in _LEGACY:
-        import importlib
+    if name == "discretize":  # renamed: loopshaping.hinf.discretize returns a discrete LTI, this the kernel's matrices
+        import warnings
 
-        module, attr = _LEGACY[name]
-        return getattr(importlib.import_module(module, __name__), attr)
+        warnings.warn("specdesign.simulate.discretize is deprecated, use specdesign.simulate.tustin_matrices",
+                      DeprecationWarning, stacklevel=2)
+        return tustin_matrices
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

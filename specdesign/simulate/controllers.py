@@ -18,7 +18,7 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "is_lti_like",
     "as_lti",
-    "discretize",
+    "tustin_matrices",
     "split_integrator",
     "SLOW_OMEGA",
     "split_slow",
@@ -68,18 +68,16 @@ def as_lti(c: object, name: str) -> control.LTI:
     """
     import control
 
+    from loopshaping.freqresp import as_siso
+
     if hasattr(c, "tf") and callable(c.tf) and not isinstance(c, control.LTI):
         c = c.tf()
-    if not isinstance(c, control.LTI):
+    if not isinstance(c, control.LTI):  # a number is no controller here: the simulator runs systems
         raise TypeError(f"{name} must be a python-control LTI system or a loopshaping Controller, got {type(c).__name__}")
-    if c.ninputs != 1 or c.noutputs != 1:
-        raise ValueError(f"{name} must be SISO, got {c.noutputs}×{c.ninputs}")
-    if c.isdtime(strict=True):
-        raise ValueError(f"{name} is discrete-time; pass the continuous controller (it is discretised at the simulation step)")
-    return c
+    return as_siso(c, name, proper=False)
 
 
-def discretize(controller: object, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def tustin_matrices(controller: object, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Tustin discretisation of a SISO continuous controller at step ``dt``.
 
     Parameters
@@ -104,7 +102,7 @@ def discretize(controller: object, dt: float) -> tuple[np.ndarray, np.ndarray, n
     Examples
     --------
     >>> import control
-    >>> A, B, C, D = discretize(control.tf([1.0], [1.0, 1.0]), 0.1)
+    >>> A, B, C, D = tustin_matrices(control.tf([1.0], [1.0, 1.0]), 0.1)
     >>> A.shape, D.shape
     ((1, 1), (1,))
     """
@@ -121,7 +119,9 @@ def discretize(controller: object, dt: float) -> tuple[np.ndarray, np.ndarray, n
     n = s.nstates
     if n == 0:
         return np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.array([float(np.squeeze(s.D))])
-    d = control.c2d(s, dt, method="tustin")
+    from loopshaping.reduction import discretize
+
+    d = discretize(s, dt, "tustin")  # the workbench's one discretisation
     return (np.asarray(d.A, float), np.asarray(d.B, float).ravel(), np.asarray(d.C, float).ravel(),
             np.array([float(np.squeeze(d.D))]))
 
@@ -289,9 +289,9 @@ def _make_bank(controller, dt):
         cb, ca = controller.local(k)
         r, rest = (0.0, None) if gains else split_integrator(cb)
         slow, rest = (None, rest) if gains or r == 0.0 else split_slow(rest)
-        As, Bs, Cs, Ds = none if slow is None else discretize(slow, dt)  # states first: the kernel's ns
-        Ab, Bb, Cb, Db = none if gains else discretize(rest, dt)
-        Aa, Ba, Ca, Da = none if ca is None else discretize(ca, dt)
+        As, Bs, Cs, Ds = none if slow is None else tustin_matrices(slow, dt)  # states first: the kernel's ns
+        Ab, Bb, Cb, Db = none if gains else tustin_matrices(rest, dt)
+        Aa, Ba, Ca, Da = none if ca is None else tustin_matrices(ca, dt)
         ns, nb, na = As.shape[0], Ab.shape[0], Aa.shape[0]
         nt = ns + nb + na
         A = np.zeros((nt, nt))
@@ -301,7 +301,7 @@ def _make_bank(controller, dt):
         mats.append((A, B, np.concatenate([Cs, Cb, Ca]), np.array([(Ds[0] if ns else 0.0) + Db[0], Da[0]]), r, ns))
     pi = None
     if gains:
-        Af, Bf, Cf, Df = discretize(controller.error_filter, dt)
+        Af, Bf, Cf, Df = tustin_matrices(controller.error_filter, dt)
         lim = (-np.inf, np.inf) if controller.pitch_limits is None else controller.pitch_limits
         pi = (controller.kp, controller.ki, Af, Bf, Cf, Df, np.array(lim, dtype=float))
     return controller.schedule_pitch, mats, controller.filter_omega, pi

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 from ..wind import wind_series
-from .checks import MAX_STEP_EIGENVALUE, check_step, warn_unstable
+from .checks import check_step, warn_unstable
 from .controllers import controller_bank, is_lti_like
 from .kernels import NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs, run_callable
 from .schedule import ScheduledController
@@ -261,7 +261,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     Raises
     ------
     ValueError
-        for a step ``dt`` above 1/|λ|max of the linearised plant (:data:`MAX_STEP_EIGENVALUE`),
+        for a step ``dt`` above 1/|λ|max of the linearised plant (:data:`specdesign.simulate.checks.MAX_STEP_EIGENVALUE`),
         or at which the loop as simulated (command held over the step, controller by Tustin)
         is unstable while the continuous loop is stable (:func:`sampled_loop_radius`; both
         limits are in the message), or for a wind record whose mean is more than

@@ -22,7 +22,6 @@ Layout
 from __future__ import annotations
 
 from .kernel import (
-    HEADER_SIZE,
     INPUT_NAMES,
     OUTPUT_NAMES,
     P_ACT_OMEGA,
@@ -46,7 +45,6 @@ from .kernel import (
     P_TWR_STIFF,
     STATE_NAMES,
     aero_loads,
-    bicubic,
     mechanics,
     outputs,
     outputs_from,
@@ -54,7 +52,6 @@ from .kernel import (
 )
 from .model import TurbineModel, iea15mw
 from .operating import AERO_VARIABLES, LOAD_INPUT_NAMES, AeroExpansion, OperatingPoint
-from .tables import DATA_DIR, HERMITE, bicubic_coefficients, read_rotor_table, read_text, uniform_step
 
 __all__ = [
     "STATE_NAMES",
@@ -77,17 +74,6 @@ __all__ = [
     "speed_filter",
 ]
 
-# Old private names of the single-module turbine.py: plain aliases of the public names.
-# TODO(issue 13): remove once callers switch
-_HEADER = HEADER_SIZE
-_DATA = DATA_DIR
-_H = HERMITE
-_bicubic = bicubic
-_bicubic_coefficients = bicubic_coefficients
-_read_text = read_text
-_read_rotor_table = read_rotor_table
-_uniform = uniform_step
-
 #: Names that live in :mod:`specdesign.rosco` and stay importable from here (public contract:
 #: ``specdesign.turbine.rosco_baseline``). Resolved on first access: :mod:`specdesign.rosco`
 #: imports this package, so importing it here at load time would be circular.
@@ -99,12 +85,8 @@ def __getattr__(name):
         from .. import rosco
 
         return getattr(rosco, name)
-    if name == "_rotor_coefficients":  # TODO(issue 13): remove once callers switch
-        from ..rosco import first_order_rotor_model
-
-        return first_order_rotor_model
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_ROSCO_NAMES) | {"_rotor_coefficients"})
+    return sorted(set(globals()) | set(_ROSCO_NAMES))

@@ -303,8 +303,6 @@ class TurbineModel:
             )
         return v
 
-    _check_wind = check_wind_speed  # TODO(issue 13): remove once callers switch
-
     def _aero_torque(self, wind, omega, pitch):
         x = np.array([omega, 0.0, 0.0, pitch, 0.0])
         return self.derivatives(x, wind, pitch, 0.0)[0] * self.drivetrain_inertia
