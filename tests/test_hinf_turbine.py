@@ -364,3 +364,10 @@ def test_reduction_report_is_consistent(design):
     diff = _resp(design.full_controller, w) - _resp(design.controller, w)
     grid = np.linalg.norm(np.moveaxis(diff, -1, 0), ord=2, axis=(1, 2)).max()
     assert grid <= red.error_hinf * (1 + 1e-6)
+
+
+def test_target_reduction_is_renamed_spec_reduction(model):
+    # design_qft's target_reduction is the controller's DEL target; design_hinf's was the notch
+    # specification's damage promise: one name, one meaning (the old keyword warns)
+    with pytest.warns(DeprecationWarning, match="spec_reduction"), pytest.raises(ValueError, match="specs="):
+        hinf.design_hinf(model, 19.0, specs="neither", target_reduction=15.0)

@@ -275,7 +275,8 @@ def design_hinf(
     wind_speed: float,
     *,
     specs: str | Any = "qft",
-    target_reduction: float = 15.0,
+    spec_reduction: float = 15.0,
+    target_reduction: float | None = None,
     measurements: Sequence[str] = ("gen_speed", "tower_top_vel"),
     order: int = 8,
     w_tower: Specification | ct.LTI | None = None,
@@ -319,9 +320,13 @@ def design_hinf(
         exactly the specs that design met. ``"rosco"``: the unrelaxed notch spec and ROSCO's
         T_{Ω,w} (this function's default before; its ζ = 0.01 dip at the tower mode is then
         a spec no well-damped loop can follow, docs/hinf.md).
-    target_reduction : float
+    spec_reduction : float
         % of tower-base damage the automatic notch specification
-        (:func:`specdesign.spec.shape_to_target`) must promise (QFT's ``spec_reduction``).
+        (:func:`specdesign.spec.shape_to_target`) must promise (the name
+        :func:`specdesign.qft.design_qft` uses).
+    target_reduction : float, optional
+        Deprecated name of ``spec_reduction`` (in ``design_qft`` it means the controller's DEL
+        target, another quantity).
     measurements : tuple of str
         ``("gen_speed", "tower_top_vel")`` (default: 1×2 controller, pitch + active tower
         damping) or ``("gen_speed",)`` (pitch only).
@@ -377,7 +382,7 @@ def design_hinf(
     ValueError
         If ``specs`` is not "qft", "rosco" or a design record; ``speed_relax_db`` is not a
         relaxation ≥ 0 dB or a sequence of them; no notch specification reaches
-        ``target_reduction``; ``wind_speed`` is outside ``model.wind_range``; or a weight,
+        ``spec_reduction``; ``wind_speed`` is outside ``model.wind_range``; or a weight,
         the generalized plant, the synthesis or the reduction rejects its arguments
         (:func:`inverse_weight`, :func:`generalized_plant`, :func:`loopshaping.hinf.synthesize`,
         :func:`loopshaping.hinf.reduce`).
@@ -403,6 +408,10 @@ def design_hinf(
     """
     from .. import spec
 
+    if target_reduction is not None:  # one name, one meaning: design_qft's target_reduction is a DEL target
+        warnings.warn("design_hinf(target_reduction=...) is deprecated, use spec_reduction=", DeprecationWarning,
+                      stacklevel=2)
+        spec_reduction = target_reduction
     v = float(wind_speed)
     base = spec.baseline_analysis(model, v, m=m, omega=omega)
     notch_spec, ladder, label = None, [None], "custom"
@@ -423,7 +432,7 @@ def design_hinf(
             ladder = [0.0]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            shaped = spec.shape_to_target(base, target_reduction)
+            shaped = spec.shape_to_target(base, spec_reduction)
         if not shaped.success:
             raise ValueError(f"no tower specification at {v:g} m/s: {shaped.message}")
         notch_spec = shaped.specification
@@ -435,7 +444,7 @@ def design_hinf(
     for k, relax in enumerate(ladder):
         wt, ws = w_tower, w_speed
         if label == "qft":
-            t_q, s_q, _ = qft_specifications(model, v, speed_relax_db=relax, spec_reduction=target_reduction,
+            t_q, s_q, _ = qft_specifications(model, v, speed_relax_db=relax, spec_reduction=spec_reduction,
                                              tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
                                              m=m, omega=omega)
             wt = t_q if wt is None else wt
