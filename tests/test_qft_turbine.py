@@ -227,3 +227,14 @@ def test_design_is_reproducible_under_round_off(model, v):
     assert b.success, b.message
     assert abs(a.del_reduction - b.del_reduction) < 0.2
     assert a.options["speed_relax_db"] == b.options["speed_relax_db"]
+
+
+def test_the_specifications_it_met_pass_the_feasibility_check(model, design):
+    # A counterexample test of specdesign.feasibility: this pitch + ATD design meets its specs
+    # on the dense grid, so the necessary conditions (valid for any controller acting through
+    # the pitch, hence without the pitch-loop margin) must hold for them.
+    from specdesign import feasibility
+
+    res = feasibility.pitch_feasibility(model, design.wind_speed, design.tower_spec, design.speed_spec,
+                                        max_sensitivity=None)
+    assert design.success and res.feasible, res.summary()

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 
     from ..spec import Promise, Specification
 
-__all__ = ["plot_specification", "NotchExplorer"]
+__all__ = ["plot_specification", "NotchExplorer", "plot_frontier"]
 
 
 def plot_specification(base: Baseline, specification: Specification | None = None, *, shaping: ArrayLike | None = None,
@@ -185,3 +185,36 @@ class NotchExplorer:
         )
         out = widgets.interactive(self.update, **sliders)
         return out
+
+
+def plot_frontier(frontiers: dict, ax: Axes | None = None) -> Axes:
+    """The pitch-control frontier: promised DEL reduction vs allowed generator-speed degradation.
+
+    Parameters
+    ----------
+    frontiers : dict
+        Wind speed (m/s) → the result of :func:`specdesign.feasibility.pitch_frontier` at that
+        speed. Solid lines with markers: the achievable promise (a stabilising design meets
+        it); dashed, same colour: the pointwise upper bound no controller beats.
+    ax : matplotlib Axes, optional
+        Where to draw (a new figure when None).
+
+    Returns
+    -------
+    matplotlib Axes
+        The axes drawn on.
+    """
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=(6.4, 4.2))
+    for k, (v, f) in enumerate(sorted(frontiers.items())):
+        color = f"C{k}"
+        ax.plot(f["speed_relax_db"], f["achievable"], "o-", color=color, label=f"{v:g} m/s achievable")
+        ax.plot(f["speed_relax_db"], f["bound"], "--", color=color, lw=1, label=f"{v:g} m/s upper bound")
+    ax.set_xlabel("generator-speed specification relaxed over ROSCO's [dB]")
+    ax.set_ylabel("tower-base DEL reduction vs ROSCO [%]")
+    ax.set_title("Pitch control only: what a specification can promise")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2, loc="center right")
+    return ax

@@ -1,0 +1,553 @@
+"""Can a specification pair be met by pitch control at all? Checked before any loop shaping.
+
+With the collective pitch as the only actuator, every closed-loop wind map of *any* linear
+controller (on the generator speed, with an active tower damping loop, of any order) is
+T_{y,w} = P_{y,w} + P_{y,β}·T_{β,w}: one complex number per frequency is free. Written with
+S = T_{Ω,w}/P_{Ω,w} (the sensitivity 1/(1 + C·P_{Ω,β}) of a controller C on Ω_g alone):
+
+    T_{Ω,w}   = P_{Ω,w}·S
+    T_{MyT,w} = K∞ + (P_{MyT,w} − K∞)·S,     K∞ = P_{MyT,w} − P_{MyT,β}·P_{Ω,w}/P_{Ω,β}
+
+(K∞ is T_{MyT,w} for C → ∞, S = 1 the open loop). So each specification is a disk for S:
+
+    speed   |T_{Ω,w}| ≤ |W_Ω|      ⇔  |S| ≤ r_Ω = |W_Ω|/|P_{Ω,w}|
+    margin  |S| ≤ M_s               (the pitch loop's robustness; None: not imposed)
+    tower   |T_{MyT,w}| ≤ |W_MyT|  ⇔  |S − c| ≤ ρ,  c = −K∞/(P_{MyT,w} − K∞),  ρ = |W_MyT|/|P_{MyT,w} − K∞|
+
+Two necessary conditions follow, for every plant case:
+
+1. **Pointwise**: at each ω the disks intersect, |c| − ρ ≤ min(r_Ω, M_s). Where they do
+   not, no controller acting through the pitch meets the specifications at that frequency,
+   whatever its measurements; the check says which specification binds against the tower's.
+2. **Interpolation** (the right-half-plane zeros z of P_{Ω,β}; the IEA 15 MW has a lightly
+   damped pair at the tower mode): T_{Ω,w}(z) = P_{Ω,w}(z), i.e. S(z) = 1, for every
+   controller, and for a stable plant the Poisson integral gives
+   (1/π)∫ ln|S(jω)|·Re z/((Re z)² + (ω − Im z)²) dω ≥ ln|S(z)| = 0 over ω ∈ ℝ. With
+   |S| ≤ s_max(ω) = min(r_Ω, M_s, |c| + ρ) pointwise, the same mean of ln s_max must be
+   ≥ 0: the specifications may not ask for |S| < 1 around Im z.
+
+Both are necessary, not sufficient: a design can still fail on causality elsewhere (Bode's
+integral spreads the cost over a band), on robustness between plant cases, or on the
+structure it is given (design_qft's sixth-order pitch controller and first-order ATD).
+
+What *can* be promised is found by design, not by check: :func:`achievable_pitch` optimises
+over every stabilising pitch controller at once (the Youla parametrisation of the stable
+plant, C = Y/(1 − P_{Ω,β}Y) with Y stable, in which every closed-loop map is affine in Y) the
+tower-base damage predicted by the paper's Eq. (10), subject to the generator-speed
+specification and |S| ≤ M_s on the grid: a convex problem (cvxpy). Its |T_{MyT,w}| is a
+specification that is feasible by construction, with the exact (Dirlik) promise.
+:func:`pitch_frontier` tabulates, per speed relaxation, that achievable promise beside the
+pointwise upper bound of condition 1 (the smallest |T_{MyT,w}| inside the speed and margin
+disks at every frequency): the true frontier lies between the two.
+
+Units: ω in rad/s, magnitudes linear (dB only in messages), DEL reductions in %.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._checks import as_omega, positive_scalar
+
+__all__ = ["PitchFeasibility", "pitch_feasibility", "AchievablePitch", "achievable_pitch", "pitch_frontier",
+           "sensitivity_disks"]
+
+
+def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
+    """The disks of the complex sensitivity S(jω) that each specification allows.
+
+    Parameters
+    ----------
+    plant : control.LTI
+        Named plant (inputs ``wind``, ``pitch_cmd``; outputs ``gen_speed``, ``tower_base_my``).
+    omega : array_like
+        Frequencies, rad/s.
+    w_tower, w_speed : array_like
+        |W_MyT(jω)| (N·m per m/s) and |W_Ω(jω)| ((rad/s) per (m/s)) on ``omega``; ``np.inf``
+        for no constraint.
+    max_sensitivity : float or None
+        M_s, the bound on |S| of the pitch loop (-); None for none.
+
+    Returns
+    -------
+    dict
+        ``c`` (complex centre) and ``rho`` (radius) of the tower disk |S − c| ≤ ρ,
+        ``r_speed`` = |W_Ω|/|P_{Ω,w}| and ``r_margin`` = M_s (radii of disks about 0),
+        ``open_loop`` = P_{MyT,w} − K∞ (the factor of S in T_{MyT,w}) and ``k_inf`` = K∞,
+        all arrays on ``omega``.
+    """
+    from .closedloop import frequency_response
+
+    w = as_omega(omega, "omega")
+    ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
+    a = frequency_response(plant, w, "tower_base_my", "wind")
+    yb = frequency_response(plant, w, "tower_base_my", "pitch_cmd")
+    ow = frequency_response(plant, w, "gen_speed", "wind")
+    ob = frequency_response(plant, w, "gen_speed", "pitch_cmd")
+    k_inf = a - yb * ow / ob
+    g = a - k_inf  # = P_{MyT,β}·P_{Ω,w}/P_{Ω,β}
+    return dict(c=-k_inf / g, rho=np.asarray(w_tower, float) / np.abs(g), r_speed=np.asarray(w_speed, float) / np.abs(ow),
+                r_margin=np.full(w.shape, ms), open_loop=g, k_inf=k_inf)
+
+
+def _rhp_zeros(plant):
+    import control
+
+    sub = control.ss(plant)["gen_speed", "pitch_cmd"]
+    z = np.asarray(control.tf(sub).zeros(), complex)
+    # the numerator of a channel carries spurious huge roots (leading coefficients ~ 0)
+    return z[(z.real > 0) & (np.abs(z) < 1e6)]
+
+
+def _poisson_mean(omega, values, z, outside):
+    """(1/π)∫_ℝ values(|ω|) x/(x² + (ω − y)²) dω for z = x + iy, x > 0, by the trapezoid rule on
+    ``omega`` (both signs of ω), with ``outside`` for the kernel's mass off the grid."""
+    x, y = float(z.real), float(z.imag)
+
+    def kernel(om):
+        return (x / (x * x + (om - y) ** 2) + x / (x * x + (om + y) ** 2)) / np.pi
+
+    def cdf(om):  # mass of the kernel on [0, om] ∪ [−om, 0], in closed form
+        return (np.arctan((om - y) / x) + np.arctan((om + y) / x)) / np.pi
+
+    inside = np.trapezoid(values * kernel(omega), omega)
+    mass = cdf(omega[-1]) - cdf(omega[0])
+    return float(inside + outside * (1.0 - mass))
+
+
+@dataclass(frozen=True)
+class PitchFeasibility:
+    """Verdict of :func:`pitch_feasibility` at one operating point.
+
+    Parameters
+    ----------
+    feasible : bool
+        Both necessary conditions hold for every plant case.
+    omega : numpy.ndarray
+        Frequencies checked, rad/s.
+    pointwise : numpy.ndarray
+        (n_omega,) True where the disks intersect for every case.
+    binding : tuple of str
+        Per frequency, the pair of specifications that cannot be met together there ("" where
+        they can): "tower vs speed" or "tower vs margin".
+    zeros : numpy.ndarray
+        Right-half-plane zeros of P_{Ω,β} (1/s), nominal case.
+    poisson_mean : numpy.ndarray
+        Per zero, the Poisson mean of ln s_max (must be ≥ 0).
+    reasons : tuple of str
+        One sentence per violated condition (empty when feasible).
+    max_sensitivity : float
+        The M_s used (-; inf for none).
+    """
+
+    feasible: bool
+    omega: np.ndarray
+    pointwise: np.ndarray
+    binding: tuple
+    zeros: np.ndarray
+    poisson_mean: np.ndarray
+    reasons: tuple
+    max_sensitivity: float
+
+    def summary(self) -> str:
+        """One paragraph: the verdict and, if infeasible, why.
+
+        Returns
+        -------
+        str
+            "feasible (necessary conditions)" or "infeasible: " and the reasons.
+        """
+        if self.feasible:
+            return ("feasible: the necessary conditions hold (pointwise at every frequency, and around the "
+                    f"right-half-plane zeros {_fmt(self.zeros)} of P_Ω,β)")
+        return "infeasible: " + "; ".join(self.reasons)
+
+
+def _fmt(z):
+    return ", ".join(f"{v.real:.3g}{v.imag:+.4g}j" for v in np.atleast_1d(z)) or "none"
+
+
+def _bands(omega, mask):
+    """Contiguous runs of ``mask`` as 'a-b rad/s' strings."""
+    idx = np.flatnonzero(mask)
+    if idx.size == 0:
+        return []
+    splits = np.flatnonzero(np.diff(idx) > 1)
+    starts, ends = np.r_[idx[0], idx[splits + 1]], np.r_[idx[splits], idx[-1]]
+    return [f"{omega[a]:.3g}-{omega[b]:.3g} rad/s" if a != b else f"{omega[a]:.3g} rad/s" for a, b in zip(starts, ends)]
+
+
+def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitivity=2.0, omega=None,
+                      cases=None) -> PitchFeasibility:
+    """Whether a tower-load and a generator-speed specification can be met by pitch control.
+
+    Checks the two necessary conditions of the module docstring (pointwise disk intersection;
+    the Poisson condition at the right-half-plane zeros of P_{Ω,β}) for every plant case.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine (anything with ``linearize(wind_speed)`` giving a named plant).
+    wind_speed : float
+        Operating point, m/s.
+    tower_spec, speed_spec : Specification or callable
+        W_MyT and W_Ω: anything with ``response(omega)`` (a :class:`specdesign.spec.Specification`)
+        or a callable ω → |W|; None for no constraint.
+    max_sensitivity : float or None
+        M_s on |S| of a pitch loop on Ω_g (-); 2.0 (6 dB) by default. None: no margin
+        condition, and the verdict holds for any controller acting through the pitch (an
+        ATD loop included).
+    omega : array_like, optional
+        Frequencies, rad/s (default :func:`specdesign.spec.default_omega`, refined around
+        the right-half-plane zeros so the Poisson kernel is resolved).
+    cases : sequence of float, optional
+        Wind speeds (m/s) of the plant cases; default only ``wind_speed``.
+
+    Returns
+    -------
+    PitchFeasibility
+        The verdict, per-frequency bindings and the reasons.
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> from specdesign import spec
+    >>> model = iea15mw()
+    >>> rosco_specs = spec.design_specifications(model, 19.0, speed_relax_db=0.0, tower_relax_db=0.0)
+    >>> pitch_feasibility(model, 19.0, rosco_specs.base.system, rosco_specs.speed).feasible  # ROSCO meets its own
+    True
+    """
+    from . import spec
+    from .closedloop import refine_grid
+
+    v = float(wind_speed)
+    ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
+    speeds = [v] if cases is None else [float(c) for c in cases]
+    plants = [model.linearize(s) for s in speeds]
+    zeros = _rhp_zeros(plants[0])
+    w = spec.default_omega() if omega is None else as_omega(omega, "omega")
+    if omega is None and zeros.size:
+        w = refine_grid(w, zeros, rel_width=0.2, rel_step=2e-4)
+    wt, ws = _magnitude(tower_spec, w, "tower_spec"), _magnitude(speed_spec, w, "speed_spec")
+    ok = np.ones(w.shape, bool)
+    binding = np.full(w.shape, "", dtype=object)
+    means = []
+    for plant in plants:
+        d = sensitivity_disks(plant, w, wt, ws, max_sensitivity)
+        dist = np.abs(d["c"]) - d["rho"]  # distance from 0 to the tower disk (≤ 0: it holds S = 0)
+        r = np.minimum(d["r_speed"], d["r_margin"])
+        bad = dist > r
+        binding[bad & (d["r_speed"] <= d["r_margin"])] = "tower vs speed"
+        binding[bad & (d["r_speed"] > d["r_margin"])] = "tower vs margin"
+        ok &= ~bad
+        s_max = np.minimum(r, np.abs(d["c"]) + d["rho"])
+        # off the grid |S| ≤ M_s, or without it the speed bound at the grid's ends (S → 1 there)
+        outside = np.log(ms) if np.isfinite(ms) else float(np.log(max(r[0], r[-1])))
+        for z in _rhp_zeros(plant):
+            if z.imag >= 0:
+                means.append(_poisson_mean(w, np.log(s_max), z, outside))
+    reasons = []
+    if not ok.all():
+        for kind in ("tower vs speed", "tower vs margin"):
+            bands = _bands(w, binding == kind)
+            if bands:
+                what = "the generator-speed specification" if kind == "tower vs speed" else f"|S| ≤ M_s = {ms:g}"
+                reasons.append(f"the tower-load specification cannot be met together with {what} at {', '.join(bands)} "
+                               "(no complex S(jω) lies in both disks)")
+    means = np.asarray(means)
+    upper = zeros[zeros.imag >= 0]
+    for z, m in zip(np.tile(upper, len(plants)), means):
+        if m < 0:
+            reasons.append(f"P_Ω,β has a right-half-plane zero at {_fmt(z)} 1/s, which forces S(z) = 1 (pitch control cannot "
+                           f"attenuate near {abs(z.imag):.3g} rad/s); the specifications allow a Poisson mean of ln|S| of "
+                           f"at most {m:.3g} < 0 there: relax the tower specification near {abs(z.imag):.3g} rad/s or add "
+                           "a tower-damping loop")
+    return PitchFeasibility(feasible=not reasons, omega=w, pointwise=ok, binding=tuple(binding.tolist()), zeros=zeros,
+                            poisson_mean=means, reasons=tuple(reasons), max_sensitivity=ms)
+
+
+def _magnitude(spec_like, omega, name):
+    """|W(jω)| on ``omega`` from a Specification, an LTI, a callable or None (no constraint)."""
+    if spec_like is None:
+        return np.full(omega.shape, np.inf)
+    if hasattr(spec_like, "response"):
+        out = np.abs(np.asarray(spec_like.response(omega)))
+    elif callable(spec_like) and not hasattr(spec_like, "ninputs"):
+        raw = np.asarray(spec_like(omega))
+        if not np.iscomplexobj(raw) and np.any(~(raw > 0)):  # a real value is a magnitude: never silently |·|
+            raise ValueError(f"{name} returned values ≤ 0 or NaN; give |W(jω)| > 0 (linear, not dB) or W(jω) complex")
+        out = np.abs(raw)
+    else:
+        from .closedloop import siso_response
+
+        out = np.abs(siso_response(spec_like, omega, name))
+    out = np.broadcast_to(np.asarray(out, float), omega.shape)
+    if np.any(~(out > 0)):
+        raise ValueError(f"{name} must be > 0 at every frequency (a magnitude, np.inf for no constraint)")
+    return out
+
+
+def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8.0), *, max_sensitivity=2.0,
+                   max_pitch_rate_ratio=1.0, m=4.0, omega=None) -> dict:
+    """The largest tower-base DEL reduction a pitch controller can promise, per speed relaxation.
+
+    For each relaxation g (dB) of the generator-speed specification W_Ω = 10^(g/20)·|T^ROSCO_{Ω,w}|:
+
+    - ``achievable``: the exact (Dirlik, 1 Hz) DEL reduction of the design of
+      :func:`achievable_pitch`, a stabilising controller that meets W_Ω, M_s and the
+      pitch-rate allowance on the grid (NaN where the solver finds none: at 0 dB only ROSCO's
+      own integral action meets W_Ω at the lowest frequencies);
+    - ``bound``: an upper bound no controller beats, from the pointwise smallest
+      |T_{MyT,w}(jω)| = |P_{MyT,w} − K∞|·max(0, |c| − min(r_Ω, M_s)) (module docstring).
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    speed_relax_db : sequence of float
+        Relaxations of the generator-speed specification, dB (≥ 0).
+    max_sensitivity : float
+        M_s (-).
+    max_pitch_rate_ratio : float
+        Allowed pitch-rate SD relative to ROSCO's (-), see :func:`achievable_pitch`.
+    m : float
+        Wöhler exponent of the tower-base S-N curve (-).
+    omega : array_like, optional
+        Frequency grid, rad/s (default :func:`specdesign.spec.default_omega`).
+
+    Returns
+    -------
+    dict
+        ``speed_relax_db`` (dB), ``achievable`` and ``bound`` (DEL reductions, %), arrays
+        with one value per relaxation, and ``designs`` (the :class:`AchievablePitch` records,
+        None where none was found).
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> f = pitch_frontier(iea15mw(), 19.0, (1.5, 6.0))
+    >>> bool(f["achievable"][1] >= f["achievable"][0] and (f["bound"] >= f["achievable"]).all())
+    True
+    """
+    from . import spec, spectral
+
+    g = np.atleast_1d(np.asarray(speed_relax_db, float))
+    if g.ndim != 1 or g.size == 0 or not np.all(np.isfinite(g)) or np.any(g < 0):
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be relaxations ≥ 0 dB")
+    ms = positive_scalar(max_sensitivity, "max_sensitivity")
+    base = spec.baseline_analysis(model, wind_speed, m=m, omega=omega)
+    w = base.omega
+    plant = model.linearize(float(wind_speed))
+    speed0 = np.abs(spec.speed_specification(model, float(wind_speed)).response(w))
+    bound, designs = [], []
+    for gi in g:
+        d = sensitivity_disks(plant, w, np.full(w.shape, np.inf), speed0 * 10 ** (gi / 20), ms)
+        r = np.minimum(d["r_speed"], d["r_margin"])
+        t_min = np.abs(d["open_loop"]) * np.maximum(0.0, np.abs(d["c"]) - r)
+        d_min = spectral.damage_rate(w, t_min ** 2 * base.wind_psd, base.m, method=base.method)
+        bound.append(float(spectral.del_reduction(100.0 * (1.0 - d_min / base.damage_rate), base.m)) if d_min > 0 else 100.0)
+        try:
+            designs.append(achievable_pitch(model, wind_speed, gi, max_sensitivity=ms,
+                                            max_pitch_rate_ratio=max_pitch_rate_ratio, base=base))
+        except RuntimeError:
+            designs.append(None)
+    achievable = np.array([np.nan if x is None else x.del_reduction for x in designs])
+    return {"speed_relax_db": g, "achievable": achievable, "bound": np.asarray(bound), "designs": tuple(designs)}
+
+
+#: Poles (rad/s) of the Youla basis: real poles spanning the wind band, and lightly damped pairs
+#: (ζ = 0.2) around the tower mode, where the specification is shaped.
+YOULA_REAL_POLES = np.geomspace(0.03, 10.0, 6)
+YOULA_PAIRS = (0.9, 1.02, 1.1, 1.25)
+
+
+def _youla_basis(s):
+    """(n_s, n_basis) complex responses of the basis functions of Y at ``s`` (1/s)."""
+    cols = [np.ones_like(s)]
+    cols += [p / (s + p) for p in YOULA_REAL_POLES]
+    for wn in YOULA_PAIRS:
+        den = s * s + 2 * 0.2 * wn * s + wn * wn
+        cols += [wn * wn / den, wn * s / den]
+    return np.stack(cols, axis=1)
+
+
+def _youla_tf(coef):
+    import control
+
+    terms = [control.tf([coef[0]], [1.0])]
+    terms += [control.tf([c * p], [1.0, p]) for c, p in zip(coef[1:1 + YOULA_REAL_POLES.size], YOULA_REAL_POLES)]
+    rest = coef[1 + YOULA_REAL_POLES.size:]
+    for k, wn in enumerate(YOULA_PAIRS):
+        a, b = rest[2 * k], rest[2 * k + 1]
+        terms.append(control.tf([b * wn, a * wn * wn], [1.0, 2 * 0.2 * wn, wn * wn]))
+    y = terms[0]
+    for t in terms[1:]:
+        y = y + t
+    return y
+
+
+@dataclass(frozen=True)
+class AchievablePitch:
+    """A stabilising pitch design from :func:`achievable_pitch` and the specification it achieves.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Operating point, m/s.
+    speed_relax_db : float
+        Relaxation of the generator-speed specification it meets, dB.
+    max_sensitivity : float
+        M_s it meets (-).
+    omega : numpy.ndarray
+        Grid, rad/s.
+    youla : numpy.ndarray
+        Coefficients of Y on the basis (:data:`YOULA_REAL_POLES`, :data:`YOULA_PAIRS`).
+    t_tower, t_speed, sensitivity : numpy.ndarray
+        T_{MyT,w} (N·m per m/s), T_{Ω,w} ((rad/s) per (m/s)) and S (-) on ``omega``, complex.
+    del_reduction : float
+        Exact (Dirlik, 1 Hz) tower-base DEL reduction against ROSCO, %.
+    speed_excess_db : float
+        Largest |T_{Ω,w}|/|W_Ω| on the grid, dB (≤ 0 up to the solver's tolerance).
+    status : str
+        The solver's status.
+    """
+
+    wind_speed: float
+    speed_relax_db: float
+    max_sensitivity: float
+    omega: np.ndarray
+    youla: np.ndarray
+    t_tower: np.ndarray
+    t_speed: np.ndarray
+    sensitivity: np.ndarray
+    del_reduction: float
+    speed_excess_db: float
+    status: str
+
+    def controller(self, model):
+        """The pitch controller C = Y/(1 − P_{Ω,β}·Y) that achieves it, β = −C·Ω_g.
+
+        Parameters
+        ----------
+        model : specdesign.turbine.TurbineModel
+            The turbine it was designed on.
+
+        Returns
+        -------
+        control.TransferFunction
+            C (rad per rad/s); of high order (the basis plus the plant): a certificate of
+            feasibility and a reference, not a controller to implement as it is.
+        """
+        import control
+
+        p = control.ss(model.linearize(self.wind_speed))["gen_speed", "pitch_cmd"]
+        y = _youla_tf(self.youla)
+        return control.minreal(control.feedback(y, control.tf(p), sign=+1), verbose=False)
+
+
+def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=2.0, max_pitch_rate_ratio=1.0,
+                     m=4.0, omega=None, base=None) -> AchievablePitch:
+    """The pitch design that minimises the predicted tower damage under a generator-speed specification.
+
+    Every stabilising controller of the stable plant is C = Y/(1 − P_{Ω,β}Y) with Y stable,
+    and then S = 1 − P_{Ω,β}Y, T_{Ω,w} = P_{Ω,w}S, T_{MyT,w} = P_{MyT,w} − P_{MyT,β}P_{Ω,w}Y:
+    affine in Y. With Y on a fixed stable basis, minimising Eq. (10)'s damage,
+    Σ ΔD%(ω)·|T_{MyT,w}|²/|T^ROSCO_{MyT,w}|², subject to |T_{Ω,w}| ≤ 10^(g/20)|T^ROSCO_{Ω,w}|
+    and |S| ≤ M_s on the grid, with at most ``max_pitch_rate_ratio`` times ROSCO's pitch-rate
+    SD, is a convex (second-order cone) problem. The design is for the nominal plant at
+    ``wind_speed`` (no plant cases besides it; robustness only through M_s), and its controller
+    is of high order: it shows what a specification can promise, not what to implement.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    speed_relax_db : float
+        Relaxation g of the generator-speed specification, dB (≥ 0).
+    max_sensitivity : float
+        M_s (-).
+    max_pitch_rate_ratio : float
+        κ: the pitch-rate SD, ∫|ω·T_{β,w}|²S_W dω on the grid, at most κ² times ROSCO's
+        (a quadratic constraint; 1.0: no more pitch activity than ROSCO).
+    m : float
+        Wöhler exponent (-).
+    omega : array_like, optional
+        Grid, rad/s (default :func:`specdesign.spec.default_omega`).
+    base : specdesign.spec.Baseline, optional
+        ROSCO's baseline at ``wind_speed`` if already computed (its grid is used).
+
+    Returns
+    -------
+    AchievablePitch
+        The design, its maps and its exact promise.
+
+    Raises
+    ------
+    RuntimeError
+        If the solver finds no solution.
+    """
+    import cvxpy as cp
+
+    from . import spec, spectral
+    from .closedloop import frequency_response, siso_response
+    from .rosco import rosco_baseline
+
+    g = float(speed_relax_db)
+    kappa = positive_scalar(max_pitch_rate_ratio, "max_pitch_rate_ratio")
+    if not (np.isfinite(g) and g >= 0):
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB")
+    ms = positive_scalar(max_sensitivity, "max_sensitivity")
+    if base is None:
+        base = spec.baseline_analysis(model, wind_speed, m=m, omega=omega)
+    w = base.omega
+    plant = model.linearize(float(wind_speed))
+    a = frequency_response(plant, w, "tower_base_my", "wind")
+    ow = frequency_response(plant, w, "gen_speed", "wind")
+    ob = frequency_response(plant, w, "gen_speed", "pitch_cmd")
+    gy = frequency_response(plant, w, "tower_base_my", "pitch_cmd") * ow
+    w_speed = np.abs(spec.speed_specification(model, float(wind_speed)).response(w)) * 10 ** (g / 20)
+    phi = _youla_basis(1j * w)
+    t_ref2 = np.abs(base.t_response) ** 2
+    weight = np.maximum(base.sensitivity, 0.0) + 1e-3 * base.sensitivity.max()
+
+    # solve in orthonormal coordinates of the basis on the grid (the raw basis is collinear)
+    q, rr = np.linalg.qr(np.vstack([phi.real, phi.imag]))
+    phi_o = q[: w.size] + 1j * q[w.size:]
+    y = cp.Variable(phi.shape[1])
+    tc, tl = a, -gy[:, None] * phi_o
+    sc, sl = np.ones_like(ob), -ob[:, None] * phi_o
+    t_re = tc.real + tl.real @ y
+    t_im = tc.imag + tl.imag @ y
+    s_re = sc.real + sl.real @ y
+    s_im = sc.imag + sl.imag @ y
+    scale = np.sqrt(weight / t_ref2)
+    objective = cp.sum_squares(cp.multiply(scale, t_re)) + cp.sum_squares(cp.multiply(scale, t_im))
+    s_bound = np.minimum(ms, w_speed / np.abs(ow))  # |S| ≤ M_s and |P_{Ω,w}S| ≤ W_Ω
+    constraints = [cp.norm(cp.vstack([s_re, s_im]), 2, axis=0) <= s_bound]
+    # pitch-rate activity: the rate spectrum |ω·T_{β,w}|²S_W, T_{β,w} = −P_{Ω,w}Y, integrated
+    # (trapezoid weights), at most κ² times ROSCO's
+    from .spectral import trapezoid_weights
+
+    tw = trapezoid_weights(w)
+    c_ref = siso_response(rosco_baseline(model, float(wind_speed)), w)
+    rate_ref = float(np.sum(tw * np.abs(w * c_ref * ow / (1 + c_ref * ob)) ** 2 * base.wind_psd))
+    rl = (w * ow)[:, None] * phi_o * np.sqrt(tw * base.wind_psd / rate_ref)[:, None]  # scaled to ROSCO's: O(1)
+    constraints.append(cp.sum_squares(rl.real @ y) + cp.sum_squares(rl.imag @ y) <= kappa ** 2)
+    prob = cp.Problem(cp.Minimize(objective), constraints)
+    prob.solve()
+    if y.value is None or prob.status not in ("optimal", "optimal_inaccurate"):
+        raise RuntimeError(f"achievable_pitch at {wind_speed:g} m/s: the solver returned {prob.status!r}")
+    yv = phi_o @ np.asarray(y.value, float)
+    coef = np.linalg.solve(rr, np.asarray(y.value, float))
+    sens = 1 - ob * yv
+    t_tower = a - gy * yv
+    t_speed = ow * sens
+    d = spectral.damage_rate(w, np.abs(t_tower) ** 2 * base.wind_psd, base.m, method=base.method)
+    red = float(spectral.del_reduction(100.0 * (1.0 - d / base.damage_rate), base.m))
+    excess = float(20 * np.log10(np.max(np.abs(t_speed) / w_speed)))
+    return AchievablePitch(float(wind_speed), g, ms, w, coef, t_tower, t_speed, sens, red, excess, str(prob.status))
