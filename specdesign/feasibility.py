@@ -39,6 +39,8 @@ specification that is feasible by construction, with the exact (Dirlik) promise.
 :func:`pitch_frontier` tabulates, per speed relaxation, that achievable promise beside the
 pointwise upper bound of condition 1 (the smallest |T_{MyT,w}| inside the speed and margin
 disks at every frequency): the true frontier lies between the two.
+:func:`specification_for_target` inverts the frontier: the smallest speed relaxation whose
+design promises a requested DEL reduction, and the specification pair it certifies.
 
 Units: ω in rad/s, magnitudes linear (dB only in messages), DEL reductions in %.
 """
@@ -51,7 +53,7 @@ import numpy as np
 from ._checks import as_omega, positive_scalar
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "AchievablePitch", "achievable_pitch", "pitch_frontier",
-           "sensitivity_disks"]
+           "TargetSpecification", "specification_for_target", "sensitivity_disks"]
 
 
 def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
@@ -551,3 +553,132 @@ def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=2
     red = float(spectral.del_reduction(100.0 * (1.0 - d / base.damage_rate), base.m))
     excess = float(20 * np.log10(np.max(np.abs(t_speed) / w_speed)))
     return AchievablePitch(float(wind_speed), g, ms, w, coef, t_tower, t_speed, sens, red, excess, str(prob.status))
+
+
+@dataclass(frozen=True)
+class TargetSpecification:
+    """A specification pair that promises a DEL reduction and is feasible by construction.
+
+    Parameters
+    ----------
+    tower : specdesign.spec.Specification
+        W_MyT: the certifying design's T_{MyT,w} times ``slack_db`` (a transfer function of
+        the order of the design).
+    speed : specdesign.spec.Specification
+        W_Ω: ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``.
+    promise : specdesign.spec.Promise
+        The tower specification's promise against ROSCO (exact Dirlik and Eq. (10)).
+    speed_relax_db : float
+        The smallest relaxation (dB, to the bisection's tolerance) whose design reaches the target.
+    slack_db : float
+        How far above the certifying design the tower specification lies, dB.
+    design : AchievablePitch
+        The certificate: a stabilising pitch controller that meets both specifications.
+    target_reduction : float
+        The DEL reduction asked for, %.
+    """
+
+    tower: object
+    speed: object
+    promise: object
+    speed_relax_db: float
+    slack_db: float
+    design: AchievablePitch
+    target_reduction: float
+
+
+def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, max_sensitivity=2.0,
+                             max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05, m=4.0,
+                             omega=None) -> TargetSpecification:
+    """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
+
+    Bisection on the relaxation g of ROSCO's generator-speed map: the smallest g whose
+    :func:`achievable_pitch` design, with its tower map raised by ``slack_db`` (room for a
+    designer's own controller), still promises ``target_reduction`` % DEL (exact Dirlik, 1 Hz).
+    The pair returned is met by that design, so it is feasible, and its promise is the
+    promise of the specification handed to the design step.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    target_reduction : float
+        Tower-base DEL reduction the specification must promise, % (0-100).
+    slack_db : float
+        W_MyT lies this far above the certifying design's |T_{MyT,w}|, dB (≥ 0).
+    max_sensitivity : float
+        M_s (-).
+    max_pitch_rate_ratio : float
+        Pitch-rate SD allowance relative to ROSCO's (-).
+    max_relax_db : float
+        Largest speed relaxation tried, dB.
+    tolerance_db : float
+        Bisection tolerance on the relaxation, dB.
+    m : float
+        Wöhler exponent (-).
+    omega : array_like, optional
+        Grid, rad/s (default :func:`specdesign.spec.default_omega`).
+
+    Returns
+    -------
+    TargetSpecification
+        The pair, its promise and its certificate.
+
+    Raises
+    ------
+    ValueError
+        For a target outside (0, 100) or a negative slack, or when even ``max_relax_db`` does
+        not reach the target (the message gives the promise reached there).
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> t = specification_for_target(iea15mw(), 19.0, 25.0)
+    >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 1.0)
+    True
+    """
+    import control
+
+    from . import spec
+    from .closedloop import closed_loop
+
+    t = float(target_reduction)
+    if not 0 < t < 100:
+        raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
+    slack = float(slack_db)
+    if not (np.isfinite(slack) and slack >= 0):
+        raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")
+    base = spec.baseline_analysis(model, wind_speed, m=m, omega=omega)
+    k = 10 ** (slack / 20)  # the slack raises |T| by this factor
+
+    def reached(g):
+        try:
+            d = achievable_pitch(model, wind_speed, g, max_sensitivity=max_sensitivity,
+                                 max_pitch_rate_ratio=max_pitch_rate_ratio, base=base)
+        except RuntimeError:
+            return None, -np.inf
+        p = spec.promise_of(k * np.abs(d.t_tower) / np.abs(base.t_response), base)  # the shaping |W|/|T^ROSCO|
+        return d, p.exact_del
+
+    hi_design, hi_red = reached(float(max_relax_db))
+    if hi_red < t:
+        raise ValueError(f"no pitch specification promises {t:g} % at {float(wind_speed):g} m/s with the speed map "
+                         f"relaxed up to {max_relax_db:g} dB (best {hi_red:.1f} % with {slack:g} dB slack); lower the "
+                         "target or the slack, or allow more pitch activity")
+    lo, hi = 0.0, float(max_relax_db)
+    best = hi_design
+    while hi - lo > tolerance_db:
+        mid = 0.5 * (lo + hi)
+        d, red = reached(mid)
+        if red >= t:
+            hi, best = mid, d
+        else:
+            lo = mid
+    plant = model.linearize(float(wind_speed))
+    # kept as a state space: the polynomial coefficients of a ~25th-order map carry no digits
+    t_sys = control.minreal(closed_loop(plant, best.controller(model), warn=False)["tower_base_my", "wind"], verbose=False)
+    tower = spec.Specification(t_sys, (spec.Gain(slack),), name="W_tower_base_my")
+    speed = spec.speed_specification(model, float(wind_speed), margin_db=hi)
+    return TargetSpecification(tower, speed, spec.promise_of(tower, base), hi, slack, best, t)

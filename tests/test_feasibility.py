@@ -138,3 +138,42 @@ def test_the_check_agrees_with_design_qfts_speed_ladder(model):
         if not ok:
             bad = res.omega[np.array(res.binding) != ""]
             assert np.all(np.abs(bad - 1.08) < 0.02) and "tower vs speed" in res.binding
+
+
+@pytest.fixture(scope="module")
+def target19(model):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return fz.specification_for_target(model, 19.0, 25.0)
+
+
+def test_a_specification_for_a_target_promises_it(model, target19):
+    # the promise recomputed independently: Dirlik DEL of |W_MyT|²·S_W against ROSCO's |T|²·S_W
+    from specdesign import spectral, wind
+
+    w = np.geomspace(0.01, 10.0, 2000)
+    s_w = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius)
+    t_r = closedloop.t_tower_wind(model.linearize(19.0), rosco_baseline(model, 19.0), w)
+    red = 100 * (1 - spectral.del_spectral(w, np.abs(target19.tower.response(w)) ** 2 * s_w, 4.0)
+                 / spectral.del_spectral(w, np.abs(t_r) ** 2 * s_w, 4.0))
+    assert red >= 25.0 - 0.3  # (a finer grid than the baseline's 400 points)
+    assert target19.promise.exact_del >= 25.0
+    assert 0 < target19.speed_relax_db < 3.0
+
+
+def test_its_certificate_meets_both_specifications_between_the_grid_points(model, target19):
+    c = target19.design.controller(model)
+    plant = model.linearize(19.0)
+    w = np.geomspace(0.011, 9.9, 5000)  # 12× denser than the design grid, off its points
+    t_my = np.abs(closedloop.t_tower_wind(plant, c, w))
+    t_om = np.abs(closedloop.t_gen_speed_wind(plant, c, w))
+    assert np.max(20 * np.log10(t_my / np.abs(target19.tower.response(w)))) <= -target19.slack_db + 1e-6
+    assert np.max(20 * np.log10(t_om / np.abs(target19.speed.response(w)))) <= 0.1
+    assert fz.pitch_feasibility(model, 19.0, target19.tower, target19.speed).feasible
+
+
+def test_an_unreachable_target_says_so(model):
+    with pytest.raises(ValueError, match=r"no pitch specification promises 95 %.*best"):
+        fz.specification_for_target(model, 19.0, 95.0, max_relax_db=3.0)
+    with pytest.raises(ValueError, match="target_reduction"):
+        fz.specification_for_target(model, 19.0, 0.0)
