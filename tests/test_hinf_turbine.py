@@ -371,3 +371,15 @@ def test_target_reduction_is_renamed_spec_reduction(model):
     # specification's damage promise: one name, one meaning (the old keyword warns)
     with pytest.warns(DeprecationWarning, match="spec_reduction"), pytest.raises(ValueError, match="specs="):
         hinf.design_hinf(model, 19.0, specs="neither", target_reduction=15.0)
+
+
+def test_a_given_specification_pair_is_the_weights(model):
+    # specs=(W_MyT, W_Ω): the pair handed over is what the synthesis weighs and the assessment
+    # measures (a loose pair: ROSCO's tower map + 3 dB, its speed map + 6 dB)
+    d = spec.design_specifications(model, V, speed_relax_db=6.0, tower_relax_db=0.0)
+    tower = spec.Specification(d.base.system, (spec.Gain(3.0),), name="W_tower")
+    res = hinf.design_hinf(model, V, specs=(tower, d.speed), measurements=("gen_speed", "tower_top_vel"), order=8)
+    assert res.specs == "given" and res.w_tower is tower and res.w_speed is d.speed
+    assert res.speed_excess_db <= 0.1
+    with pytest.raises(ValueError, match="pair"):
+        hinf.design_hinf(model, V, specs=(tower,))

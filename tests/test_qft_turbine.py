@@ -238,3 +238,28 @@ def test_the_specifications_it_met_pass_the_feasibility_check(model, design):
     res = feasibility.pitch_feasibility(model, design.wind_speed, design.tower_spec, design.speed_spec,
                                         max_sensitivity=None)
     assert design.success and res.feasible, res.summary()
+
+
+def test_a_given_specification_pair_is_what_the_design_meets(model):
+    # design_qft(spec=...): no notch spec, no DEL penalty; the pair handed over is met. Checked
+    # independently of the tuner's grids: the nominal closed loop by the explicit formula on a
+    # dense grid against the specification's own transfer functions.
+    from specdesign import closedloop, spec
+
+    d = spec.design_specifications(model, 19.0, speed_relax_db=6.0, tower_relax_db=0.0)
+    tower = spec.Specification(d.base.system, (spec.Gain(3.0),), name="W_tower")  # ROSCO's map + 3 dB
+    q = qft.design_qft(model, 19.0, spec=(tower, d.speed))
+    assert q.success, q.message
+    assert q.tower_spec is tower and q.speed_spec is d.speed
+    assert q.promise.exact_del == pytest.approx(spec.promise_of(tower, d.base).exact_del, abs=1e-9)
+    assert q.target_reduction == pytest.approx(q.promise.exact_del)  # the target the spec carries
+    w = np.geomspace(0.005, 20.0, 3000)
+    plant = model.linearize(19.0)
+    atd = dict(atd_controller=q.atd_controller)
+    t_my = np.abs(closedloop.t_tower_wind(plant, q.pitch_controller, w, **atd))
+    t_om = np.abs(closedloop.t_gen_speed_wind(plant, q.pitch_controller, w, **atd))
+    assert np.max(20 * np.log10(t_my / np.abs(tower.response(w)))) <= 0.1  # issue 14: |T| ≤ |W| + 0.1 dB
+    assert np.max(20 * np.log10(t_om / np.abs(d.speed.response(w)))) <= 0.1
+    assert q.del_reduction >= q.promise.exact_del - 0.1
+    with pytest.raises(TypeError, match="spec must be"):
+        qft.design_qft(model, 19.0, spec="W")

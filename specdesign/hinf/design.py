@@ -308,7 +308,7 @@ def design_hinf(
         E.g. :func:`specdesign.turbine.iea15mw`.
     wind_speed : float
         Operating point, m/s, above rated.
-    specs : "qft", "rosco" or specdesign.qft.QFTDesign
+    specs : "qft", "rosco", specdesign.qft.QFTDesign, TargetSpecification or (W_MyT, W_Ω)
         Which specifications are the weights (``w_tower``/``w_speed``, when given, override).
         ``"qft"`` (default): those of :func:`specdesign.qft.design_qft`
         (:func:`qft_specifications`): the notch spec relaxed by ``tower_relax_db`` above
@@ -319,7 +319,9 @@ def design_hinf(
         A ``QFTDesign``: its own ``tower_spec`` and ``speed_spec``, for a comparison on
         exactly the specs that design met. ``"rosco"``: the unrelaxed notch spec and ROSCO's
         T_{Ω,w} (this function's default before; its ζ = 0.01 dip at the tower mode is then
-        a spec no well-damped loop can follow, docs/hinf.md).
+        a spec no well-damped loop can follow, docs/hinf.md). A
+        :class:`specdesign.feasibility.TargetSpecification` or a pair (W_MyT, W_Ω): those
+        specifications as given (label ``"given"``; the design is assessed against them).
     spec_reduction : float
         % of tower-base damage the automatic notch specification
         (:func:`specdesign.spec.shape_to_target`) must promise (the name
@@ -415,7 +417,14 @@ def design_hinf(
     v = float(wind_speed)
     base = spec.baseline_analysis(model, v, m=m, omega=omega)
     notch_spec, ladder, label = None, [None], "custom"
-    if _is_design(specs):
+    if not isinstance(specs, str) and not _is_design(specs):
+        # a given pair: a feasibility.TargetSpecification (tower, speed) or a tuple (W_MyT, W_Ω)
+        pair = (specs.tower, specs.speed) if hasattr(specs, "tower") and hasattr(specs, "speed") else specs
+        if not (isinstance(pair, (tuple, list)) and len(pair) == 2):
+            raise ValueError(f"specs={specs!r} must be 'qft', 'rosco', a specdesign.qft.QFTDesign, a "
+                             "feasibility.TargetSpecification or a pair (W_MyT, W_Ω)")
+        label, w_tower, w_speed = "given", pair[0] if w_tower is None else w_tower, pair[1] if w_speed is None else w_speed
+    elif _is_design(specs):
         label = "qft_design"
         w_tower = specs.tower_spec if w_tower is None else w_tower
         w_speed = specs.speed_spec if w_speed is None else w_speed
@@ -436,8 +445,9 @@ def design_hinf(
         if not shaped.success:
             raise ValueError(f"no tower specification at {v:g} m/s: {shaped.message}")
         notch_spec = shaped.specification
-    else:
-        raise ValueError(f"specs={specs!r} must be 'qft', 'rosco' or a specdesign.qft.QFTDesign")
+    elif label != "given":
+        raise ValueError(f"specs={specs!r} must be 'qft', 'rosco', a specdesign.qft.QFTDesign, a "
+                         "feasibility.TargetSpecification or a pair (W_MyT, W_Ω)")
     if w_tower is not None and w_speed is not None and label in ("qft", "rosco"):
         label, ladder, notch_spec = "custom", [None], None
     design = None

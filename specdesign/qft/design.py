@@ -298,7 +298,8 @@ def _callable(fn, key):
 
 
 def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
-               speed_relax_db: float | Sequence[float] = (3.0, 4.5, 6.0, 8.0), **kwargs: Any) -> QFTDesign:
+               speed_relax_db: float | Sequence[float] = (3.0, 4.5, 6.0, 8.0), spec: Any = None,
+               **kwargs: Any) -> QFTDesign:
     """QFT design of C_β and C_atd at ``wind_speed`` (m/s) against the fatigue-based specs.
 
     The automatic procedure of :mod:`specdesign.qft`: fixed structures started from ROSCO,
@@ -315,7 +316,15 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     speed_relax_db : float or sequence of float
         Relaxation of the generator-speed spec in dB (≥ 0), or an increasing sequence tried
         in turn (default 3, 4.5, 6, 8 dB): the design with the smallest relaxation that meets
-        every spec is returned (else the last attempt, with a warning).
+        every spec is returned (else the last attempt, with a warning). Not used with ``spec``.
+    spec : TargetSpecification or (tower, speed), optional
+        The specification pair to meet instead of the notch specification and the DEL target:
+        a :class:`specdesign.feasibility.TargetSpecification`, or two objects with a
+        ``response(omega)`` (e.g. :class:`specdesign.spec.Specification`), W_MyT and W_Ω of
+        the nominal case. Each plant case gets ROSCO's map at its speed times the nominal
+        ratio W/T^ROSCO; no DEL penalty is used (the specification carries the target, and
+        ``target_reduction`` is set to its promise). ``success`` then means: every bound met,
+        the dense check passed for every case, every loop stable.
     **kwargs
         Options of each design attempt (keyword only):
 
@@ -396,6 +405,8 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
     if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
+    if spec is not None:
+        return _design_single(model, wind_speed, None, speed_relax_db=float(ladder[0]), given=_given_spec(spec), **kwargs)
     design = None
     for relax in ladder:
         with warnings.catch_warnings():
@@ -408,7 +419,28 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     return design
 
 
-def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=15.0, template_offsets=(-1.0, -0.5, 0.5, 1.0),
+def _ratio(spec_like, ref):
+    """ω → spec_like.response(ω)/ref(jω): a given specification relative to ROSCO's map."""
+    from ..closedloop import siso_response
+
+    def f(omega):
+        w = np.asarray(omega, float)
+        return np.asarray(spec_like.response(w)) / siso_response(ref, w, "reference")
+
+    return f
+
+
+def _given_spec(spec):
+    """(tower, speed) of a TargetSpecification or a pair, each with ``response(omega)``."""
+    pair = (spec.tower, spec.speed) if hasattr(spec, "tower") and hasattr(spec, "speed") else spec
+    if not (isinstance(pair, (tuple, list)) and len(pair) == 2 and all(hasattr(x, "response") for x in pair)):
+        raise TypeError("spec must be a feasibility.TargetSpecification or a pair (tower, speed) of specifications with "
+                        f"response(omega), got {type(spec).__name__}")
+    return tuple(pair)
+
+
+def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec_reduction=15.0,
+                   template_offsets=(-1.0, -0.5, 0.5, 1.0),
                    design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
                    max_sensitivity=1.9, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
@@ -420,8 +452,8 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
     if not isinstance(model, turbine.TurbineModel):
         raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()), got {type(model).__name__}")
     v = model.check_wind_speed(wind_speed)
-    t = float(target_reduction)
-    if not 0 < t < 100:
+    t = None if given is not None else float(target_reduction)
+    if t is not None and not 0 < t < 100:
         raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
     for name, val in (("speed_relax_db", speed_relax_db), ("tower_relax_db", tower_relax_db)):
         if not (np.isfinite(val) and val >= 0):
@@ -441,9 +473,22 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
                                      tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
                                      keep_below=keep_below)
     base, shaping, tower_spec, speed_spec = specs.base, specs.shaping, specs.tower, specs.speed
-    promise = sp.promise_of(tower_spec, base)
+    tower_shaping, speed_shaping = tower_spec.shaping, None
+    if given is not None:
+        # a given pair: each case gets ROSCO's map times the nominal ratio W/T^ROSCO
+        tower_spec, speed_spec = given
+        t_ref, s_ref = base.system, sp.speed_specification(model, v).baseline
+        tower_shaping = _ratio(tower_spec, t_ref)
+        speed_shaping = _ratio(speed_spec, s_ref)
+        shaping = sp.ShapingResult((), sp.promise_of(tower_shaping(base.omega), base), float("nan"), "del", True,
+                                   "given specification",
+                                   tower_spec if isinstance(tower_spec, sp.Specification) else None)
+    promise = sp.promise_of(tower_spec, base) if given is None else shaping.promise
+    if t is None:
+        t = float(promise.exact_del)  # the target the specification carries
 
-    prob = TuningProblem(model, v, speeds, nom, wd, tower_spec.shaping, speed_relax_db, max_sensitivity, base)
+    prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, speed_relax_db, max_sensitivity, base,
+                         speed_shaping=speed_shaping)
     # Sharp features of the specs (the lightly damped tower-mode poles and zeros of every case's
     # ROSCO loop) are design frequencies and dense-check points too: a bound that holds on
     # both sides of a narrow dip of W can still fail inside it.
@@ -454,7 +499,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, spec_reduction=1
     x = rosco_start(prob.rosco[nom])
     rounds = 0
     while True:
-        x, feasible = tune(prob, x, t, min_decay, maxfev)
+        x, feasible = tune(prob, x, None if given is not None else t, min_decay, maxfev)
         cb, ca = controllers(x, v)
         pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = _checks(prob, cb, ca, wdense)
         bad = [w for chk in (pitch_check, atd_check) for name in chk.names for w in [chk.worst(name)] if w[1] < 0]

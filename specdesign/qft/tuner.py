@@ -102,7 +102,7 @@ class TuningProblem:
 
     def __init__(self, model: TurbineModel, v: float, speeds: Sequence[float], nominal: int, design_omega: ArrayLike,
                  tower_shaping: Callable[[np.ndarray], np.ndarray], speed_relax_db: float, max_sensitivity: float,
-                 base: Baseline) -> None:
+                 base: Baseline, speed_shaping: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
         from .. import turbine
 
         self.v, self.speeds, self.nom = v, speeds, nominal
@@ -110,6 +110,7 @@ class TuningProblem:
         self.rosco = [turbine.rosco_baseline(model, s) for s in speeds]
         self.tower_shaping = tower_shaping  # callable ω → complex shaping (notches × relaxation)
         self.speed_gain = 10 ** (speed_relax_db / 20)
+        self.speed_shaping = speed_shaping  # callable ω → W_Ω/T^ROSCO_{Ω,w} (nominal), or None: speed_gain
         self.ms = max_sensitivity
         self.base = base
         self.wf, self.S = base.omega, base.wind_psd
@@ -154,7 +155,8 @@ class TuningProblem:
         """
         R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"))
         c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
-        w_speed = np.abs(self._t(R, c, 0.0, "gen_speed")) * self.speed_gain
+        gain = self.speed_gain if self.speed_shaping is None else np.abs(self.speed_shaping(omega))[:, None]
+        w_speed = np.abs(self._t(R, c, 0.0, "gen_speed")) * gain
         w_tower = np.abs(self._t(R, c, 0.0, "tower_base_my")) * np.abs(self.tower_shaping(omega))[:, None]
         return w_speed, w_tower
 
@@ -304,8 +306,9 @@ class TuningProblem:
         ----------
         x : array_like
             Parameter vector (:mod:`specdesign.qft.structure`).
-        target : float
-            Required tower-base DEL reduction, %.
+        target : float or None
+            Required tower-base DEL reduction, %; None when a given specification carries it
+            (no DEL constraint).
         min_decay : float
             Required decay rate, 1/s (poles left of −``min_decay``).
 
@@ -317,7 +320,8 @@ class TuningProblem:
             margin specs), the DEL margin (pp) and the n_cases decay margins (1/s).
         """
         g = self.margins(x)
-        return np.r_[(g[:2] - self._safety()).ravel(), (g[2:] - STABILITY_SAFETY_DB).ravel(), self.performance(x)[0] - target,
+        del_margin = [] if target is None else [self.performance(x)[0] - target]
+        return np.r_[(g[:2] - self._safety()).ravel(), (g[2:] - STABILITY_SAFETY_DB).ravel(), del_margin,
                      -(self.max_real(x) + min_decay)]
 
     def cost(self, x: ArrayLike, target: float, min_decay: float, weight: float = 1e3) -> float:
@@ -330,8 +334,8 @@ class TuningProblem:
         ----------
         x : array_like
             Parameter vector (:mod:`specdesign.qft.structure`).
-        target : float
-            Required tower-base DEL reduction, %.
+        target : float or None
+            Required tower-base DEL reduction, %; None for no DEL penalty.
         min_decay : float
             Required decay rate, 1/s.
         weight : float
@@ -355,7 +359,8 @@ class TuningProblem:
         excess = np.sum(np.maximum(mr + min_decay, 0.0))
         if excess > 0:  # a barrier: never trade stability for anything
             return float(1e10 * (1 + excess))
-        return float(self.objective(x) + 10 * max(target - red, 0.0) ** 2 + weight * viol)
+        shortfall = 0.0 if target is None else max(target - red, 0.0)
+        return float(self.objective(x) + 10 * shortfall ** 2 + weight * viol)
 
 
 #: Largest constraint violation a polished candidate may keep and still count as feasible
@@ -363,7 +368,7 @@ class TuningProblem:
 FEASIBLE_TOL = 1e-6
 
 
-def tune(prob: TuningProblem, x0: ArrayLike, target: float, min_decay: float, maxfev: int) -> tuple[np.ndarray, bool]:
+def tune(prob: TuningProblem, x0: ArrayLike, target: float | None, min_decay: float, maxfev: int) -> tuple[np.ndarray, bool]:
     """Tune from ``x0``: explore, polish, and keep the best candidate by a total order.
 
     Powell on the penalty cost explores (a derivative-free search that gets past the kinks of
@@ -381,8 +386,9 @@ def tune(prob: TuningProblem, x0: ArrayLike, target: float, min_decay: float, ma
         The precomputed problem.
     x0 : array_like
         Start parameter vector, e.g. :func:`specdesign.qft.structure.rosco_start`.
-    target : float
-        Required tower-base DEL reduction, %.
+    target : float or None
+        Required tower-base DEL reduction, %; None: no DEL constraint (a given specification
+        carries the target).
     min_decay : float
         Required closed-loop decay rate, 1/s.
     maxfev : int
