@@ -587,14 +587,16 @@ class TargetSpecification:
     target_reduction: float
 
 
-def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, max_sensitivity=2.0,
-                             max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05, m=4.0,
-                             omega=None) -> TargetSpecification:
+def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
+                             max_sensitivity=2.0, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
+                             m=4.0, omega=None) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
     Bisection on the relaxation g of ROSCO's generator-speed map: the smallest g whose
     :func:`achievable_pitch` design, with its tower map raised by ``slack_db`` (room for a
     designer's own controller), still promises ``target_reduction`` % DEL (exact Dirlik, 1 Hz).
+    Or, with ``speed_relax_db`` given, the other way round: the design at that relaxation and
+    the largest slack that still promises the target (the most room for a low-order design).
     The pair returned is met by that design, so it is feasible, and its promise is the
     promise of the specification handed to the design step.
 
@@ -607,7 +609,11 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     target_reduction : float
         Tower-base DEL reduction the specification must promise, % (0-100).
     slack_db : float
-        W_MyT lies this far above the certifying design's |T_{MyT,w}|, dB (≥ 0).
+        W_MyT lies this far above the certifying design's |T_{MyT,w}|, dB (≥ 0); ignored with
+        ``speed_relax_db``.
+    speed_relax_db : float, optional
+        A fixed relaxation of the speed map, dB: the slack is then the largest that keeps
+        the promise ≥ ``target_reduction`` (bisection to ``tolerance_db``).
     max_sensitivity : float
         M_s (-).
     max_pitch_rate_ratio : float
@@ -639,10 +645,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 1.0)
     True
     """
-    import control
-
     from . import spec
-    from .closedloop import closed_loop
 
     t = float(target_reduction)
     if not 0 < t < 100:
@@ -662,6 +665,23 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         p = spec.promise_of(k * np.abs(d.t_tower) / np.abs(base.t_response), base)  # the shaping |W|/|T^ROSCO|
         return d, p.exact_del
 
+    if speed_relax_db is not None:
+        g = float(speed_relax_db)
+        design, _ = reached(g)
+        if design is None:
+            raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {float(wind_speed):g} m/s")
+
+        def promise_with(sl):
+            return spec.promise_of(10 ** (sl / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
+
+        if promise_with(0.0) < t:
+            raise ValueError(f"no pitch specification promises {t:g} % at {float(wind_speed):g} m/s with the speed map "
+                             f"relaxed by {g:g} dB (best {promise_with(0.0):.1f} % with no slack); relax it more")
+        lo, hi = 0.0, 40.0
+        while hi - lo > tolerance_db:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if promise_with(mid) >= t else (lo, mid)
+        return _target_result(model, wind_speed, design, base, lo, g, t)
     hi_design, hi_red = reached(float(max_relax_db))
     if hi_red < t:
         raise ValueError(f"no pitch specification promises {t:g} % at {float(wind_speed):g} m/s with the speed map "
@@ -676,9 +696,19 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
             hi, best = mid, d
         else:
             lo = mid
+    return _target_result(model, wind_speed, best, base, slack, hi, t)
+
+
+def _target_result(model, wind_speed, design, base, slack, g, target):
+    import control
+
+    from . import spec
+    from .closedloop import closed_loop
+
     plant = model.linearize(float(wind_speed))
     # kept as a state space: the polynomial coefficients of a ~25th-order map carry no digits
-    t_sys = control.minreal(closed_loop(plant, best.controller(model), warn=False)["tower_base_my", "wind"], verbose=False)
+    t_sys = control.minreal(closed_loop(plant, design.controller(model), warn=False)["tower_base_my", "wind"],
+                            verbose=False)
     tower = spec.Specification(t_sys, (spec.Gain(slack),), name="W_tower_base_my")
-    speed = spec.speed_specification(model, float(wind_speed), margin_db=hi)
-    return TargetSpecification(tower, speed, spec.promise_of(tower, base), hi, slack, best, t)
+    speed = spec.speed_specification(model, float(wind_speed), margin_db=g)
+    return TargetSpecification(tower, speed, spec.promise_of(tower, base), g, slack, design, target)

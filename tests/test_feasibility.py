@@ -177,3 +177,14 @@ def test_an_unreachable_target_says_so(model):
         fz.specification_for_target(model, 19.0, 95.0, max_relax_db=3.0)
     with pytest.raises(ValueError, match="target_reduction"):
         fz.specification_for_target(model, 19.0, 0.0)
+
+
+def test_a_fixed_speed_relaxation_gives_the_largest_slack(model):
+    # speed_relax_db given: the tower slack is the largest that keeps the promise ≥ the target
+    # (a larger one, by the bisection's tolerance, falls below it)
+    t = fz.specification_for_target(model, 19.0, 25.0, speed_relax_db=6.0)
+    base = spec.baseline_analysis(model, 19.0)
+    assert t.speed_relax_db == 6.0 and t.promise.exact_del >= 25.0
+    ratio = np.abs(t.design.t_tower) / np.abs(base.t_response)
+    over = spec.promise_of(10 ** ((t.slack_db + 0.1) / 20) * ratio, base).exact_del
+    assert over < 25.0 < t.promise.exact_del < 25.0 + 1.0
