@@ -188,3 +188,13 @@ def test_a_fixed_speed_relaxation_gives_the_largest_slack(model):
     ratio = np.abs(t.design.t_tower) / np.abs(base.t_response)
     over = spec.promise_of(10 ** ((t.slack_db + 0.1) / 20) * ratio, base).exact_del
     assert over < 25.0 < t.promise.exact_del < 25.0 + 1.0
+
+
+def test_round_off_does_not_move_the_frontier_or_the_specification(model, target19):
+    # a convex design and a bisection on it: 1e-9 m/s moves neither (issue 12's reproducibility)
+    a = fz.achievable_pitch(model, 19.0, 3.0)
+    b = fz.achievable_pitch(model, 19.0 + 1e-9, 3.0)
+    assert abs(a.del_reduction - b.del_reduction) < 0.05
+    t = fz.specification_for_target(model, 19.0 + 1e-9, 25.0)
+    assert abs(t.promise.exact_del - target19.promise.exact_del) < 0.2
+    assert abs(t.speed_relax_db - target19.speed_relax_db) <= 0.06

@@ -66,6 +66,9 @@ class TuningProblem:
     base : specdesign.spec.Baseline
         ROSCO's nominal loop (grid ``omega`` in rad/s, ``wind_psd`` in (m/s)² per rad/s,
         Wöhler exponent ``m`` and damage method).
+    speed_shaping : callable, optional
+        ω → W_Ω(jω)/T^ROSCO_{Ω,w}(jω) of the nominal case, applied to every case in place of
+        the constant relaxation ``speed_relax_db`` (a given generator-speed specification).
 
     Attributes
     ----------
