@@ -136,7 +136,8 @@ class PitchFeasibility:
     zeros : numpy.ndarray
         Right-half-plane zeros of P_{Ω,β} (1/s), nominal case.
     poisson_mean : numpy.ndarray
-        Per zero, the Poisson mean of ln s_max (must be ≥ 0).
+        Per plant case and right-half-plane zero (upper half-plane; in that order), the
+        Poisson mean of ln s_max (must be ≥ 0).
     reasons : tuple of str
         One sentence per violated condition (empty when feasible).
     max_sensitivity : float
@@ -248,7 +249,7 @@ def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitiv
         outside = np.log(ms) if np.isfinite(ms) else float(np.log(max(r[0], r[-1])))
         for z in _rhp_zeros(plant):
             if z.imag >= 0:
-                means.append(_poisson_mean(w, np.log(s_max), z, outside))
+                means.append((z, _poisson_mean(w, np.log(s_max), z, outside)))
     reasons = []
     if not ok.all():
         for kind in ("tower vs speed", "tower vs margin"):
@@ -257,14 +258,13 @@ def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitiv
                 what = "the generator-speed specification" if kind == "tower vs speed" else f"|S| ≤ M_s = {ms:g}"
                 reasons.append(f"the tower-load specification cannot be met together with {what} at {', '.join(bands)} "
                                "(no complex S(jω) lies in both disks)")
-    means = np.asarray(means)
-    upper = zeros[zeros.imag >= 0]
-    for z, m in zip(np.tile(upper, len(plants)), means):
+    for z, m in means:
         if m < 0:
-            reasons.append(f"P_Ω,β has a right-half-plane zero at {_fmt(z)} 1/s, which forces S(z) = 1 (pitch control cannot "
-                           f"attenuate near {abs(z.imag):.3g} rad/s); the specifications allow a Poisson mean of ln|S| of "
-                           f"at most {m:.3g} < 0 there: relax the tower specification near {abs(z.imag):.3g} rad/s or add "
-                           "a tower-damping loop")
+            reasons.append(f"P_Ω,β has a right-half-plane zero at {_fmt(z)} 1/s, which pins T_Ω,w(z) to the open loop's "
+                           f"(S(z) = 1, for any controller acting through the pitch); the specifications allow a Poisson "
+                           f"mean of ln|S| of at most {m:.3g} < 0 there: relax the speed or the tower specification near "
+                           f"{abs(z.imag):.3g} rad/s")
+    means = np.array([m for _, m in means])
     return PitchFeasibility(feasible=not reasons, omega=w, pointwise=ok, binding=tuple(binding.tolist()), zeros=zeros,
                             poisson_mean=means, reasons=tuple(reasons), max_sensitivity=ms)
 

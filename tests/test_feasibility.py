@@ -198,3 +198,13 @@ def test_round_off_does_not_move_the_frontier_or_the_specification(model, target
     t = fz.specification_for_target(model, 19.0 + 1e-9, 25.0)
     assert abs(t.promise.exact_del - target19.promise.exact_del) < 0.2
     assert abs(t.speed_relax_db - target19.speed_relax_db) <= 0.06
+
+
+def test_a_speed_map_below_roscos_everywhere_breaks_the_interpolation_condition(model):
+    # |T_Ω,w| ≤ ½|T^ROSCO_Ω,w| everywhere: around the RHP zero the specs allow at most |S| = ½|S_R|,
+    # whose Poisson mean is ln ½ + 0 < 0 (S(z) = 1 pins it): infeasible for any controller
+    speed = spec.speed_specification(model, 19.0, margin_db=-6.0)
+    res = fz.pitch_feasibility(model, 19.0, None, speed, max_sensitivity=None)
+    assert not res.feasible and res.pointwise.all()  # pointwise it is fine (no tower spec)
+    assert res.poisson_mean.size == 1 and res.poisson_mean[0] == pytest.approx(np.log(0.5), abs=0.02)
+    assert "pins T_Ω,w(z)" in res.summary()
