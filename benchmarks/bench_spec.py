@@ -38,7 +38,7 @@ def main():
 
     t_cb = best_of(lambda: callback(False), 50)
     t_render = best_of(lambda: callback(True), 10)
-    t_compute = best_of(lambda: spec.evaluate(spec.Notch(1.05, 6.0, 0.2).response(base.omega), base), 200)
+    t_compute = best_of(lambda: spec.promise_of(spec.Notch(1.05, 6.0, 0.2).response(base.omega), base), 200)
     t_base = best_of(lambda: spec.baseline_analysis(model, 19.0), 5)
     t_shape = best_of(lambda: spec.shape_to_target(base, 15.0), 5)
     print("specification benchmarks (best of N, 400-point grid)")
