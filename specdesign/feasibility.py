@@ -52,8 +52,8 @@ import numpy as np
 
 from ._checks import as_omega, positive_scalar
 
-__all__ = ["PitchFeasibility", "pitch_feasibility", "AchievablePitch", "achievable_pitch", "pitch_frontier",
-           "TargetSpecification", "specification_for_target", "sensitivity_disks"]
+__all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
+           "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks"]
 
 
 def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
@@ -102,20 +102,36 @@ def _rhp_zeros(plant):
     return z[(z.real > 0) & (np.abs(z) < 1e6)]
 
 
-def _poisson_mean(omega, values, z, outside):
-    """(1/π)∫_ℝ values(|ω|) x/(x² + (ω − y)²) dω for z = x + iy, x > 0, by the trapezoid rule on
-    ``omega`` (both signs of ω), with ``outside`` for the kernel's mass off the grid."""
+def _poisson_kernel(z):
     x, y = float(z.real), float(z.imag)
 
-    def kernel(om):
+    def kernel(om):  # both signs of ω folded onto ω ≥ 0
         return (x / (x * x + (om - y) ** 2) + x / (x * x + (om + y) ** 2)) / np.pi
 
-    def cdf(om):  # mass of the kernel on [0, om] ∪ [−om, 0], in closed form
+    def cdf(om):  # its mass on [0, om]
         return (np.arctan((om - y) / x) + np.arctan((om + y) / x)) / np.pi
 
-    inside = np.trapezoid(values * kernel(omega), omega)
-    mass = cdf(omega[-1]) - cdf(omega[0])
-    return float(inside + outside * (1.0 - mass))
+    return kernel, cdf
+
+
+def _poisson_weights(omega, z):
+    """Weights q with q @ f = (1/π)∫ f(|ω|)·Re z/((Re z)² + (ω − Im z)²) dω over the grid
+    (ω of both signs), trapezoid rule, for z = x + iy with x > 0."""
+    from .spectral import trapezoid_weights
+
+    kernel, _ = _poisson_kernel(z)
+    return trapezoid_weights(omega) * kernel(omega)
+
+
+def _poisson_mass(omega, z):
+    """The Poisson kernel's mass on the grid's span (closed form)."""
+    _, cdf = _poisson_kernel(z)
+    return float(cdf(omega[-1]) - cdf(omega[0]))
+
+
+def _poisson_mean(omega, values, z, outside):
+    """Poisson mean of ``values`` over the grid plus ``outside`` times the kernel's mass off it."""
+    return float(_poisson_weights(omega, z) @ values + outside * (1.0 - _poisson_mass(omega, z)))
 
 
 @dataclass(frozen=True)
@@ -221,35 +237,155 @@ def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitiv
     >>> pitch_feasibility(model, 19.0, rosco_specs.base.system, rosco_specs.speed).feasible  # ROSCO meets its own
     True
     """
+    checkers = pitch_checkers(model, wind_speed, speed_spec, max_sensitivity=max_sensitivity, omega=omega, cases=cases)
+    w = checkers[0].omega
+    return combine([c.check(_magnitude(tower_spec, w, "tower_spec")) for c in checkers])
+
+
+@dataclass(frozen=True)
+class PitchChecker:
+    """The feasibility conditions of one plant case, precomputed for a given speed specification.
+
+    Everything but the tower specification is fixed, so :meth:`check` is a few vector
+    operations on the grid (≪ 1 ms): fast enough for a slider callback.
+
+    Parameters
+    ----------
+    omega : numpy.ndarray
+        Grid, rad/s (refined around the right-half-plane zeros of P_{Ω,β}).
+    c : numpy.ndarray
+        Centre of the tower disk for S (complex).
+    inv_g : numpy.ndarray
+        1/|P_{MyT,w} − K∞|, so that ρ = |W_MyT|/|P_{MyT,w} − K∞| (per N·m per m/s).
+    r_speed, r_margin : numpy.ndarray
+        Radii of the speed and margin disks about 0 (-).
+    t_rosco : numpy.ndarray
+        |T^ROSCO_{MyT,w}| on ``omega`` (N·m per m/s): a specification's reference.
+    zeros : numpy.ndarray
+        Right-half-plane zeros of P_{Ω,β} of this case (upper half-plane), 1/s.
+    kernels : numpy.ndarray
+        (n_zeros, n_omega) Poisson weights (trapezoid rule included) of each zero.
+    outside : numpy.ndarray
+        (n_zeros,) the kernel's mass off the grid times the bound on ln|S| there.
+    max_sensitivity : float
+        M_s (-; inf for none).
+    """
+
+    omega: np.ndarray
+    c: np.ndarray
+    inv_g: np.ndarray
+    r_speed: np.ndarray
+    r_margin: np.ndarray
+    t_rosco: np.ndarray
+    zeros: np.ndarray
+    kernels: np.ndarray
+    outside: np.ndarray
+    max_sensitivity: float
+
+    def check(self, w_tower) -> PitchFeasibility:
+        """The verdict for a tower specification of magnitude ``w_tower`` on :attr:`omega`.
+
+        Parameters
+        ----------
+        w_tower : array_like
+            |W_MyT(jω)| on :attr:`omega`, N·m per m/s (``np.inf``: no constraint).
+
+        Returns
+        -------
+        PitchFeasibility
+            This case's verdict.
+        """
+        rho = np.asarray(w_tower, float) * self.inv_g
+        ac = np.abs(self.c)
+        r = np.minimum(self.r_speed, self.r_margin)
+        bad = ac - rho > r  # the tower disk misses the disk about 0
+        binding = np.where(bad, np.where(self.r_speed <= self.r_margin, "tower vs speed", "tower vs margin"), "")
+        with np.errstate(divide="ignore"):
+            s_max = np.log(np.minimum(r, ac + rho))
+        means = self.kernels @ s_max + self.outside if self.zeros.size else np.zeros(0)
+        return _verdict(self.omega, ~bad, binding, self.zeros, means, self.max_sensitivity)
+
+
+def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=None, cases=None) -> list:
+    """One :class:`PitchChecker` per plant case, on one grid.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    speed_spec : Specification, callable or None
+        W_Ω ((rad/s) per (m/s)), as in :func:`pitch_feasibility`.
+    max_sensitivity : float or None
+        M_s (-), or None for none.
+    omega : array_like, optional
+        Grid, rad/s (default :func:`specdesign.spec.default_omega` refined around the
+        right-half-plane zeros of the nominal P_{Ω,β}).
+    cases : sequence of float, optional
+        Wind speeds (m/s) of the plant cases; default only ``wind_speed``.
+
+    Returns
+    -------
+    list of PitchChecker
+        Nominal case first when ``cases`` is None, else in the order given.
+    """
     from . import spec
-    from .closedloop import refine_grid
+    from .closedloop import refine_grid, t_tower_wind
+    from .rosco import rosco_baseline
 
     v = float(wind_speed)
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
     speeds = [v] if cases is None else [float(c) for c in cases]
-    plants = [model.linearize(s) for s in speeds]
-    zeros = _rhp_zeros(plants[0])
+    plants = [model.linearize(x) for x in speeds]
     w = spec.default_omega() if omega is None else as_omega(omega, "omega")
-    if omega is None and zeros.size:
-        w = refine_grid(w, zeros, rel_width=0.2, rel_step=2e-4)
-    wt, ws = _magnitude(tower_spec, w, "tower_spec"), _magnitude(speed_spec, w, "speed_spec")
-    ok = np.ones(w.shape, bool)
-    binding = np.full(w.shape, "", dtype=object)
-    means = []
+    zeros0 = _rhp_zeros(plants[0])
+    if omega is None and zeros0.size:
+        w = refine_grid(w, zeros0, rel_width=0.2, rel_step=2e-4)
+    ws = _magnitude(speed_spec, w, "speed_spec")
+    t_rosco = np.abs(t_tower_wind(model.linearize(v), rosco_baseline(model, v), w))
+    out = []
     for plant in plants:
-        d = sensitivity_disks(plant, w, wt, ws, max_sensitivity)
-        dist = np.abs(d["c"]) - d["rho"]  # distance from 0 to the tower disk (≤ 0: it holds S = 0)
+        d = sensitivity_disks(plant, w, np.ones(w.shape), ws, max_sensitivity)
         r = np.minimum(d["r_speed"], d["r_margin"])
-        bad = dist > r
-        binding[bad & (d["r_speed"] <= d["r_margin"])] = "tower vs speed"
-        binding[bad & (d["r_speed"] > d["r_margin"])] = "tower vs margin"
-        ok &= ~bad
-        s_max = np.minimum(r, np.abs(d["c"]) + d["rho"])
+        zs = _rhp_zeros(plant)
+        zs = zs[zs.imag >= 0]
         # off the grid |S| ≤ M_s, or without it the speed bound at the grid's ends (S → 1 there)
-        outside = np.log(ms) if np.isfinite(ms) else float(np.log(max(r[0], r[-1])))
-        for z in _rhp_zeros(plant):
-            if z.imag >= 0:
-                means.append((z, _poisson_mean(w, np.log(s_max), z, outside)))
+        outside_bound = np.log(ms) if np.isfinite(ms) else float(np.log(max(r[0], r[-1])))
+        kernels = np.array([_poisson_weights(w, z) for z in zs]).reshape(len(zs), w.size)
+        outside = np.array([outside_bound * (1.0 - _poisson_mass(w, z)) for z in zs])
+        out.append(PitchChecker(w, d["c"], 1.0 / np.abs(d["open_loop"]), d["r_speed"], d["r_margin"], t_rosco, zs,
+                                kernels, outside, ms))
+    return out
+
+
+def combine(verdicts) -> PitchFeasibility:
+    """One verdict from several plant cases' (on one grid): feasible only if every case is.
+
+    Parameters
+    ----------
+    verdicts : sequence of PitchFeasibility
+        From :meth:`PitchChecker.check`, nominal first.
+
+    Returns
+    -------
+    PitchFeasibility
+        Pointwise where every case is, the first binding pair per frequency, the zeros of the
+        first case, every case's Poisson means and reasons.
+    """
+    verdicts = list(verdicts)
+    first = verdicts[0]
+    if len(verdicts) == 1:
+        return first
+    ok = np.logical_and.reduce([x.pointwise for x in verdicts])
+    binding = tuple(next((b[i] for b in (x.binding for x in verdicts) if b[i]), "") for i in range(first.omega.size))
+    reasons = tuple(dict.fromkeys(r for x in verdicts for r in x.reasons))
+    return PitchFeasibility(feasible=all(x.feasible for x in verdicts), omega=first.omega, pointwise=ok, binding=binding,
+                            zeros=first.zeros, poisson_mean=np.concatenate([x.poisson_mean for x in verdicts]),
+                            reasons=reasons, max_sensitivity=first.max_sensitivity)
+
+
+def _verdict(w, ok, binding, zeros, means, ms) -> PitchFeasibility:
     reasons = []
     if not ok.all():
         for kind in ("tower vs speed", "tower vs margin"):
@@ -258,15 +394,15 @@ def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitiv
                 what = "the generator-speed specification" if kind == "tower vs speed" else f"|S| ≤ M_s = {ms:g}"
                 reasons.append(f"the tower-load specification cannot be met together with {what} at {', '.join(bands)} "
                                "(no complex S(jω) lies in both disks)")
-    for z, m in means:
+    for z, m in zip(zeros, means):
         if m < 0:
             reasons.append(f"P_Ω,β has a right-half-plane zero at {_fmt(z)} 1/s, which pins T_Ω,w(z) to the open loop's "
                            f"(S(z) = 1, for any controller acting through the pitch); the specifications allow a Poisson "
                            f"mean of ln|S| of at most {m:.3g} < 0 there: relax the speed or the tower specification near "
                            f"{abs(z.imag):.3g} rad/s")
-    means = np.array([m for _, m in means])
-    return PitchFeasibility(feasible=not reasons, omega=w, pointwise=ok, binding=tuple(binding.tolist()), zeros=zeros,
-                            poisson_mean=means, reasons=tuple(reasons), max_sensitivity=ms)
+    return PitchFeasibility(feasible=not reasons, omega=w, pointwise=ok, binding=tuple(binding.tolist()),
+                            zeros=np.asarray(zeros), poisson_mean=np.asarray(means, float), reasons=tuple(reasons),
+                            max_sensitivity=ms)
 
 
 def _magnitude(spec_like, omega, name):

@@ -208,3 +208,23 @@ def test_a_speed_map_below_roscos_everywhere_breaks_the_interpolation_condition(
     assert not res.feasible and res.pointwise.all()  # pointwise it is fine (no tower spec)
     assert res.poisson_mean.size == 1 and res.poisson_mean[0] == pytest.approx(np.log(0.5), abs=0.02)
     assert "pins T_Ω,w(z)" in res.summary()
+
+
+def test_the_notch_explorer_shows_the_verdict_of_pitch_feasibility(model):
+    # the slider callback's verdict (a precomputed PitchChecker) is pitch_feasibility's for the
+    # same specification pair
+    from specdesign.plots.spec import NotchExplorer
+
+    base = spec.baseline_analysis(model, 19.0)
+    speed = spec.speed_specification(model, 19.0, margin_db=1.5)
+    checker = fz.pitch_checkers(model, 19.0, speed, max_sensitivity=None)[0]
+    explorer = NotchExplorer(base, checker=checker)
+    # with the speed map relaxed by 1.5 dB: a notch below the band is fine, one at the tower
+    # mode (the RHP zero of P_Ω,β) is not
+    for args, ok in (((0.3, 3.0, 0.3), True), ((1.08, 6.0, 0.2), False)):
+        explorer.update(*args, redraw=False)
+        direct = fz.pitch_feasibility(model, 19.0, spec.Specification(base.system, (spec.Notch(*args),)), speed,
+                                      max_sensitivity=None)
+        assert explorer.verdict.feasible == direct.feasible == ok
+        assert explorer.verdict.binding == direct.binding
+        assert ("INFEASIBLE" in explorer.ax_mag.get_title()) != ok

@@ -91,6 +91,10 @@ class NotchExplorer:
         Initial notch (default 6 dB deep, width 0.2, at 1.05 rad/s).
     scale : float
         Display factor of the magnitudes (1e-3: N·m → kN·m).
+    checker : specdesign.feasibility.PitchChecker, optional
+        With a generator-speed specification fixed (:func:`specdesign.feasibility.pitch_checkers`),
+        every update also says, in the title, whether ROSCO's map × the notch can be met
+        through the pitch at all (:attr:`verdict`).
 
     Attributes
     ----------
@@ -98,6 +102,8 @@ class NotchExplorer:
         The current notch.
     promise : specdesign.spec.Promise
         Its promise against ``base``, %.
+    verdict : specdesign.feasibility.PitchFeasibility or None
+        The feasibility verdict of the last update (with a ``checker``).
     fig : matplotlib.figure.Figure
         The figure.
 
@@ -112,10 +118,12 @@ class NotchExplorer:
     damage −28.4 %
     """
 
-    def __init__(self, base: Baseline, notch: Notch | None = None, *, scale: float = 1e-3):
+    def __init__(self, base: Baseline, notch: Notch | None = None, *, scale: float = 1e-3, checker: Any = None):
         import matplotlib.pyplot as plt
 
         self.base = base
+        self.checker = checker
+        self.verdict = None
         self.notch = notch or Notch(1.05, 6.0, 0.2)
         self.fig, (self.ax_mag, self.ax_sens) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
         plot_specification(base, shaping=self.notch.response(base.omega), ax=self.ax_mag, scale=scale)
@@ -160,9 +168,17 @@ class NotchExplorer:
         self.line.set_ydata(self._t_db + 20 * np.log10(np.abs(shaping)))
         self.marker.set_xdata([omega_n, omega_n])
         p = self.promise
-        self.ax_mag.set_title(
-            f"damage −{p.exact_damage:.1f} % (Eq. 10: −{p.predicted_damage:.1f} %), DEL −{p.exact_del:.2f} %"
-        )
+        title = f"damage −{p.exact_damage:.1f} % (Eq. 10: −{p.predicted_damage:.1f} %), DEL −{p.exact_del:.2f} %"
+        if self.checker is not None:
+            c = self.checker
+            self.verdict = c.check(c.t_rosco * np.abs(self.notch.response(c.omega)))
+            if self.verdict.feasible:
+                title += "\npitch: feasible (necessary conditions)"
+            else:
+                bad = c.omega[np.array(self.verdict.binding) != ""]
+                where = f"{bad.min():.3g}-{bad.max():.3g} rad/s" if bad.size else "the RHP zero"
+                title += f"\npitch: INFEASIBLE at {where}"
+        self.ax_mag.set_title(title, fontsize=9)
         if redraw:
             self.fig.canvas.draw_idle()
         return self.promise
