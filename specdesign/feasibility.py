@@ -790,7 +790,6 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     if not (np.isfinite(slack) and slack >= 0):
         raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")
     base = spec.baseline_analysis(model, wind_speed, m=m, omega=omega)
-    k = 10 ** (slack / 20)  # the slack raises |T| by this factor
 
     def reached(g):
         try:
@@ -798,8 +797,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
                                  max_pitch_rate_ratio=max_pitch_rate_ratio, base=base)
         except RuntimeError:
             return None, -np.inf
-        p = spec.promise_of(k * np.abs(d.t_tower) / np.abs(base.t_response), base)  # the shaping |W|/|T^ROSCO|
-        return d, p.exact_del
+        return d, _slack_promise(d, base, slack)
 
     if speed_relax_db is not None:
         g = float(speed_relax_db)
@@ -808,7 +806,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
             raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {float(wind_speed):g} m/s")
 
         def promise_with(sl):
-            return spec.promise_of(10 ** (sl / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
+            return _slack_promise(design, base, sl)
 
         if promise_with(0.0) < t:
             raise ValueError(f"no pitch specification promises {t:g} % at {float(wind_speed):g} m/s with the speed map "
@@ -833,6 +831,13 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         else:
             lo = mid
     return _target_result(model, wind_speed, best, base, slack, hi, t)
+
+
+def _slack_promise(design, base, slack_db):
+    """Exact DEL promise (%) of a design's |T_{MyT,w}| raised by ``slack_db`` (the shaping |W|/|T^ROSCO|)."""
+    from . import spec
+
+    return spec.promise_of(10 ** (slack_db / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
 
 
 def _target_result(model, wind_speed, design, base, slack, g, target):

@@ -54,6 +54,7 @@ __all__ = [
     "specification_table",
     "DesignSpecifications",
     "design_specifications",
+    "specification_pair",
     "from_element",
 ]
 
@@ -1167,6 +1168,25 @@ class DesignSpecifications:
     shaping: ShapingResult
     tower: Specification
     speed: Specification
+
+
+def specification_pair(obj) -> tuple | None:
+    """The (tower, speed) specifications a design is handed, or None if ``obj`` is not a pair.
+
+    Parameters
+    ----------
+    obj : object
+        A record with ``tower`` and ``speed`` attributes (a
+        :class:`specdesign.feasibility.TargetSpecification`, :class:`DesignSpecifications`),
+        or a tuple/list of two (W_MyT, W_Ω).
+
+    Returns
+    -------
+    tuple or None
+        ``(tower, speed)``; None for anything else (the caller says what it accepts).
+    """
+    pair = (obj.tower, obj.speed) if hasattr(obj, "tower") and hasattr(obj, "speed") else obj
+    return tuple(pair) if isinstance(pair, (tuple, list)) and len(pair) == 2 else None
 
 
 def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,

@@ -419,8 +419,8 @@ def design_hinf(
     notch_spec, ladder, label = None, [None], "custom"
     if not isinstance(specs, str) and not _is_design(specs):
         # a given pair: a feasibility.TargetSpecification (tower, speed) or a tuple (W_MyT, W_Ω)
-        pair = (specs.tower, specs.speed) if hasattr(specs, "tower") and hasattr(specs, "speed") else specs
-        if not (isinstance(pair, (tuple, list)) and len(pair) == 2):
+        pair = spec.specification_pair(specs)
+        if pair is None:
             raise ValueError(f"specs={specs!r} must be 'qft', 'rosco', a specdesign.qft.QFTDesign, a "
                              "feasibility.TargetSpecification or a pair (W_MyT, W_Ω)")
         label, w_tower, w_speed = "given", pair[0] if w_tower is None else w_tower, pair[1] if w_speed is None else w_speed

@@ -450,11 +450,13 @@ def _spec_roots(spec_like) -> np.ndarray:
 
 def _given_spec(spec):
     """(tower, speed) of a TargetSpecification or a pair, each with ``response(omega)``."""
-    pair = (spec.tower, spec.speed) if hasattr(spec, "tower") and hasattr(spec, "speed") else spec
-    if not (isinstance(pair, (tuple, list)) and len(pair) == 2 and all(hasattr(x, "response") for x in pair)):
+    from ..spec import specification_pair
+
+    pair = specification_pair(spec)
+    if pair is None or not all(hasattr(x, "response") for x in pair):
         raise TypeError("spec must be a feasibility.TargetSpecification or a pair (tower, speed) of specifications with "
                         f"response(omega), got {type(spec).__name__}")
-    return tuple(pair)
+    return pair
 
 
 def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec_reduction=15.0,
