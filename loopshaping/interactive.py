@@ -2,11 +2,13 @@
 
 :class:`Designer` keeps a :class:`~loopshaping.controller.Controller`; every edit recomputes
 the nominal loop on a dense grid, checks the bounds at the design frequencies exactly
-(:meth:`~loopshaping.qft.Bounds.is_allowed`) and updates the line data of the Nichols chart
-and of the closed-loop magnitude plot (worst case over the plant cases) without rebuilding
-the figure. The numbers live in :meth:`Designer.state`, so the designer also works headless
-(tests, benchmarks). ipywidgets is imported only by :meth:`Designer.widget`; with the
-``%matplotlib widget`` backend (ipympl) the figure updates live in the notebook.
+(:meth:`~loopshaping.qft.Bounds.is_allowed`, spec by spec), computes the closed-loop poles of
+1 + L for every plant case (stability is checked live, not assumed from the bounds) and updates
+the line data of the Nichols chart and of the closed-loop magnitude plot (worst case over the
+plant cases) without rebuilding the figure. The numbers live in :meth:`Designer.state`, so the
+designer also works headless (tests, benchmarks). ipywidgets is imported only by
+:meth:`Designer.widget`; with the ``%matplotlib widget`` backend (ipympl) the figure updates
+live in the notebook, otherwise the widget re-displays a static figure after each edit.
 """
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ from .freqresp import check_grid, evaluate
 from .nichols import draw, loop_nichols
 from .templates import Template
 
-__all__ = ["DesignState", "Designer"]
+__all__ = ["DesignState", "Designer", "closed_loop_poles"]
 
 _DEFAULTS = {
     "gain": {"k": 1.0},
@@ -33,11 +35,12 @@ _DEFAULTS = {
     "lead_lag": {"zero": 1.0, "pole": 10.0},
     "notch": {"omega": 1.0, "zeta_zero": 0.05, "zeta_pole": 0.5},
 }
+_STATE_VERSION = 1
 
 
 @dataclass(frozen=True, eq=False)
 class DesignState:
-    """Numbers behind one redraw: nominal loop (Nichols), bound check, closed-loop peaks.
+    """Numbers behind one redraw: nominal loop (Nichols), bound check, stability, closed-loop peaks.
 
     Parameters
     ----------
@@ -46,18 +49,102 @@ class DesignState:
     magnitude_db : numpy.ndarray
         (n,) nominal loop magnitude, dB.
     design_allowed : numpy.ndarray
-        (n_design,) bounds met at each design frequency.
+        (n_design,) every bound met at each design frequency.
     worst_T_db : numpy.ndarray
         (n,) max over cases of |L/(1+L)|, dB.
     worst_S_db : numpy.ndarray
         (n,) max over cases of |1/(1+L)|, dB.
+    stable : numpy.ndarray
+        (n_cases,) True where every closed-loop pole of 1 + L of that plant case has a negative
+        real part; False also when it cannot be decided (an improper controller, a plant
+        without a state-space realisation: see ``rightmost_pole``).
+    rightmost_pole : numpy.ndarray
+        (n_cases,) complex closed-loop pole of largest real part per case, rad/s (NaN when
+        undecided, complex infinity for an ill-posed loop 1 + D_G·D_P = 0).
+    spec_violations : dict
+        Spec name (:attr:`loopshaping.qft.Bounds.names`) → design frequencies (rad/s) where it
+        fails; an empty array where it is met.
     """
 
-    phase_deg: np.ndarray  # (n,) nominal loop phase on the dense grid
-    magnitude_db: np.ndarray  # (n,)
-    design_allowed: np.ndarray  # (n_design,) bounds met at each design frequency
-    worst_T_db: np.ndarray  # (n,) max over cases of |L/(1+L)|, dB
-    worst_S_db: np.ndarray  # (n,) max over cases of |1/(1+L)|, dB
+    phase_deg: np.ndarray
+    magnitude_db: np.ndarray
+    design_allowed: np.ndarray
+    worst_T_db: np.ndarray
+    worst_S_db: np.ndarray
+    stable: np.ndarray
+    rightmost_pole: np.ndarray
+    spec_violations: dict
+
+    @property
+    def all_stable(self) -> bool:
+        """True when every plant case's closed loop is stable."""
+        return bool(np.all(self.stable))
+
+    @property
+    def bounds_met(self) -> bool:
+        """True when every bound is met at every design frequency."""
+        return bool(np.all(self.design_allowed))
+
+
+def _state_space(p):
+    """(A, B, C, D) float arrays of a SISO LTI, or None when it has no state-space realisation."""
+    import control as ct
+
+    try:
+        ss = ct.ss(p)
+    except (TypeError, ValueError, NotImplementedError):
+        return None
+    return tuple(np.asarray(m, float) for m in (ss.A, ss.B, ss.C, ss.D))
+
+
+def closed_loop_poles(plant, num, den) -> np.ndarray:
+    """Poles of the loop closed by unity negative feedback around L = G·P (the zeros of 1 + L).
+
+    Internal poles included: a pole cancelled between G and P stays a closed-loop pole.
+
+    Parameters
+    ----------
+    plant : tuple
+        (A, B, C, D) of the SISO plant P (a state-space realisation, arrays).
+    num, den : array_like
+        Controller G(s) = num/den, descending powers of s; proper.
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex closed-loop poles, rad/s; ``[inf]`` for an ill-posed loop (1 + G(∞)P(∞) = 0).
+
+    Raises
+    ------
+    ValueError
+        If G is improper or ``den`` is zero.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from loopshaping.interactive import closed_loop_poles
+    >>> P = (np.array([[-1.0]]), np.array([[1.0]]), np.array([[1.0]]), np.array([[0.0]]))  # 1/(s+1)
+    >>> closed_loop_poles(P, [3.0], [1.0])  # 1 + 3/(s+1) = 0 at s = −4
+    array([-4.+0.j])
+    """
+    from scipy.signal import tf2ss
+
+    num, den = np.trim_zeros(np.atleast_1d(np.asarray(num, float)), "f"), np.trim_zeros(np.atleast_1d(np.asarray(den, float)), "f")
+    if den.size == 0:
+        raise ValueError("den must be a non-zero polynomial")
+    if num.size > den.size:
+        raise ValueError("the controller must be proper (no more zeros than poles) for its closed-loop poles")
+    Ap, Bp, Cp, Dp = (np.atleast_2d(m) for m in plant)
+    if den.size == 1:  # a static gain: tf2ss would add a spurious state at s = 0
+        Ag, Bg, Cg, Dg = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[num[0] / den[0] if num.size else 0.0]])
+    else:
+        Ag, Bg, Cg, Dg = tf2ss(num if num.size else [0.0], den)
+    r = 1.0 + Dg[0, 0] * Dp[0, 0]
+    if r == 0:
+        return np.array([complex(np.inf, 0.0)])
+    Kx, Kg = -Dg[0, 0] * Cp / r, Cg / r  # u = Kx·x_P + Kg·x_G with e = −y
+    A = np.block([[Ap + Bp @ Kx, Bp @ Kg], [-Bg @ (Cp + Dp @ Kx), Ag - Bg @ Dp @ Kg]])
+    return np.linalg.eigvals(A).astype(complex)
 
 
 class Designer:
@@ -69,7 +156,7 @@ class Designer:
         The bounds to shape against.
     plant : Template or control LTI
         A :class:`~loopshaping.templates.Template` with systems (the nominal case is shaped,
-        all cases enter the closed-loop plot) or a SISO LTI nominal plant.
+        all cases enter the closed-loop plot and the stability check) or a SISO LTI nominal plant.
     controller : Controller, optional
         Starting controller (default: unit gain).
     omega : array_like, optional
@@ -81,14 +168,30 @@ class Designer:
         If ``bounds`` is not a Bounds.
     ValueError
         If the Template has no systems or the grid is bad.
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> from loopshaping import qft
+    >>> from loopshaping.controller import Controller, gain
+    >>> from loopshaping.interactive import Designer
+    >>> tmpl = qft.Template.from_systems([ct.tf([k], [1, 31, 30]) for k in (1.0, 10.0)], [0.1, 5.0])
+    >>> d = Designer(qft.bounds(tmpl, "stability", 1.2), tmpl, Controller((gain(-100.0),)))
+    >>> st = d.state()
+    >>> bool(st.all_stable), f"{st.rightmost_pole[1].real:+.2f}"  # s² + 31 s + 30 − 1000 = 0 at s = +19.29
+    (False, '+19.29')
     """
 
     def __init__(self, bounds: Bounds, plant, controller: Controller | None = None, omega=None):
         if not isinstance(bounds, Bounds):
             raise TypeError(f"bounds must be a loopshaping.qft.Bounds; got {type(bounds).__name__}")
+        if controller is not None and not isinstance(controller, Controller):
+            raise TypeError(f"controller must be a loopshaping Controller (Controller.from_tf converts an LTI); "
+                            f"got {type(controller).__name__}")
         self.bounds = bounds
         d = bounds.omega
-        w = np.logspace(np.log10(d.min() / 100), np.log10(d.max() * 100), 600) if omega is None else omega
+        self._omega_arg = None if omega is None else check_grid(omega, "omega")
+        w = np.logspace(np.log10(d.min() / 100), np.log10(d.max() * 100), 600) if omega is None else self._omega_arg
         self.omega = np.unique(np.concatenate([check_grid(w, "omega"), d]))
         self._design_idx = np.searchsorted(self.omega, d)
         if isinstance(plant, Template):
@@ -99,9 +202,95 @@ class Designer:
             systems, nominal = [plant], 0
         self._P = np.stack([evaluate(p, self.omega, "plant") for p in systems], axis=1)
         self._P0 = self._P[:, nominal]
+        self._ss = [_state_space(p) for p in systems]
         self.controller = controller if controller is not None else Controller((Element("gain", {"k": 1.0}),))
+        self.selected = 0
         self.figure = None
         self._artists = {}
+
+    # -- saved state
+    def to_state(self) -> dict:
+        """The designer's state as a JSON-ready dict (the controller, the grid, the selected element).
+
+        Returns
+        -------
+        dict
+            ``{"version", "controller"`` (:meth:`Controller.to_dict`), ``"omega"`` (the dense
+            grid given, rad/s, or None for the default), ``"selected"}``; read by
+            :meth:`from_state`. Floats are kept exactly by JSON's repr.
+        """
+        w = None if self._omega_arg is None else [float(x) for x in self._omega_arg]
+        return {"version": _STATE_VERSION, "controller": self.controller.to_dict(), "omega": w,
+                "selected": int(self.selected)}
+
+    @classmethod
+    def from_state(cls, state: dict, bounds: Bounds, plant) -> Designer:
+        """A designer restored from :meth:`to_state` against ``bounds`` and ``plant``.
+
+        Parameters
+        ----------
+        state : dict
+            As written by :meth:`to_state`.
+        bounds : Bounds
+            The bounds to shape against (not part of the state: recompute them from their
+            settings, e.g. a saved design session's QFT settings).
+        plant : Template or control LTI
+            The plant cases, as for the constructor.
+
+        Returns
+        -------
+        Designer
+            The designer with the saved controller, grid and selection.
+
+        Raises
+        ------
+        ValueError
+            For unknown keys, a newer state version or an invalid controller.
+        """
+        if not isinstance(state, dict) or "controller" not in state:
+            raise ValueError("state must be a dict with a 'controller' (from Designer.to_state)")
+        extra = set(state) - {"version", "controller", "omega", "selected"}
+        if extra:
+            raise ValueError(f"unknown designer state keys {sorted(extra)}; allowed: version, controller, omega, selected")
+        version = state.get("version", _STATE_VERSION)
+        if type(version) is not int or version > _STATE_VERSION or version < 1:
+            raise ValueError(f"designer state version {version!r} is not supported (this version reads 1 to "
+                             f"{_STATE_VERSION}); upgrade loopshaping to read it")
+        out = cls(bounds, plant, Controller.from_dict(state["controller"]), omega=state.get("omega"))
+        sel = state.get("selected", 0)
+        if type(sel) is not int or not 0 <= sel < max(len(out.controller.elements), 1):
+            raise ValueError(f"selected={sel!r} must be an element index of the saved controller")
+        out.selected = sel
+        return out
+
+    @classmethod
+    def from_session(cls, session, bounds: Bounds, plant) -> Designer:
+        """A designer restored from a saved design session (any object with a ``designer`` state).
+
+        Parameters
+        ----------
+        session : object or dict
+            A record whose ``designer`` attribute (or key) holds :meth:`to_state`, e.g. the
+            result of ``specdesign.session.load_session``.
+        bounds : Bounds
+            The bounds to shape against.
+        plant : Template or control LTI
+            The plant cases.
+
+        Returns
+        -------
+        Designer
+            As :meth:`from_state`.
+
+        Raises
+        ------
+        ValueError
+            If the session holds no designer state.
+        """
+        state = session.get("designer") if isinstance(session, dict) else getattr(session, "designer", None)
+        if not state:
+            raise ValueError("the session holds no designer state; save one with the Designer's to_state()")
+        return cls.from_state(state, bounds, plant)
 
     # -- numbers
     def state(self) -> DesignState:
@@ -110,7 +299,8 @@ class Designer:
         Returns
         -------
         DesignState
-            Loop on the Nichols chart, bounds met, worst closed-loop magnitudes.
+            Loop on the Nichols chart, bounds met (all and per spec), stability of every plant
+            case, worst closed-loop magnitudes.
         """
         G = self.controller.response(self.omega)
         ph, mag = loop_nichols(self._P0 * G, self.omega)
@@ -120,7 +310,30 @@ class Designer:
         with np.errstate(divide="ignore"):
             T = 20 * np.log10(np.abs(L / (1 + L)).max(axis=1))
             S = 20 * np.log10(np.abs(1 / (1 + L)).max(axis=1))
-        return DesignState(ph, mag, allowed, T, S)
+        stable, rightmost = self._stability()
+        L0 = self._P0[i] * G[i]
+        violations = {}
+        for part in self.bounds.parts:
+            k = np.searchsorted(self.bounds.omega, part.omega)
+            bad = [w for fi, w in enumerate(part.omega) if not part.ok(fi, L0[k[fi]])]
+            name = part.spec.name
+            violations[name] = np.union1d(violations.get(name, np.empty(0)), bad)
+        return DesignState(ph, mag, allowed, T, S, stable, rightmost, violations)
+
+    def _stability(self):
+        n = len(self._ss)
+        stable, rightmost = np.zeros(n, bool), np.full(n, complex(np.nan, np.nan))
+        if not self.controller.is_proper:
+            return stable, rightmost
+        num, den = self.controller.polys()
+        for c, ss in enumerate(self._ss):
+            if ss is None:
+                continue
+            poles = closed_loop_poles(ss, num, den)
+            p = poles[np.argmax(poles.real)]
+            rightmost[c] = p
+            stable[c] = bool(np.isfinite(p) and p.real < -1e-9 * max(1.0, abs(p)))
+        return stable, rightmost
 
     # -- editing
     def set_controller(self, controller: Controller) -> DesignState:
@@ -140,7 +353,7 @@ class Designer:
         return self.update()
 
     def set_param(self, index: int, **params) -> DesignState:
-        """Change parameters of element ``index`` and update.
+        """Change parameters of element ``index`` and update (values are kept exactly).
 
         Parameters
         ----------
@@ -197,12 +410,14 @@ class Designer:
 
     # -- drawing
     def draw(self, live=None):
-        """Build the figure (Nichols chart + closed-loop magnitudes).
+        """Build the figure (Nichols chart + closed-loop magnitudes) without displaying it.
+
+        :meth:`widget` displays it (once) with the controls.
 
         Parameters
         ----------
         live : bool, optional
-            Redraw edits by blitting (only the loop, markers and closed-loop lines are
+            Redraw edits by blitting (only the loop, markers, title and closed-loop lines are
             re-rendered). Default: on with the ipympl backend. Blitted artists are skipped by
             ``savefig`` and static inline display, hence off elsewhere.
 
@@ -216,23 +431,25 @@ class Designer:
 
         if live is None:
             live = "ipympl" in matplotlib.get_backend() or "widget" in matplotlib.get_backend()
-
-        fig, (ax_n, ax_b) = plt.subplots(1, 2, figsize=(11, 4.5))
+        # pyplot would also show a figure made with interactive mode on at the end of the cell,
+        # beside the one the widget shows: twice
+        with plt.ioff():
+            fig, (ax_n, ax_b) = plt.subplots(1, 2, figsize=(11, 4.8))
         draw(self.bounds, loop=None, ax=ax_n, legend=False)
         st = self.state()
-        (loop,) = ax_n.plot(st.phase_deg, st.magnitude_db, "k-", lw=1.5, label="nominal loop L0")
+        (loop,) = ax_n.plot(st.phase_deg, st.magnitude_db, "k-", lw=1.5, label="nominal loop $L_0$")
         i = self._design_idx
         marks = ax_n.scatter(st.phase_deg[i], st.magnitude_db[i], s=50, zorder=5,
-                             c=self._marker_colours(st), edgecolors="k", label="design frequencies")
+                             c=self._marker_colours(st), edgecolors="k", label="design frequencies (green: met)")
         ax_n.legend(fontsize=8, loc="lower right")
-        (t_line,) = ax_b.semilogx(self.omega, st.worst_T_db, label="max over cases |T| [dB]")
-        (s_line,) = ax_b.semilogx(self.omega, st.worst_S_db, label="max over cases |S| [dB]")
-        ax_b.set_xlabel("ω [rad/s]")
-        ax_b.set_ylabel("Closed-loop magnitude [dB]")
+        (t_line,) = ax_b.semilogx(self.omega, st.worst_T_db, label="max over cases |T| (dB)")
+        (s_line,) = ax_b.semilogx(self.omega, st.worst_S_db, label="max over cases |S| (dB)")
+        ax_b.set_xlabel("frequency ω (rad/s)")
+        ax_b.set_ylabel("closed-loop magnitude (dB)")
         ax_b.grid(True, which="both", lw=0.3)
         ax_b.legend(fontsize=8)
-        title = ax_n.set_title(self._title(st), fontsize=9)
-        fig.tight_layout()  # once: a layout engine would re-run on every redraw
+        title = fig.suptitle(self._title(st), fontsize=9, color=self._title_colour(st))
+        fig.tight_layout(rect=(0, 0, 1, 0.86))  # once: a layout engine would re-run on every redraw
         self.figure = fig
         self._artists = dict(loop=loop, marks=marks, T=t_line, S=s_line, title=title)
         # Blitting: the bounds and axes are rendered once into a cached background; an edit
@@ -252,7 +469,7 @@ class Designer:
 
     def _blit_artists(self):
         for a in self._artists.values():
-            a.axes.draw_artist(a)
+            self.figure.draw_artist(a)
 
     def update(self, redraw=True) -> DesignState:
         """Recompute and push the new data into the existing artists (no figure rebuild).
@@ -266,7 +483,7 @@ class Designer:
         Returns
         -------
         DesignState
-            The numbers behind this redraw (nominal loop, bound check, closed-loop peaks).
+            The numbers behind this redraw (nominal loop, bound check, stability, closed-loop peaks).
         """
         st = self.state()
         if self.figure is not None:
@@ -278,6 +495,7 @@ class Designer:
             a["T"].set_ydata(st.worst_T_db)
             a["S"].set_ydata(st.worst_S_db)
             a["title"].set_text(self._title(st))
+            a["title"].set_color(self._title_colour(st))
             if redraw:
                 canvas = self.figure.canvas
                 if not self._live:
@@ -293,14 +511,36 @@ class Designer:
     def _marker_colours(self, st):
         return np.where(st.design_allowed, "tab:green", "tab:red")
 
+    @staticmethod
+    def _title_colour(st):
+        return "black" if st.all_stable and st.bounds_met else "tab:red"
+
     def _title(self, st):
-        bad = self.bounds.omega[~st.design_allowed]
-        head = "all bounds met" if bad.size == 0 else "bounds violated at ω = " + ", ".join(f"{w:.3g}" for w in bad)
-        return f"{head}\nG = {self.controller}"
+        n = st.stable.size
+        bad = np.flatnonzero(~st.stable)
+        if bad.size:
+            c = int(bad[np.argmax(np.nan_to_num(st.rightmost_pole[bad].real, nan=-np.inf))])
+            p = st.rightmost_pole[c]
+            what = (f"closed-loop pole at {p.real:+.3g}{p.imag:+.3g}j" if np.isfinite(p) else
+                    "stability undecided (improper controller or no state-space plant)" if np.isnan(p) else
+                    "ill-posed loop (1 + L(∞) = 0)")
+            head = f"UNSTABLE: plant case {c} of {n}: {what}" + (f" ({bad.size} unstable cases)" if bad.size > 1 else "")
+        elif st.bounds_met:
+            head = f"all bounds met, all {n} plant case(s) stable"
+        else:
+            w = self.bounds.omega[~st.design_allowed]
+            head = f"{n} plant case(s) stable; bounds violated at ω = " + ", ".join(f"{x:.3g}" for x in w) + " rad/s"
+        specs = "; ".join(f"{name}: " + ("met" if v.size == 0 else "violated at " + ", ".join(f"{x:.3g}" for x in v))
+                          for name, v in st.spec_violations.items())
+        return f"{head}\nspecs checked: {specs}\nG = {self.controller}"
 
     # -- widgets
     def widget(self):
-        """ipywidgets UI: element list, parameter sliders, add/remove, and the figure.
+        """ipywidgets UI: element list, parameter controls, add/remove, and the figure (shown once).
+
+        Frequencies and gains move on log sliders (steps of 0.005 decade, 1.2 %, over ±2
+        decades around the value when the element is selected; a negative gain keeps its
+        sign) beside a text box whose typed value is used exactly.
 
         Returns
         -------
@@ -312,85 +552,18 @@ class Designer:
         ImportError
             Without ipywidgets.
         """
-        try:
-            import ipywidgets as ipw
-        except ImportError as e:
-            raise ImportError("the interactive designer needs ipywidgets (and ipympl for a live figure)") from e
+        from ._designer_widget import build_widget
+
         if self.figure is None:
             self.draw()
-        elements = ipw.Select(options=self._element_options(), rows=6, description="elements")
-        sliders = ipw.VBox()
-        kind = ipw.Dropdown(options=KINDS, value="real_pole", description="add")
-        add_btn, rm_btn = ipw.Button(description="add element"), ipw.Button(description="remove selected")
-        json_box = ipw.Textarea(value=self.controller.to_json(), layout=ipw.Layout(width="100%"), disabled=True)
+        return build_widget(self)
 
-        busy = [False]
+    def element_options(self) -> list:
+        """Labels of the elements for a selection list.
 
-        def refresh(select=None):
-            # Relabel the list without letting the selection (and the slider being dragged) jump.
-            keep = elements.value if select is None else select
-            busy[0] = True
-            elements.options = self._element_options()
-            if elements.options:
-                elements.value = min(keep or 0, len(elements.options) - 1)
-            busy[0] = False
-            json_box.value = self.controller.to_json()
-
-        def build_sliders(change=None):
-            if busy[0]:
-                return
-            idx = elements.value
-            if idx is None or idx >= len(self.controller.elements):
-                sliders.children = ()
-                return
-            e = self.controller.elements[idx]
-            items = []
-            for name, value in e.params.items():
-                if name == "order":
-                    sl = ipw.IntSlider(value=value, min=1, max=4, description=name)
-                elif name.startswith("zeta"):
-                    sl = ipw.FloatSlider(value=value, min=0.0 if name == "zeta_zero" else 0.005, max=0.99,
-                                         step=0.005, description=name, continuous_update=True)
-                else:
-                    sign = -1.0 if value < 0 else 1.0
-                    mag = abs(value)
-                    sl = ipw.FloatLogSlider(value=mag, base=10, min=np.log10(mag) - 3, max=np.log10(mag) + 3,
-                                            step=0.01, description=name + (" (−)" if sign < 0 else ""))
-                    sl._sign = sign
-
-                def on_change(ch, name=name, sl=sl, idx=idx):
-                    v = ch["new"] * getattr(sl, "_sign", 1.0)
-                    self.set_param(idx, **{name: v})
-                    refresh()
-
-                sl.observe(on_change, names="value")
-                items.append(sl)
-            sliders.children = tuple(items)
-
-        def on_add(_):
-            self.add(kind.value)
-            refresh(select=len(self.controller.elements) - 1)
-            build_sliders()
-
-        def on_remove(_):
-            if elements.value is not None and self.controller.elements:
-                self.remove(elements.value)
-                refresh(select=0)
-                build_sliders()
-
-        elements.observe(build_sliders, names="value")
-        add_btn.on_click(on_add)
-        rm_btn.on_click(on_remove)
-        build_sliders()
-        canvas = self.figure.canvas
-        fig_box = canvas if isinstance(canvas, ipw.DOMWidget) else ipw.Output()
-        if not isinstance(canvas, ipw.DOMWidget):
-            with fig_box:
-                from IPython.display import display
-
-                display(self.figure)
-        controls = ipw.VBox([elements, ipw.HBox([kind, add_btn, rm_btn]), sliders, json_box])
-        return ipw.VBox([controls, fig_box])
-
-    def _element_options(self):
+        Returns
+        -------
+        list of tuple
+            ``(label, index)`` per element of the controller.
+        """
         return [(f"{i}: {e}", i) for i, e in enumerate(self.controller.elements)]

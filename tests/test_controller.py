@@ -140,12 +140,17 @@ def test_interactive_designer_numbers_and_widget():
     assert len(d.controller.elements) == 3
     ui = d.widget()
     assert type(ui).__name__ == "VBox"
-    select, row, sliders, _ = ui.children[0].children
+    select, row, rows, _, msg = ui.children[0].children
     select.value = 1
-    slider = sliders.children[0]
+    slider, text = rows.children[0].children
     slider.value = 30.0  # drag the zero
-    assert d.controller.elements[1] == lc.real_zero(30.0)
-    assert select.value == 1 and sliders.children[0] is slider  # the dragged slider survives
+    assert d.controller.elements[1] == lc.real_zero(30.0) and text.value == 30.0
+    assert select.value == 1 and rows.children[0].children[0] is slider  # the dragged slider survives
+    # the front end echoes a value rounded to the slider's step: not a move (the value stays exact)
+    text.value = 30.123456789  # typed: kept exactly
+    assert d.controller.elements[1] == lc.real_zero(30.123456789)
+    slider.value = 10 ** (0.005 * round(np.log10(30.123456789) / 0.005))
+    assert d.controller.elements[1] == lc.real_zero(30.123456789)
     row.children[0].value = "notch"
     row.children[1].click()
     assert d.controller.elements[-1].kind == "notch" and select.value == 3

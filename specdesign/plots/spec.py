@@ -125,7 +125,9 @@ class NotchExplorer:
         self.checker = checker
         self.verdict = None
         self.notch = notch or Notch(1.05, 6.0, 0.2)
-        self.fig, (self.ax_mag, self.ax_sens) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+        # not shown by pyplot at the end of the cell: widget() shows it once, with the sliders
+        with plt.ioff():
+            self.fig, (self.ax_mag, self.ax_sens) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
         plot_specification(base, shaping=self.notch.response(base.omega), ax=self.ax_mag, scale=scale)
         self.line = self.ax_mag.get_lines()[-1]
         self._t_db = 20 * np.log10(np.abs(base.t_response) * scale)
@@ -136,6 +138,7 @@ class NotchExplorer:
         self.ax_sens.grid(True, which="both", alpha=0.3)
         self.ax_sens.legend()
         self.promise = None
+        self._out = None  # the ipywidgets Output a static (non-ipympl) figure is shown in
         self.update(self.notch.omega_n, self.notch.depth_db, self.notch.width)
 
     def update(self, omega_n: float, depth_db: float, width: float, *, redraw: bool = True) -> Promise:
@@ -163,6 +166,8 @@ class NotchExplorer:
             If the notch parameters are invalid (:class:`specdesign.spec.Notch`).
         """
         self.notch = Notch(float(omega_n), float(depth_db), float(width))
+        self.line.set_label(f"specification $|W_y|$: notch at {self.notch.omega_n:.3g} rad/s, "
+                            f"{self.notch.depth_db:.3g} dB, ζ_p = {self.notch.width:.3g}")
         shaping = self.notch.response(self.base.omega)
         self.promise = promise_of(shaping, self.base)
         self.line.set_ydata(self._t_db + 20 * np.log10(np.abs(shaping)))
@@ -179,28 +184,104 @@ class NotchExplorer:
                 where = f"{bad.min():.3g}-{bad.max():.3g} rad/s" if bad.size else "the RHP zero"
                 title += f"\npitch: INFEASIBLE at {where}"
         self.ax_mag.set_title(title, fontsize=9)
+        self.ax_mag.legend(fontsize=8, loc="lower left")
         if redraw:
             self.fig.canvas.draw_idle()
+            if self._out is not None:
+                self._show()
         return self.promise
 
-    def widget(self) -> Any:
-        """Sliders for ω_n, depth and width wired to :meth:`update`.
+    @classmethod
+    def from_session(cls, session: Any, name: str | None = None, *, scale: float = 1e-3, checker: Any = None) -> "NotchExplorer":
+        """An explorer starting from a saved design session's specification.
+
+        The baseline is recomputed from the session's model at the specification's wind speed
+        (:meth:`specdesign.session.Session.baseline`), the notch is the specification's first.
+
+        Parameters
+        ----------
+        session : specdesign.session.Session or str or os.PathLike
+            A session record, or the path of a session file (:func:`specdesign.session.load_session`).
+        name : str, optional
+            Which specification (default: the only one, or the first saved).
+        scale : float
+            Display factor of the magnitudes (1e-3: N·m → kN·m).
+        checker : specdesign.feasibility.PitchChecker, optional
+            As for the constructor.
 
         Returns
         -------
-        ipywidgets.interactive
-            The widget box (needs ipywidgets; ``%matplotlib widget`` for live redraw in Jupyter).
+        NotchExplorer
+            The explorer, its notch and promise those of the saved specification.
+
+        Raises
+        ------
+        ValueError
+            If the session holds no specification, ``name`` is not one of them, or the
+            specification has no notch.
+        """
+        from ..session import Session, load_session
+
+        if not isinstance(session, Session):
+            session = load_session(session)
+        name = session.specification_name(name)
+        notches = [e for e in session.specifications[name].elements if isinstance(e, Notch)]
+        if not notches:
+            raise ValueError(f"specification {name!r} of the session has no notch for the explorer to move")
+        return cls(session.baseline(name), notches[0], scale=scale, checker=checker)
+
+    def _show(self):
+        from IPython.display import clear_output, display
+
+        with self._out:
+            clear_output(wait=True)
+            display(self.fig)
+
+    def widget(self) -> Any:
+        """Sliders for ω_n, depth and width wired to :meth:`update`, above the figure (shown once).
+
+        The starting notch is kept exactly: the browser rounds a slider's value to its step and
+        sends it back, and an event within half a step of the current value is taken for that
+        echo, not for a move.
+
+        Returns
+        -------
+        ipywidgets.VBox
+            The sliders and the figure (needs ipywidgets; with ``%matplotlib widget`` the
+            figure is the live canvas, otherwise a static image re-shown on every move).
         """
         import ipywidgets as widgets
 
         w = self.base.omega
+        n = self.notch
         sliders = dict(
-            omega_n=widgets.FloatLogSlider(value=self.notch.omega_n, base=10, min=np.log10(max(w[0], 0.05)), max=np.log10(w[-1]), step=0.005, description="ω_n (rad/s)"),
-            depth_db=widgets.FloatSlider(value=self.notch.depth_db, min=0.0, max=30.0, step=0.1, description="depth (dB)"),
-            width=widgets.FloatSlider(value=self.notch.width, min=0.02, max=1.0, step=0.01, description="width ζ_p"),
+            omega_n=widgets.FloatLogSlider(value=n.omega_n, base=10, min=np.log10(max(w[0], 0.05)), max=np.log10(w[-1]),
+                                           step=0.005, description="ω_n (rad/s)", readout_format=".4g"),
+            depth_db=widgets.FloatSlider(value=n.depth_db, min=0.0, max=30.0, step=0.1, description="depth (dB)",
+                                         readout_format=".3g"),
+            width=widgets.FloatSlider(value=n.width, min=0.02, max=1.0, step=0.01, description="width ζ_p",
+                                      readout_format=".3g"),
         )
-        out = widgets.interactive(self.update, **sliders)
-        return out
+
+        def moved(change, name):
+            cur = getattr(self.notch, name)
+            new = change["new"]
+            dist = abs(np.log10(new / cur)) if name == "omega_n" else abs(new - cur)
+            if dist < 0.5 * sliders[name].step:
+                return
+            vals = dict(omega_n=self.notch.omega_n, depth_db=self.notch.depth_db, width=self.notch.width)
+            vals[name] = new
+            self.update(**vals)
+
+        for name, sl in sliders.items():
+            sl.observe(lambda change, name=name: moved(change, name), names="value")
+        canvas = self.fig.canvas
+        if isinstance(canvas, widgets.DOMWidget):
+            fig_box = canvas
+        else:
+            fig_box = self._out = widgets.Output()
+            self._show()
+        return widgets.VBox([widgets.VBox(list(sliders.values())), fig_box])
 
 
 def plot_frontier(frontiers: dict, ax: Axes | None = None) -> Axes:

@@ -1,0 +1,187 @@
+"""The ipywidgets controls of :class:`loopshaping.interactive.Designer` (imported by its ``widget``).
+
+Kept apart so that the designer's numbers and figure import no widget library.
+"""
+from __future__ import annotations
+
+import math
+
+from .controller import KINDS
+
+__all__ = ["build_widget", "LOG_STEP", "LOG_SPAN"]
+
+LOG_STEP = 0.005  # decades per slider step: 1.2 %, fine enough to place a corner frequency
+LOG_SPAN = 2.0  # decades either side of the value the slider was built around
+
+
+def _log_range(value):
+    c = math.log10(abs(value))
+    return c - LOG_SPAN, c + LOG_SPAN
+
+
+def build_widget(d):
+    """The controls and the figure of a designer, wired to its editing methods.
+
+    Parameters
+    ----------
+    d : loopshaping.interactive.Designer
+        The designer (its figure already drawn).
+
+    Returns
+    -------
+    ipywidgets.VBox
+        ``VBox([controls, figure])``; ``controls`` holds the element list, the add/remove
+        row, the selected element's parameter rows (slider + exact text box each), the
+        controller's JSON and a message line.
+
+    Raises
+    ------
+    ImportError
+        Without ipywidgets.
+    """
+    try:
+        import ipywidgets as ipw
+    except ImportError as e:
+        raise ImportError("the interactive designer needs ipywidgets (and ipympl for a live figure)") from e
+    from IPython.display import clear_output, display
+
+    elements = ipw.Select(options=d.element_options(), rows=6, description="elements",
+                          layout=ipw.Layout(width="60%"))
+    if elements.options:
+        elements.value = min(d.selected, len(elements.options) - 1)
+    rows = ipw.VBox()
+    kind = ipw.Dropdown(options=KINDS, value="real_pole", description="add")
+    add_btn, rm_btn = ipw.Button(description="add element"), ipw.Button(description="remove selected")
+    json_box = ipw.Textarea(value=d.controller.to_json(), layout=ipw.Layout(width="100%"), disabled=True)
+    msg = ipw.HTML()
+    canvas = d.figure.canvas
+    live = isinstance(canvas, ipw.DOMWidget)
+    fig_box = canvas if live else ipw.Output()
+    shown = {"idx": None}
+    busy = [False]
+
+    def show_figure():
+        if not live:  # a static backend: show the re-rendered figure in place of the old one
+            with fig_box:
+                clear_output(wait=True)
+                display(d.figure)
+
+    def after_edit(select=None):
+        # Relabel the list without letting the selection (and the control being dragged) jump.
+        keep = elements.value if select is None else select
+        busy[0] = True
+        try:
+            elements.options = d.element_options()
+            if elements.options:
+                elements.value = min(keep or 0, len(elements.options) - 1)
+        finally:
+            busy[0] = False
+        d.selected = elements.value or 0
+        json_box.value = d.controller.to_json()
+        show_figure()
+
+    def apply(idx, name, value):
+        try:
+            d.set_param(idx, **{name: value})
+        except (TypeError, ValueError) as err:
+            msg.value = f"<span style='color:#c00'>{name} = {value!r} rejected: {err}</span>"
+            return False
+        msg.value = ""
+        after_edit()
+        return True
+
+    def param_row(idx, name, value):
+        current = lambda: d.controller.elements[idx].params[name]  # noqa: E731
+        if name == "order":
+            sl = ipw.IntSlider(value=value, min=1, max=4, description=name)
+            sl.observe(lambda ch: apply(idx, name, int(ch["new"])), names="value")
+            return sl
+        is_log = not name.startswith("zeta")
+        if is_log:
+            lo, hi = _log_range(value)
+            sl = ipw.FloatLogSlider(value=abs(value), base=10, min=lo, max=hi, step=LOG_STEP,
+                                    description=name + (" (−)" if value < 0 else ""), readout_format=".4g")
+        else:
+            sl = ipw.FloatSlider(value=value, min=0.0 if name == "zeta_zero" else 0.005, max=2.0, step=0.005,
+                                 description=name, readout_format=".4g")
+        text = ipw.FloatText(value=value, description="exact", continuous_update=False, layout=ipw.Layout(width="14em"))
+        quiet = [False]
+
+        def set_quietly(widget, v):
+            quiet[0] = True
+            try:
+                if is_log and widget is sl:
+                    lo, hi = _log_range(v)
+                    if not 10 ** sl.min <= abs(v) <= 10 ** sl.max:  # re-centre on a typed value out of range
+                        with sl.hold_sync():
+                            sl.min, sl.max = min(lo, sl.min), max(hi, sl.max)
+                    sl.description = name + (" (−)" if v < 0 else "")
+                    v = abs(v)
+                widget.value = v
+            finally:
+                quiet[0] = False
+
+        def on_slider(ch):
+            if quiet[0]:
+                return
+            cur = current()
+            new = math.copysign(ch["new"], cur) if is_log else ch["new"]
+            # The front end rounds a value set from Python to its step and echoes it back: an
+            # event within half a step of the current value is that echo, not a move.
+            dist = abs(math.log10(abs(new)) - math.log10(abs(cur))) if is_log else abs(new - cur)
+            if dist < 0.5 * sl.step:
+                return
+            if apply(idx, name, new):
+                set_quietly(text, new)
+
+        def on_text(ch):
+            if quiet[0]:
+                return
+            v = float(ch["new"])
+            if is_log and not (math.isfinite(v) and v != 0):
+                msg.value = f"<span style='color:#c00'>{name} = {v!r} rejected: a log-scale value must be finite and non-zero</span>"
+                set_quietly(text, current())
+            elif apply(idx, name, v):  # the typed value, exactly
+                set_quietly(sl, v)
+            else:
+                set_quietly(text, current())
+
+        sl.observe(on_slider, names="value")
+        text.observe(on_text, names="value")
+        return ipw.HBox([sl, text])
+
+    def build_rows(change=None):
+        if busy[0]:
+            return
+        idx = elements.value
+        if idx is None or idx >= len(d.controller.elements):
+            rows.children, shown["idx"] = (), None
+            return
+        if idx == shown["idx"] and change is not None:
+            return  # the list was relabelled, the element is the same: keep the control being dragged
+        shown["idx"] = idx
+        d.selected = idx
+        e = d.controller.elements[idx]
+        rows.children = tuple(param_row(idx, name, value) for name, value in e.params.items())
+
+    def on_add(_):
+        d.add(kind.value)
+        shown["idx"] = None
+        after_edit(select=len(d.controller.elements) - 1)
+        build_rows()
+
+    def on_remove(_):
+        if elements.value is not None and d.controller.elements:
+            d.remove(elements.value)
+            shown["idx"] = None
+            after_edit(select=0)
+            build_rows()
+
+    elements.observe(build_rows, names="value")
+    add_btn.on_click(on_add)
+    rm_btn.on_click(on_remove)
+    build_rows()
+    show_figure()
+    controls = ipw.VBox([elements, ipw.HBox([kind, add_btn, rm_btn]), rows, json_box, msg])
+    return ipw.VBox([controls, fig_box])
+

@@ -1,0 +1,131 @@
+"""The interactive loop: the QFT Designer's live stability check and controls, the notch explorer's sliders.
+
+Oracles: the closed-loop poles of 1 + L from python-control's ``feedback`` (an independent
+interconnection) and, for a first-order loop, the root in closed form; the promise of the
+starting notch by :func:`specdesign.spec.promise_of` on the same notch.
+"""
+from __future__ import annotations
+
+import control as ct
+import matplotlib
+import numpy as np
+import pytest
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from loopshaping import controller as lc  # noqa: E402
+from loopshaping import qft  # noqa: E402
+from loopshaping.interactive import Designer, closed_loop_poles  # noqa: E402
+
+
+@pytest.fixture
+def loop():
+    P = [ct.tf([k], [1, 31, 30]) for k in (1.0, 5.0, 10.0)]
+    tmpl = qft.Template.from_systems(P, np.array([0.1, 5.0, 100.0]))
+    yield P, tmpl, qft.bounds(tmpl, "stability", 1.2, name="margins |S| ≤ 1.2")
+    plt.close("all")
+
+
+def test_bounds_met_but_unstable_is_shown_red_naming_the_case_and_the_pole():
+    # L = −100/(s + 1): |S| = |(s+1)/(s−99)| < 1.2 at every design frequency, yet 1 + L = 0 at
+    # s = +99 (the sign error behind "all bounds met" with a pole at +322 in issue 18)
+    P = ct.tf([1.0], [1.0, 1.0])
+    tmpl = qft.Template.from_systems([P, 2 * P], np.array([0.1, 1.0, 5.0]))
+    b = qft.bounds(tmpl, "stability", 1.2)
+    d = Designer(b, tmpl, lc.Controller((lc.gain(-100.0),)))
+    fig = d.draw(live=False)
+    st = d.state()
+    assert st.bounds_met and not st.all_stable
+    np.testing.assert_allclose(st.rightmost_pole, [99.0, 199.0], rtol=1e-12)  # s + 1 − 100k = 0
+    title = d._artists["title"]
+    assert title.get_text().startswith("UNSTABLE: plant case 1 of 2: closed-loop pole at +199")
+    assert "all bounds met" not in title.get_text() and matplotlib.colors.same_color(title.get_color(), "tab:red")
+    st = d.set_param(0, k=100.0)
+    assert st.all_stable and title.get_text().startswith("all bounds met, all 2 plant case(s) stable")
+    assert matplotlib.colors.same_color(title.get_color(), "black")
+    assert len(plt.get_fignums()) == 1 and fig is d.figure
+
+
+def test_closed_loop_poles_match_python_control_for_every_case(loop):
+    P, tmpl, b = loop
+    G = lc.Controller((lc.gain(379.0), lc.integrator(1), lc.real_zero(42.0), lc.complex_pole(247.0, 0.5)))
+    d = Designer(b, tmpl, G)
+    st = d.state()
+    for c, p in enumerate(P):
+        want = ct.feedback(G.tf() * p).poles()
+        got = closed_loop_poles(tuple(np.asarray(m) for m in (ct.ss(p).A, ct.ss(p).B, ct.ss(p).C, ct.ss(p).D)),
+                                *G.polys())
+        np.testing.assert_allclose(np.sort_complex(got), np.sort_complex(want), rtol=1e-8)
+        assert st.rightmost_pole[c] == pytest.approx(want[np.argmax(want.real)], rel=1e-8)
+        assert st.stable[c] == (want.real.max() < 0)
+    # an improper controller: stability undecided, said so, never "stable"
+    st = d.set_controller(lc.Controller((lc.gain(1.0), lc.differentiator(1))))
+    assert not st.stable.any() and np.isnan(st.rightmost_pole).all()
+    with pytest.raises(ValueError, match="proper"):
+        closed_loop_poles((np.zeros((1, 1)),) * 4, [1.0, 0.0], [1.0])
+
+
+def test_the_title_names_each_spec_checked_and_where_it_fails(loop):
+    P, tmpl, b = loop
+    both = qft.intersect(b, qft.bounds(tmpl, "sensitivity", 0.5, name="|S| ≤ 0.5"))
+    d = Designer(both, tmpl, lc.Controller((lc.gain(379.0), lc.real_zero(42.0), lc.complex_pole(247.0, 0.5))))
+    st = d.state()
+    # per spec, from the bounds of that spec alone (Bounds.is_allowed: the oracle)
+    for bs, name in ((b, "margins |S| ≤ 1.2"), (qft.bounds(tmpl, "sensitivity", 0.5, name="|S| ≤ 0.5"), "|S| ≤ 0.5")):
+        L0 = P[0](1j * bs.omega) * d.controller.response(bs.omega)
+        ok = bs.is_allowed(bs.omega, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
+        np.testing.assert_array_equal(st.spec_violations[name], bs.omega[~ok])
+    assert "specs checked: margins |S| ≤ 1.2: " in d._title(st) and "|S| ≤ 0.5: " in d._title(st)
+
+
+def test_gain_and_frequency_controls_move_in_log_steps_and_keep_typed_values(loop):
+    P, tmpl, b = loop
+    d = Designer(b, tmpl, lc.Controller((lc.gain(-379.0), lc.real_zero(42.0), lc.notch(5.0, 0.05, 0.5))))
+    ui = d.widget()
+    select, _, rows, json_box, msg = ui.children[0].children
+    assert len(ui.children) == 2 and len(plt.get_fignums()) == 1  # one figure
+    slider, text = rows.children[0].children
+    # ±2 decades around |k|, steps of 0.005 decade (1.2 %); the sign of a negative gain is kept
+    assert (slider.min, slider.max, slider.step) == pytest.approx((np.log10(379) - 2, np.log10(379) + 2, 0.005))
+    one_step = 10 ** (np.log10(379.0) + 0.005)
+    slider.value = one_step
+    assert d.controller.elements[0].params["k"] == -one_step and text.value == -one_step
+    text.value = -1234.5678901  # typed: kept exactly, beyond the slider's range (it re-centres)
+    assert d.controller.elements[0].params["k"] == -1234.5678901
+    assert 10 ** slider.min <= 1234.5678901 <= 10 ** slider.max and slider.value == 1234.5678901
+    slider.value = 10 ** (0.005 * round(np.log10(1234.5678901) / 0.005))  # the browser's rounded echo
+    assert d.controller.elements[0].params["k"] == -1234.5678901
+    assert '"k": -1234.5678901' in json_box.value
+    text.value = 0.0  # refused with a message, the gain unchanged
+    assert "rejected" in msg.value and d.controller.elements[0].params["k"] == -1234.5678901
+    select.value = 2  # the notch: a linear slider on ζ, an invalid typed ζ refused
+    zeta_zero = rows.children[1].children[1]
+    zeta_zero.value = -0.1  # a negative damping ratio
+    assert "rejected" in msg.value and d.controller.elements[2].params["zeta_zero"] == 0.05
+
+
+def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
+    from specdesign import spec
+    from specdesign.plots.spec import NotchExplorer
+    from specdesign.turbine import iea15mw
+
+    base = spec.baseline_analysis(iea15mw(), 19.0)
+    start = spec.Notch(1.0712345678, 7.8312345, 0.23456789)
+    ex = NotchExplorer(base, start)
+    want = spec.promise_of(start.response(base.omega), base)
+    ui = ex.widget()
+    sliders = ui.children[0].children
+    assert [s.description for s in sliders] == ["ω_n (rad/s)", "depth (dB)", "width ζ_p"]  # no "redraw" checkbox
+    assert len(plt.get_fignums()) == 1
+    assert ex.promise == want and ex.notch == start
+    # the browser rounds each slider to its step and echoes it: the starting notch stays exact
+    sliders[0].value = 10 ** (0.005 * round(np.log10(start.omega_n) / 0.005))
+    sliders[1].value = round(start.depth_db, 1)
+    sliders[2].value = round(start.width, 2)
+    assert ex.notch == start and ex.promise == want
+    sliders[1].value = 12.0  # a real move
+    assert ex.notch == spec.Notch(1.0712345678, 12.0, 0.23456789)
+    assert ex.promise == spec.promise_of(ex.notch.response(base.omega), base)
+    assert "12 dB" in ex.line.get_label() and f"{ex.promise.exact_damage:.1f} %" in ex.ax_mag.get_title()
+    plt.close("all")
