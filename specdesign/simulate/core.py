@@ -271,6 +271,8 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         turbine twice the rated generator speed or the tower-base moment of 10 m of tower-top
         deflection), naming its wind speed, seed and time.
 
+    Notes
+    -----
     Pitch limits and anti-windup: with ``plant.pitch_limits`` (the turbine's pitch range) the
     command of every compiled controller is saturated there, and no controller winds up:
 

@@ -1,0 +1,112 @@
+"""MkDocs hook: one API-reference page per public module of ``specdesign`` and ``loopshaping``.
+
+The pages are generated at build time from the packages themselves, so a new module or a new
+name in a module's ``__all__`` is documented without editing the site: a leaf module's page is
+rendered by mkdocstrings (its ``__all__`` decides the members); a package's page shows its
+docstring and, for each name it re-exports from a submodule, a link to the one place that
+name is documented (rendering it twice would give two anchors for one object).
+``tests/test_docs_site.py`` checks that every name of every ``__all__`` has an anchor.
+"""
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+from mkdocs.plugins import event_priority
+from mkdocs.structure.files import File
+
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGES = ("specdesign", "loopshaping")
+
+
+def _all_names(module: str) -> list[str]:
+    """The module's ``__all__`` (imported: a package may build it, e.g. from a table of lazy names)."""
+    return list(getattr(importlib.import_module(module), "__all__", []))
+
+
+def public_modules() -> dict[str, tuple[Path, bool]]:
+    """Module name → (source file, is a package) for every module without a private part."""
+    out = {}
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            parts = list(path.relative_to(ROOT).with_suffix("").parts)
+            is_pkg = parts[-1] == "__init__"
+            if is_pkg:
+                parts.pop()
+            if any(p.startswith("_") for p in parts) or parts[-1] == "__main__":
+                continue
+            out[".".join(parts)] = (path, is_pkg)
+    return dict(sorted(out.items()))
+
+
+def _page_path(module: str) -> str:
+    return "api/" + module.replace(".", "/") + ".md"
+
+
+def _home(package: str, name: str, modules: dict) -> str | None:
+    """The public leaf module documenting ``package.name``: the one exporting the same object,
+    its defining module first, then the package's own submodules (None: defined in the package)."""
+    obj = getattr(importlib.import_module(package), name)
+    leaves = [m for m in modules if not modules[m][1]]
+    first = getattr(obj, "__module__", None)
+    ordered = ([first] if first in leaves else []) + [m for m in leaves if m.startswith(package + ".")] + leaves
+    for m in ordered:
+        if name in _all_names(m) and getattr(importlib.import_module(m), name) is obj:
+            return m
+    return None
+
+
+def _page(module: str, modules: dict) -> str:
+    path, is_pkg = modules[module]
+    names = _all_names(module)
+    title = f"# `{module}`\n\n"
+    if not is_pkg:
+        return title + f"::: {module}\n    options:\n      show_root_heading: false\n"
+    # a package: each re-exported name links to the one leaf module that documents it
+    subs = [m for m in modules if m.startswith(module + ".") and m.count(".") == module.count(".") + 1]
+    home, own = {}, []
+    for name in names:
+        where = _home(module, name, modules)
+        if where is None:
+            own.append(name)
+        else:
+            home[name] = where
+    text = title + f"::: {module}\n    options:\n      show_root_heading: false\n"
+    text += "      members: " + ("[" + ", ".join(own) + "]" if own else "false") + "\n\n"
+    if subs:
+        text += "## Submodules\n\n" + "".join(f"- [`{m}`]({Path(_page_path(m)).relative_to(Path(_page_path(module)).parent)})\n"
+                                               for m in subs) + "\n"
+    if home:
+        text += "## Names exported here\n\nEach is documented in its own module:\n\n"
+        for name, where in home.items():
+            # an empty anchor (autorefs registers it): a reference to the package's name lands here
+            text += f"- [](){{#{module}.{name}}}[`{name}`][{where}.{name}] (`{where}`)\n"
+    return text
+
+
+def on_config(config):
+    """Append the API reference to the navigation, packages before their modules."""
+    modules = public_modules()
+    api = []
+    for pkg in PACKAGES:
+        api.append({pkg: [{m: _page_path(m)} for m in modules if m == pkg or m.startswith(pkg + ".")]})
+    config["nav"].append({"API reference": api})
+    return config
+
+
+def notebooks() -> list[Path]:
+    """The shipped notebooks (``notebooks/*.ipynb``), in order."""
+    return sorted((ROOT / "notebooks").glob("*.ipynb"))
+
+
+# before mkdocs-jupyter's on_files (priority 0), which turns the notebooks added here into pages
+@event_priority(50)
+def on_files(files, config):
+    """Add the generated API pages and the notebooks, read where they live (nothing copied into docs/)."""
+    modules = public_modules()
+    for m in modules:
+        files.append(File.generated(config, _page_path(m), content=_page(m, modules)))
+    for nb in notebooks():
+        files.append(File(f"notebooks/{nb.name}", src_dir=str(ROOT), dest_dir=config["site_dir"],
+                          use_directory_urls=config["use_directory_urls"]))
+    return files
