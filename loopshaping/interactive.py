@@ -515,6 +515,22 @@ class Designer:
     def _title_colour(st):
         return "black" if st.all_stable and st.bounds_met else "tab:red"
 
+    def summary(self, state: DesignState | None = None) -> str:
+        """What the figure's title says: stability (the unstable case and its pole), bounds, specs, G.
+
+        Parameters
+        ----------
+        state : DesignState, optional
+            The state to describe (default: the current controller's).
+
+        Returns
+        -------
+        str
+            Three lines: the verdict, each spec checked (met, or the design frequencies in
+            rad/s where it fails) and the controller.
+        """
+        return self._title(self.state() if state is None else state)
+
     def _title(self, st):
         n = st.stable.size
         bad = np.flatnonzero(~st.stable)

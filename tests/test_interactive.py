@@ -129,3 +129,23 @@ def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
     assert ex.promise == spec.promise_of(ex.notch.response(base.omega), base)
     assert "12 dB" in ex.line.get_label() and f"{ex.promise.exact_damage:.1f} %" in ex.ax_mag.get_title()
     plt.close("all")
+
+
+def test_notebooks_enable_the_widget_backend_and_carry_no_outputs():
+    # every notebook with a live control turns the ipympl backend on itself, and git holds the
+    # notebooks without outputs (they are executed by tests/test_notebooks.py and the docs)
+    import json
+    from pathlib import Path
+
+    notebooks = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
+    interactive = []
+    for path in notebooks:
+        nb = json.loads(path.read_text())
+        code = ["".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code"]
+        assert all(not c.get("outputs") and c.get("execution_count") is None
+                   for c in nb["cells"] if c["cell_type"] == "code"), f"{path.name} has outputs: strip them"
+        if any(".widget()" in s for s in code):
+            interactive.append(path.stem)
+            first = next(i for i, s in enumerate(code) if ".widget()" in s)
+            assert any('run_line_magic("matplotlib", "widget")' in s for s in code[:first]), path.name
+    assert {"00_qft_toolbox_example", "03_specification", "04_qft_design"} <= set(interactive)
