@@ -1,0 +1,46 @@
+"""ROSCO in one place: its pitch PI gain schedule, the baseline controller, its scheduled form,
+schedules read from DISCON.IN files and the compiled ROSCO controller itself.
+
+- :mod:`specdesign.rosco.baseline`: the NREL ROSCO controller of the IEA 15 MW as the
+  workbench reproduces it from the reduced model (:func:`rosco_gain_schedule`,
+  :func:`speed_filter`, :func:`rosco_baseline`, :func:`rosco_scheduled`).
+- :mod:`specdesign.rosco.discon_file`: a DISCON.IN file read as the schedule
+  :func:`rosco_scheduled` runs (:func:`from_discon`, :class:`DisconSchedule`).
+- :mod:`specdesign.rosco.discon`: ROSCO's compiled DISCON library (from the ``rosco``
+  package, optional extra ``specdesign[rosco]``) as a controller of
+  :func:`specdesign.simulate.simulate` (:class:`Discon`).
+
+This package does not import :mod:`specdesign.simulate` at load time (it imports
+:mod:`specdesign.turbine`, which :mod:`specdesign.simulate` imports too), so both
+:mod:`specdesign.turbine` and :mod:`specdesign.simulate` re-export names of it.
+"""
+from __future__ import annotations
+
+from .baseline import (
+    RoscoSchedule,
+    first_order_rotor_model,
+    rosco_baseline,
+    rosco_gain_schedule,
+    rosco_scheduled,
+    speed_filter,
+)
+from .discon import Discon, DisconError, rosco_library, rosco_test_cases
+from .discon_file import DisconEntry, DisconSchedule, from_discon, iea15mw_discon, read_discon
+
+__all__ = [
+    "RoscoSchedule",
+    "first_order_rotor_model",
+    "rosco_gain_schedule",
+    "speed_filter",
+    "rosco_baseline",
+    "rosco_scheduled",
+    "DisconEntry",
+    "DisconSchedule",
+    "iea15mw_discon",
+    "read_discon",
+    "from_discon",
+    "Discon",
+    "DisconError",
+    "rosco_library",
+    "rosco_test_cases",
+]
