@@ -53,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     from specdesign import __version__
 
-    parser = argparse.ArgumentParser(prog="specdesign", description=__doc__.splitlines()[0],
+    parser = argparse.ArgumentParser(prog="specdesign", description=_DESCRIPTION,
                                      epilog="Campaign file schema: docs/validation.md.")
     parser.add_argument("--version", action="version", version=f"specdesign {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -72,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
             output_folder(args.out, "--out")
             run_demo(out=args.out, fast=args.fast)
         else:
-            run_config(args.config, out=args.out)
+            run_config(args.config, out=args.out, echo=True)
     except (ConfigError, OSError) as e:
         # bad input from the user (a file, a key, an unwritable folder): the message names it
         # and says what it must be; a traceback would only hide it. Other exceptions are
@@ -83,6 +83,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"specdesign {args.command}: interrupted", file=sys.stderr)
         return 130
     return 0
+
+
+# argparse prints these as they are: plain text, no reST markup (the module docstring has it)
+_DESCRIPTION = ("Fatigue-based pitch-controller design: 'specdesign demo' runs the 19 m/s design loop, "
+                "'specdesign validate CONFIG' reruns an offline validation campaign from a TOML/JSON file "
+                "(also 'python -m specdesign').")
 
 
 def _choose_backend() -> None:
@@ -138,9 +144,6 @@ def output_folder(folder: str | os.PathLike, key: str, *, source: str | os.PathL
     return folder
 
 
-# One schema for campaign files: key → (check, what it must be). Every key of the file is
-# checked, at every level, before the first simulation: a typo or a wrong type is an error
-# naming the file and the key, not a traceback after minutes of simulation.
 # One schema for campaign files: key → (check, what it must be). Every key of the file is
 # checked, at every level, before the first simulation: a typo or a wrong type is an error
 # naming the file and the key, not a traceback after minutes of simulation.
@@ -481,7 +484,7 @@ def read_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -
                 designed=designed, promised=promised, out=folder)
 
 
-def run_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -> Campaign:
+def run_config(path: str | os.PathLike, out: str | os.PathLike | None = None, *, echo: bool = False) -> Campaign:
     """Run the campaign described by a TOML/JSON file and write its tables and figures.
 
     The whole file is checked first (:func:`read_config`). Writes into the output folder:
@@ -495,6 +498,9 @@ def run_config(path: str | os.PathLike, out: str | os.PathLike | None = None) ->
     out : str or os.PathLike, optional
         Output folder; default the file's ``output`` key, else ``validation_output``, beside
         the file.
+    echo : bool, default False
+        Print what the campaign is, then Table 3 and Table 2 (with two or more controllers)
+        and the path of every file written, to standard output (``specdesign validate`` does).
 
     Returns
     -------
@@ -509,15 +515,29 @@ def run_config(path: str | os.PathLike, out: str | os.PathLike | None = None) ->
         See :func:`read_config`; also an output file that cannot be written.
     """
     c = read_config(path, out)
-    camp = run_campaign(c["controllers"], c["wind_speeds"], c["seeds"], keep_series=1, **c["kwargs"])
+    say = (lambda msg: print(msg, flush=True)) if echo else (lambda msg: None)
+    kw = c["kwargs"]
+    say(f"{path}: {len(c['controllers'])} controller(s) ({', '.join(c['controllers'])}) × "
+        f"{len(c['wind_speeds'])} wind speed(s) × {len(c['seeds'])} seed(s) × {kw['duration']:g} s")
+    camp = run_campaign(c["controllers"], c["wind_speeds"], c["seeds"], keep_series=1, **kw)
     folder, baseline, designed = c["out"], c["baseline"], c["designed"]
-    _write_indicators(camp, folder / "indicators.csv")
+    written = [folder / "indicators.csv"]
+    _write_indicators(camp, written[0])
     if len(camp.controllers) >= 2:
         t2, t3 = table2(camp, designed, baseline), table3(camp, designed, baseline, promised=c["promised"])
-        for t, stem in ((t2, "table2"), (t3, "table3")):
+        # Table 3 first: the promise against what rainflow measured is the answer a campaign gives
+        for t, stem in ((t3, "table3"), (t2, "table2")):
             (folder / f"{stem}.md").write_text(t.to_markdown())
             t.to_csv(folder / f"{stem}.csv")
-    _write_figures(camp, folder, designed, baseline if len(camp.controllers) >= 2 else None)
+            written += [folder / f"{stem}.md", folder / f"{stem}.csv"]
+            say("\n" + t.to_markdown())
+    else:
+        say(f"one controller ({camp.controllers[0]}): no Tables 2-3 (they compare a design with a baseline); "
+            "the indicators are in indicators.csv")
+    written += _write_figures(camp, folder, designed, baseline if len(camp.controllers) >= 2 else None)
+    say(f"\nwrote {len(written)} files to {folder}:")
+    for f in written:
+        say(f"  {f}")
     return camp
 
 
@@ -532,24 +552,30 @@ def _write_indicators(camp: Campaign, path: Path) -> None:
                     w.writerow([name, v, int(seed)] + [repr(float(camp.values[k][c, i, s])) for k in INDICATORS])
 
 
-def _write_figures(camp: Campaign, out: Path, designed, baseline) -> None:
-    """Figs. 8-10 as PNG files: figures made without pyplot, so no backend is involved."""
+def _write_figures(camp: Campaign, out: Path, designed, baseline) -> list[Path]:
+    """Figs. 8-10 as PNG files (the paths written): figures made without pyplot, so no backend
+    is involved."""
     from matplotlib.figure import Figure
 
     from .plots import validation as pv
 
+    written = []
     for v in camp.wind_speeds:
         fig = Figure(figsize=(7, 6))
         axes = fig.subplots(2, 1, sharex=True)
         pv.plot_spectra(camp, v, "gen_speed", ax=axes[0])
         pv.plot_spectra(camp, v, "tower_base_my", ax=axes[1])
         fig.tight_layout()
-        fig.savefig(out / f"fig8_{v:g}mps.png", dpi=120)
+        written.append(out / f"fig8_{v:g}mps.png")
+        fig.savefig(written[-1], dpi=120)
         if camp.series:
             fig = Figure(figsize=(8, 8))
             pv.plot_time_series(camp.series, v, seed_index=0, axes=fig.subplots(4, 1, sharex=True))
-            fig.savefig(out / f"fig9_{v:g}mps.png", dpi=120)
+            written.append(out / f"fig9_{v:g}mps.png")
+            fig.savefig(written[-1], dpi=120)
     if baseline is not None:
         fig = Figure()
         pv.plot_reductions(acceptance(camp, designed, baseline), ax=fig.subplots())
-        fig.savefig(out / "fig10.png", dpi=120)
+        written.append(out / "fig10.png")
+        fig.savefig(written[-1], dpi=120)
+    return written

@@ -76,3 +76,47 @@ def test_a_campaign_file_writes_its_figures_without_pyplot(tmp_path):
     for f in ("table2.md", "table2.csv", "table3.md", "table3.csv", "indicators.csv", "fig8_19mps.png",
               "fig9_19mps.png", "fig10.png"):
         assert (tmp_path / "out" / f).stat().st_size > 0, f
+
+
+def test_version_is_the_package_version():
+    from specdesign import __version__
+
+    r = _run("--version")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == f"specdesign {__version__}"
+
+
+def test_help_is_plain_text_without_rest_markup():
+    """argparse prints help as it is: no ``literals``, :func:`roles` or other reST markup."""
+    import re
+
+    for args in (("--help",), ("demo", "--help"), ("validate", "--help")):
+        r = _run(*args)
+        assert r.returncode == 0, r.stderr
+        assert r.stdout.startswith("usage: specdesign"), args
+        assert "``" not in r.stdout, (args, r.stdout)
+        assert not re.search(r":[a-z]+:`|`[^`\n]+`_|^\s*\.\. [a-z]+::", r.stdout, re.M), (args, r.stdout)
+    top = _run("--help").stdout
+    assert "demo" in top and "validate" in top and "--version" in top
+
+
+def test_validate_prints_tables_3_and_2_and_the_files_it_wrote(tmp_path, capsys):
+    """The campaign's answer on the terminal: Table 3 (promise vs rainflow) and Table 2 as
+    written to table3.md/table2.md, then every file written, each of which exists."""
+    from specdesign.cli import main
+
+    (tmp_path / "pi.json").write_text('{"num": [-0.3, -0.06], "den": [1.0, 0.0]}')
+    (tmp_path / "c.toml").write_text('wind_speeds = [19.0]\nseeds = 1\nduration = 30.0\ntransient = 5.0\n'
+                                     'baseline = "ROSCO"\ndesigned = "PI"\n'
+                                     '[controllers.ROSCO]\nkind = "rosco"\n[controllers.PI]\nfile = "pi.json"\n')
+    out = tmp_path / "out"
+    assert main(["validate", str(tmp_path / "c.toml"), "--out", str(out)]) == 0
+    stdout = capsys.readouterr().out
+    t3, t2 = (out / "table3.md").read_text(), (out / "table2.md").read_text()
+    assert "Table 3" in t3 and "Table 2" in t2
+    assert t3.strip() in stdout and t2.strip() in stdout
+    assert stdout.index("Table 3") < stdout.index("Table 2")
+    listed = [line.strip() for line in stdout.splitlines() if line.startswith("  ")]
+    files = sorted(str(p) for p in out.iterdir())
+    assert sorted(listed) == files  # every file written is listed, and only those
+    assert f"wrote {len(files)} files to {out}" in stdout
