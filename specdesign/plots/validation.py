@@ -126,18 +126,36 @@ def plot_time_series(series, wind_speed: float, *, seed_index: int = 0, controll
     return axes
 
 
-def plot_reductions(acc, *, ax=None):
+#: One style per series of Fig. 10 (colour, line style, marker all fixed, none shared), so a
+#: series added later with the default colour cycle cannot take a drawn series' look.
+_REDUCTION_STYLES = {
+    "predicted": dict(color="C0", ls="--", marker="o"),
+    "rainflow": dict(color="C1", ls="-", marker="s"),
+    "rainflow_linear": dict(color="C4", ls=":", marker="v"),
+    "volterra": dict(color="C3", ls="-.", marker="d"),
+    "promised": dict(color="C2", ls=":", marker="^"),
+    "target": dict(color="0.5", ls="-.", marker=""),
+}
+
+
+def plot_reductions(acc, *, promised=None, target: float | None = None, ax=None):
     """Fig. 10: tower-base DEL reduction (%) vs mean wind speed (m/s).
 
     Linear prediction and rainflow evaluation with ±1 standard error bars (paired seeds),
     plus rainflow on the linearised model when the campaign had a linear twin (the gap between
     the two rainflow curves is the plant nonlinearity's part) and the Volterra prediction when
-    the campaign had one (``run_campaign(volterra=k)``).
+    the campaign had one (``run_campaign(volterra=k)``). Every series has its own colour, line
+    style and marker.
 
     Parameters
     ----------
     acc : specdesign.validate.Acceptance
         The acceptance of a design (:func:`~specdesign.validate.acceptance`).
+    promised : dict of float to float, optional
+        Wind speed (m/s) → the specification's promised DEL reduction (%), drawn as its own
+        series.
+    target : float, optional
+        The design target (DEL reduction, %), drawn as a horizontal line.
     ax : matplotlib.axes.Axes, optional
         Axes to draw on (default a new pyplot figure).
 
@@ -145,17 +163,30 @@ def plot_reductions(acc, *, ax=None):
     -------
     matplotlib.axes.Axes
         The axes.
+
+    Raises
+    ------
+    TypeError
+        If ``promised`` is not a mapping of wind speed to reduction.
     """
+    if promised is not None and not hasattr(promised, "items"):
+        raise TypeError(f"promised must be a dict of wind speed (m/s) → DEL reduction (%), got {type(promised).__name__}")
+    st = _REDUCTION_STYLES
     ax = _axes(ax)
-    ax.plot(acc.wind_speeds, acc.predicted, "o--", label="linear prediction (Dirlik on |T|²S_W)")
-    ax.errorbar(acc.wind_speeds, acc.rainflow, yerr=acc.se, fmt="s-", capsize=3,
+    ax.plot(acc.wind_speeds, acc.predicted, **st["predicted"], label="linear prediction (Dirlik on |T|²S_W)")
+    ax.errorbar(acc.wind_speeds, acc.rainflow, yerr=acc.se, capsize=3, **st["rainflow"],
                 label=f"rainflow, nonlinear model ({acc.n_seeds} paired seeds, ±1 SE)")
     if np.all(np.isfinite(acc.rainflow_linear)):
-        ax.errorbar(acc.wind_speeds, acc.rainflow_linear, yerr=acc.se_spectral, fmt="^:", capsize=3,
+        ax.errorbar(acc.wind_speeds, acc.rainflow_linear, yerr=acc.se_spectral, capsize=3, **st["rainflow_linear"],
                     label="rainflow, linearised model (same seeds, ±1 SE)")
     if acc.volterra_order and np.all(np.isfinite(acc.volterra)):
-        ax.plot(acc.wind_speeds, acc.volterra, "d-.",
+        ax.plot(acc.wind_speeds, acc.volterra, **st["volterra"],
                 label=f"Volterra prediction, order {acc.volterra_order} (rainflow, same seeds)")
+    if promised:
+        v = sorted(promised)
+        ax.plot(v, [promised[k] for k in v], **st["promised"], label="specification's promise")
+    if target is not None:
+        ax.axhline(float(target), lw=0.8, **st["target"], label=f"design target ({float(target):g} %)")
     ax.set_xlabel("mean wind speed (m/s)")
     ax.set_ylabel("tower-base DEL reduction (%)")
     ax.legend(fontsize="small")
