@@ -29,13 +29,18 @@ def _nan_point(out, omega, n_seeds, linear_twin, volterra):
             out["volterra"].setdefault(k, []).append(nan)
     out["pred"].append(np.nan)
     for k in SPECTRA:
-        out["welch"][k].append(np.full(omega.size, np.nan))
+        out["welch"][k].append(np.full((n_seeds, omega.size), np.nan))
         out["ppsd"][k].append(np.full(omega.size, np.nan))
 
 
 def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
                     turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0):
-    """One wind speed, every controller, the same seeds: indicators, spectra, predictions."""
+    """One wind speed, every controller, the same seeds: indicators, per-seed spectra, predictions.
+
+    The results of a seed do not depend on the other seeds of the call (the wind of a run
+    depends on (v, seed) only and the runs of a batch do not interact), which is what lets
+    a resumed campaign run only its missing seeds.
+    """
     from .. import wind as wmod
     from ..closedloop import ClosedLoopUnstableWarning
     from ..simulate import SimulationDivergedError, SimulationResult, simulate, wind_series
@@ -89,7 +94,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
                 out["volterra"].setdefault(k, []).append(val[0])
         for k in SPECTRA:
             omega, p = welch_psd(r[k][0], r.dt, nperseg)
-            out["welch"][k].append(p.mean(axis=0))
+            out["welch"][k].append(p)  # (S, nω) per seed: the campaign averages the cells it assembles
         if predict and has_linear_form(c):
             pr = linear_prediction(model, c, v, m=m, omega=prediction_grid(duration), turbulence_class=turbulence_class)
             out["pred"].append(pr.del_)

@@ -245,7 +245,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                  record_dt: float = 0.1, transient: float = 60.0, m: float = 4.0, predict: bool = True,
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
                  volterra: int = 0, executor=None, progress: bool | None = None,
-                 nperseg: int | None = None) -> Campaign:
+                 nperseg: int | None = None, store=None) -> Campaign:
     """Run every controller at every wind speed on the same seeds and post-process.
 
     Parameters
@@ -288,16 +288,29 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         evaluated for every LTI-like controller on the same wind and window, FFT-fast:
         ``Campaign.volterra_values``, which :func:`~specdesign.validate.acceptance` compares
         with rainflow too.
-    executor : concurrent.futures.Executor, optional
-        Wind speeds are submitted as separate tasks (a dask.distributed Client qualifies).
-        Default: run locally, the compiled simulator already using every core. For a local
-        process pool use a "spawn" context,
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Wind speeds are submitted as separate tasks (every controller and seed of a speed
+        in one task: one wind synthesis, the seeds batched) to anything with
+        ``submit(fn, *args)`` returning futures: a ``concurrent.futures`` executor,
+        ``client.get_executor()`` or the dask ``Client`` itself (docs/campaigns.md shows a
+        multi-machine cluster); the results are bitwise those of a local run, collected as
+        they finish. Default: run locally, the compiled simulator already using every core.
+        For a local process pool use a "spawn" context,
         ``ProcessPoolExecutor(mp_context=multiprocessing.get_context("spawn"))``: numba's
         OpenMP threads make fork() unsafe.
     progress : bool, optional
-        Show a tqdm bar over wind speeds; None → only when stderr is a terminal.
+        Show a tqdm bar over the runs (one per wind speed, seed and controller), advanced as
+        tasks finish, locally or on the cluster; None → only when stderr is a terminal.
     nperseg : int, optional
         Welch segment length (:func:`~specdesign.validate.welch_psd`).
+    store : str or os.PathLike, optional
+        A directory keeping every finished run, one file per (wind speed, seed,
+        controller) (:mod:`specdesign.validate.store`: NetCDF cells that xarray reads, an
+        index that pandas reads). Run again with the same directory, the campaign loads the
+        runs already there and simulates only the missing ones: an interrupted campaign
+        resumes, and one given more seeds, speeds or controllers runs only those. The
+        result is bitwise that of an uninterrupted run. A store holding other settings,
+        another model or another controller under the same name is refused.
 
     Returns
     -------
@@ -310,8 +323,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         ``controllers`` is not a non-empty dict, or ``volterra`` asks for a model without
         ``aero_expansion``.
     ValueError
-        Invalid seeds or ``volterra``, or a step too large (:func:`check_campaign_step`),
-        before the first simulation; errors of :func:`specdesign.simulate.simulate`.
+        Invalid seeds or ``volterra``, a step too large (:func:`check_campaign_step`) or a
+        store of another campaign, before the first simulation; errors of
+        :func:`specdesign.simulate.simulate`.
     """
     if not isinstance(controllers, dict) or not controllers:
         raise TypeError("controllers must be a non-empty dict {name: controller}")
@@ -326,56 +340,141 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     if volterra and not hasattr(model, "aero_expansion"):
         raise TypeError(f"volterra={volterra} needs a turbine.TurbineModel, got {type(model).__name__}")
     check_campaign_step(model, controllers, vs, dt)
-    args = [(model, controllers, float(v), seeds, duration, dt, record_dt, transient, m, predict, turbulence_class,
-             keep_series, nperseg, bool(linear_twin), int(volterra)) for v in vs]
+    names = tuple(controllers)
+    n_keep = len(seeds) if keep_series is True else int(keep_series)
+    settings = {"duration": float(duration), "dt": float(dt), "record_dt": float(record_dt),
+                "transient": float(transient), "m": float(m), "predict": bool(predict),
+                "turbulence_class": turbulence_class, "keep_series": n_keep, "linear_twin": bool(linear_twin),
+                "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg)}
+    wanted = [(float(v), int(s), n) for v in vs for s in seeds for n in names]
+    records, st = {}, None
+    if store is not None:
+        from .store import CampaignStore, fingerprint
+
+        st = CampaignStore(store, settings, fingerprint(model), {n: fingerprint(c) for n, c in controllers.items()})
+        records = st.load(wanted)
+    kept = set(seeds[:n_keep].tolist())
+    tasks = []
+    for v in vs:
+        # controllers missing the same seeds at this speed share one task (one wind synthesis,
+        # seeds batched); a fresh campaign has one task per wind speed
+        groups = {}
+        for n in names:
+            todo = tuple(int(s) for s in seeds if (float(v), int(s), n) not in records)
+            if todo:
+                groups.setdefault(todo, []).append(n)
+        for todo, group in groups.items():
+            tasks.append((float(v), np.asarray(todo, dtype=np.int64), tuple(group)))
     show = (sys.stderr.isatty()) if progress is None else bool(progress)
     from tqdm.auto import tqdm
 
-    bar = tqdm(total=len(args), desc="validation", unit="wind speed", disable=not show)
+    bar = tqdm(total=sum(t[1].size * len(t[2]) for t in tasks), desc="validation", unit="run", disable=not show)
+
+    def args(task):
+        v, todo, group = task
+        # the kept seeds are a prefix of the task's seeds (both in campaign order)
+        return (model, {n: controllers[n] for n in group}, v, todo, duration, dt, record_dt, transient, m, predict,
+                turbulence_class, sum(s in kept for s in todo.tolist()), nperseg, bool(linear_twin), int(volterra))
+
+    def finish(task, point):
+        new = _cells(task, point)
+        records.update(new)
+        if st is not None:
+            st.write(new)
+        bar.update(len(new))
+
     try:
         if executor is None:
-            points = []
-            for a in args:
-                points.append(campaign_point(*a))
-                bar.update()
+            for t in tasks:
+                finish(t, campaign_point(*args(t)))
         else:
-            futs = [executor.submit(campaign_point, *a) for a in args]
-            points = []
-            for f in futs:
-                points.append(f.result())
-                bar.update()
+            futs = {executor.submit(campaign_point, *args(t)): t for t in tasks}
+            try:
+                for f in _as_completed(list(futs)):
+                    finish(futs[f], f.result())
+            finally:  # on an error or an interrupt, do not leave the rest running on the cluster
+                for f in futs:
+                    f.cancel()
     finally:
         bar.close()
-    names = tuple(controllers)
-    values = {k: np.stack([np.stack(p["values"][k]) for p in points], axis=1) for k in INDICATORS}
+    return _assemble(records, names, vs, seeds, settings)
+
+
+def _as_completed(futures):
+    """Futures in the order they finish: concurrent.futures ones, or any with ``add_done_callback``
+    (a dask.distributed Client's own futures)."""
+    import concurrent.futures as cf
+    import queue
+
+    if all(isinstance(f, cf.Future) for f in futures):
+        yield from cf.as_completed(futures)
+        return
+    done = queue.SimpleQueue()
+    for f in futures:
+        f.add_done_callback(done.put)
+    for _ in futures:
+        yield done.get()
+
+
+def _cells(task, point) -> dict:
+    """Split the result of one task (a wind speed, some controllers, some seeds) into cells."""
+    v, todo, group = task
+    out = {}
+    for i, name in enumerate(group):
+        r = point["series"].get(name)
+        for j, s in enumerate(todo.tolist()):
+            series = None
+            if r is not None and j < r.seeds.size:
+                series = {"time": r.time, "dt": r.dt, "sim_dt": r.sim_dt,
+                          "outputs": {k: a[0, j] for k, a in r.outputs.items()}}
+            out[(v, s, name)] = {
+                "values": {k: point["values"][k][i][j] for k in INDICATORS},
+                "linear": {k: point["linear"][k][i][j] for k in point["linear"]},
+                "volterra": {k: point["volterra"][k][i][j] for k in point["volterra"]},
+                "welch": {k: point["welch"][k][i][j] for k in SPECTRA},
+                "ppsd": {k: point["ppsd"][k][i] for k in SPECTRA},
+                "pred": point["pred"][i], "unstable": point["unstable"][i], "omega": point["omega"], "series": series}
+    return out
+
+
+def _assemble(records, names, vs, seeds, settings) -> Campaign:
+    """The :class:`Campaign` of the cells (v, seed, controller), whichever run or store they came from."""
+    cell = [[[records[(float(v), int(s), n)] for s in seeds] for v in vs] for n in names]
+    first = [[row[0] for row in by_v] for by_v in cell]  # per-(controller, speed) entries: any seed has them
+
+    def per_seed(group, keys):
+        return {k: np.array([[[c[group][k] for c in row] for row in by_v] for by_v in cell]) for k in keys}
+
+    def spectra(key, mean):
+        if mean:  # the seed average as np.mean of the (S, nω) block a batch of seeds gives
+            return {k: np.array([[np.stack([c[key][k] for c in row]).mean(axis=0) for row in by_v] for by_v in cell])
+                    for k in SPECTRA}
+        return {k: np.array([[f[key][k] for f in by_v] for by_v in first]) for k in SPECTRA}
+
     series = {}
-    if keep_series:
+    n_keep = settings["keep_series"]
+    if n_keep:
         from ..simulate import SimulationResult
 
-        for name in names:
-            rs = [p["series"].get(name) for p in points]
-            ok = next((r for r in rs if r is not None), None)
+        for ci, name in enumerate(names):
+            kept = [[c["series"] for c in row[:n_keep]] for row in cell[ci]]
+            ok = next((r for row in kept for r in row if r is not None), None)
             if ok is None:  # unstable or diverged at every speed (warned): no series to keep
                 continue
             # where it was unstable or diverged (warned), NaN series: the other speeds are kept
-            outs = {k: np.concatenate([(r.outputs[k] if r is not None else np.full_like(ok.outputs[k], np.nan))
-                                       for r in rs], axis=0) for k in ok.outputs}
-            series[name] = SimulationResult(time=ok.time, wind_speeds=vs, seeds=ok.seeds, outputs=outs, dt=ok.dt,
-                                            sim_dt=ok.sim_dt, controller=name)
+            outs = {k: np.stack([np.stack([(r["outputs"][k] if r is not None else np.full_like(a, np.nan)) for r in row])
+                                 for row in kept]) for k, a in ok["outputs"].items()}
+            series[name] = SimulationResult(time=ok["time"], wind_speeds=vs, seeds=seeds[:n_keep], outputs=outs,
+                                            dt=ok["dt"], sim_dt=ok["sim_dt"], controller=name)
     return Campaign(
-        controllers=names, wind_speeds=vs, seeds=seeds, duration=float(duration), dt=float(record_dt), m=float(m),
-        values=values,
-        predicted_del=np.array([p["pred"] for p in points]).T,
-        omega=points[0]["omega"],
-        welch={k: np.stack([np.stack(p["welch"][k]) for p in points], axis=1) for k in SPECTRA},
-        predicted_psd={k: np.stack([np.stack(p["ppsd"][k]) for p in points], axis=1) for k in SPECTRA},
-        series=series,
-        linear_values={k: np.stack([np.stack(p["linear"][k]) for p in points], axis=1) for k in INDICATORS}
-        if linear_twin else {},
-        volterra_values={k: np.stack([np.stack(p["volterra"][k]) for p in points], axis=1) for k in INDICATORS}
-        if volterra else {},
-        volterra_order=int(volterra),
-        unstable=np.array([p["unstable"] for p in points]).T,
+        controllers=names, wind_speeds=vs, seeds=seeds, duration=settings["duration"], dt=settings["record_dt"],
+        m=settings["m"], values=per_seed("values", INDICATORS),
+        predicted_del=np.array([[f["pred"] for f in by_v] for by_v in first]),
+        omega=cell[0][0][0]["omega"], welch=spectra("welch", True), predicted_psd=spectra("ppsd", False),
+        series=series, linear_values=per_seed("linear", INDICATORS) if settings["linear_twin"] else {},
+        volterra_values=per_seed("volterra", INDICATORS) if settings["volterra"] else {},
+        volterra_order=settings["volterra"],
+        unstable=np.array([[bool(f["unstable"]) for f in by_v] for by_v in first]),
     )
 
 
