@@ -6,7 +6,8 @@ names, resolved the way Python resolves the name in the docstring's scope (the m
 names and its imports): ``:func:`shape_to_target``` in ``specdesign.spec`` links to
 ``specdesign.spec.shape_to_target``; ``~a.b.c`` shows ``c``. A target in ``specdesign`` or
 ``loopshaping`` is a required link, so a broken one fails the strict build; a name outside
-them (``json.dumps``, ``ValueError``) is shown as code without a link.
+them (``json.dumps``, ``ValueError``) is shown as code without a link. Doctest blocks outside
+an Examples section are fenced as code (Markdown would read ``>>>`` as block quotes).
 """
 from __future__ import annotations
 
@@ -44,6 +45,30 @@ def _canonical(obj: griffe.Object, path: str) -> str:
         return path  # not loaded (the other package) or not found: left as written, checked by autorefs
 
 
+def fence_doctests(text: str) -> str:
+    """Doctest blocks outside an Examples section as fenced ``pycon`` code.
+
+    Griffe reads ``>>>`` blocks as code only in an Examples section; elsewhere (a module's
+    "Typical use:" paragraph) Markdown would show them as nested block quotes.
+    """
+    lines, out, section, i = text.split("\n"), [], "", 0
+    while i < len(lines):
+        line = lines[i]
+        if i + 1 < len(lines) and line.strip() and re.fullmatch(r"\s*-{3,}\s*", lines[i + 1]):
+            section = line.strip()
+        if line.lstrip().startswith(">>>") and section not in ("Examples", "Example"):
+            indent = line[: len(line) - len(line.lstrip())]
+            block = []
+            while i < len(lines) and lines[i].strip():
+                block.append(lines[i])
+                i += 1
+            out += [f"{indent}```pycon", *block, f"{indent}```"]
+            continue
+        out.append(line)
+        i += 1
+    return "\n".join(out)
+
+
 def _convert(obj: griffe.Object, text: str) -> str:
     def link(m: re.Match) -> str:
         target = m["target"].strip()
@@ -68,5 +93,5 @@ class RestRoles(griffe.Extension):
         while stack:
             obj = stack.pop()
             if obj.docstring is not None:
-                obj.docstring.value = _convert(obj, obj.docstring.value)
+                obj.docstring.value = fence_doctests(_convert(obj, obj.docstring.value))
             stack.extend(m for m in obj.members.values() if not m.is_alias)
