@@ -244,8 +244,9 @@ def _margins(L, omega):
         for cc, gg in zip(c[keep], g):
             if abs(gg) < abs(gm[cc]):
                 gm[cc] = gg
-    # Gain crossovers: |L| crosses 1.
-    ldb = 20 * np.log10(mag)
+    # Gain crossovers: |L| crosses 1 (a zero loop, e.g. an absent ATD, lies at −∞ dB: none).
+    with np.errstate(divide="ignore"):
+        ldb = 20 * np.log10(mag)
     i, c = np.nonzero(np.sign(ldb[:-1]) != np.sign(ldb[1:]))
     if i.size:
         t = ldb[i, c] / (ldb[i, c] - ldb[i + 1, c])

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from specdesign import closedloop, feasibility as fz, spec, validate
+from specdesign.feasibility import conditions as fzc
 from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw
 
@@ -59,12 +60,12 @@ def test_poisson_mean_of_rosco_sensitivity_is_zero(model):
     # Poisson mean of ln|S(jω)| of ROSCO's loop is ln|S(z)| = 0 (the quadrature and the kernel's
     # mass off the grid, checked on the real loop)
     plant = model.linearize(19.0)
-    z = fz._rhp_zeros(plant)
+    z = fzc._rhp_zeros(plant)
     z = z[z.imag > 0][0]
     w = closedloop.refine_grid(np.geomspace(1e-3, 1e3, 3000), [z], rel_width=0.2, rel_step=2e-4)
     c = closedloop.siso_response(rosco_baseline(model, 19.0), w)
     s = 1 / (1 + c * closedloop.frequency_response(plant, w, "gen_speed", "pitch_cmd"))
-    assert abs(fz._poisson_mean(w, np.log(np.abs(s)), z, 0.0)) < 2e-3
+    assert abs(fzc._poisson_mean(w, np.log(np.abs(s)), z, 0.0)) < 2e-3
 
 
 def test_rosco_meets_its_own_specifications(model):
@@ -184,7 +185,8 @@ def test_a_fixed_speed_relaxation_gives_the_largest_slack(model):
     # (a larger one, by the bisection's tolerance, falls below it)
     t = fz.specification_for_target(model, 19.0, 25.0, speed_relax_db=6.0)
     base = spec.baseline_analysis(model, 19.0)
-    assert t.speed_relax_db == 6.0 and t.promise.exact_del >= 25.0
+    # the certificate meets the 6 dB map; W_Ω covers what it needs at the other plant cases too
+    assert t.design.speed_relax_db == 6.0 and t.speed_relax_db >= 6.0 and t.promise.exact_del >= 25.0
     ratio = np.abs(t.design.t_tower) / np.abs(base.t_response)
     over = spec.promise_of(10 ** ((t.slack_db + 0.1) / 20) * ratio, base).exact_del
     assert over < 25.0 < t.promise.exact_del < 25.0 + 1.0

@@ -494,8 +494,8 @@ def loop_maps(plant: control.LTI, pitch_controller: ElementLike, omega: ArrayLik
     )
 
 
-def plant_responses(plants: Sequence[control.LTI], omega: ArrayLike,
-                    outputs: Sequence[str] = LOOP_OUTPUTS) -> dict[tuple[str, str], np.ndarray]:
+def plant_responses(plants: Sequence[control.LTI], omega: ArrayLike, outputs: Sequence[str] = LOOP_OUTPUTS, *,
+                    method: str = "python-control") -> dict[tuple[str, str], np.ndarray]:
     """Frequency responses of several plant cases from both plant inputs to some outputs.
 
     Parameters
@@ -506,6 +506,12 @@ def plant_responses(plants: Sequence[control.LTI], omega: ArrayLike,
         Frequencies, rad/s: 1-D, increasing, non-negative.
     outputs : sequence of str
         Plant outputs to evaluate (default :data:`LOOP_OUTPUTS`).
+    method : {"python-control", "batched"}
+        ``"python-control"``: each channel by :func:`frequency_response` (python-control
+        evaluates the whole plant once per frequency). ``"batched"``: one batched solve of
+        (jωI − A)X = B per plant for the selected channels, ~100× faster on long grids, equal
+        to round-off (the tests compare them); the fixed-structure QFT tuner keeps the first,
+        whose round-off its documented designs were made with.
 
     Returns
     -------
@@ -519,13 +525,34 @@ def plant_responses(plants: Sequence[control.LTI], omega: ArrayLike,
         If a plant is not an LTI system.
     ValueError
         If ``omega`` is not a valid grid or a plant lacks a named signal; an empty ``plants``
-        also raises (numpy cannot stack nothing).
+        also raises (numpy cannot stack nothing); an unknown ``method``.
     """
-
+    if method == "batched":
+        w = as_omega(omega, "omega")
+        per_plant = [_batched(P, w, outputs) for P in plants]
+        return {key: np.stack([r[key] for r in per_plant], axis=1) for key in per_plant[0]}
+    if method != "python-control":
+        raise ValueError(f"method={method!r} must be 'python-control' or 'batched'")
     return {
         (o, i): np.stack([frequency_response(P, omega, o, i) for P in plants], axis=1)
         for o in outputs for i in PLANT_INPUTS
     }
+
+
+def _batched(P, w, outputs):
+    import control
+
+    if not isinstance(P, control.LTI):
+        raise TypeError(f"each plant must be a python-control LTI system, got {type(P).__name__}")
+    require_signals(P, "plant", inputs=PLANT_INPUTS, outputs=tuple(outputs))
+    ss = control.ss(P)
+    oi = [ss.output_labels.index(o) for o in outputs]
+    ii = [ss.input_labels.index(i) for i in PLANT_INPUTS]
+    a, b = np.asarray(ss.A), np.asarray(ss.B)[:, ii]
+    c, d = np.asarray(ss.C)[oi], np.asarray(ss.D)[np.ix_(oi, ii)]
+    x = np.linalg.solve(1j * w[:, None, None] * np.eye(a.shape[0]) - a, np.broadcast_to(b, (w.size,) + b.shape))
+    y = c @ x + d
+    return {(o, i): y[:, k, j] for k, o in enumerate(outputs) for j, i in enumerate(PLANT_INPUTS)}
 
 
 def close_responses(R: Mapping[tuple[str, str], np.ndarray], k: ArrayLike, measurement: str,

@@ -15,8 +15,8 @@ import control as ct
 import numpy as np
 
 from .._checks import positive_scalar
-from ..closedloop import (check_stability, close_responses, closed_loop, general_coefficients, lightly_damped,
-                          partial_loop, plant_responses, refine_grid, siso_response)
+from ..closedloop import check_stability, closed_loop, lightly_damped, plant_responses, refine_grid, siso_response
+from .checks import bounds_met, loop_checks
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
 
@@ -28,7 +28,8 @@ if TYPE_CHECKING:
     from ..spec import Baseline, Promise, ShapingResult, Specification
     from ..turbine import TurbineModel
 
-__all__ = ["QFTDesign", "design_qft", "design_schedule", "design_table", "format_table", "DEFAULT_DESIGN_OMEGA"]
+__all__ = ["QFTDesign", "design_qft", "assemble_design", "design_schedule", "design_table", "format_table",
+           "DEFAULT_DESIGN_OMEGA"]
 
 
 #: Default QFT design frequencies, rad/s: the wind band, the tower mode (~1.06 rad/s) and
@@ -290,16 +291,9 @@ def _template_speeds(model, v, offsets):
     return tuple(speeds), speeds.index(v)
 
 
-def _callable(fn, key):
-    def f(omega):
-        return fn(np.asarray(omega, float))[key]
-
-    return f
-
-
 def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
                speed_relax_db: float | Sequence[float] = (3.0, 4.5, 6.0, 8.0), spec: Any = None,
-               **kwargs: Any) -> QFTDesign:
+               structure: str | None = None, **kwargs: Any) -> QFTDesign:
     """QFT design of C_β and C_atd at ``wind_speed`` (m/s) against the fatigue-based specs.
 
     The automatic procedure of :mod:`specdesign.qft`: fixed structures started from ROSCO,
@@ -325,6 +319,12 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         ratio W/T^ROSCO; no DEL penalty is used (the specification carries the target, and
         ``target_reduction`` is set to its promise). ``success`` then means: every bound met,
         the dense check passed for every case, every loop stable.
+    structure : {"certificate", "fixed"}, optional
+        The controller designed. ``"fixed"``: the tuned fixed structures (PI + notch + low-pass
+        and a first-order ATD). ``"certificate"`` (only with a TargetSpecification; its
+        default): the specification's certificate reduced to the lowest order that meets it
+        over the plant cases (:func:`specdesign.qft.certificate.design_from_certificate`;
+        options ``max_sensitivity``, ``min_decay``, ``design_omega``, ``dense_omega``).
     **kwargs
         Options of each design attempt (keyword only):
 
@@ -405,6 +405,22 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
     if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
+    from ..feasibility import TargetSpecification
+
+    if structure not in (None, "certificate", "fixed"):
+        raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
+    if structure == "certificate" and not isinstance(spec, TargetSpecification):
+        raise ValueError("structure='certificate' needs spec=feasibility.TargetSpecification (it carries the certificate)")
+    if isinstance(spec, TargetSpecification) and structure != "fixed":
+        from .certificate import design_from_certificate
+
+        allowed = {"max_sensitivity", "min_decay", "design_omega", "dense_omega"}
+        if set(kwargs) - allowed:
+            raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
+                            f"got {sorted(set(kwargs) - allowed)}")
+        if model.check_wind_speed(wind_speed) != spec.design.wind_speed:
+            raise ValueError(f"spec was made at {spec.design.wind_speed:g} m/s, not at wind_speed={wind_speed!r}")
+        return design_from_certificate(model, spec, **kwargs)
     if spec is not None:
         return _design_single(model, wind_speed, None, speed_relax_db=float(ladder[0]), given=_given_spec(spec), **kwargs)
     design = None
@@ -531,7 +547,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
     while True:
         x, feasible = tune(prob, x, None if given is not None else t, min_decay, maxfev)
         cb, ca = controllers(x, v)
-        pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = _checks(prob, cb, ca, wdense)
+        pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = loop_checks(prob, cb, ca, wdense)
         bad = [w for chk in (pitch_check, atd_check) for name in chk.names for w in [chk.worst(name)] if w[1] < 0]
         # more design frequencies cannot rescue a design that already fails on the ones it has
         if not bad or not feasible or rounds >= refine:
@@ -542,12 +558,69 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
         prob.set_design(new)
         rounds += 1
 
+    red, dred, gs, ps, rate = prob.performance(x)
+    return assemble_design(model, prob, cb, ca, wdense, t, (red, dred, gs, ps, rate), base=base, tower_spec=tower_spec,
+                           speed_spec=speed_spec, shaping=shaping, promise=promise, parameters=from_vector(x),
+                           options=dict(spec_reduction=spec_reduction, template_offsets=tuple(offsets),
+                                        speed_relax_db=speed_relax_db, tower_relax_db=tower_relax_db,
+                                        tower_relax_omega=tower_relax_omega, max_sensitivity=max_sensitivity,
+                                        min_decay=min_decay, refine_rounds=rounds),
+                           checks=(pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs))
+
+
+def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_spec, speed_spec, shaping, promise,
+                    parameters, options, checks=None) -> QFTDesign:
+    """Check a pair of controllers against a tuning problem's specifications and record the design.
+
+    The exact bounds at the design frequencies, the dense checks of both loops over every
+    plant case, closed-loop stability of every case, and the nominal performance.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine (kept for the record's provenance).
+    prob : specdesign.qft.tuner.TuningProblem
+        Plant cases, weights, design frequencies, ``max_sensitivity``.
+    cb, ca : control.LTI
+        Pitch controller C_β (rad per rad/s) and ATD controller C_atd (rad per m/s).
+    wdense : numpy.ndarray
+        Grid of the dense check, rad/s.
+    t : float
+        The DEL reduction the design must reach, % (0.5 pp tolerance).
+    performance : tuple of float
+        (DEL reduction %, damage reduction %, σ ratios of gen speed, pitch, pitch rate) nominal.
+    base : specdesign.spec.Baseline
+        ROSCO's baseline at the nominal speed.
+    tower_spec, speed_spec : object
+        The specifications met (recorded).
+    shaping : specdesign.spec.ShapingResult
+        The shaping the tower specification came from (recorded).
+    promise : specdesign.spec.Promise
+        The promise of the tower specification (recorded).
+    parameters : dict
+        Controller parameters (recorded).
+    options : dict
+        Options of the design (recorded).
+    checks : tuple, optional
+        :func:`specdesign.qft.checks.loop_checks`'s result for these controllers, if computed.
+
+    Returns
+    -------
+    QFTDesign
+        The design; ``success`` False with a message (and a RuntimeWarning) when a check fails.
+    """
+    from loopshaping import qft as lqft
+
+    v, nom, speeds = prob.v, prob.nom, prob.speeds
+    if checks is None:
+        checks = loop_checks(prob, cb, ca, wdense)
+    pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = checks
     # exact bounds on the final design frequencies, for the Nichols charts and the bound check
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", lqft.BoundsWarning)
         pitch_bounds = lqft.intersect(*[lqft.bounds(pitch_t, s_) for s_ in pitch_specs])
         atd_bounds = lqft.intersect(*[lqft.bounds(atd_t, s_) for s_ in atd_specs])
-    bounds_met = _bounds_met(pitch_bounds, cb, pitch_t, prob.wd) and _bounds_met(atd_bounds, ca, atd_t, prob.wd)
+    met = bounds_met(pitch_bounds, cb, pitch_t, prob.wd) and bounds_met(atd_bounds, ca, atd_t, prob.wd)
 
 
     with warnings.catch_warnings():
@@ -555,15 +628,15 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
         stable = [check_stability(closed_loop(P, cb, ca, warn=False), tol=0.0) for P in prob.plants]
         cl = closed_loop(prob.plants[nom], cb, ca, warn=False)
     all_stable = bool(np.all(stable))
-    red, dred, gs, ps, rate = prob.performance(x)
-    Rdense = plant_responses(prob.plants, wdense, ("gen_speed", "tower_top_vel"))
+    red, dred, gs, ps, rate = performance
+    Rdense = plant_responses(prob.plants, wdense, ("gen_speed", "tower_top_vel"), method=prob.response_method)
     cdn, kdn = siso_response(cb, wdense)[:, None], siso_response(ca, wdense)[:, None]
     peak_in = float(np.max(1 / np.abs(1 + cdn * Rdense[("gen_speed", "pitch_cmd")] + kdn * Rdense[("tower_top_vel", "pitch_cmd")])))
     nomp = pitch_t.nominal
     problems = []
     if red < t - 0.5:
         problems.append(f"DEL reduction {red:.1f} % below the target {t:g} %")
-    if not bounds_met:
+    if not met:
         problems.append("a bound is violated at a design frequency")
     if not pitch_check.passed:
         problems.append("dense check of the pitch loop failed: " + pitch_check.summary().replace("\n", "; "))
@@ -574,87 +647,20 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
     success = not problems
     message = "all specifications met" if success else "; ".join(problems)
     if not success:
-        warnings.warn(f"design_qft at {v:g} m/s: {message}", RuntimeWarning, stacklevel=2)
+        warnings.warn(f"design_qft at {v:g} m/s: {message}", RuntimeWarning, stacklevel=3)
     return QFTDesign(
         wind_speed=v, pitch_controller=cb, atd_controller=ca, baseline_controller=prob.rosco[nom],
         template_speeds=speeds, design_omega=prob.wd.copy(), dense_omega=wdense, tower_spec=tower_spec,
         speed_spec=speed_spec, shaping=shaping, promise=promise, pitch_template=pitch_t, atd_template=atd_t,
         pitch_bounds=pitch_bounds, atd_bounds=atd_bounds, pitch_check=pitch_check, atd_check=atd_check, closed_loop=cl,
-        baseline=base, bounds_met=bool(bounds_met), all_stable=all_stable, del_reduction=float(red),
+        baseline=base, bounds_met=bool(met), all_stable=all_stable, del_reduction=float(red),
         damage_reduction=float(dred), gen_speed_sd_change=100 * (gs - 1), pitch_sd_change=100 * (ps - 1),
         pitch_rate_sd_change=100 * (rate - 1), pitch_rate_sd=float(rate * prob.sd0["pitch_rate"]),
         gain_margin_db=float(pitch_check.gain_margin_db[nomp]), phase_margin_deg=float(pitch_check.phase_margin_deg[nomp]),
         atd_gain_margin_db=float(atd_check.gain_margin_db[nomp]), atd_phase_margin_deg=float(atd_check.phase_margin_deg[nomp]),
-        actuator_peak_sensitivity=peak_in, target_reduction=t, success=success, message=message, parameters=from_vector(x),
-        options=dict(spec_reduction=spec_reduction, template_offsets=tuple(offsets), speed_relax_db=speed_relax_db,
-                     tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega, max_sensitivity=max_sensitivity,
-                     min_decay=min_decay, refine_rounds=rounds),
+        actuator_peak_sensitivity=peak_in, target_reduction=t, success=success, message=message, parameters=parameters,
+        options=options,
     )
-
-
-def _checks(prob, cb, ca, wdense):
-    """Templates, specs (general form, callables of ω) and dense checks of both loops."""
-    from loopshaping import qft as lqft
-    from loopshaping.check import check as lcheck
-
-    plants, nom = prob.plants, prob.nom
-
-    def data(omega):
-        w = np.asarray(omega, float)
-        R = plant_responses(plants, w, ("gen_speed", "tower_base_my", "tower_top_vel"))
-        c, k = siso_response(cb, w)[:, None], siso_response(ca, w)[:, None]
-        W_speed, W_tower = prob.weights(w)
-        Rp = close_responses(R, k, "tower_top_vel", ("gen_speed", "tower_base_my"))  # ATD closed: C_β's plant
-        Ra = close_responses(R, c, "gen_speed", ("tower_top_vel", "tower_base_my", "gen_speed"))  # pitch closed: ATD's plant
-        out = {"W_speed": W_speed, "W_tower": W_tower}
-        for tag, RR, meas in (("p", Rp, "gen_speed"), ("a", Ra, "tower_top_vel")):
-            for y in ("gen_speed", "tower_base_my"):
-                A, B, C, D = general_coefficients(RR, y, meas)
-                out.update({f"{tag}{y}A": A, f"{tag}{y}B": B, f"{tag}{y}C": C, f"{tag}{y}D": D})
-        out["pin_A"] = 1 / (1 + k * R[("tower_top_vel", "pitch_cmd")])
-        out["zero"] = np.zeros_like(out["pin_A"])
-        out["one"] = np.ones_like(out["pin_A"])
-        out["pin_D"] = Rp[("gen_speed", "pitch_cmd")]
-        return out
-
-    cache = {}
-
-    def fn(w):
-        key = w.tobytes()
-        if key not in cache:
-            cache[key] = data(w)
-        return cache[key]
-
-    def general(tag, y, weight, name):
-        return lqft.Spec("general", _callable(fn, weight), name=name,
-                         kind_args={k: _callable(fn, f"{tag}{y}{k}") for k in "ABCD"})
-
-    pitch_specs = [
-        general("p", "gen_speed", "W_speed", "speed"),
-        general("p", "tower_base_my", "W_tower", "tower"),
-        lqft.Spec("sensitivity", prob.ms, name="margin"),
-        lqft.Spec("general", prob.ms, name="actuator_margin",
-                  kind_args={"A": _callable(fn, "pin_A"), "B": _callable(fn, "zero"), "C": _callable(fn, "one"),
-                             "D": _callable(fn, "pin_D")}),
-    ]
-    atd_specs = [
-        general("a", "gen_speed", "W_speed", "speed"),
-        general("a", "tower_base_my", "W_tower", "tower"),
-        lqft.Spec("sensitivity", prob.ms, name="margin"),
-    ]
-    pitch_plants = [partial_loop(P, ca, "tower_top_vel")["gen_speed", "pitch_cmd"] for P in plants]
-    atd_plants = [partial_loop(P, cb, "gen_speed")["tower_top_vel", "pitch_cmd"] for P in plants]
-    pitch_t = lqft.Template.from_systems(pitch_plants, prob.wd, nom)
-    atd_t = lqft.Template.from_systems(atd_plants, prob.wd, nom)
-    pitch_check = lcheck(pitch_t, cb, pitch_specs, wdense)
-    atd_check = lcheck(atd_t, ca, atd_specs, wdense)
-    return pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs
-
-
-def _bounds_met(bounds, controller, template, omega):
-    L0 = template.nominal_response * siso_response(controller, template.omega)
-    ok = bounds.is_allowed(template.omega, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
-    return bool(np.all(ok))
 
 
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),

@@ -69,6 +69,10 @@ class TuningProblem:
     speed_shaping : callable, optional
         ω → W_Ω(jω)/T^ROSCO_{Ω,w}(jω) of the nominal case, applied to every case in place of
         the constant relaxation ``speed_relax_db`` (a given generator-speed specification).
+    response_method : {"python-control", "batched"}
+        How the plant cases are evaluated (:func:`specdesign.closedloop.plant_responses`); the
+        fixed-structure design keeps python-control's round-off, the certificate design the
+        fast batched solve.
 
     Attributes
     ----------
@@ -105,10 +109,12 @@ class TuningProblem:
 
     def __init__(self, model: TurbineModel, v: float, speeds: Sequence[float], nominal: int, design_omega: ArrayLike,
                  tower_shaping: Callable[[np.ndarray], np.ndarray], speed_relax_db: float, max_sensitivity: float,
-                 base: Baseline, speed_shaping: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+                 base: Baseline, speed_shaping: Callable[[np.ndarray], np.ndarray] | None = None,
+                 response_method: str = "python-control") -> None:
         from .. import turbine
 
         self.v, self.speeds, self.nom = v, speeds, nominal
+        self.response_method = response_method  # plant_responses' method, for every evaluation of the plants
         self.plants = [model.linearize(s) for s in speeds]
         self.rosco = [turbine.rosco_baseline(model, s) for s in speeds]
         self.tower_shaping = tower_shaping  # callable ω → complex shaping (notches × relaxation)
@@ -117,7 +123,7 @@ class TuningProblem:
         self.ms = max_sensitivity
         self.base = base
         self.wf, self.S = base.omega, base.wind_psd
-        self.Rf = plant_responses(self.plants, self.wf)
+        self.Rf = plant_responses(self.plants, self.wf, method=response_method)
         self.pss = []
         for P in self.plants:
             p = ct.ss(P)[["gen_speed", "tower_top_vel"], "pitch_cmd"]
@@ -156,7 +162,7 @@ class TuningProblem:
         w_tower : numpy.ndarray
             |W_MyT| = |T^ROSCO_{MyT,w}|·|tower_shaping| per case, N·m per m/s.
         """
-        R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"))
+        R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method=self.response_method)
         c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
         gain = self.speed_gain if self.speed_shaping is None else np.abs(self.speed_shaping(omega))[:, None]
         w_speed = np.abs(self._t(R, c, 0.0, "gen_speed")) * gain
@@ -172,7 +178,8 @@ class TuningProblem:
             New design frequencies, rad/s (replaces ``wd``, ``Rd``, ``WO``, ``WM``).
         """
         self.wd = np.asarray(omega, float)
-        self.Rd = plant_responses(self.plants, self.wd, ("gen_speed", "tower_base_my", "tower_top_vel"))
+        self.Rd = plant_responses(self.plants, self.wd, ("gen_speed", "tower_base_my", "tower_top_vel"),
+                                  method=self.response_method)
         self.WO, self.WM = self.weights(self.wd)
 
     def margins(self, x: ArrayLike) -> np.ndarray:
@@ -259,8 +266,6 @@ class TuningProblem:
             Tower-base DEL reduction (%), damage reduction (%), and the ratios σ/σ_ROSCO (-) of
             generator speed, pitch and pitch rate.
         """
-        from .. import spectral
-
         key = np.asarray(x, float).tobytes()
         if getattr(self, "_perf_key", None) == key:  # the objective and the constraints ask for the same x
             return self._perf
@@ -268,15 +273,32 @@ class TuningProblem:
         s = 1j * self.wf[:, None]
         c = np.polyval(nb, s) / np.polyval(db, s)
         k = np.polyval(na, s) / np.polyval(da, s)
+        self._perf_key, self._perf = key, self.performance_of(c, k)
+        return self._perf
+
+    def performance_of(self, c: np.ndarray, k: np.ndarray) -> tuple[float, float, float, float, float]:
+        """:meth:`performance` of any controllers, given their responses on the baseline's grid.
+
+        Parameters
+        ----------
+        c, k : numpy.ndarray
+            C_β (rad per rad/s) and C_atd (rad per m/s) at jω for ω = ``base.omega``, shape
+            (n_omega, 1) (or broadcasting to it).
+
+        Returns
+        -------
+        tuple of float
+            As :meth:`performance`.
+        """
+        from .. import spectral
+
         tm = self._t(self.Rf, c, k, "tower_base_my")[:, self.nom]
         tp = self._t(self.Rf, c, k, "pitch")[:, self.nom]
         to = self._t(self.Rf, c, k, "gen_speed")[:, self.nom]
         d = float(spectral.damage_rate(self.wf, np.abs(tm) ** 2 * self.S, self.base.m, method=self.base.method))
         ratio = d / self.d0
-        self._perf_key, self._perf = key, (
-            100 * (1 - ratio ** (1 / self.base.m)), 100 * (1 - ratio), self._sd(to) / self.sd0["gen_speed"],
-            self._sd(tp) / self.sd0["pitch"], self._sd(tp * 1j * self.wf) / self.sd0["pitch_rate"])
-        return self._perf
+        return (100 * (1 - ratio ** (1 / self.base.m)), 100 * (1 - ratio), self._sd(to) / self.sd0["gen_speed"],
+                self._sd(tp) / self.sd0["pitch"], self._sd(tp * 1j * self.wf) / self.sd0["pitch_rate"])
 
     def objective(self, x: ArrayLike) -> float:
         """The tuning objective: (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)², nominal case.

@@ -1,0 +1,213 @@
+"""The best pitch design over every stabilising controller: a convex Youla design (see :mod:`specdesign.feasibility`)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import positive_scalar
+
+__all__ = ["YOULA_REAL_POLES", "YOULA_PAIRS", "AchievablePitch", "achievable_pitch"]
+
+
+#: Poles (rad/s) of the Youla basis: real poles spanning the wind band, and lightly damped pairs
+#: (ζ = 0.2) around the tower mode, where the specification is shaped.
+YOULA_REAL_POLES = np.geomspace(0.03, 10.0, 6)
+YOULA_PAIRS = (0.9, 1.02, 1.1, 1.25)
+
+
+def _youla_basis(s):
+    """(n_s, n_basis) complex responses of the basis functions of Y at ``s`` (1/s)."""
+    cols = [np.ones_like(s)]
+    cols += [p / (s + p) for p in YOULA_REAL_POLES]
+    for wn in YOULA_PAIRS:
+        den = s * s + 2 * 0.2 * wn * s + wn * wn
+        cols += [wn * wn / den, wn * s / den]
+    return np.stack(cols, axis=1)
+
+
+def _youla_tf(coef):
+    import control
+
+    terms = [control.tf([coef[0]], [1.0])]
+    terms += [control.tf([c * p], [1.0, p]) for c, p in zip(coef[1:1 + YOULA_REAL_POLES.size], YOULA_REAL_POLES)]
+    rest = coef[1 + YOULA_REAL_POLES.size:]
+    for k, wn in enumerate(YOULA_PAIRS):
+        a, b = rest[2 * k], rest[2 * k + 1]
+        terms.append(control.tf([b * wn, a * wn * wn], [1.0, 2 * 0.2 * wn, wn * wn]))
+    y = terms[0]
+    for t in terms[1:]:
+        y = y + t
+    return y
+
+
+@dataclass(frozen=True)
+class AchievablePitch:
+    """A stabilising pitch design from :func:`achievable_pitch` and the specification it achieves.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Operating point, m/s.
+    speed_relax_db : float
+        Relaxation of the generator-speed specification it meets, dB.
+    max_sensitivity : float
+        M_s it meets (-).
+    omega : numpy.ndarray
+        Grid, rad/s.
+    youla : numpy.ndarray
+        Coefficients of Y on the basis (:data:`YOULA_REAL_POLES`, :data:`YOULA_PAIRS`).
+    t_tower, t_speed, sensitivity : numpy.ndarray
+        T_{MyT,w} (N·m per m/s), T_{Ω,w} ((rad/s) per (m/s)) and S (-) on ``omega``, complex.
+    del_reduction : float
+        Exact (Dirlik, 1 Hz) tower-base DEL reduction against ROSCO, %.
+    speed_excess_db : float
+        Largest |T_{Ω,w}|/|W_Ω| on the grid, dB (≤ 0 up to the solver's tolerance).
+    status : str
+        The solver's status.
+    """
+
+    wind_speed: float
+    speed_relax_db: float
+    max_sensitivity: float
+    omega: np.ndarray
+    youla: np.ndarray
+    t_tower: np.ndarray
+    t_speed: np.ndarray
+    sensitivity: np.ndarray
+    del_reduction: float
+    speed_excess_db: float
+    status: str
+
+    def controller(self, model):
+        """The pitch controller C = Y/(1 − P_{Ω,β}·Y) that achieves it, β = −C·Ω_g.
+
+        Parameters
+        ----------
+        model : specdesign.turbine.TurbineModel
+            The turbine it was designed on.
+
+        Returns
+        -------
+        control.TransferFunction
+            C (rad per rad/s); of high order (the basis plus the plant): a certificate of
+            feasibility and a reference, not a controller to implement as it is.
+        """
+        import control
+
+        p = control.ss(model.linearize(self.wind_speed))["gen_speed", "pitch_cmd"]
+        y = _youla_tf(self.youla)
+        return control.minreal(control.feedback(y, control.tf(p), sign=+1), verbose=False)
+
+
+def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=2.0, max_pitch_rate_ratio=1.0,
+                     m=4.0, omega=None, base=None, integral_action=True) -> AchievablePitch:
+    """The pitch design that minimises the predicted tower damage under a generator-speed specification.
+
+    Every stabilising controller of the stable plant is C = Y/(1 − P_{Ω,β}Y) with Y stable,
+    and then S = 1 − P_{Ω,β}Y, T_{Ω,w} = P_{Ω,w}S, T_{MyT,w} = P_{MyT,w} − P_{MyT,β}P_{Ω,w}Y:
+    affine in Y. With Y on a fixed stable basis, minimising Eq. (10)'s damage,
+    Σ ΔD%(ω)·|T_{MyT,w}|²/|T^ROSCO_{MyT,w}|², subject to |T_{Ω,w}| ≤ 10^(g/20)|T^ROSCO_{Ω,w}|
+    and |S| ≤ M_s on the grid, with at most ``max_pitch_rate_ratio`` times ROSCO's pitch-rate
+    SD, is a convex (second-order cone) problem. The design is for the nominal plant at
+    ``wind_speed`` (no plant cases besides it; robustness only through M_s), and its controller
+    is of high order: it shows what a specification can promise, not what to implement.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    speed_relax_db : float
+        Relaxation g of the generator-speed specification, dB (≥ 0).
+    max_sensitivity : float
+        M_s (-).
+    max_pitch_rate_ratio : float
+        κ: the pitch-rate SD, ∫|ω·T_{β,w}|²S_W dω on the grid, at most κ² times ROSCO's
+        (a quadratic constraint; 1.0: no more pitch activity than ROSCO).
+    m : float
+        Wöhler exponent (-).
+    omega : array_like, optional
+        Grid, rad/s (default :func:`specdesign.spec.default_omega`).
+    base : specdesign.spec.Baseline, optional
+        ROSCO's baseline at ``wind_speed`` if already computed (its grid is used).
+    integral_action : bool
+        Require S(0) = 0 (a linear equality on Y(0)): the controller integrates the speed error
+        as ROSCO's PI does, so T_{Ω,w} vanishes at 0 rad/s and the speed specification holds
+        below the grid too (without it the design may trade the steady-state speed error).
+
+    Returns
+    -------
+    AchievablePitch
+        The design, its maps and its exact promise.
+
+    Raises
+    ------
+    RuntimeError
+        If the solver finds no solution.
+    """
+    import cvxpy as cp
+
+    from .. import spec, spectral
+    from ..closedloop import frequency_response, siso_response
+    from ..rosco import rosco_baseline
+
+    g = float(speed_relax_db)
+    kappa = positive_scalar(max_pitch_rate_ratio, "max_pitch_rate_ratio")
+    if not (np.isfinite(g) and g >= 0):
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB")
+    ms = positive_scalar(max_sensitivity, "max_sensitivity")
+    if base is None:
+        base = spec.baseline_analysis(model, wind_speed, m=m, omega=omega)
+    w = base.omega
+    plant = model.linearize(float(wind_speed))
+    a = frequency_response(plant, w, "tower_base_my", "wind")
+    ow = frequency_response(plant, w, "gen_speed", "wind")
+    ob = frequency_response(plant, w, "gen_speed", "pitch_cmd")
+    gy = frequency_response(plant, w, "tower_base_my", "pitch_cmd") * ow
+    w_speed = np.abs(spec.speed_specification(model, float(wind_speed)).response(w)) * 10 ** (g / 20)
+    phi = _youla_basis(1j * w)
+    t_ref2 = np.abs(base.t_response) ** 2
+    weight = np.maximum(base.sensitivity, 0.0) + 1e-3 * base.sensitivity.max()
+
+    # solve in orthonormal coordinates of the basis on the grid (the raw basis is collinear)
+    q, rr = np.linalg.qr(np.vstack([phi.real, phi.imag]))
+    phi_o = q[: w.size] + 1j * q[w.size:]
+    y = cp.Variable(phi.shape[1])
+    tc, tl = a, -gy[:, None] * phi_o
+    sc, sl = np.ones_like(ob), -ob[:, None] * phi_o
+    t_re = tc.real + tl.real @ y
+    t_im = tc.imag + tl.imag @ y
+    s_re = sc.real + sl.real @ y
+    s_im = sc.imag + sl.imag @ y
+    scale = np.sqrt(weight / t_ref2)
+    objective = cp.sum_squares(cp.multiply(scale, t_re)) + cp.sum_squares(cp.multiply(scale, t_im))
+    s_bound = np.minimum(ms, w_speed / np.abs(ow))  # |S| ≤ M_s and |P_{Ω,w}S| ≤ W_Ω
+    constraints = [cp.norm(cp.vstack([s_re, s_im]), 2, axis=0) <= s_bound]
+    # pitch-rate activity: the rate spectrum |ω·T_{β,w}|²S_W, T_{β,w} = −P_{Ω,w}Y, integrated
+    # (trapezoid weights), at most κ² times ROSCO's
+    from ..spectral import trapezoid_weights
+
+    tw = trapezoid_weights(w)
+    c_ref = siso_response(rosco_baseline(model, float(wind_speed)), w)
+    rate_ref = float(np.sum(tw * np.abs(w * c_ref * ow / (1 + c_ref * ob)) ** 2 * base.wind_psd))
+    rl = (w * ow)[:, None] * phi_o * np.sqrt(tw * base.wind_psd / rate_ref)[:, None]  # scaled to ROSCO's: O(1)
+    constraints.append(cp.sum_squares(rl.real @ y) + cp.sum_squares(rl.imag @ y) <= kappa ** 2)
+    if integral_action:  # S(0) = 1 − P_{Ω,β}(0)·Y(0) = 0, in the orthonormal coordinates
+        p0 = float(np.real(plant["gen_speed", "pitch_cmd"].dcgain()))
+        phi0 = np.linalg.solve(rr.T, np.real(_youla_basis(np.zeros(1, complex))[0]))
+        constraints.append(p0 * (phi0 @ y) == 1.0)
+    prob = cp.Problem(cp.Minimize(objective), constraints)
+    prob.solve()
+    if y.value is None or prob.status not in ("optimal", "optimal_inaccurate"):
+        raise RuntimeError(f"achievable_pitch at {wind_speed:g} m/s: the solver returned {prob.status!r}")
+    yv = phi_o @ np.asarray(y.value, float)
+    coef = np.linalg.solve(rr, np.asarray(y.value, float))
+    sens = 1 - ob * yv
+    t_tower = a - gy * yv
+    t_speed = ow * sens
+    d = spectral.damage_rate(w, np.abs(t_tower) ** 2 * base.wind_psd, base.m, method=base.method)
+    red = float(spectral.del_reduction(100.0 * (1.0 - d / base.damage_rate), base.m))
+    excess = float(20 * np.log10(np.max(np.abs(t_speed) / w_speed)))
+    return AchievablePitch(float(wind_speed), g, ms, w, coef, t_tower, t_speed, sens, red, excess, str(prob.status))

@@ -1,0 +1,301 @@
+"""A feasible specification pair for a DEL-reduction target (see :mod:`specdesign.feasibility`)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .achievable import AchievablePitch, achievable_pitch
+
+__all__ = ["TargetSpecification", "specification_for_target", "DEFAULT_CASE_OFFSETS", "RELAX_LADDER_DB"]
+
+
+#: Wind-speed offsets (m/s) of the plant cases a target specification is certified on: the
+#: neighbouring operating points design_qft's templates use by default.
+DEFAULT_CASE_OFFSETS = (-1.0, -0.5, 0.5, 1.0)
+#: Relaxations of the speed map (dB) tried in turn by :func:`specification_for_target` before
+#: its bisection.
+RELAX_LADDER_DB = (0.5, 1.0, 1.5, 2.0, 3.0, 4.5, 6.0, 8.0)
+
+
+@dataclass(frozen=True)
+class TargetSpecification:
+    """A specification pair that promises a DEL reduction and is feasible by construction.
+
+    Parameters
+    ----------
+    tower : specdesign.spec.Specification
+        W_MyT: the certifying design's nominal T_{MyT,w} times ``slack_db`` (a transfer function
+        of the order of the design).
+    speed : specdesign.spec.Specification
+        W_Ω: ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``.
+    promise : specdesign.spec.Promise
+        The tower specification's promise against ROSCO (exact Dirlik and Eq. (10)).
+    speed_relax_db : float
+        Relaxation of ROSCO's speed map in W_Ω, dB: what the certificate needs over every
+        plant case, plus ``speed_slack_db``.
+    slack_db : float
+        How far above the certifying design's nominal |T_{MyT,w}| the tower specification lies,
+        dB: ``robustness_db`` (what the plant cases need) plus the designer's slack.
+    design : AchievablePitch
+        The certificate: a stabilising pitch controller that meets both specifications at
+        every plant case.
+    target_reduction : float
+        The DEL reduction asked for, %.
+    case_speeds : tuple of float
+        Operating points of the plant cases (m/s), the nominal one included; at case i the
+        specifications are W_i = T^ROSCO_i·(W/T^ROSCO at the nominal speed).
+    robustness_db : float
+        Largest excess (dB, ≥ 0) of the certificate's |T_{MyT,w}|/|T^ROSCO_{MyT,w}| at a plant
+        case over its nominal ratio, on the dense grid: the part of ``slack_db`` that is not
+        the designer's.
+    speed_slack_db : float
+        Room left above the certificate's speed map, dB.
+    """
+
+    tower: object
+    speed: object
+    promise: object
+    speed_relax_db: float
+    slack_db: float
+    design: AchievablePitch
+    target_reduction: float
+    case_speeds: tuple = ()
+    robustness_db: float = 0.0
+    speed_slack_db: float = 0.0
+
+    @property
+    def template_offsets(self) -> tuple:
+        """Offsets (m/s) of the non-nominal plant cases from the nominal speed.
+
+        Returns
+        -------
+        tuple of float
+            ``case_speeds`` minus the nominal speed, without the nominal 0.
+        """
+        v = self.design.wind_speed
+        return tuple(float(c - v) for c in self.case_speeds if c != v)
+
+
+def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
+                             max_sensitivity=1.8, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
+                             m=4.0, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
+                             dense_omega=None) -> TargetSpecification:
+    """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
+
+    A ladder (:data:`RELAX_LADDER_DB`) then bisection on the relaxation g of ROSCO's
+    generator-speed map: the smallest g whose
+    :func:`achievable_pitch` design, with its tower map raised by ``slack_db`` (room for a
+    designer's own controller) and by what the neighbouring plant cases need, still promises
+    ``target_reduction`` % DEL (exact Dirlik, 1 Hz). Or, with ``speed_relax_db`` given, the
+    other way round: the design at that relaxation and the largest slack that still promises
+    the target (the most room for a low-order design).
+
+    The certificate (the design's controller) is closed around every plant case
+    (``wind_speed`` + ``case_offsets``) on a dense grid (0.005-20 rad/s, refined around lightly
+    damped roots); W_MyT is raised by its largest excess over the nominal ratio to ROSCO's map
+    and W_Ω relaxed to cover its speed maps. So the pair returned is met by that design at
+    every case and feasible by construction, and its promise is the promise of the
+    specification handed to the design step.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    target_reduction : float
+        Tower-base DEL reduction the specification must promise, % (0-100).
+    slack_db : float
+        The designer's room above the certificate's |T_{MyT,w}|, dB (≥ 0); ignored with
+        ``speed_relax_db``.
+    speed_relax_db : float, optional
+        A fixed relaxation of the certificate's speed constraint, dB: the slack is then the
+        largest that keeps the promise ≥ ``target_reduction`` (bisection to ``tolerance_db``).
+    max_sensitivity : float
+        M_s of the certificate (-); below design_qft's 1.9 so that the plant cases and a
+        reduced-order controller keep their margins.
+    max_pitch_rate_ratio : float
+        Pitch-rate SD allowance relative to ROSCO's (-).
+    max_relax_db : float
+        Largest speed relaxation tried, dB.
+    tolerance_db : float
+        Bisection tolerance on the relaxation, dB.
+    m : float
+        Wöhler exponent (-).
+    omega : array_like, optional
+        Grid of the design and the promise, rad/s (default :func:`specdesign.spec.default_omega`).
+    case_offsets : sequence of float
+        Wind-speed offsets of the plant cases, m/s (clipped to ``model.wind_range``; ``()``
+        for the nominal plant only).
+    speed_slack_db : float
+        Room left above the certificate's speed maps in W_Ω, dB (≥ 0).
+    dense_omega : array_like, optional
+        Grid of the plant-case check, rad/s (default 600 points, 0.005-20, refined).
+
+    Returns
+    -------
+    TargetSpecification
+        The pair, its promise and its certificate.
+
+    Raises
+    ------
+    ValueError
+        For a target outside (0, 100), a negative slack, invalid offsets, or when even
+        ``max_relax_db`` does not reach the target (the message gives the promise reached there).
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> t = specification_for_target(iea15mw(), 19.0, 25.0)
+    >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 2.0)
+    True
+    """
+    from .. import spec
+    from .._checks import as_omega
+
+    t = float(target_reduction)
+    if not 0 < t < 100:
+        raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
+    slack = float(slack_db)
+    if not (np.isfinite(slack) and slack >= 0):
+        raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")
+    sslack = float(speed_slack_db)
+    if not (np.isfinite(sslack) and sslack >= 0):
+        raise ValueError(f"speed_slack_db={speed_slack_db!r} must be a finite margin ≥ 0 dB")
+    offsets = np.atleast_1d(np.asarray(case_offsets, float))
+    if offsets.ndim != 1 or not np.all(np.isfinite(offsets)):
+        raise ValueError(f"case_offsets={case_offsets!r} must be finite wind-speed offsets in m/s")
+    v = model.check_wind_speed(wind_speed)
+    lo, hi = model.wind_range
+    speeds = tuple(sorted({float(np.clip(v + o, lo, hi)) for o in offsets} | {v}))
+    dense = (np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None
+             else as_omega(dense_omega, "dense_omega", allow_zero=False))
+    base = spec.baseline_analysis(model, v, m=m, omega=omega)
+    cases = _Cases(model, speeds, v)
+
+    def reached(g, sl=slack):
+        try:
+            d = achievable_pitch(model, v, g, max_sensitivity=max_sensitivity,
+                                 max_pitch_rate_ratio=max_pitch_rate_ratio, base=base)
+        except RuntimeError:
+            return None, -np.inf, None
+        rob = cases.excess(d.controller(model), dense)
+        if rob is None:  # the certificate destabilises a plant case
+            return d, -np.inf, None
+        return d, _slack_promise(d, base, sl + rob[0]), rob
+
+    if speed_relax_db is not None:
+        g = float(speed_relax_db)
+        design, best, rob = reached(g, 0.0)
+        if design is None or rob is None:
+            raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {v:g} m/s over the plant "
+                             f"cases {speeds} m/s")
+        if best < t:
+            raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s with the speed map relaxed by "
+                             f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs); relax it more")
+        lo_s, hi_s = 0.0, 40.0
+        while hi_s - lo_s > tolerance_db:
+            mid = 0.5 * (lo_s + hi_s)
+            lo_s, hi_s = (mid, hi_s) if _slack_promise(design, base, mid + rob[0]) >= t else (lo_s, mid)
+        return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t)
+    # a ladder first, then bisection inside the first rung that reaches the target: the promise
+    # over the plant cases is not monotone in g (bolder designs are less robust), so a bisection
+    # over the whole range could step past the smallest relaxation that works
+    ladder = [g for g in RELAX_LADDER_DB if g < max_relax_db] + [float(max_relax_db)]
+    lo_g, found, best_red = 0.0, None, -np.inf
+    for g in ladder:
+        d, red, rob = reached(g)
+        best_red = max(best_red, red)
+        if red >= t:
+            found = (g, d, rob)
+            break
+        lo_g = g
+    if found is None:
+        raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s over the plant cases {speeds} m/s with "
+                         f"the speed map relaxed up to {max_relax_db:g} dB (best {best_red:.1f} % with {slack:g} dB "
+                         "slack over the plant cases' needs); lower the target or the slack, or allow more pitch "
+                         "activity")
+    hi_g, best, best_rob = found
+    while hi_g - lo_g > tolerance_db:
+        mid = 0.5 * (lo_g + hi_g)
+        d, red, rob = reached(mid)
+        if red >= t:
+            hi_g, best, best_rob = mid, d, rob
+        else:
+            lo_g = mid
+    return _target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t)
+
+
+class _Cases:
+    """The plant cases and ROSCO's loops on them, for the certificate's robustness check."""
+
+    def __init__(self, model, speeds, v):
+        from ..rosco import rosco_baseline
+
+        self.plants = [model.linearize(s) for s in speeds]
+        self.rosco = [rosco_baseline(model, s) for s in speeds]
+        self.nom = speeds.index(v)
+        self._grid = {}
+
+    def _on(self, omega):
+        """Plant responses and ROSCO's maps (|T_MyT|, |T_Ω|), each (n_omega, n_cases), cached per grid."""
+        from ..closedloop import closed_map, plant_responses, siso_response
+
+        key = omega.tobytes()
+        if key not in self._grid:
+            R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
+            c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
+            self._grid[key] = (R, np.abs(closed_map(R, c, 0.0, "tower_base_my")), np.abs(closed_map(R, c, 0.0, "gen_speed")))
+        return self._grid[key]
+
+    def excess(self, controller, omega):
+        """(tower robustness, speed relaxation needed), dB, or None if a case is unstable.
+
+        The grid is refined around the lightly damped roots of the certificate's nominal maps:
+        a narrow dip of W between grid points would hide a violation.
+        """
+        import warnings
+
+        from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response, system_roots
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            loops = [closed_loop(p, controller, warn=False) for p in self.plants]
+        if any(np.max(np.real(cl.poles())) >= 0 for cl in loops):
+            return None
+        cl0 = loops[self.nom]
+        roots = np.concatenate([system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])])
+        w = refine_grid(omega, lightly_damped(roots))
+        R, rt, rs = self._on(w)
+        c = siso_response(controller, w)[:, None]
+        ratio = np.abs(closed_map(R, c, 0.0, "tower_base_my")) / rt
+        speed_db = float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / rs)))
+        tower_db = float(20 * np.log10(np.max(ratio / ratio[:, self.nom:self.nom + 1])))
+        return max(tower_db, 0.0), speed_db
+
+
+def _slack_promise(design, base, slack_db):
+    """Exact DEL promise (%) of a design's |T_{MyT,w}| raised by ``slack_db`` (the shaping |W|/|T^ROSCO|)."""
+    from .. import spec
+
+    return spec.promise_of(10 ** (slack_db / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
+
+
+def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target):
+    import control
+
+    from .. import spec
+    from ..closedloop import closed_loop
+
+    plant = model.linearize(float(wind_speed))
+    # kept as a state space: the polynomial coefficients of a ~25th-order map carry no digits
+    t_sys = control.minreal(closed_loop(plant, design.controller(model), warn=False)["tower_base_my", "wind"],
+                            verbose=False)
+    robust, speed_needed = rob
+    total = slack + robust
+    tower = spec.Specification(t_sys, (spec.Gain(total),), name="W_tower_base_my")
+    relax = max(g, speed_needed) + speed_slack
+    speed = spec.speed_specification(model, float(wind_speed), margin_db=relax)
+    return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, total, design, target,
+                               tuple(speeds), robust, speed_slack)
