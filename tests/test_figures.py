@@ -202,7 +202,7 @@ def _sensitivity(r):
     from specdesign.plots.fatigue import plot_sensitivity
 
     b = r.getfixturevalue("baseline")
-    return plot_sensitivity(b.omega, np.stack([b.sensitivity, 0.5 * b.sensitivity]))
+    return plot_sensitivity(b.omega, np.stack([b.sensitivity * k for k in np.linspace(0.5, 1.0, 12)]))  # > 10 colours
 
 
 def _specification(r):
@@ -243,7 +243,7 @@ FIGURES = {
     "turbine.plot_open_vs_baseline": (_open_vs_baseline, "(rad/s)", ["dB", "dB", "dB"], ["open loop", "ROSCO"]),
     "turbine.plot_fatigue_origin": (_fatigue_origin, "(rad/s)", ["(dB", "per rad/s", "(%)"], ["T_MyT,w", "S_MyT", "ΔD%"]),
     "fatigue.plot_range_histogram": (_range_histogram, "[kN·m]", ["[1/kN·m]"], ["rainflow", "Dirlik"]),
-    "fatigue.plot_sensitivity": (_sensitivity, "[rad/s]", ["[%]"], ["ΔD%(ω) [0]", "ΔD%(ω) [1]"]),
+    "fatigue.plot_sensitivity": (_sensitivity, "[rad/s]", ["[%]"], ["ΔD%(ω) [0]", "ΔD%(ω) [11]"]),
     "spec.plot_specification": (_specification, "(rad/s)", ["(dB re 1 kN·m/(m/s))"], ["baseline", "specification"]),
     "spec.plot_frontier": (_frontier, "[dB]", ["[%]"], ["17 m/s achievable", "19 m/s upper bound"]),
 }

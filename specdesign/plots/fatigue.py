@@ -78,7 +78,9 @@ def plot_sensitivity(omega, dd, ax=None, *, label: str = "ΔD%(ω)"):
         raise ValueError(f"dd must have shape (..., {w.size}) to match omega, got {np.shape(dd)}")
     ax = _axes(ax)
     for i, row in enumerate(d):
-        ax.semilogx(w, row, label=label if d.shape[0] == 1 else f"{label} [{i}]")
+        # past the 10 colours of the cycle the line style changes, so no two rows look alike
+        ax.semilogx(w, row, color=f"C{i % 10}", ls=("-", "--", "-.", ":")[(i // 10) % 4],
+                    label=label if d.shape[0] == 1 else f"{label} [{i}]")
     ax.set_xlabel("frequency ω [rad/s]")
     ax.set_ylabel("ΔD% per 1 % PSD reduction [%]")
     ax.grid(True, which="both", alpha=0.3)

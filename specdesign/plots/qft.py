@@ -26,8 +26,8 @@ def _verdict(design_db, spec_db, w, name):
     excess = design_db - spec_db
     k = int(np.nanargmax(excess))
     if excess[k] <= 0:
-        return f"meets {name} (closest {excess[k]:.1f} dB at {w[k]:.3g} rad/s)"
-    return f"above {name} by up to {excess[k]:.1f} dB at {w[k]:.3g} rad/s"
+        return f"meets {name} (closest {excess[k]:.2f} dB at {w[k]:.3g} rad/s)"
+    return f"above {name} by up to {excess[k]:.2f} dB at {w[k]:.3g} rad/s"
 
 
 def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega: ArrayLike | None = None,
