@@ -362,3 +362,21 @@ def test_design_bode_says_which_spec_the_design_meets(design, model):
     assert any(f"ROSCO + {design.options['speed_relax_db']:g} dB" in lab for lab in speed_labels)
     assert design.message in fig.axes[0].get_title()
     plt.close("all")
+
+
+def test_fig10_as_notebook_06_draws_it_has_no_shared_style(campaign):
+    """Notebook 06 adds the promise ("^:", C2) and the target to plot_reductions' axes: the issue's
+    'two series share one style in Fig. 10' was that promise taking the linearised rainflow's look."""
+    import matplotlib.pyplot as plt
+
+    from specdesign import validate as va
+    from specdesign.plots.validation import plot_reductions
+
+    acc = va.acceptance(campaign, "ATD", "ROSCO")
+    ax = plot_reductions(acc)
+    ax.plot([19.0], [12.0], "^:", color="C2", label="notch specification's promise")  # the notebook's own lines
+    ax.axhline(25.0, color="0.5", lw=0.8, ls="-.", label="design target (25 %)")
+    ax.legend(fontsize="small")
+    _check_figure(ax, "(m/s)", ["(%)"], ["rainflow, linearised model", "Volterra prediction", "notch specification's promise",
+                                        "design target"])
+    plt.close("all")
