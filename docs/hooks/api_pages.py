@@ -84,13 +84,44 @@ def _page(module: str, modules: dict) -> str:
     return text
 
 
+def _nav_paths(nav) -> set[str]:
+    """Every page path the navigation names."""
+    if isinstance(nav, str):
+        return {nav}
+    if isinstance(nav, dict):
+        return set().union(*(_nav_paths(v) for v in nav.values()))
+    if isinstance(nav, list):
+        return set().union(set(), *(_nav_paths(v) for v in nav))
+    return set()
+
+
+def _section(nav: list, title: str) -> list:
+    """The item list of the top-level section ``title`` (created at the end if absent)."""
+    for item in nav:
+        if isinstance(item, dict) and title in item:
+            return item[title]
+    nav.append({title: []})
+    return nav[-1][title]
+
+
 def on_config(config):
-    """Append the API reference to the navigation, packages before their modules."""
+    """Complete the navigation: a reference note (``docs/*.md``) or a notebook that mkdocs.yml
+    does not list yet goes at the end of its section (titled by its first heading), and the API
+    reference is appended, packages before their modules."""
+    nav = config["nav"]
+    listed = _nav_paths(nav)
+    docs = Path(config["docs_dir"])
+    for page in sorted(docs.glob("*.md")):
+        if page.name not in listed:
+            _section(nav, "Reference notes").append(page.name)
+    for nb in notebooks():
+        if f"notebooks/{nb.name}" not in listed:
+            _section(nav, "Notebooks").append(f"notebooks/{nb.name}")
     modules = public_modules()
     api = []
     for pkg in PACKAGES:
         api.append({pkg: [{m: _page_path(m)} for m in modules if m == pkg or m.startswith(pkg + ".")]})
-    config["nav"].append({"API reference": api})
+    nav.append({"API reference": api})
     return config
 
 

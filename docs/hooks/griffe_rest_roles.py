@@ -7,7 +7,7 @@ names and its imports): ``:func:`shape_to_target``` in ``specdesign.spec`` links
 ``specdesign.spec.shape_to_target``; ``~a.b.c`` shows ``c``. A target in ``specdesign`` or
 ``loopshaping`` is a required link, so a broken one fails the strict build; a name outside
 them (``json.dumps``, ``ValueError``) is shown as code without a link. Doctest blocks outside
-an Examples section are fenced as code (Markdown would read ``>>>`` as block quotes).
+an Examples section, and reST literal blocks (``text::`` + an indented block), are fenced as code.
 """
 from __future__ import annotations
 
@@ -69,6 +69,33 @@ def fence_doctests(text: str) -> str:
     return "\n".join(out)
 
 
+def literal_blocks(text: str) -> str:
+    """reST literal blocks (a paragraph ending in ``::``, then an indented block) as fenced code;
+    Markdown would show the ``::`` and read the block by its indentation alone."""
+    lines, out, i = text.split("\n"), [], 0
+    while i < len(lines):
+        line = lines[i]
+        out.append(line)
+        i += 1
+        if not (line.rstrip().endswith("::") and line.strip() != "::" and i < len(lines) and not lines[i].strip()):
+            continue
+        base = len(line) - len(line.lstrip())
+        j = i + 1
+        while j < len(lines) and (not lines[j].strip() or len(lines[j]) - len(lines[j].lstrip()) > base):
+            j += 1
+        block = lines[i + 1:j]
+        while block and not block[-1].strip():
+            block.pop()
+        if not block:
+            continue
+        out[-1] = line.rstrip()[:-1]  # "Layout of ``path``::" → "Layout of ``path``:"
+        cut = min(len(b) - len(b.lstrip()) for b in block if b.strip())
+        pad = " " * base
+        out += ["", pad + "```text", *[pad + b[cut:] for b in block], pad + "```", ""]
+        i = j
+    return "\n".join(out)
+
+
 def _convert(obj: griffe.Object, text: str) -> str:
     def link(m: re.Match) -> str:
         target = m["target"].strip()
@@ -93,5 +120,5 @@ class RestRoles(griffe.Extension):
         while stack:
             obj = stack.pop()
             if obj.docstring is not None:
-                obj.docstring.value = fence_doctests(_convert(obj, obj.docstring.value))
+                obj.docstring.value = literal_blocks(fence_doctests(_convert(obj, obj.docstring.value)))
             stack.extend(m for m in obj.members.values() if not m.is_alias)
