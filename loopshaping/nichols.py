@@ -283,7 +283,7 @@ def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes |
             if style in styles:
                 ax.plot([], [], style, color="0.5", lw=1.5, label=meaning[style])
     for n, m in enumerate(() if m_contours_db is None else np.atleast_1d(m_contours_db)):
-        ph, mag = m_contour(float(m), np.arange(lo + 0.25, min(hi, lo + 360.0), 0.5))
+        ph, mag = m_contour(float(m), np.arange(lo + 0.25, hi, 0.5))
         ax.plot(ph, mag, ":", color="0.5", lw=0.8, label=None if n else "M-contours: closed-loop |L0/(1+L0)|")
         j = np.nanargmin(np.abs(ph - (lo + np.mod(-220.0 - lo, 360.0))))
         ax.annotate(f"M = {m:.3g} dB", (ph[j], mag[j]), color="0.4", fontsize=7)

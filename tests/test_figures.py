@@ -312,7 +312,13 @@ def test_nichols_draw_shows_points_beyond_minus_360(template, bounds):
     np.testing.assert_allclose(got, -360.0 + np.mod(at_design + 360.0, 360.0), atol=1e-9)
     assert np.all((got >= -360.0) & (got <= 0.0))
     # a window shifted by −180°: same wrapping, bounds repeated into it
-    ax2 = nichols.draw(bounds, loop=L, omega=grid, xlim=(-540.0, -180.0))
+    ax2 = nichols.draw(bounds, loop=L, omega=grid, xlim=(-540.0, -180.0), m_contours_db=[1.58])
+    mc = next(ln for ln in ax2.get_lines() if ln.get_linestyle() == ":" and len(ln.get_xdata()) > 1)
+    mx, my = np.asarray(mc.get_xdata(), float), np.asarray(mc.get_ydata(), float)
+    ok = np.isfinite(mx) & np.isfinite(my)
+    assert mx[ok].min() < -400.0 and mx[ok].max() > -250.0  # the contour fills the shifted window
+    Lm = 10 ** (my[ok] / 20) * np.exp(1j * np.deg2rad(mx[ok]))
+    np.testing.assert_allclose(20 * np.log10(np.abs(Lm / (1 + Lm))), 1.58, atol=1e-9)
     x2 = np.asarray(next(ln for ln in ax2.get_lines() if ln.get_label() == "nominal loop L0").get_xdata(), float)
     assert np.nanmin(x2) >= -540.0 and np.nanmax(x2) <= -180.0
     bound_x = np.concatenate([ln.get_xdata() for ln in ax2.get_lines() if ln.get_color() != "k" and len(ln.get_xdata()) > 1
