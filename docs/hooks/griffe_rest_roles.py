@@ -7,7 +7,8 @@ names and its imports): ``:func:`shape_to_target``` in ``specdesign.spec`` links
 ``specdesign.spec.shape_to_target``; ``~a.b.c`` shows ``c``. A target in ``specdesign`` or
 ``loopshaping`` is a required link, so a broken one fails the strict build; a name outside
 them (``json.dumps``, ``ValueError``) is shown as code without a link. Doctest blocks outside
-an Examples section, and reST literal blocks (``text::`` + an indented block), are fenced as code.
+an Examples section, and reST literal blocks (``text::`` + an indented block), are fenced as code;
+reST simple tables become Markdown tables.
 """
 from __future__ import annotations
 
@@ -96,6 +97,52 @@ def literal_blocks(text: str) -> str:
     return "\n".join(out)
 
 
+BORDER = re.compile(r"\s*=+( +=+)+\s*")
+
+
+def simple_tables(text: str) -> str:
+    """reST simple tables (columns under ``====  ====`` borders) as Markdown tables; a row whose
+    first cell is empty continues the row above. Markdown would run the cells into one line."""
+    lines, out, i = text.split("\n"), [], 0
+    while i < len(lines):
+        if not BORDER.fullmatch(lines[i]):
+            out.append(lines[i])
+            i += 1
+            continue
+        j = i
+        while j < len(lines) and lines[j].strip():
+            j += 1
+        borders = [k for k in range(i, j) if BORDER.fullmatch(lines[k])]
+        spans = [(m.start(), m.end()) for m in re.finditer(r"=+", lines[i])]
+        starts = [a for a, _ in spans] + [None]
+
+        def cells(line):
+            return [line[starts[c]:starts[c + 1]].strip() if starts[c] < len(line) else ""
+                    for c in range(len(spans))]
+
+        def rows(a, b):
+            got = []
+            for line in lines[a + 1:b]:
+                row = cells(line)
+                if got and not row[0]:
+                    got[-1] = [f"{x} {y}".strip() for x, y in zip(got[-1], row)]
+                else:
+                    got.append(row)
+            return got
+
+        if len(borders) >= 3:
+            head, body = rows(borders[0], borders[1]), rows(borders[1], borders[2])
+        else:
+            head, body = [[""] * len(spans)], rows(borders[0], borders[-1])
+        head = [" ".join(c).strip() for c in zip(*head)] if head else [""] * len(spans)
+        md = lambda row: "| " + " | ".join(c.replace("|", "\\|") for c in row) + " |"
+        if out and out[-1].strip():
+            out.append("")
+        out += [md(head), "|" + "---|" * len(spans), *map(md, body), ""]
+        i = j
+    return "\n".join(out)
+
+
 def _convert(obj: griffe.Object, text: str) -> str:
     def link(m: re.Match) -> str:
         target = m["target"].strip()
@@ -120,5 +167,5 @@ class RestRoles(griffe.Extension):
         while stack:
             obj = stack.pop()
             if obj.docstring is not None:
-                obj.docstring.value = literal_blocks(fence_doctests(_convert(obj, obj.docstring.value)))
+                obj.docstring.value = simple_tables(literal_blocks(fence_doctests(_convert(obj, obj.docstring.value))))
             stack.extend(m for m in obj.members.values() if not m.is_alias)
