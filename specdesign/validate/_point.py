@@ -52,6 +52,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
     out = {"values": {}, "linear": {}, "volterra": {}, "pred": [], "welch": {k: [] for k in SPECTRA},
            "ppsd": {k: [] for k in SPECTRA}, "series": {}, "unstable": []}
     omega = welch_psd(np.zeros((1, int(round(duration / record_dt)))), record_dt, nperseg)[0]
+    sw = None
     for name, c in controllers.items():
         bad = unstable_poles(model, c, v) if has_linear_form(c) else np.zeros(0)
         if bad.size:
@@ -98,7 +99,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
         if predict and has_linear_form(c):
             pr = linear_prediction(model, c, v, m=m, omega=prediction_grid(duration), turbulence_class=turbulence_class)
             out["pred"].append(pr.del_)
-            sw = wmod.rotor_effective_spectrum(omega, v, radius, turbulence_class=turbulence_class)
+            if sw is None:  # the same for every controller at this speed (its disc coherence is costly)
+                sw = wmod.rotor_effective_spectrum(omega, v, radius, turbulence_class=turbulence_class)
             pos = omega > 0  # an integrating controller makes T singular at ω = 0: leave DC out
             for k in SPECTRA:
                 pp = np.full(omega.size, np.nan)
