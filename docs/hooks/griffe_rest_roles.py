@@ -8,7 +8,7 @@ names and its imports): ``:func:`shape_to_target``` in ``specdesign.spec`` links
 ``loopshaping`` is a required link, so a broken one fails the strict build; a name outside
 them (``json.dumps``, ``ValueError``) is shown as code without a link. Doctest blocks outside
 an Examples section, and reST literal blocks (``text::`` + an indented block), are fenced as code;
-reST simple tables become Markdown tables.
+reST simple tables become Markdown tables, and numpydoc "See Also" entries a list of links.
 """
 from __future__ import annotations
 
@@ -143,6 +143,45 @@ def simple_tables(text: str) -> str:
     return "\n".join(out)
 
 
+SEE_ALSO_ITEM = re.compile(r"(?P<names>~?[\w.]+(?:\s*,\s*~?[\w.]+)*)\s*(?::\s*(?P<desc>.*))?")
+
+
+def see_also(obj: griffe.Object, text: str) -> str:
+    """A numpydoc "See Also" section (``name : description`` lines) as a list of links; griffe
+    would run its entries together into one paragraph."""
+    lines, out, i = text.split("\n"), [], 0
+    while i < len(lines):
+        out.append(lines[i])
+        if not (lines[i].strip() == "See Also" and i + 1 < len(lines) and re.fullmatch(r"\s*-{3,}\s*", lines[i + 1])):
+            i += 1
+            continue
+        out.append(lines[i + 1])
+        base = len(lines[i]) - len(lines[i].lstrip())
+        i += 2
+        items = []
+        while i < len(lines) and not (i + 1 < len(lines) and lines[i].strip()
+                                      and re.fullmatch(r"\s*-{3,}\s*", lines[i + 1])):
+            line = lines[i]
+            indent = len(line) - len(line.lstrip())
+            m = SEE_ALSO_ITEM.fullmatch(line.strip())
+            if line.strip() and indent == base and m:
+                items.append([m["names"], m["desc"] or ""])
+            elif line.strip() and items:
+                items[-1][1] = f"{items[-1][1]} {line.strip()}".strip()
+            elif line.strip():
+                break  # not a See Also list after all: leave the rest as written
+            i += 1
+        for names, desc in items:
+            links = []
+            for name in (n.strip() for n in names.split(",")):
+                path = _resolve(obj, name.lstrip("~"))
+                shown = f"`{name.lstrip('~').rsplit('.', 1)[-1] if name.startswith('~') else name}`"
+                links.append(f"[{shown}][{_canonical(obj, path)}]" if path else shown)
+            out.append(" " * base + "- " + ", ".join(links) + (f": {desc}" if desc else ""))
+        out.append("")
+    return "\n".join(out)
+
+
 def _convert(obj: griffe.Object, text: str) -> str:
     def link(m: re.Match) -> str:
         target = m["target"].strip()
@@ -167,5 +206,5 @@ class RestRoles(griffe.Extension):
         while stack:
             obj = stack.pop()
             if obj.docstring is not None:
-                obj.docstring.value = simple_tables(literal_blocks(fence_doctests(_convert(obj, obj.docstring.value))))
+                obj.docstring.value = simple_tables(literal_blocks(fence_doctests(_convert(obj, see_also(obj, obj.docstring.value)))))
             stack.extend(m for m in obj.members.values() if not m.is_alias)
