@@ -35,6 +35,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 
 from .discon_file import read_discon
 
@@ -44,6 +45,31 @@ __all__ = ["SWAP_SIZE", "DisconError", "rosco_library", "rosco_test_cases", "Dis
 SWAP_SIZE = 2000
 #: Length of the message buffer (avcMSG).
 _MSG_SIZE = 1024
+
+
+@njit(cache=True)
+def _fill_swap(sw, t, omega, pitch, power, acc, n):
+    """The measurements of one step into each run's swap array (0-based: Bladed index − 1)."""
+    for r in range(sw.shape[0]):
+        sw[r, 1] = t
+        sw[r, 3] = pitch[r]
+        sw[r, 32] = pitch[r]
+        sw[r, 33] = pitch[r]
+        sw[r, 13] = sw[r, 22] * omega[r] * n
+        sw[r, 14] = power[r]
+        sw[r, 19] = omega[r] * n
+        sw[r, 20] = omega[r]
+        sw[r, 52] = acc[r]
+
+
+@njit(cache=True)
+def _read_swap(sw, omega, dt, n, pitch, torque):
+    """ROSCO's commands out of the swap arrays; the azimuth and measured torque for the next step."""
+    for r in range(sw.shape[0]):
+        sw[r, 59] = (sw[r, 59] + omega[r] * dt) % (2.0 * np.pi)
+        sw[r, 22] = sw[r, 46]  # the torque ROSCO measures next is the one it commands now
+        pitch[r] = sw[r, 44]
+        torque[r] = sw[r, 46] * n
 
 
 class DisconError(RuntimeError):
@@ -220,10 +246,21 @@ class Discon:
         for r in range(R):
             so = folder / f"libdiscon_{r}{self.library.suffix}"
             shutil.copyfile(self.library, so)
-            fn = ctypes.CDLL(str(so)).DISCON
+            lib = ctypes.CDLL(str(so))
+            fn = lib.DISCON
             fn.restype = None
             fn.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_char_p, ctypes.c_char_p, ctypes.c_void_p]
             self._fns.append(fn)
+        # ROSCO prints through gfortran's stdout, buffered on a pipe: flushed after each step, or
+        # it would surface at exit, far from its run (and outside pytest's capture)
+        flush = getattr(lib, "_gfortran_flush_i4", None) if R else None
+        if flush is not None:
+            flush.restype = None
+            flush.argtypes = [ctypes.c_void_p]
+            self._unit6 = ctypes.c_int32(6)
+            self._flush = lambda: flush(ctypes.addressof(self._unit6))
+        else:
+            self._flush = lambda: None
         self._infile = str(infile).encode() + b"\0"
         self._outnames = [str(folder / f"run{r}").encode() + b"\0" for r in range(R)]
         self._swap = np.zeros((R, SWAP_SIZE), dtype=np.float32)
@@ -251,7 +288,8 @@ class Discon:
         fns, infile = self._fns, self._infile
         for r, (a, f, o, m) in enumerate(self._args):
             fns[r](a, f, infile, o, m)
-        if np.any(self._fail < 0):
+        self._flush()
+        if self._fail.min() < 0:
             r = int(np.flatnonzero(self._fail < 0)[0])
             msg = self._message(r)
             if status == 0:
@@ -292,23 +330,15 @@ class Discon:
         """
         if not self._runs:
             raise RuntimeError("Discon.start(dt, wind, pitch, torque) must run first (simulate calls it)")
-        sw, n = self._swap, self.gearbox_ratio
-        omega = np.asarray(y["gen_speed"], dtype=float)
-        pitch = y["pitch"]
-        sw[:, 1] = t
-        sw[:, 3] = pitch
-        sw[:, 32] = pitch
-        sw[:, 33] = pitch
-        sw[:, 13] = sw[:, 22] * omega * n
-        sw[:, 14] = y["power"]
-        sw[:, 19] = omega * n
-        sw[:, 20] = omega
-        sw[:, 52] = y["tower_top_acc"]
+        omega = np.ascontiguousarray(y["gen_speed"], dtype=float)
+        _fill_swap(self._swap, float(t), omega, np.ascontiguousarray(y["pitch"], dtype=float),
+                   np.ascontiguousarray(y["power"], dtype=float), np.ascontiguousarray(y["tower_top_acc"], dtype=float),
+                   self.gearbox_ratio)
         self._call_all(0 if self._step == 0 else 1)
         self._step += 1
-        sw[:, 59] = np.mod(sw[:, 59] + omega * self._dt, 2 * np.pi)
-        sw[:, 22] = sw[:, 46]  # the torque ROSCO measures next is the one it commands now
-        return sw[:, 44].astype(float), sw[:, 46].astype(float) * n
+        pitch, torque = np.empty(self._runs), np.empty(self._runs)
+        _read_swap(self._swap, omega, self._dt, self.gearbox_ratio, pitch, torque)
+        return pitch, torque
 
     def close(self) -> None:
         """End the runs (ROSCO's final call, status −1) and remove their library copies.

@@ -16,7 +16,8 @@ summed into the pitch command with the same negative-feedback sign as in
 :mod:`specdesign.closedloop`. β₀ is the trim pitch at the run's mean wind speed.
 
 Gain scheduling (``ScheduledController``) has two forms, both scheduled on β_f, the pitch
-command low-pass filtered (first order, ``filter_omega``), with piecewise-linear weights
+command low-pass filtered (first order at ``filter_omega``, or second order with
+``filter_damping`` as ROSCO filters it), with piecewise-linear weights
 between K scheduling pitches β_k, clamped at the ends:
 
 * ``form="output"`` (general designed controllers, :func:`scheduled`): the K local
@@ -42,7 +43,10 @@ LTI system (SISO, proper; discretised by Tustin at the simulation step), a
 ``loopshaping.controller.Controller`` (its ``.tf()``), a ``ScheduledController``, or a
 Python callable ``f(t, y) -> pitch_cmd`` (the slow path: called once per step with ``y`` a
 dict of the model outputs, each an array over all runs, returning the absolute pitch
-command in rad for all runs; use it for MPC or other time-domain controllers).
+command in rad for all runs, or a tuple of it and the generator torque in N·m on the rotor
+shaft, which the controller then commands; a ``start(dt, wind, pitch, torque)`` method, if it
+has one, is called once before the first step; use it for MPC or other time-domain
+controllers, and for ROSCO's compiled controller, :class:`specdesign.rosco.Discon`).
 
 A linear simulation of the same closed loop (``linear=True``) integrates the linearisation
 ``model.linearize(v)`` with the same loop, the same RK4 step and the same discrete

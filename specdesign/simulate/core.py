@@ -6,7 +6,6 @@ See :mod:`specdesign.simulate` for the conventions (signs, scheduling, anti-wind
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -18,7 +17,7 @@ from ..wind import wind_series
 from .checks import check_step, warn_unstable
 from .controllers import controller_bank, is_lti_like
 from .kernels import NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs, run_callable
-from .schedule import ScheduledController
+from .schedule import ScheduledController, schedule_filter_coefficients
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
@@ -410,7 +409,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         for q, (A, B, C, D, r, ns) in enumerate(mats):
             n = A.shape[0]
             Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :], Rq[q], Ns[q] = A, B, C, D, r, ns
-        a_filt = 1.0 - math.exp(-fw * dt)
+        sfilt = schedule_filter_coefficients(fw, getattr(controller, "filter_damping", None), dt)
         cmd_lim = np.array((-np.inf, np.inf) if plant.pitch_limits is None else plant.pitch_limits, dtype=float)
         if pi is None:
             pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
@@ -421,7 +420,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
             # narrowed to the plant's (the plant's alone when it has none), so it cannot wind up
             lim = np.array([max(lim[0], cmd_lim[0]), min(lim[1], cmd_lim[1])])
         run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
-                  beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on,
+                  beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on,
                   *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim, cmd_lim)),
                   lim_idx, lim_val, Rq, Ns, status)
     _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)

@@ -198,7 +198,7 @@ NONFINITE = 63
 
 @njit(cache=True)
 def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-             beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
+             beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
              cmd_lim, lim_idx, lim_val, Rq, Ns):
     """One run; returns −1, or 64·step + code at the first step where it diverged (code: the
     index of the output limit exceeded, or NONFINITE)."""
@@ -231,6 +231,11 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
     ef_prev = 0.0
     bcmd = beta0
     bf = beta0
+    # past inputs and outputs of a second-order scheduling filter (ROSCO's), at rest at the trim
+    fu1 = beta0
+    fu2 = beta0
+    fy1 = beta0
+    fy2 = beta0
     j = 0
     for k in range(nsteps):
         t = k * dt
@@ -335,14 +340,21 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
             integ = min(max(integ, lo), hi)
             u += min(max(kpv * ef + integ, lo), hi)
         bcmd = min(max(beta0 + u, cmd_lim[0]), cmd_lim[1])
-        bf += a_filt * (bcmd - bf)
+        if sfilt.size == 1:  # first order, exact discretisation: sfilt = [1 − exp(−ω_f·dt)]
+            bf += sfilt[0] * (bcmd - bf)
+        else:  # second order by Tustin, sfilt = [b0, b1, b2, a1, a2] normalised by a0
+            bf = sfilt[0] * bcmd + sfilt[1] * fu1 + sfilt[2] * fu2 - sfilt[3] * fy1 - sfilt[4] * fy2
+            fu2 = fu1
+            fu1 = bcmd
+            fy2 = fy1
+            fy1 = bf
         _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
     return -1
 
 
 @njit(cache=True, parallel=True)
 def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
-               beta0, omega_ref, torque, a_filt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
+               beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
                cmd_lim, lim_idx, lim_val, Rq, Ns, status):
     """All runs, one per prange iteration; the controller bank is shared by the batch.
     ``status[r]``: −1, or where run r diverged (see :func:`_run_one`)."""
@@ -350,7 +362,7 @@ def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched
     for r in prange(X0.shape[0]):
         x = X0[r].copy()
         status[r] = _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-                             beta0[r], omega_ref[r], torque[r], a_filt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf,
+                             beta0[r], omega_ref[r], torque[r], sfilt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf,
                              Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq, Ns)
 
 
@@ -438,14 +450,19 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
     """Run a batch with a Python controller ``fn(t, y) -> pitch_cmd`` (the slow path).
 
     ``fn`` is called once per step with ``y`` a dict of the outputs, each an array over all
-    runs; the command it returns is held over the step. The records are written into ``Y``,
-    and the first divergence of each run into ``status`` (checked at the record steps).
+    runs; the command it returns is held over the step. It may command the generator torque
+    too by returning ``(pitch_cmd, gen_torque)``; otherwise the torque stays at ``torque``.
+    If ``fn`` has a ``start`` method, ``fn.start(dt, wind, pitch, torque)`` is called once
+    before the first step with the step (s) and, per run, the wind at t = 0 (m/s), the
+    initial pitch (rad) and torque (N·m) (a stateful controller initialises itself there).
+    The records are written into ``Y``, and the first divergence of each run into ``status``
+    (checked at the record steps).
 
     Parameters
     ----------
     fn : callable
         ``fn(t, y)``: time (s), dict output name → (R,) array (SI) → (R,) absolute pitch
-        command (rad).
+        command (rad), or a tuple of it and the (R,) generator torque on the rotor shaft (N·m).
     step_all, outputs_all : callable
         The one-step and outputs functions of :func:`compiled_for`.
     kind : int
@@ -485,27 +502,39 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
     Raises
     ------
     ValueError
-        If ``fn`` returns a command that is not finite or not of shape (R,).
+        If ``fn`` returns a command (pitch or torque) that is not finite or not of shape (R,).
     """
     X = X0.copy()
     R = X.shape[0]
     bcmd = beta0.copy()
+    start = getattr(fn, "start", None)
+    if callable(start):
+        start(dt, Wr[:, 0].copy(), beta0.copy(), torque.copy())
     y = np.empty((R, ny))
     outputs_all(kind, P, X, Wr, wdt, 0.0, bcmd, torque, y)
     j = 0
     for k in range(nsteps):
         t = k * dt
         # checked at the record steps: a per-step numpy check would cost as much as the step
-        bad = (~np.all(np.isfinite(y), axis=1) | np.any(np.abs(y[:, lim_idx]) > lim_val, axis=1)
-               if k % rec_every == 0 else np.zeros(0, bool))
-        if np.any(bad):
-            r = np.flatnonzero(bad)
-            nonfinite = ~np.all(np.isfinite(y[r]), axis=1)
-            over = np.argmax(np.abs(y[r][:, lim_idx]) > lim_val, axis=1)
-            status[r] = 64 * k + np.where(nonfinite, NONFINITE, over)
-            return
-        cmd = np.asarray(fn(t, {n: y[:, i].copy() for i, n in enumerate(names)}), dtype=float)
-        if cmd.shape != (R,) or not np.all(np.isfinite(cmd)):
+        if k % rec_every == 0:
+            bad = ~np.all(np.isfinite(y), axis=1) | np.any(np.abs(y[:, lim_idx]) > lim_val, axis=1)
+            if np.any(bad):
+                r = np.flatnonzero(bad)
+                nonfinite = ~np.all(np.isfinite(y[r]), axis=1)
+                over = np.argmax(np.abs(y[r][:, lim_idx]) > lim_val, axis=1)
+                status[r] = 64 * k + np.where(nonfinite, NONFINITE, over)
+                return
+        cmd = fn(t, {n: y[:, i].copy() for i, n in enumerate(names)})
+        if isinstance(cmd, tuple):
+            if len(cmd) != 2:
+                raise ValueError(f"controller callable must return pitch_cmd or (pitch_cmd, gen_torque), got {len(cmd)} items")
+            cmd, torque = np.asarray(cmd[0], dtype=float), np.asarray(cmd[1], dtype=float)
+            # a sum is finite iff every term is (barring overflow past 1e308): cheaper per step
+            if torque.shape != (R,) or not math.isfinite(torque.sum()):
+                raise ValueError(f"controller callable must return a finite generator torque (N·m) of shape ({R},), "
+                                 f"got {torque.shape}")
+        cmd = np.asarray(cmd, dtype=float)
+        if cmd.shape != (R,) or not math.isfinite(cmd.sum()):
             raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}")
         if k % rec_every == 0:
             Y[:, :ny, j] = y

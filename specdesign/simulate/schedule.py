@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 from .._checks import positive_scalar
 from .controllers import as_lti
 
-__all__ = ["SCHEDULE_FILTER_OMEGA", "FORMS", "ScheduledController", "scheduled"]
+__all__ = ["SCHEDULE_FILTER_OMEGA", "FORMS", "ScheduledController", "scheduled", "schedule_filter_coefficients"]
 
 #: Default low-pass corner of the scheduling pitch filter (rad/s): slow enough that the
 #: scheduling variable follows the mean operating point rather than the turbulence
@@ -68,6 +68,11 @@ class ScheduledController:
         :func:`specdesign.simulate.simulate` narrows them to the plant's pitch limits, and uses
         the plant's alone when this is None (default): the integrator never winds up beyond
         what the actuator can reach; on a plant without limits, None means no saturation.
+    filter_damping : float or None, optional
+        None (default): the scheduling filter is first order, ω_f/(s + ω_f), ω_f =
+        ``filter_omega``, discretised exactly. A damping ratio ζ: second order,
+        ω_f²/(s² + 2ζω_f s + ω_f²), discretised by Tustin, as ROSCO filters its scheduling
+        pitch (``Filters.f90``: ω_f = 0.25·F_LPFCornerFreq, ζ = 0.7).
 
     Raises
     ------
@@ -87,6 +92,7 @@ class ScheduledController:
     ki: np.ndarray | None = field(default=None, repr=False)
     error_filter: object = field(default=None, repr=False)
     pitch_limits: tuple | None = None
+    filter_damping: float | None = None
 
     def __post_init__(self):
         b = np.atleast_1d(np.asarray(self.schedule_pitch, dtype=float))
@@ -98,6 +104,8 @@ class ScheduledController:
         if self.atd is not None and len(self.atd) != b.size:
             raise ValueError(f"atd needs one controller per scheduling pitch ({b.size}), got {len(self.atd)}")
         positive_scalar(self.filter_omega, "filter_omega")
+        if self.filter_damping is not None:
+            object.__setattr__(self, "filter_damping", positive_scalar(self.filter_damping, "filter_damping"))
         if self.form not in FORMS:
             raise ValueError(f"form must be one of {FORMS}, got {self.form!r}")
         if self.form == "output":
@@ -148,7 +156,8 @@ class ScheduledController:
     @classmethod
     def gain_scheduled_pi(cls, schedule_pitch: ArrayLike, kp: ArrayLike, ki: ArrayLike, error_filter: object, *,
                           atd: Sequence | None = None, filter_omega: float = SCHEDULE_FILTER_OMEGA, name: str = "PI",
-                          pitch_limits: tuple[float, float] | None = None) -> ScheduledController:
+                          pitch_limits: tuple[float, float] | None = None,
+                          filter_damping: float | None = None) -> ScheduledController:
         """ROSCO-form gain-scheduled PI: u = K_p(β_f)·e_f + ∫K_i(β_f)·e_f dt, e_f = F·(Ω_ref − Ω_g).
 
         Parameters
@@ -171,6 +180,8 @@ class ScheduledController:
         pitch_limits : tuple of float or None, optional
             (min, max) pitch (rad) saturating the integrator and the PI output (ROSCO's
             anti-windup), or None (the simulated plant's limits, see the class).
+        filter_damping : float or None, optional
+            None: first-order scheduling filter; a damping ratio: second order (see the class).
 
         Returns
         -------
@@ -199,7 +210,8 @@ class ScheduledController:
             raise ValueError(f"kp and ki must be 1-D arrays of the same length, got shapes {kp.shape} and {ki.shape}")
         pitch = tuple(control.tf([a, c], [1.0, 0.0]) * f for a, c in zip(kp, ki))
         return cls(schedule_pitch, pitch, None if atd is None else tuple(atd), filter_omega, name,
-                   form="gains", kp=kp, ki=ki, error_filter=f, pitch_limits=pitch_limits)
+                   form="gains", kp=kp, ki=ki, error_filter=f, pitch_limits=pitch_limits,
+                   filter_damping=filter_damping)
 
 
 def scheduled(model: object, pitch: dict, atd: dict | None = None, *, filter_omega: float = SCHEDULE_FILTER_OMEGA,
@@ -259,3 +271,44 @@ def scheduled(model: object, pitch: dict, atd: dict | None = None, *, filter_ome
         filter_omega=filter_omega,
         name=name,
     )
+
+
+def schedule_filter_coefficients(omega: float, damping: float | None, dt: float) -> np.ndarray:
+    """Coefficients of the discrete scheduling filter the simulator runs on the pitch command.
+
+    Parameters
+    ----------
+    omega : float
+        Corner ω_f (rad/s).
+    damping : float or None
+        None for the first-order filter ω_f/(s + ω_f) (exact discretisation), or the damping
+        ratio ζ of the second-order ω_f²/(s² + 2ζω_f s + ω_f²) (Tustin, as ROSCO's
+        ``SecLPFilter``).
+    dt : float
+        Step (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``[1 − exp(−ω_f·dt)]`` (first order: β_f += c·(β − β_f)), or ``[b0, b1, b2, a1, a2]``
+        of y_k = b0·u_k + b1·u_{k−1} + b2·u_{k−2} − a1·y_{k−1} − a2·y_{k−2}.
+
+    Raises
+    ------
+    ValueError
+        For a non-positive ``omega``, ``damping`` or ``dt``.
+
+    Examples
+    --------
+    >>> c = schedule_filter_coefficients(0.25, 0.7, 0.02)
+    >>> round(float((c[0] + c[1] + c[2]) / (1 + c[3] + c[4])), 9)  # unit gain at s = 0
+    1.0
+    """
+    w = positive_scalar(omega, "omega")
+    dt = positive_scalar(dt, "dt")
+    if damping is None:
+        return np.array([1.0 - math.exp(-w * dt)])
+    z = positive_scalar(damping, "damping")
+    wt2 = (w * dt) ** 2
+    a0 = wt2 + 4.0 + 4.0 * z * w * dt
+    return np.array([wt2, 2.0 * wt2, wt2, 2.0 * wt2 - 8.0, wt2 + 4.0 - 4.0 * z * w * dt]) / a0
