@@ -7,7 +7,7 @@ import numpy as np
 
 from .._checks import positive_scalar
 
-__all__ = ["YOULA_REAL_POLES", "YOULA_PAIRS", "AchievablePitch", "achievable_pitch"]
+__all__ = ["YOULA_REAL_POLES", "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "YoulaProblem"]
 
 
 #: Poles (rad/s) of the Youla basis: real poles spanning the wind band, and lightly damped pairs
@@ -147,67 +147,129 @@ def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=2
     RuntimeError
         If the solver finds no solution.
     """
-    import cvxpy as cp
-
-    from .. import spec, spectral
-    from ..closedloop import frequency_response, siso_response
-    from ..rosco import rosco_baseline
-
     g = float(speed_relax_db)
-    kappa = positive_scalar(max_pitch_rate_ratio, "max_pitch_rate_ratio")
     if not (np.isfinite(g) and g >= 0):
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB")
-    ms = positive_scalar(max_sensitivity, "max_sensitivity")
-    if base is None:
-        base = spec.baseline_analysis(model, wind_speed, m=m, omega=omega)
-    w = base.omega
-    plant = model.linearize(float(wind_speed))
-    a = frequency_response(plant, w, "tower_base_my", "wind")
-    ow = frequency_response(plant, w, "gen_speed", "wind")
-    ob = frequency_response(plant, w, "gen_speed", "pitch_cmd")
-    gy = frequency_response(plant, w, "tower_base_my", "pitch_cmd") * ow
-    w_speed = np.abs(spec.speed_specification(model, float(wind_speed)).response(w)) * 10 ** (g / 20)
-    phi = _youla_basis(1j * w)
-    t_ref2 = np.abs(base.t_response) ** 2
-    weight = np.maximum(base.sensitivity, 0.0) + 1e-3 * base.sensitivity.max()
+    return YoulaProblem(model, wind_speed, max_sensitivity=max_sensitivity, max_pitch_rate_ratio=max_pitch_rate_ratio,
+                        m=m, omega=omega, base=base, integral_action=integral_action).solve(g)
 
-    # solve in orthonormal coordinates of the basis on the grid (the raw basis is collinear)
-    q, rr = np.linalg.qr(np.vstack([phi.real, phi.imag]))
-    phi_o = q[: w.size] + 1j * q[w.size:]
-    y = cp.Variable(phi.shape[1])
-    tc, tl = a, -gy[:, None] * phi_o
-    sc, sl = np.ones_like(ob), -ob[:, None] * phi_o
-    t_re = tc.real + tl.real @ y
-    t_im = tc.imag + tl.imag @ y
-    s_re = sc.real + sl.real @ y
-    s_im = sc.imag + sl.imag @ y
-    scale = np.sqrt(weight / t_ref2)
-    objective = cp.sum_squares(cp.multiply(scale, t_re)) + cp.sum_squares(cp.multiply(scale, t_im))
-    s_bound = np.minimum(ms, w_speed / np.abs(ow))  # |S| ≤ M_s and |P_{Ω,w}S| ≤ W_Ω
-    constraints = [cp.norm(cp.vstack([s_re, s_im]), 2, axis=0) <= s_bound]
-    # pitch-rate activity: the rate spectrum |ω·T_{β,w}|²S_W, T_{β,w} = −P_{Ω,w}Y, integrated
-    # (trapezoid weights), at most κ² times ROSCO's
-    from ..spectral import trapezoid_weights
 
-    tw = trapezoid_weights(w)
-    c_ref = siso_response(rosco_baseline(model, float(wind_speed)), w)
-    rate_ref = float(np.sum(tw * np.abs(w * c_ref * ow / (1 + c_ref * ob)) ** 2 * base.wind_psd))
-    rl = (w * ow)[:, None] * phi_o * np.sqrt(tw * base.wind_psd / rate_ref)[:, None]  # scaled to ROSCO's: O(1)
-    constraints.append(cp.sum_squares(rl.real @ y) + cp.sum_squares(rl.imag @ y) <= kappa ** 2)
-    if integral_action:  # S(0) = 1 − P_{Ω,β}(0)·Y(0) = 0, in the orthonormal coordinates
-        p0 = float(np.real(plant["gen_speed", "pitch_cmd"].dcgain()))
-        phi0 = np.linalg.solve(rr.T, np.real(_youla_basis(np.zeros(1, complex))[0]))
-        constraints.append(p0 * (phi0 @ y) == 1.0)
-    prob = cp.Problem(cp.Minimize(objective), constraints)
-    prob.solve()
-    if y.value is None or prob.status not in ("optimal", "optimal_inaccurate"):
-        raise RuntimeError(f"achievable_pitch at {wind_speed:g} m/s: the solver returned {prob.status!r}")
-    yv = phi_o @ np.asarray(y.value, float)
-    coef = np.linalg.solve(rr, np.asarray(y.value, float))
-    sens = 1 - ob * yv
-    t_tower = a - gy * yv
-    t_speed = ow * sens
-    d = spectral.damage_rate(w, np.abs(t_tower) ** 2 * base.wind_psd, base.m, method=base.method)
-    red = float(spectral.del_reduction(100.0 * (1.0 - d / base.damage_rate), base.m))
-    excess = float(20 * np.log10(np.max(np.abs(t_speed) / w_speed)))
-    return AchievablePitch(float(wind_speed), g, ms, w, coef, t_tower, t_speed, sens, red, excess, str(prob.status))
+class YoulaProblem:
+    """The convex problem of :func:`achievable_pitch` at one operating point, compiled once.
+
+    Only the generator-speed bound changes with the relaxation g (a cvxpy parameter), so
+    :meth:`solve` at several g (a frontier, a bisection) re-uses the compiled problem.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+    max_sensitivity : float
+        M_s (-).
+    max_pitch_rate_ratio : float
+        κ, pitch-rate SD allowance relative to ROSCO's (-).
+    m : float
+        Wöhler exponent (-).
+    omega : array_like, optional
+        Grid, rad/s (default :func:`specdesign.spec.default_omega`).
+    base : specdesign.spec.Baseline, optional
+        ROSCO's baseline at ``wind_speed`` if already computed (its grid is used).
+    integral_action : bool
+        Require S(0) = 0 (see :func:`achievable_pitch`).
+    """
+
+    def __init__(self, model, wind_speed, *, max_sensitivity=2.0, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
+                 base=None, integral_action=True):
+        import cvxpy as cp
+
+        from .. import spec
+        from ..closedloop import frequency_response, siso_response
+        from ..rosco import rosco_baseline
+        from ..spectral import trapezoid_weights
+
+        kappa = positive_scalar(max_pitch_rate_ratio, "max_pitch_rate_ratio")
+        self.ms = positive_scalar(max_sensitivity, "max_sensitivity")
+        self.wind_speed = float(wind_speed)
+        if base is None:
+            base = spec.baseline_analysis(model, wind_speed, m=m, omega=omega)
+        self.base, w = base, base.omega
+        plant = model.linearize(self.wind_speed)
+        self.a = frequency_response(plant, w, "tower_base_my", "wind")
+        self.ow = frequency_response(plant, w, "gen_speed", "wind")
+        self.ob = frequency_response(plant, w, "gen_speed", "pitch_cmd")
+        self.gy = frequency_response(plant, w, "tower_base_my", "pitch_cmd") * self.ow
+        self.w_speed0 = np.abs(spec.speed_specification(model, self.wind_speed).response(w))
+        phi = _youla_basis(1j * w)
+        t_ref2 = np.abs(base.t_response) ** 2
+        weight = np.maximum(base.sensitivity, 0.0) + 1e-3 * base.sensitivity.max()
+
+        # solve in orthonormal coordinates of the basis on the grid (the raw basis is collinear)
+        q, self.rr = np.linalg.qr(np.vstack([phi.real, phi.imag]))
+        self.phi_o = phi_o = q[: w.size] + 1j * q[w.size:]
+        self.y = y = cp.Variable(phi.shape[1])
+        tl = -self.gy[:, None] * phi_o
+        sl = -self.ob[:, None] * phi_o
+        t_re = self.a.real + tl.real @ y
+        t_im = self.a.imag + tl.imag @ y
+        s_re = 1.0 + sl.real @ y
+        s_im = sl.imag @ y
+        scale = np.sqrt(weight / t_ref2)
+        objective = cp.sum_squares(cp.multiply(scale, t_re)) + cp.sum_squares(cp.multiply(scale, t_im))
+        self.s_bound = cp.Parameter(w.size, nonneg=True)  # min(M_s, W_Ω/|P_{Ω,w}|): |S| ≤ M_s and |P_{Ω,w}S| ≤ W_Ω
+        constraints = [cp.norm(cp.vstack([s_re, s_im]), 2, axis=0) <= self.s_bound]
+        # pitch-rate activity: the rate spectrum |ω·T_{β,w}|²S_W, T_{β,w} = −P_{Ω,w}Y, integrated
+        # (trapezoid weights), at most κ² times ROSCO's
+        tw = trapezoid_weights(w)
+        c_ref = siso_response(rosco_baseline(model, self.wind_speed), w)
+        rate_ref = float(np.sum(tw * np.abs(w * c_ref * self.ow / (1 + c_ref * self.ob)) ** 2 * base.wind_psd))
+        rl = (w * self.ow)[:, None] * phi_o * np.sqrt(tw * base.wind_psd / rate_ref)[:, None]  # scaled to ROSCO's: O(1)
+        constraints.append(cp.sum_squares(rl.real @ y) + cp.sum_squares(rl.imag @ y) <= kappa ** 2)
+        if integral_action:  # S(0) = 1 − P_{Ω,β}(0)·Y(0) = 0, in the orthonormal coordinates
+            p0 = float(np.real(plant["gen_speed", "pitch_cmd"].dcgain()))
+            phi0 = np.linalg.solve(self.rr.T, np.real(_youla_basis(np.zeros(1, complex))[0]))
+            constraints.append(p0 * (phi0 @ y) == 1.0)
+        self.problem = cp.Problem(cp.Minimize(objective), constraints)
+
+    def solve(self, speed_relax_db):
+        """The design under the speed map relaxed by ``speed_relax_db``.
+
+        Parameters
+        ----------
+        speed_relax_db : float
+            Relaxation g of the generator-speed specification, dB (≥ 0).
+
+        Returns
+        -------
+        AchievablePitch
+            The design, its maps and its exact promise.
+
+        Raises
+        ------
+        ValueError
+            For a negative or non-finite relaxation.
+        RuntimeError
+            If the solver finds no solution.
+        """
+        from .. import spectral
+
+        g = float(speed_relax_db)
+        if not (np.isfinite(g) and g >= 0):
+            raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB")
+        base, w = self.base, self.base.omega
+        w_speed = self.w_speed0 * 10 ** (g / 20)
+        self.s_bound.value = np.minimum(self.ms, w_speed / np.abs(self.ow))
+        self.problem.solve()
+        y, status = self.y.value, self.problem.status
+        if y is None or status not in ("optimal", "optimal_inaccurate"):
+            raise RuntimeError(f"achievable_pitch at {self.wind_speed:g} m/s: the solver returned {status!r}")
+        yv = self.phi_o @ np.asarray(y, float)
+        coef = np.linalg.solve(self.rr, np.asarray(y, float))
+        sens = 1 - self.ob * yv
+        t_tower = self.a - self.gy * yv
+        t_speed = self.ow * sens
+        d = spectral.damage_rate(w, np.abs(t_tower) ** 2 * base.wind_psd, base.m, method=base.method)
+        red = float(spectral.del_reduction(100.0 * (1.0 - d / base.damage_rate), base.m))
+        excess = float(20 * np.log10(np.max(np.abs(t_speed) / w_speed)))
+        return AchievablePitch(self.wind_speed, g, self.ms, w, coef, t_tower, t_speed, sens, red, excess, str(status))

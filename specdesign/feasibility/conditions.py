@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import as_omega, positive_scalar
-from .achievable import achievable_pitch
+from .achievable import YoulaProblem
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "pitch_frontier",
            "sensitivity_disks"]
@@ -437,6 +437,7 @@ def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8
     plant = model.linearize(float(wind_speed))
     speed0 = np.abs(spec.speed_specification(model, float(wind_speed)).response(w))
     bound, designs = [], []
+    youla = YoulaProblem(model, wind_speed, max_sensitivity=ms, max_pitch_rate_ratio=max_pitch_rate_ratio, base=base)
     for gi in g:
         d = sensitivity_disks(plant, w, np.full(w.shape, np.inf), speed0 * 10 ** (gi / 20), ms)
         r = np.minimum(d["r_speed"], d["r_margin"])
@@ -444,8 +445,7 @@ def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8
         d_min = spectral.damage_rate(w, t_min ** 2 * base.wind_psd, base.m, method=base.method)
         bound.append(float(spectral.del_reduction(100.0 * (1.0 - d_min / base.damage_rate), base.m)) if d_min > 0 else 100.0)
         try:
-            designs.append(achievable_pitch(model, wind_speed, gi, max_sensitivity=ms,
-                                            max_pitch_rate_ratio=max_pitch_rate_ratio, base=base))
+            designs.append(youla.solve(gi))
         except RuntimeError:
             designs.append(None)
     achievable = np.array([np.nan if x is None else x.del_reduction for x in designs])

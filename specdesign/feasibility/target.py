@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .achievable import AchievablePitch, achievable_pitch
+from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["TargetSpecification", "specification_for_target", "DEFAULT_CASE_OFFSETS", "RELAX_LADDER_DB"]
 
@@ -174,10 +174,11 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     base = spec.baseline_analysis(model, v, m=m, omega=omega)
     cases = _Cases(model, speeds, v)
 
+    youla = YoulaProblem(model, v, max_sensitivity=max_sensitivity, max_pitch_rate_ratio=max_pitch_rate_ratio, base=base)
+
     def reached(g, sl=slack):
         try:
-            d = achievable_pitch(model, v, g, max_sensitivity=max_sensitivity,
-                                 max_pitch_rate_ratio=max_pitch_rate_ratio, base=base)
+            d = youla.solve(g)
         except RuntimeError:
             return None, -np.inf, None
         rob = cases.excess(d.controller(model), dense)
