@@ -16,7 +16,6 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.slow  # one full site build, ~20-40 s
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("specdesign", "loopshaping")
@@ -38,6 +37,7 @@ def site(tmp_path_factory):
     return out, r.returncode, r.stdout + r.stderr
 
 
+@pytest.mark.slow  # one full site build (shared), ~20-40 s
 def test_site_builds_strict_without_warnings(site):
     out, code, log = site
     warnings = [line for line in log.splitlines() if re.match(r"\s*(WARNING|ERROR)\b", line)]
@@ -72,6 +72,7 @@ def _api_html(out: Path) -> str:
     return "".join(p.read_text(encoding="utf-8") for p in sorted((out / "api").rglob("*.html")))
 
 
+@pytest.mark.slow  # one full site build (shared), ~20-40 s
 def test_api_reference_covers_every_public_name(site):
     out, code, _ = site
     assert code == 0, "the site did not build; see test_site_builds_strict_without_warnings"
@@ -88,6 +89,7 @@ def test_api_reference_covers_every_public_name(site):
     assert not missing, f"{len(missing)} public names missing from the API reference: {missing[:30]}"
 
 
+@pytest.mark.slow  # one full site build (shared), ~20-40 s
 def test_api_reference_has_no_raw_rest_markup(site):
     """The numpydoc docstrings use Sphinx roles, literal blocks and simple tables; the site
     turns them into links, code and tables, not raw text."""
@@ -100,3 +102,30 @@ def test_api_reference_has_no_raw_rest_markup(site):
     assert not raw, raw[:5]
     # a doctest outside an Examples section, read as Markdown, becomes nested block quotes
     assert not re.search(r"<blockquote>\s*<blockquote>", page)
+
+
+# ----------------------------------------------------------------------------- the docstring conversions
+def _roles():
+    pytest.importorskip("griffe", reason='the docs extra is not installed: pip install -e ".[docs]"')
+    sys.path.insert(0, str(ROOT / "docs" / "hooks"))
+    try:
+        return importlib.import_module("griffe_rest_roles")
+    finally:
+        sys.path.pop(0)
+
+
+def test_rest_literal_blocks_and_simple_tables_become_markdown():
+    g = _roles()
+    text = "Layout of ``path``::\n\n    a.json   settings\n    b.csv    index\n\nAfter."
+    assert g.literal_blocks(text) == ("Layout of ``path``:\n\n```text\na.json   settings\nb.csv    index\n```\n\nAfter.")
+    table = ("Elements:\n\n====  ======  ====\nkind  params  f\n====  ======  ====\ngain  k       k\n"
+             "notch omega,   N(s)\n      zeta\n====  ======  ====\n\nAfter.")
+    assert g.simple_tables(table).split("\n")[2:7] == [
+        "| kind | params | f |", "|---|---|---|", "| gain | k | k |", "| notch | omega, zeta | N(s) |", ""]
+    assert g.simple_tables("a\n==== ====\nb") == "a\n==== ====\nb"  # a lone rule is not a table
+
+
+def test_doctests_are_fenced_outside_examples_only():
+    g = _roles()
+    text = "Use:\n\n>>> f(1)\n2\n\nExamples\n--------\n>>> f(2)\n3"
+    assert g.fence_doctests(text) == "Use:\n\n```pycon\n>>> f(1)\n2\n```\n\nExamples\n--------\n>>> f(2)\n3"

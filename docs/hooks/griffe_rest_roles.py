@@ -113,6 +113,10 @@ def simple_tables(text: str) -> str:
         while j < len(lines) and lines[j].strip():
             j += 1
         borders = [k for k in range(i, j) if BORDER.fullmatch(lines[k])]
+        if len(borders) < 2:  # a lone rule, not a table: left as written
+            out += lines[i:j]
+            i = j
+            continue
         spans = [(m.start(), m.end()) for m in re.finditer(r"=+", lines[i])]
         starts = [a for a, _ in spans] + [None]
 
