@@ -16,6 +16,7 @@ Layout
   input and output names and the layout of the parameter array: see its docstring, "the
   kernel interface".
 - :mod:`specdesign.turbine.tables`: the shipped data and the bicubic rotor-table coefficients.
+- :mod:`specdesign.turbine.openfast_deck`: :func:`from_openfast`, a model from an OpenFAST deck.
 - ROSCO (:func:`rosco_baseline`, :func:`rosco_gain_schedule`, :class:`RoscoSchedule`,
   :func:`speed_filter`) lives in :mod:`specdesign.rosco` and is re-exported here.
 """
@@ -51,6 +52,7 @@ from .kernel import (
     rhs,
 )
 from .model import TurbineModel, iea15mw
+from .openfast_deck import from_openfast
 from .operating import AERO_VARIABLES, LOAD_INPUT_NAMES, AeroExpansion, OperatingPoint
 
 __all__ = [
@@ -69,6 +71,7 @@ __all__ = [
     "AeroExpansion",
     "RoscoSchedule",
     "iea15mw",
+    "from_openfast",
     "rosco_baseline",
     "rosco_gain_schedule",
     "speed_filter",
