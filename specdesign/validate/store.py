@@ -3,8 +3,9 @@
 ``run_campaign(..., store=path)`` writes every finished run here and, run again with the
 same path, loads the cells already there and simulates only the missing ones, so an
 interrupted campaign resumes where it stopped and a campaign grows by more seeds, wind
-speeds or controllers without rerunning anything. The final :class:`Campaign` is assembled
-from the cells in both cases: bitwise the same as an uninterrupted run.
+speeds or controllers without rerunning anything. The final
+:class:`~specdesign.validate.Campaign` is assembled from the cells in both cases: bitwise
+the same as an uninterrupted run.
 
 Layout of ``path``::
 
@@ -99,9 +100,9 @@ class CampaignStore:
         The campaign's settings (JSON-serialisable: duration, steps, m, ...); a store made
         with other settings is refused.
     model : str
-        :func:`fingerprint` of the turbine model.
+        :func:`~specdesign.validate.store.fingerprint` of the turbine model.
     controllers : dict
-        Controller name → :func:`fingerprint`. Names new to the store are added; a name
+        Controller name → :func:`~specdesign.validate.store.fingerprint`. Names new to the store are added; a name
         stored with another fingerprint is refused.
 
     Raises
@@ -165,7 +166,7 @@ class CampaignStore:
         Returns
         -------
         dict
-            (v, seed, controller) → cell record (the form :meth:`write` takes) for every
+            (v, seed, controller) → cell record (the form :meth:`~specdesign.validate.store.CampaignStore.write` takes) for every
             wanted cell that is stored; missing ones are absent.
         """
         out = {}
