@@ -1,7 +1,14 @@
-// MathJax for pymdownx.arithmatex (generic mode), as the Material theme documents it
+// MathJax 3 for pymdownx.arithmatex (generic mode: \( \) and \[ \] in span/div.arithmatex), as the
+// Material theme documents it, and for the notebooks' Markdown cells, which keep $ and $$
+// (mkdocs-jupyter's own MathJax 2 configuration does not apply to MathJax 3).
 window.MathJax = {
-  tex: {inlineMath: [["\\(", "\\)"]], displayMath: [["\\[", "\\]"]], processEscapes: true, processEnvironments: true},
-  options: {ignoreHtmlClass: ".*|", processHtmlClass: "arithmatex"}
+  tex: {
+    inlineMath: [["\\(", "\\)"], ["$", "$"]],
+    displayMath: [["\\[", "\\]"], ["$$", "$$"]],
+    processEscapes: true,
+    processEnvironments: true
+  },
+  options: {ignoreHtmlClass: ".*|", processHtmlClass: "arithmatex|jp-RenderedMarkdown"}
 };
 document$.subscribe(() => {
   MathJax.startup.output.clearCache();
