@@ -240,15 +240,45 @@ class _Cases:
         self._grid = {}
 
     def _on(self, omega):
-        """Plant responses and ROSCO's maps (|T_MyT|, |T_Ω|), each (n_omega, n_cases), cached per grid."""
+        """Plant responses and ROSCO's maps (|T_MyT|, |T_Ω|), each (n_omega, n_cases), on ``omega``."""
         from ..closedloop import closed_map, plant_responses, siso_response
 
+        R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
+        c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
+        return R, np.abs(closed_map(R, c, 0.0, "tower_base_my")), np.abs(closed_map(R, c, 0.0, "gen_speed"))
+
+    def _on_refined(self, omega, extra):
+        """:meth:`_on` on ``omega`` ∪ ``extra``: ``omega``'s part computed once (the ladder and the
+        bisection refine the same dense grid around each certificate's own roots)."""
         key = omega.tobytes()
         if key not in self._grid:
-            R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
-            c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
-            self._grid[key] = (R, np.abs(closed_map(R, c, 0.0, "tower_base_my")), np.abs(closed_map(R, c, 0.0, "gen_speed")))
-        return self._grid[key]
+            self._grid[key] = self._on(omega)
+        extra = np.setdiff1d(extra, omega)
+        if extra.size == 0:
+            return omega, self._grid[key]
+        more = self._on(extra)
+        w = np.r_[omega, extra]
+        order = np.argsort(w, kind="stable")
+        R = {k: np.concatenate([v, more[0][k]])[order] for k, v in self._grid[key][0].items()}
+        return w[order], (R,) + tuple(np.concatenate([x, y])[order] for x, y in zip(self._grid[key][1:], more[1:]))
+
+    def _unstable(self, controller):
+        """Whether some case's loop β = −C·Ω_g has a pole in the closed right half-plane (the
+        closed-loop A of the state spaces: python-control's interconnection costs 20× more)."""
+        import control
+
+        k = control.ss(controller)
+        ak, bk, ck, dk = (np.asarray(x) for x in (k.A, k.B, k.C, k.D))
+        for p in self.plants:
+            ss = control.ss(p)
+            i, o = ss.input_labels.index("pitch_cmd"), ss.output_labels.index("gen_speed")
+            a, b, c = np.asarray(ss.A), np.asarray(ss.B)[:, [i]], np.asarray(ss.C)[[o]]
+            if np.asarray(ss.D)[o, i] != 0:
+                raise ValueError("the plant has a direct feedthrough pitch → generator speed; not supported")
+            acl = np.block([[a - b @ dk @ c, -b @ ck], [bk @ c, ak]])
+            if np.max(np.linalg.eigvals(acl).real) >= 0:
+                return True
+        return False
 
     def excess(self, controller, omega):
         """(tower robustness, speed relaxation needed), dB, or None if a case is unstable.
@@ -260,15 +290,13 @@ class _Cases:
 
         from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response, system_roots
 
+        if self._unstable(controller):
+            return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            loops = [closed_loop(p, controller, warn=False) for p in self.plants]
-        if any(np.max(np.real(cl.poles())) >= 0 for cl in loops):
-            return None
-        cl0 = loops[self.nom]
+            cl0 = closed_loop(self.plants[self.nom], controller, warn=False)
         roots = np.concatenate([system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])])
-        w = refine_grid(omega, lightly_damped(roots))
-        R, rt, rs = self._on(w)
+        w, (R, rt, rs) = self._on_refined(omega, refine_grid(omega, lightly_damped(roots)))
         c = siso_response(controller, w)[:, None]
         ratio = np.abs(closed_map(R, c, 0.0, "tower_base_my")) / rt
         speed_db = float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / rs)))
