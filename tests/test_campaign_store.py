@@ -152,3 +152,18 @@ def test_store_refuses_another_campaign(setup, tmp_path):
     (tmp_path / "a_file").write_text("")
     with pytest.raises(ValueError, match="is a file"):
         run_campaign({"PI19": ctrls["PI19"]}, [19.0], [0], model=model, store=tmp_path / "a_file", **KW)
+
+
+def test_store_reruns_runs_whose_records_are_now_kept(setup, tmp_path, monkeypatch):
+    # keep_series=1 keeps the first seed's records; the same store with the seeds reordered
+    # must rerun the new first seed (stored without records), not show NaN records
+    model, ctrls = setup
+    kw = dict(model=model, keep_series=1, **KW)
+    store = tmp_path / "reorder"
+    run_campaign({"PI19": ctrls["PI19"]}, [19.0], [4, 5], store=store, **kw)
+    calls = recording(monkeypatch)
+    reordered = run_campaign({"PI19": ctrls["PI19"]}, [19.0], [5, 4], store=store, **kw)
+    assert cells_of(calls) == {(19.0, 5, "PI19")}
+    monkeypatch.undo()
+    assert_bitwise_equal(reordered, run_campaign({"PI19": ctrls["PI19"]}, [19.0], [5, 4], **kw))
+    assert np.all(np.isfinite(reordered.series["PI19"].outputs["tower_base_my"]))

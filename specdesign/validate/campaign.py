@@ -344,7 +344,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     n_keep = len(seeds) if keep_series is True else int(keep_series)
     settings = {"duration": float(duration), "dt": float(dt), "record_dt": float(record_dt),
                 "transient": float(transient), "m": float(m), "predict": bool(predict),
-                "turbulence_class": turbulence_class, "keep_series": n_keep, "linear_twin": bool(linear_twin),
+                # True (every seed) stays True: a store grown by more seeds keeps theirs too
+                "turbulence_class": turbulence_class, "keep_series": True if keep_series is True else n_keep,
+                "linear_twin": bool(linear_twin),
                 "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg)}
     wanted = [(float(v), int(s), n) for v in vs for s in seeds for n in names]
     records, st = {}, None
@@ -354,6 +356,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         st = CampaignStore(store, settings, fingerprint(model), {n: fingerprint(c) for n, c in controllers.items()})
         records = st.load(wanted)
     kept = set(seeds[:n_keep].tolist())
+    # a stored run among the first keep_series seeds but stored without its records (the
+    # seeds were reordered) runs again, rather than showing NaN records
+    records = {c: r for c, r in records.items() if not (c[1] in kept and r["series"] is None and not r["unstable"])}
     tasks = []
     for v in vs:
         # controllers missing the same seeds at this speed share one task (one wind synthesis,
@@ -452,7 +457,7 @@ def _assemble(records, names, vs, seeds, settings) -> Campaign:
         return {k: np.array([[f[key][k] for f in by_v] for by_v in first]) for k in SPECTRA}
 
     series = {}
-    n_keep = settings["keep_series"]
+    n_keep = len(seeds) if settings["keep_series"] is True else settings["keep_series"]
     if n_keep:
         from ..simulate import SimulationResult
 
