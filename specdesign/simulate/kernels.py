@@ -435,7 +435,12 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
         g["_krhs"], g["_kout"] = njit(krhs), njit(kout)
 
         def copy(f, **kw):
-            return njit(**kw)(types.FunctionType(f.py_func.__code__, g, f.py_func.__name__))
+            fn = types.FunctionType(f.py_func.__code__, g, f.py_func.__name__)
+            # a name of its own: numba names compiled symbols after the qualified name and a
+            # per-process counter, and a module function loaded from the on-disk cache (named
+            # in the process that saved it) could otherwise link to this copy's symbol
+            fn.__qualname__ = f"{f.py_func.__qualname__}_rebound{len(_REBOUND)}"
+            return njit(**kw)(fn)
 
         g["_rk4"] = copy(_rk4)
         g["_run_one"] = copy(_run_one)
