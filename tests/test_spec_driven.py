@@ -114,3 +114,45 @@ def test_the_certificate_structure_needs_a_target_specification(model, chain19):
         design_qft(model, 21.0, spec=ts)
     with pytest.raises(TypeError, match="options"):
         design_qft(model, 19.0, spec=ts, maxfev=10)
+
+
+def test_qft_bounds_checker_agrees_with_a_brute_force_scan(model, chain19):
+    # the explorer's live check: empty QFT bounds where no loop value meets every case, checked
+    # here by scanning L₀(jω) on a magnitude × phase grid with the closed-loop formula
+    from specdesign import spec
+    from specdesign.qft.boundscheck import bounds_checker
+
+    ts, _ = chain19
+    checker = bounds_checker(model, 19.0, ts.speed, template_offsets=ts.template_offsets)
+    assert checker.check(ts.tower).feasible  # the certificate meets them: they cannot be empty
+    tight = spec.Specification(ts.tower.baseline, (spec.Gain(-6.0),))
+    verdict = checker.check(tight)
+    assert not verdict.feasible and "empty at" in verdict.summary()
+    assert not _scan(model, ts, tight, verdict.omega[verdict.empty][0]).any()
+    # the scan itself finds loop values where the bounds are not empty (the feasible pair)
+    assert _scan(model, ts, ts.tower, 0.5).any()
+
+
+def _scan(model, ts, tower, w0):
+    """Which L₀(jω0) on a 0.25 dB × 1° grid meet tower, speed and |S| ≤ 1.9 at every case."""
+    w = np.array([w0, 2 * w0])  # the grid helpers want a grid; only w0 is scanned
+    speeds = ts.case_speeds
+    plants = [model.linearize(s) for s in speeds]
+    R = closedloop.plant_responses(plants, w, ("gen_speed", "tower_base_my", "tower_top_vel"))
+    rc = np.stack([closedloop.siso_response(rosco_baseline(model, s), w) for s in speeds], axis=1)
+    nom = speeds.index(19.0)
+    t_r = closedloop.closed_map(R, rc, 0.0, "tower_base_my")
+    s_r = closedloop.closed_map(R, rc, 0.0, "gen_speed")
+    w_tower = np.abs(t_r) * np.abs(tower.response(w) / t_r[:, nom])[:, None]
+    w_speed = np.abs(s_r) * np.abs(ts.speed.response(w) / s_r[:, nom])[:, None]
+    mag = 10 ** (np.arange(-60, 60, 0.25) / 20)
+    ph = np.deg2rad(np.arange(0, 360, 1.0))
+    L0 = (mag[:, None] * np.exp(1j * ph[None, :])).reshape(-1)
+    c = L0 / R[("gen_speed", "pitch_cmd")][0, nom]  # the controller value giving L₀ on the nominal plant
+    ok = np.ones(L0.shape[0], bool)
+    for i in range(len(speeds)):
+        Ri = {k: v[0, i] for k, v in R.items()}
+        ok &= np.abs(closedloop.closed_map(Ri, c, 0.0, "tower_base_my")) <= w_tower[0, i]
+        ok &= np.abs(closedloop.closed_map(Ri, c, 0.0, "gen_speed")) <= w_speed[0, i]
+        ok &= np.abs(1 / (1 + c * Ri[("gen_speed", "pitch_cmd")])) <= 1.9
+    return ok
