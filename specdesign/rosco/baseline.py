@@ -168,7 +168,7 @@ def first_order_rotor_model(model: TurbineModel, wind_speed: float) -> tuple[flo
 
 
 def rosco_gain_schedule(model: TurbineModel, wind_speeds: ArrayLike | None = None, *, omega_pc: float = 0.2,
-                        zeta_pc: float = 1.0) -> RoscoSchedule:
+                        zeta_pc: float = 1.0, constant_power: bool = False) -> RoscoSchedule:
     """ROSCO's pitch PI schedule by pole placement on the first-order rotor model.
 
     With e = Ω_ref − Ω and β = Kp·e + Ki∫e, the closed rotor loop is
@@ -187,11 +187,16 @@ def rosco_gain_schedule(model: TurbineModel, wind_speeds: ArrayLike | None = Non
         Natural frequency of the desired closed-loop rotor-speed poles (rad/s).
     zeta_pc : float, optional
         Their damping ratio (-).
+    constant_power : bool, optional
+        Tune as ROSCO does for a torque controller that holds the power above rated
+        (DISCON.IN ``VS_ConstPower = 1``): A gains ROSCO's term P_rated/(J·Ω_rated²), the
+        torque falling as the speed rises. The reduced model itself holds the torque
+        constant; default False (the IEA 15 MW's ROSCO, ``VS_ConstPower = 0``).
 
     Returns
     -------
     RoscoSchedule
-        The schedule over ``wind_speeds``.
+        The schedule over ``wind_speeds`` (with ``constant_power``, ``A`` includes the term).
 
     Raises
     ------
@@ -215,6 +220,8 @@ def rosco_gain_schedule(model: TurbineModel, wind_speeds: ArrayLike | None = Non
         raise ValueError(f"wind_speeds must be a 1-D array of at least 2 speeds in m/s (the gains use a line fit), got shape {v.shape}")
     rows = np.array([first_order_rotor_model(model, s) for s in v])
     pitch, A, Bb, Bw = rows.T
+    if constant_power:
+        A = A + model.rated_power / (model.drivetrain_inertia * model.rated_rotor_speed**2)
     A_fit = np.polyval(np.polyfit(v, A, 1), v)
     B_fit = np.polyval(np.polyfit(v, Bb, 1), v)
     return RoscoSchedule(

@@ -244,7 +244,7 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     Returns
     -------
     TurbineModel
-        The model, named after the ``.fst`` file, wind range from the first whole m/s above
+        The model, named after the ``.fst`` file, wind range from the first 0.1 m/s above
         rated to 25 m/s.
 
     Raises
@@ -309,7 +309,8 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     pa = [float(entries[k].values[0]) if k in entries else v for k, v in (("PA_CornerFreq", 3.14), ("PA_Damping", 0.707))]
     try:
         model = _model(fst_path, rho, tip, inertia, mass, stiff, zeta, my_per_m, pa, ds, gb, tsr, pitch, cp, ct)
-        return dataclasses.replace(model, wind_range=(float(math.floor(model.rated_wind_speed()) + 1), 25.0))
+        # from the first 0.1 m/s above rated: ROSCO's schedule starts just above rated
+        return dataclasses.replace(model, wind_range=(math.ceil(10 * model.rated_wind_speed() + 1e-9) / 10, 25.0))
     except ValueError as e:
         raise ValueError(f"{fst.path} (rotor table {cp_table}): {e}") from None
 
