@@ -8,7 +8,8 @@ window.MathJax = {
     processEscapes: true,
     processEnvironments: true
   },
-  options: {ignoreHtmlClass: ".*|", processHtmlClass: "arithmatex|jp-RenderedMarkdown"}
+  // not Material's ignoreHtmlClass ".*|": it also skips the class-less <p> inside a notebook cell
+  options: {ignoreHtmlClass: "tex2jax_ignore", processHtmlClass: "arithmatex|jp-RenderedMarkdown"}
 };
 document$.subscribe(() => {
   MathJax.startup.output.clearCache();
