@@ -156,3 +156,13 @@ def _scan(model, ts, tower, w0):
         ok &= np.abs(closedloop.closed_map(Ri, c, 0.0, "gen_speed")) <= w_speed[0, i]
         ok &= np.abs(1 / (1 + c * Ri[("gen_speed", "pitch_cmd")])) <= 1.9
     return ok
+
+
+def test_a_specification_driven_schedule(model):
+    from specdesign.qft import design_schedule
+
+    (d,) = design_schedule(model, (25.0,), specification="target", progress=False)
+    assert d.success and d.promise.exact_del >= 24.5 and d.del_reduction >= d.promise.exact_del - 0.1
+    assert d.options["structure"] == "certificate"
+    with pytest.raises(ValueError, match="specification"):
+        design_schedule(model, (25.0,), specification="youla")

@@ -664,7 +664,8 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
 
 
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
-                    target_reduction: float | Sequence[float] = 25.0, **kwargs: Any) -> tuple[QFTDesign, ...]:
+                    target_reduction: float | Sequence[float] = 25.0, *, specification: str = "notch",
+                    progress: bool = True, **kwargs: Any) -> tuple[QFTDesign, ...]:
     """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
 
     Parameters
@@ -675,6 +676,13 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         Operating points, m/s.
     target_reduction : float or sequence of float
         Tower-base DEL reduction to reach, %: one number, or one value per wind speed.
+    specification : {"notch", "target"}
+        ``"notch"``: the fixed-structure design against the notch specification and a DEL
+        target (:func:`design_qft` without ``spec``). ``"target"``: specification-driven, the
+        specification for the target first (:func:`specdesign.feasibility.specification_for_target`),
+        then ``design_qft(spec=...)``.
+    progress : bool
+        Show a progress bar over the wind speeds (tqdm.auto: a widget in Jupyter).
     **kwargs
         Other keywords go to :func:`design_qft`.
 
@@ -687,7 +695,8 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     ------
     ValueError
         If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` does not
-        broadcast to it, or :func:`design_qft` raises.
+        broadcast to it, ``specification`` is unknown, or :func:`design_qft` (or, with
+        ``"target"``, :func:`specdesign.feasibility.specification_for_target`) raises.
     TypeError
         As :func:`design_qft`.
 
@@ -707,7 +716,20 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     if vs.ndim != 1 or vs.size == 0:
         raise ValueError("wind_speeds must be a non-empty 1-D sequence of wind speeds in m/s")
     targets = np.broadcast_to(np.asarray(target_reduction, float), vs.shape)
-    return tuple(design_qft(model, float(v), float(tr), **kwargs) for v, tr in zip(vs, targets))
+    if specification not in ("notch", "target"):
+        raise ValueError(f"specification={specification!r} must be 'notch' or 'target'")
+    from tqdm.auto import tqdm
+
+    out = []
+    for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
+                      disable=not progress):
+        if specification == "target":
+            from ..feasibility import specification_for_target
+
+            out.append(design_qft(model, float(v), spec=specification_for_target(model, float(v), float(tr)), **kwargs))
+        else:
+            out.append(design_qft(model, float(v), float(tr), **kwargs))
+    return tuple(out)
 
 
 def design_table(designs: Iterable[QFTDesign]) -> list[dict[str, Any]]:
