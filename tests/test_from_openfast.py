@@ -103,3 +103,15 @@ def test_missing_or_inconsistent_values_name_the_file_and_key(cases, tmp_path):
         from_openfast(deck / "NREL-5MW.fst")
     with pytest.raises(FileNotFoundError, match="does not exist"):
         from_openfast(deck / "NREL-5MW.fst", cp_table=tmp_path / "none.txt")
+
+
+def test_simulate_synthesises_the_wind_for_the_models_rotor(nrel5mw):
+    # the rotor-effective spectrum depends on the rotor radius: the deck's 63 m, not the IEA 15 MW's
+    from specdesign.simulate import simulate
+
+    c = rosco_scheduled(nrel5mw)
+    kw = dict(seeds=[1], duration=20.0, transient=0.0)
+    own = simulate(nrel5mw, c, [19.0], **kw)
+    given = simulate(nrel5mw, c, [19.0], wind_rotor_radius=63.0, **kw)
+    other = simulate(nrel5mw, c, [19.0], wind_rotor_radius=120.97, **kw)
+    assert np.array_equal(own["wind"], given["wind"]) and not np.array_equal(own["wind"], other["wind"])

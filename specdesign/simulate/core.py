@@ -247,7 +247,9 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     linear : bool, optional
         Integrate the linearisation at each wind speed instead of the nonlinear model.
     wind_rotor_radius : float, optional
-        Rotor radius for the rotor-effective spectrum (m) (default: the IEA 15 MW's).
+        Rotor radius for the rotor-effective spectrum (m) (default: ``plant.rotor_radius``
+        for a TurbineModel, e.g. one of :func:`specdesign.turbine.from_openfast`, else the
+        IEA 15 MW's).
     wind_mean_tol : float, optional
         Largest |mean of a given wind record − its wind speed| (m/s) (default
         :data:`WIND_MEAN_TOLERANCE`).
@@ -305,6 +307,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     >>> r["gen_speed"].shape
     (1, 1, 100)
     """
+    model_radius = getattr(plant, "rotor_radius", None)
     plant = turbine_plant(plant) if not isinstance(plant, KernelPlant) else plant
     dt = positive_scalar(dt, "dt")
     duration = positive_scalar(duration, "duration")
@@ -325,7 +328,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
             raise ValueError("give either seeds (turbulent wind is synthesised) or wind (W, S, n) in m/s")
         seeds = np.atleast_1d(np.asarray(seeds, dtype=np.int64))
         wind_dt = record_dt if wind_dt is None else positive_scalar(wind_dt, "wind_dt")
-        radius = wind_rotor_radius
+        radius = wind_rotor_radius if wind_rotor_radius is not None else model_radius
         if radius is None:
             from .. import turbine
 
