@@ -11,7 +11,7 @@ from .controller import KINDS
 __all__ = ["build_widget", "LOG_STEP", "LOG_SPAN"]
 
 LOG_STEP = 0.005  # decades per slider step: 1.2 %, fine enough to place a corner frequency
-LOG_SPAN = 2.0  # decades either side of the value the slider was built around
+LOG_SPAN = 1.0  # decades either side of the value the slider was built around (re-centred on a typed value)
 
 
 def _log_range(value):
@@ -99,13 +99,16 @@ def build_widget(d):
         is_log = not name.startswith("zeta")
         if is_log:
             lo, hi = _log_range(value)
+            # a wide track: about 1.5 % per pixel, so a small drag is a small change
             sl = ipw.FloatLogSlider(value=abs(value), base=10, min=lo, max=hi, step=LOG_STEP,
-                                    description=name + (" (−)" if value < 0 else ""), readout_format=".4g")
+                                    description=name + (" (−)" if value < 0 else ""), readout_format=".4g",
+                                    layout=ipw.Layout(width="36em"))
         else:
             sl = ipw.FloatSlider(value=value, min=0.0 if name == "zeta_zero" else 0.005, max=2.0, step=0.005,
-                                 description=name, readout_format=".4g")
+                                 description=name, readout_format=".4g", layout=ipw.Layout(width="36em"))
         text = ipw.FloatText(value=value, description="exact", continuous_update=False, layout=ipw.Layout(width="14em"))
         quiet = [False]
+        sent = [value]  # the values Python put on the slider since the last move (signed)
 
         def set_quietly(widget, v):
             quiet[0] = True
@@ -118,19 +121,22 @@ def build_widget(d):
                     sl.description = name + (" (−)" if v < 0 else "")
                     v = abs(v)
                 widget.value = v
+                if widget is sl:
+                    sent.append(math.copysign(sl.value, v) if is_log else sl.value)
             finally:
                 quiet[0] = False
 
         def on_slider(ch):
             if quiet[0]:
                 return
-            cur = current()
-            new = math.copysign(ch["new"], cur) if is_log else ch["new"]
-            # The front end rounds a value set from Python to its step and echoes it back: an
-            # event within half a step of the current value is that echo, not a move.
-            dist = abs(math.log10(abs(new)) - math.log10(abs(cur))) if is_log else abs(new - cur)
-            if dist < 0.5 * sl.step:
+            new = math.copysign(ch["new"], current()) if is_log else ch["new"]
+            # The front end rounds each value set from Python to its step and echoes it back
+            # (maybe after later cells ran): within half a step of a value Python set since the
+            # last move, it is such an echo, not a move.
+            dist = [abs(math.log10(abs(new)) - math.log10(abs(v))) if is_log else abs(new - v) for v in sent]
+            if min(dist) < 0.5 * sl.step:
                 return
+            sent[:] = [new]
             if apply(idx, name, new):
                 set_quietly(text, new)
 

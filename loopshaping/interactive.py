@@ -12,6 +12,7 @@ live in the notebook, otherwise the widget re-displays a static figure after eac
 """
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 
 import numpy as np
@@ -409,39 +410,47 @@ class Designer:
         return self.set_controller(self.controller.remove(index))
 
     # -- drawing
-    def draw(self, live=None):
+    def draw(self, live: bool | None = None):
         """Build the figure (Nichols chart + closed-loop magnitudes) without displaying it.
 
         :meth:`widget` displays it (once) with the controls.
 
         Parameters
         ----------
-        live : bool, optional
+        live : bool, default False
             Redraw edits by blitting (only the loop, markers, title and closed-loop lines are
-            re-rendered). Default: on with the ipympl backend. Blitted artists are skipped by
-            ``savefig`` and static inline display, hence off elsewhere.
+            re-rendered on a cached background). Off by default: ipympl's blit of an edit made
+            before the browser drew the figure once left the canvas empty (a broken image), and
+            blitted artists are skipped by ``savefig`` and static inline display; an edit then
+            asks for a full redraw (``draw_idle``), which ipympl coalesces.
 
         Returns
         -------
         matplotlib.figure.Figure
             The designer's figure (also kept as ``self.figure``).
         """
-        import matplotlib
         import matplotlib.pyplot as plt
 
         if live is None:
-            live = "ipympl" in matplotlib.get_backend() or "widget" in matplotlib.get_backend()
+            live = False
         # pyplot would also show a figure made with interactive mode on at the end of the cell,
         # beside the one the widget shows: twice
         with plt.ioff():
-            fig, (ax_n, ax_b) = plt.subplots(1, 2, figsize=(11, 4.8))
+            fig, (ax_n, ax_b) = plt.subplots(1, 2, figsize=(10, 5.2))
+        if hasattr(fig.canvas, "header_visible"):  # ipympl: the title says it all, no "Figure n" label
+            fig.canvas.header_visible = False
         draw(self.bounds, loop=None, ax=ax_n, legend=False)
         st = self.state()
         (loop,) = ax_n.plot(st.phase_deg, st.magnitude_db, "k-", lw=1.5, label="nominal loop $L_0$")
         i = self._design_idx
         marks = ax_n.scatter(st.phase_deg[i], st.magnitude_db[i], s=50, zorder=5,
                              c=self._marker_colours(st), edgecolors="k", label="design frequencies (green: met)")
-        ax_n.legend(fontsize=8, loc="lower right")
+        # the loop, the markers and what solid/dashed bounds mean; not one entry per design
+        # frequency (a turbine loop has dozens)
+        few = self.bounds.omega.size <= 8
+        keep = [(h, lab) for h, lab in zip(*ax_n.get_legend_handles_labels())
+                if few or h in (loop, marks) or lab.startswith(("solid", "dashed"))]
+        ax_n.legend(*zip(*keep), fontsize=7, loc="lower right")
         (t_line,) = ax_b.semilogx(self.omega, st.worst_T_db, label="max over cases |T| (dB)")
         (s_line,) = ax_b.semilogx(self.omega, st.worst_S_db, label="max over cases |S| (dB)")
         ax_b.set_xlabel("frequency ω (rad/s)")
@@ -449,7 +458,9 @@ class Designer:
         ax_b.grid(True, which="both", lw=0.3)
         ax_b.legend(fontsize=8)
         title = fig.suptitle(self._title(st), fontsize=9, color=self._title_colour(st))
-        fig.tight_layout(rect=(0, 0, 1, 0.86))  # once: a layout engine would re-run on every redraw
+        # fixed margins (no layout engine: it would re-run on every redraw); room for the
+        # three-line title above the axes
+        fig.subplots_adjust(left=0.08, right=0.98, bottom=0.11, top=0.79, wspace=0.28)
         self.figure = fig
         self._artists = dict(loop=loop, marks=marks, T=t_line, S=s_line, title=title)
         # Blitting: the bounds and axes are rendered once into a cached background; an edit
@@ -526,8 +537,8 @@ class Designer:
         Returns
         -------
         str
-            Three lines: the verdict, each spec checked (met, or the design frequencies in
-            rad/s where it fails) and the controller.
+            The verdict, each spec checked (met, or the design frequencies in rad/s where it
+            fails) and the controller (wrapped), one per line.
         """
         return self._title(self.state() if state is None else state)
 
@@ -548,15 +559,17 @@ class Designer:
             head = f"{n} plant case(s) stable; bounds violated at ω = " + ", ".join(f"{x:.3g}" for x in w) + " rad/s"
         specs = "; ".join(f"{name}: " + ("met" if v.size == 0 else "violated at " + ", ".join(f"{x:.3g}" for x in v))
                           for name, v in st.spec_violations.items())
-        return f"{head}\nspecs checked: {specs}\nG = {self.controller}"
+        g = textwrap.fill(textwrap.shorten(f"G = {self.controller}", width=230, placeholder=" …"), 120)
+        return f"{head}\nspecs checked: {specs}\n{g}"
 
     # -- widgets
     def widget(self):
         """ipywidgets UI: element list, parameter controls, add/remove, and the figure (shown once).
 
-        Frequencies and gains move on log sliders (steps of 0.005 decade, 1.2 %, over ±2
-        decades around the value when the element is selected; a negative gain keeps its
-        sign) beside a text box whose typed value is used exactly.
+        Frequencies and gains move on log sliders (steps of 0.005 decade, 1.2 %, over ±1
+        decade around the value when the element is selected, re-centred on a typed value
+        outside; a negative gain keeps its sign) beside a text box whose typed value is used
+        exactly.
 
         Returns
         -------

@@ -86,8 +86,8 @@ def test_gain_and_frequency_controls_move_in_log_steps_and_keep_typed_values(loo
     select, _, rows, json_box, msg = ui.children[0].children
     assert len(ui.children) == 2 and len(plt.get_fignums()) == 1  # one figure
     slider, text = rows.children[0].children
-    # ±2 decades around |k|, steps of 0.005 decade (1.2 %); the sign of a negative gain is kept
-    assert (slider.min, slider.max, slider.step) == pytest.approx((np.log10(379) - 2, np.log10(379) + 2, 0.005))
+    # ±1 decade around |k|, steps of 0.005 decade (1.2 %); the sign of a negative gain is kept
+    assert (slider.min, slider.max, slider.step) == pytest.approx((np.log10(379) - 1, np.log10(379) + 1, 0.005))
     one_step = 10 ** (np.log10(379.0) + 0.005)
     slider.value = one_step
     assert d.controller.elements[0].params["k"] == -one_step and text.value == -one_step
@@ -128,12 +128,21 @@ def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
     assert ex.notch == spec.Notch(1.0712345678, 12.0, 0.23456789)
     assert ex.promise == spec.promise_of(ex.notch.response(base.omega), base)
     assert "12 dB" in ex.line.get_label() and f"{ex.promise.exact_damage:.1f} %" in ex.ax_mag.get_title()
+    # update() from code (a later cell) moves the sliders; a late echo of the first rounding,
+    # arriving after it, is not a move either (it was: notebook 03 showed 15.3 % for 15.0 %)
+    ex.update(1.05, 9.0, 0.2)
+    assert [s.value for s in sliders] == [1.05, 9.0, 0.2]
+    sliders[1].value = round(12.0 + 0.04, 1)  # the echo of 12.0, from before the update
+    sliders[2].value = round(start.width, 2)
+    assert ex.notch == spec.Notch(1.05, 9.0, 0.2)
+    sliders[1].value = 15.0  # a move again
+    assert ex.notch == spec.Notch(1.05, 15.0, 0.2)
     plt.close("all")
 
 
-def test_notebooks_enable_the_widget_backend_and_carry_no_outputs():
-    # every notebook with a live control turns the ipympl backend on itself, and git holds the
-    # notebooks without outputs (they are executed by tests/test_notebooks.py and the docs)
+def test_notebooks_with_live_controls_enable_the_widget_backend():
+    # every notebook with a live control turns the ipympl backend on itself, before the control
+    # (tests/test_notebook_outputs.py checks that they are committed without outputs)
     import json
     from pathlib import Path
 
@@ -142,8 +151,6 @@ def test_notebooks_enable_the_widget_backend_and_carry_no_outputs():
     for path in notebooks:
         nb = json.loads(path.read_text())
         code = ["".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code"]
-        assert all(not c.get("outputs") and c.get("execution_count") is None
-                   for c in nb["cells"] if c["cell_type"] == "code"), f"{path.name} has outputs: strip them"
         if any(".widget()" in s for s in code):
             interactive.append(path.stem)
             first = next(i for i, s in enumerate(code) if ".widget()" in s)

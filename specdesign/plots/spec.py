@@ -139,6 +139,9 @@ class NotchExplorer:
         self.ax_sens.legend()
         self.promise = None
         self._out = None  # the ipywidgets Output a static (non-ipympl) figure is shown in
+        self._sliders, self._sent, self._quiet = None, {}, False  # the widget's sliders, once built
+        if hasattr(self.fig.canvas, "header_visible"):  # ipympl: no "Figure n" label above the plot
+            self.fig.canvas.header_visible = False
         self.update(self.notch.omega_n, self.notch.depth_db, self.notch.width)
 
     def update(self, omega_n: float, depth_db: float, width: float, *, redraw: bool = True) -> Promise:
@@ -185,6 +188,16 @@ class NotchExplorer:
                 title += f"\npitch: INFEASIBLE at {where}"
         self.ax_mag.set_title(title, fontsize=9)
         self.ax_mag.legend(fontsize=8, loc="lower left")
+        if self._sliders is not None:  # a call from code: the sliders follow (not a move)
+            self._quiet = True
+            try:
+                for k, sl in self._sliders.items():
+                    v = getattr(self.notch, k)
+                    if sl.value != v:
+                        sl.value = v
+                        self._sent[k].append(sl.value)  # as clamped to the slider's range
+            finally:
+                self._quiet = False
         if redraw:
             self.fig.canvas.draw_idle()
             if self._out is not None:
@@ -241,8 +254,9 @@ class NotchExplorer:
         """Sliders for ω_n, depth and width wired to :meth:`update`, above the figure (shown once).
 
         The starting notch is kept exactly: the browser rounds a slider's value to its step and
-        sends it back, and an event within half a step of the current value is taken for that
-        echo, not for a move.
+        sends it back (possibly after later cells ran), and an event within half a step of a value
+        Python set since the last move is taken for that echo, not for a move. :meth:`update`
+        called from code moves the sliders too.
 
         Returns
         -------
@@ -263,12 +277,19 @@ class NotchExplorer:
                                       readout_format=".3g"),
         )
 
+        self._sliders, self._sent = sliders, {k: [getattr(n, k)] for k in sliders}
+
         def moved(change, name):
-            cur = getattr(self.notch, name)
-            new = change["new"]
-            dist = abs(np.log10(new / cur)) if name == "omega_n" else abs(new - cur)
-            if dist < 0.5 * sliders[name].step:
+            if self._quiet:
                 return
+            new = change["new"]
+            # The browser rounds each value set from Python to the slider's step and sends it
+            # back, possibly after later cells have set others: within half a step of a value
+            # Python set since the last move, it is such an echo, not a move.
+            dist = [abs(np.log10(new / v)) if name == "omega_n" else abs(new - v) for v in self._sent[name]]
+            if min(dist) < 0.5 * sliders[name].step:
+                return
+            self._sent[name] = [new]
             vals = dict(omega_n=self.notch.omega_n, depth_db=self.notch.depth_db, width=self.notch.width)
             vals[name] = new
             self.update(**vals)

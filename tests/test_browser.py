@@ -1,0 +1,252 @@
+"""The interactive notebooks in a real browser: JupyterLab + headless Chromium (Python playwright).
+
+The test starts its own JupyterLab on 127.0.0.1 (a free port, a random token, no browser) over a
+temporary copy of notebooks 03 (the specification explorer) and 04 (the QFT Designer on the
+19 m/s pitch loop), opens each in Debian's Chromium driven by playwright (``executable_path``:
+playwright's own browser downloads are not used), runs all cells, drags a slider, and checks
+from pixels that the live (ipympl) figure changed, then saves the notebook through JupyterLab
+and reads it back to check that every code cell ran and none errored. Screenshots go to
+``build/browser-screenshots/`` (kept by CI as artefacts). The server and its kernels are
+stopped in every case (the process group it was started in).
+
+Skipped, with the reason, only when Chromium is not installed (``apt-get install -y chromium``;
+``.ci/run`` installs it).
+"""
+from __future__ import annotations
+
+import io
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHOTS = ROOT / "build" / "browser-screenshots"
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    if CHROMIUM is None:
+        pytest.skip("Debian's chromium is not installed (apt-get update && apt-get install -y chromium; .ci/run does it)")
+    tmp = tmp_path_factory.mktemp("lab")
+    root = tmp / "notebooks"
+    root.mkdir()
+    for name in ("03_specification.ipynb", "04_qft_design.ipynb"):
+        shutil.copy(ROOT / "notebooks" / name, root / name)  # the browser saves outputs into the copies
+    # every cell rendered in the DOM (no virtual scrolling), so the test can find the widget cells
+    settings = tmp / "settings" / "@jupyterlab" / "notebook-extension"
+    settings.mkdir(parents=True)
+    (settings / "tracker.jupyterlab-settings").write_text(json.dumps({"windowingMode": "none"}))
+    news = tmp / "settings" / "@jupyterlab" / "apputils-extension"
+    news.mkdir(parents=True)
+    (news / "notification.jupyterlab-settings").write_text(json.dumps({"fetchNews": "false"}))
+    port, token = _free_port(), os.urandom(16).hex()
+    env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}  # the notebooks turn ipympl on
+    env.update(SPECDESIGN_FAST="1", JUPYTER_RUNTIME_DIR=str(tmp / "runtime"), PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")])))
+    log = open(tmp / "jupyterlab.log", "w")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jupyter", "lab", "--no-browser", "--ip=127.0.0.1", f"--port={port}",
+         f"--IdentityProvider.token={token}", f"--ServerApp.root_dir={root}", f"--LabApp.user_settings_dir={tmp / 'settings'}",
+         f"--LabApp.workspaces_dir={tmp / 'workspaces'}", "--LabApp.news_url=", "--ServerApp.port_retries=0", "--allow-root"],
+        cwd=root, env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        url = f"http://127.0.0.1:{port}"
+        deadline = time.monotonic() + 90
+        while True:
+            try:
+                with urllib.request.urlopen(f"{url}/api/status?token={token}", timeout=2) as r:
+                    if r.status == 200:
+                        break
+            except OSError:
+                pass
+            if proc.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError(f"JupyterLab did not start: {(tmp / 'jupyterlab.log').read_text()[-2000:]}")
+            time.sleep(0.5)
+        yield url, token, root
+    finally:
+        # the server and the kernels it started share its process group
+        try:
+            os.killpg(proc.pid, signal.SIGTERM)
+            proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=10)
+        except ProcessLookupError:
+            pass
+        log.close()
+
+
+@pytest.fixture(scope="module")
+def browser(lab):
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, headless=True,
+                               args=["--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu"])
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+def _pixels(png: bytes) -> np.ndarray:
+    import matplotlib.image
+
+    return matplotlib.image.imread(io.BytesIO(png), format="png")
+
+
+def _run_all(page, url, token, name, timeout_s):
+    """Open ``name``, wait for its kernel, run all cells, wait until every code cell has run."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    page.goto(f"{url}/lab/tree/{name}?token={token}")
+    page.wait_for_selector(".jp-Notebook .jp-CodeCell", timeout=60_000)
+    panel = ".jp-NotebookPanel:not(.lm-mod-hidden)"  # the notebook just opened, not an earlier tab
+    idle = "() => /\\| Idle/.test(document.querySelector('.jp-StatusBar-Widget')?.innerText || '')"
+    prompts = f"() => [...document.querySelectorAll('{panel} .jp-CodeCell .jp-InputPrompt')].map(e => e.textContent)"
+    for attempt in range(3):
+        time.sleep(2)
+        dialog = page.locator(".jp-Dialog", has_text="Select Kernel")
+        if dialog.count():  # JupyterLab sometimes asks even though the notebook names python3
+            dialog.locator(".jp-mod-accept").click()
+        page.wait_for_function(idle, timeout=90_000)  # the kernel started and connected
+        page.locator(f"{panel} .jp-Notebook").first.click(position={"x": 5, "y": 5})
+        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
+        page.locator(".lm-Menu-itemLabel").get_by_text("Run All Cells", exact=True).click()
+        try:  # a run-all sent while the kernel was still connecting is lost: send it again
+            page.wait_for_function(f"() => ({prompts})().some(t => /\\[(\\*|\\d+)\\]/.test(t))", timeout=15_000)
+            break
+        except PlaywrightTimeout:
+            if attempt == 2:
+                raise
+    page.wait_for_function(f"() => ({prompts})().every(t => /\\[\\d+\\]/.test(t))",
+                           timeout=timeout_s * 1000, polling=500)
+    return page.locator(panel)
+
+
+def _saved_errors(page, root, name):
+    """Save through JupyterLab, read the file: (cells not run, error outputs)."""
+    path = root / name
+    before = path.stat().st_mtime_ns
+    # the toolbar's save button: a key press would go to a focused widget's text box
+    page.locator(".jp-NotebookPanel:not(.lm-mod-hidden) [data-command='docmanager:save']").first.click()
+    deadline = time.monotonic() + 30
+    while path.stat().st_mtime_ns == before and time.monotonic() < deadline:
+        time.sleep(0.3)
+    assert path.stat().st_mtime_ns != before, f"JupyterLab did not save {name}"
+    nb = json.loads(path.read_text())
+    code = [c for c in nb["cells"] if c["cell_type"] == "code"]
+    not_run = [i for i, c in enumerate(code) if c.get("execution_count") is None]
+    errors = [(o.get("ename"), o.get("evalue")) for c in code for o in c.get("outputs", []) if o.get("output_type") == "error"]
+    return not_run, errors
+
+
+def _drag(page, handle, dx):
+    box = handle.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + dx / 2, y, steps=5)
+    page.mouse.move(x + dx, y, steps=5)
+    page.mouse.up()
+
+
+def _wait_changed(figure, before, timeout_s=40.0):
+    """The canvas once it differs from ``before`` and has stopped changing: (pixels, changed fraction)."""
+    deadline = time.monotonic() + timeout_s
+    last = before
+    while True:
+        time.sleep(1.0)
+        after = _pixels(figure.screenshot())
+        changed = float(np.mean(np.any(after != before, axis=-1))) if after.shape == before.shape else 1.0
+        settled = after.shape == last.shape and np.array_equal(after, last)
+        if (changed > 0.001 and settled) or time.monotonic() > deadline:
+            return after, changed
+        last = after
+
+
+@pytest.mark.slow
+def test_notebook_03_explorer_slider_redraws_the_figure(lab, browser):
+    url, token, root = lab
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    try:
+        nb = _run_all(page, url, token, "03_specification.ipynb", timeout_s=150)
+        cell = nb.locator(".jp-CodeCell", has_text="explorer.widget()").first
+        cell.scroll_into_view_if_needed()
+        figures = cell.locator(".jupyter-matplotlib-figure")
+        figures.first.wait_for(timeout=30_000)
+        assert figures.count() == 1  # one figure, no copy beside the widget
+        sliders = cell.locator(".widget-slider")
+        assert sliders.count() == 3 and cell.locator(".widget-checkbox").count() == 0  # no "redraw" box
+        canvas = figures.first.locator("canvas").first
+        page.screenshot(path=str(SHOTS / "03_explorer_before.png"), full_page=False)
+        before = _pixels(canvas.screenshot())
+        title_before = cell.locator(".widget-readout").nth(1).inner_text()
+        _drag(page, sliders.nth(1).locator(".noUi-handle"), 60)  # depth
+        after, changed = _wait_changed(canvas, before)
+        cell.screenshot(path=str(SHOTS / "03_explorer_after.png"))
+        assert cell.locator(".widget-readout").nth(1).inner_text() != title_before
+        assert changed > 0.001, f"the figure did not change after the depth slider moved ({changed:.4%} of pixels)"
+        not_run, errors = _saved_errors(page, root, "03_specification.ipynb")
+        assert not not_run and not errors, (not_run, errors)
+    finally:
+        page.screenshot(path=str(SHOTS / "03_final.png"), full_page=True)
+        page.close()
+
+
+@pytest.mark.slow
+def test_notebook_04_designer_gain_edit_redraws_the_figure(lab, browser):
+    url, token, root = lab
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    page = browser.new_page(viewport={"width": 1400, "height": 1100})
+    try:
+        nb = _run_all(page, url, token, "04_qft_design.ipynb", timeout_s=170)
+        cell = nb.locator(".jp-CodeCell", has_text="designer.widget()").first
+        cell.scroll_into_view_if_needed()
+        figures = cell.locator(".jupyter-matplotlib-figure")
+        figures.first.wait_for(timeout=30_000)
+        assert figures.count() == 1  # the Designer shows its figure once
+        canvas = figures.first.locator("canvas").first
+        before = _pixels(canvas.screenshot())
+        cell.screenshot(path=str(SHOTS / "04_designer_before.png"))
+        gain = cell.locator(".widget-slider").first  # the selected element 0: the gain
+        json_box = cell.locator("textarea").first
+        k_before = json.loads(json_box.input_value())["elements"][0]["params"]["k"]
+        _drag(page, gain.locator(".noUi-handle"), 40)
+        after, changed = _wait_changed(canvas, before)
+        page.wait_for_function("([el, k]) => JSON.parse(el.value).elements[0].params.k !== k",
+                               arg=[json_box.element_handle(), k_before], timeout=20_000)
+        k_after = json.loads(json_box.input_value())["elements"][0]["params"]["k"]
+        # a 40-pixel drag is a fraction of a decade, in the gain's sign (not three decades)
+        assert k_after * k_before > 0 and 0.02 < abs(np.log10(k_after / k_before)) < 0.6, (k_before, k_after)
+        cell.screenshot(path=str(SHOTS / "04_designer_after_drag.png"))
+        assert changed > 0.001, f"the Designer's figure did not change after the gain moved ({changed:.4%} of pixels)"
+        # a typed gain is kept exactly (the controller's JSON shows it)
+        exact = cell.locator(".widget-text input").first
+        exact.fill("-0.0123456789")
+        exact.press("Enter")
+        page.wait_for_function("(el) => JSON.parse(el.value).elements[0].params.k === -0.0123456789",
+                               arg=json_box.element_handle(), timeout=20_000)
+        cell.screenshot(path=str(SHOTS / "04_designer_typed_gain.png"))
+        not_run, errors = _saved_errors(page, root, "04_qft_design.ipynb")
+        assert not not_run and not errors, (not_run, errors)
+    finally:
+        page.screenshot(path=str(SHOTS / "04_final.png"), full_page=True)
+        page.close()
