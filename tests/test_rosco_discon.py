@@ -142,3 +142,16 @@ def test_rosco_scheduled_with_roscos_filter_matches_the_real_discon(campaign):
     assert np.all(np.abs(ws_s / ws_d - 1) < 0.01), ws_s / ws_d - 1
     assert np.all(np.abs(p_s / p_d - 1) < 0.01), p_s / p_d - 1
     assert np.all(np.abs(del_s / del_d - 1) < 0.005), del_s / del_d - 1
+
+
+def test_discon_pickles_for_campaign_workers(model, discon_in):
+    import pickle
+
+    d = Discon(discon_in)
+    kw = dict(seeds=[2], duration=5.0, transient=0.0)
+    a = simulate(model, d, [19.0], **kw)
+    e = pickle.loads(pickle.dumps(d))  # after a run: the loaded copies stay behind
+    assert e.discon_in == d.discon_in and e.gearbox_ratio == d.gearbox_ratio
+    assert_allclose(simulate(model, e, [19.0], **kw)["pitch_cmd"], a["pitch_cmd"], rtol=0, atol=0)
+    d.close()
+    e.close()

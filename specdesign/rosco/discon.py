@@ -188,6 +188,11 @@ class Discon:
     at the first step, naming the parameter ROSCO refused and quoting ROSCO's message; a
     later failure raises :class:`DisconError`.
 
+    Each simulation loads fresh copies (about 1 MB each), which stay mapped until the process
+    ends; a campaign of a few hundred runs is fine. ROSCO's hub-height wind input receives the
+    run's wind at t = 0 only (its estimators, ``WE_Mode`` 1 or 2, use it to start). A pickled
+    Discon (a campaign task sent to a worker) carries its file names and starts there anew.
+
     Examples
     --------
     >>> import numpy as np
@@ -220,6 +225,12 @@ class Discon:
         self.__name__ = str(name)
         self._tmp = None
         self._runs = 0
+
+    def __getstate__(self):
+        # the loaded library copies stay with this process: a pickled Discon (a campaign's
+        # task on another worker) carries its files and starts fresh copies there
+        keep = ("discon_in", "file_version", "library", "gearbox_ratio", "__name__")
+        return {**{k: self.__dict__[k] for k in keep}, "_tmp": None, "_runs": 0}
 
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
         """Prepare one fresh library copy per run (the simulator calls it before the first step).
