@@ -3,8 +3,10 @@
 A session keeps what a design session in Jupyter builds up, so that closing the notebook loses
 nothing and reopening it gives the same numbers:
 
-- the model reference: the embedded ``"iea15mw"``, or a set of OpenFAST ``.lin`` files
-  (``{"lin_files": [...]}``, paths relative to the session file);
+- the model reference: the embedded ``"iea15mw"``, an OpenFAST deck (``{"fst": path,
+  "cp_table": path or null, "discon": path or null}``, read by
+  :func:`specdesign.turbine.from_openfast`) or a set of OpenFAST ``.lin`` files
+  (``{"lin_files": [...]}``); relative paths are taken from the session file's folder;
 - the wind speeds (m/s) and the specifications (:class:`specdesign.spec.Specification`: the
   baseline T_{y,w}(s) as exact state-space or transfer-function coefficients, the shaping
   elements by their own fields) with the context their baseline is recomputed from (wind
@@ -52,8 +54,9 @@ class Session:
     Parameters
     ----------
     model : str or dict
-        ``"iea15mw"`` (the embedded model) or ``{"lin_files": [paths]}`` (OpenFAST
-        linearisations, read by :meth:`linearization`).
+        ``"iea15mw"`` (the embedded model), ``{"fst": path, "cp_table": path or None,
+        "discon": path or None}`` (an OpenFAST deck, :func:`specdesign.turbine.from_openfast`)
+        or ``{"lin_files": [paths]}`` (OpenFAST linearisations, read by :meth:`linearization`).
     wind_speeds : tuple of float
         The session's operating points, m/s.
     specifications : dict
@@ -143,19 +146,21 @@ class Session:
         Returns
         -------
         specdesign.turbine.TurbineModel
-            The embedded IEA 15 MW model.
+            The embedded IEA 15 MW model, or the reduced model of the OpenFAST deck.
 
         Raises
         ------
         ValueError
             If the session refers to a set of ``.lin`` files (read those with :meth:`linearization`).
         """
-        if self.model != "iea15mw":
-            raise ValueError("the session's model is a set of OpenFAST .lin files, not a TurbineModel; "
-                             "read it with Session.linearization()")
-        from .turbine import iea15mw
+        from . import turbine
 
-        return iea15mw()
+        if self.model == "iea15mw":
+            return turbine.iea15mw()
+        if "fst" in self.model:
+            return turbine.from_openfast(self.model["fst"], self.model.get("cp_table"), self.model.get("discon"))
+        raise ValueError("the session's model is a set of OpenFAST .lin files, not a TurbineModel; "
+                         "read it with Session.linearization()")
 
     def linearization(self, **kwargs):
         """The session's OpenFAST linearisation set (:func:`specdesign.openfast.read_linearization`).
@@ -175,8 +180,8 @@ class Session:
         ValueError
             If the session refers to the embedded model.
         """
-        if not isinstance(self.model, dict):
-            raise ValueError("the session's model is the embedded 'iea15mw'; use Session.turbine()")
+        if not isinstance(self.model, dict) or "lin_files" not in self.model:
+            raise ValueError("the session's model is not a set of .lin files; use Session.turbine()")
         from .openfast import read_linearization
 
         return read_linearization(self.model["lin_files"], **kwargs)
@@ -230,10 +235,14 @@ class Session:
 def _model_ref(model):
     if model == "iea15mw":
         return
-    ok = (isinstance(model, dict) and set(model) == {"lin_files"} and isinstance(model["lin_files"], list)
-          and model["lin_files"] and all(isinstance(p, str) and p for p in model["lin_files"]))
-    if not ok:
-        raise ValueError(f"model must be 'iea15mw' (the embedded model) or {{'lin_files': [paths of OpenFAST .lin files]}}, "
+    lin = (isinstance(model, dict) and set(model) == {"lin_files"} and isinstance(model["lin_files"], list)
+           and model["lin_files"] and all(isinstance(p, str) and p for p in model["lin_files"]))
+    deck = (isinstance(model, dict) and "fst" in model and set(model) <= {"fst", "cp_table", "discon"}
+            and isinstance(model["fst"], str) and model["fst"]
+            and all(model.get(k) is None or isinstance(model[k], str) and model[k] for k in ("cp_table", "discon")))
+    if not (lin or deck):
+        raise ValueError("model must be 'iea15mw' (the embedded model), {'fst': path, 'cp_table': path or None, "
+                         "'discon': path or None} (an OpenFAST deck) or {'lin_files': [paths of OpenFAST .lin files]}, "
                          f"got {model!r:.120}")
 
 
@@ -409,7 +418,8 @@ def save_session(path: str | os.PathLike, session: Session) -> Path:
 def load_session(path: str | os.PathLike) -> Session:
     """Read a design session written by :func:`save_session`.
 
-    Relative ``lin_files`` paths of the model reference are taken from the session file's folder.
+    Relative paths of the model reference (``fst``, ``cp_table``, ``discon``, ``lin_files``) are
+    taken from the session file's folder.
 
     Parameters
     ----------
@@ -441,9 +451,16 @@ def load_session(path: str | os.PathLike) -> Session:
 
     try:
         data = json.loads(path.read_text(encoding="utf-8"), object_pairs_hook=pairs)
-        if isinstance(data, dict) and isinstance(data.get("model"), dict) and isinstance(data["model"].get("lin_files"), list):
-            data["model"]["lin_files"] = [str((path.parent / p).resolve()) if isinstance(p, str) else p
-                                          for p in data["model"]["lin_files"]]
+        model = data.get("model") if isinstance(data, dict) else None
+        if isinstance(model, dict):
+            def here(p):
+                return str((path.parent / p).resolve()) if isinstance(p, str) and p else p
+
+            for k in ("fst", "cp_table", "discon"):
+                if k in model:
+                    model[k] = here(model[k])
+            if isinstance(model.get("lin_files"), list):
+                model["lin_files"] = [here(p) for p in model["lin_files"]]
         return session_from_dict(data)
     except (ValueError, TypeError) as e:
         raise ValueError(f"{path}: {e}") from None

@@ -144,3 +144,38 @@ def test_bad_session_fields_name_the_field():
         session_to_dict({"wind_speeds": [19.0]})
     with pytest.raises(ValueError, match="continuous-time"):
         session_to_dict(Session(controllers={"C": ct.tf([1.0], [1.0, 0.5], 0.1)}))
+
+
+def test_a_session_on_an_openfast_deck_reloads_its_model_by_reference(tmp_path):
+    # the model is referred to, not copied: the deck's path relative to the session file; the
+    # baseline recomputed from the reloaded session is the one computed from the deck directly
+    try:
+        from specdesign.rosco import rosco_test_cases
+
+        deck = rosco_test_cases() / "NREL-5MW"
+    except ModuleNotFoundError as e:
+        pytest.skip(f"the rosco package (its OpenFAST decks) is not installed ({e})")
+    import os
+    import shutil
+
+    from specdesign.turbine import from_openfast
+
+    shutil.copytree(deck, tmp_path / "NREL-5MW")
+    folder = tmp_path / "sessions"
+    folder.mkdir()
+    model = from_openfast(tmp_path / "NREL-5MW" / "NREL-5MW.fst")
+    base = spec.baseline_analysis(model, 18.0)
+    w = base.system
+    s = Session(model={"fst": os.path.join("..", "NREL-5MW", "NREL-5MW.fst")}, wind_speeds=(18.0,),
+                specifications={"tower": spec.Specification(w, (spec.Notch(2.0, 3.0, 0.3),))},
+                spec_context={"tower": {"wind_speed": 18.0, "output": "tower_base_my", "m": 4.0}})
+    back = load_session(save_session(folder / "deck.json", s))
+    assert back.model["fst"] == str((tmp_path / "NREL-5MW" / "NREL-5MW.fst").resolve())
+    assert back.turbine().name == "NREL-5MW"
+    again = back.baseline("tower")
+    np.testing.assert_array_equal(again.sensitivity, base.sensitivity)
+    assert spec.promise_of(back.specifications["tower"], again) == spec.promise_of(s.specifications["tower"], base)
+    with pytest.raises(ValueError, match="not a set of .lin files"):
+        back.linearization()
+    with pytest.raises(ValueError, match="an OpenFAST deck"):
+        Session(model={"fst": "a.fst", "turbsim": "b.inp"})
