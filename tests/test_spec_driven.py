@@ -166,3 +166,22 @@ def test_a_specification_driven_schedule(model):
     assert d.options["structure"] == "certificate"
     with pytest.raises(ValueError, match="specification"):
         design_schedule(model, (25.0,), specification="youla")
+
+
+def test_the_figures_say_which_specification_the_design_meets(model, chain19):
+    from matplotlib.figure import Figure
+
+    from specdesign.plots.qft import plot_design_bode, plot_design_nichols
+
+    ts, d = chain19
+    fig = Figure()
+    axes = fig.subplots(2, 1)
+    plot_design_bode(d, model, axes=axes)
+    labels = [t.get_text() for ax in axes for t in ax.get_legend().get_texts()]
+    assert any(f"for the target (promises {ts.promise.exact_del:.1f} % DEL" in lab for lab in labels)
+    assert any(f"ROSCO + {ts.speed_relax_db:.2f} dB" in lab for lab in labels)
+    assert sum(lab.startswith("spec-driven") and "meets W_y" in lab for lab in labels) == 1
+    axes = Figure().subplots(1, 2)
+    plot_design_nichols(d, axes=axes)
+    assert "pitch-only" in axes[1].texts[0].get_text() and not axes[1].lines  # no ATD loop drawn
+    assert axes[0].lines  # the pitch loop and its bounds are

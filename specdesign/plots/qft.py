@@ -78,21 +78,28 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
         return 20 * np.log10(np.abs(x))
 
     # design_qft(spec=...) records a given pair this way: no notches of its own, no relaxation
-    given = design.shaping.message == "given specification"
+    given = design.shaping.message in ("given specification", "target specification")
+    target = opts.get("structure") == "certificate"  # the specification-driven design: pitch only
     checked = "the design is checked against it"
+    name = "spec-driven $C_\\beta$ (pitch only)" if target else "QFT $C_\\beta$ + ATD"
     for ax, out, unit in ((axes[0], "gen_speed", "(rad/s)/(m/s)"), (axes[1], "tower_base_my", "N·m/(m/s)")):
         t_qft = db(closedloop.frequency_response(design.closed_loop, w, out))
         ax.semilogx(w, db(closedloop.frequency_response(cl_base, w, out)), "C0", label="ROSCO (ATD off)")
         verdicts = []
         if out == "gen_speed":
-            how = "given" if given else f"ROSCO + {opts.get('speed_relax_db', float('nan')):g} dB"
+            relax = opts.get("speed_relax_db", float("nan"))
+            how = (f"ROSCO + {relax:.2f} dB" if target else "given" if given else f"ROSCO + {relax:g} dB")
             w_db = db(design.speed_spec.response(w))
             ax.semilogx(w, w_db, "C3--", label=f"generator-speed spec W_Ω ({how}; {checked})")
             verdicts.append(_verdict(t_qft, w_db, w, "W_Ω"))
         else:
             r_db = db(design.tower_spec.response(w))
             notch = design.shaping.specification
-            if given or notch is None:
+            if target:
+                ax.semilogx(w, r_db, "C3--", label=f"tower-load spec W_y for the target (promises "
+                            f"{design.promise.exact_del:.1f} % DEL; {checked})")
+                verdicts.append(_verdict(t_qft, r_db, w, "W_y"))
+            elif given or notch is None:
                 ax.semilogx(w, r_db, "C3--", label=f"tower-load spec W_y ({'given' if given else 'relaxed'}; {checked})")
                 verdicts.append(_verdict(t_qft, r_db, w, "W_y"))
             else:
@@ -103,7 +110,7 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
                             f"{opts.get('tower_relax_omega', float('nan')):g} rad/s (promises "
                             f"{design.promise.exact_del:.1f} % DEL; {checked})")
                 verdicts += [_verdict(t_qft, r_db, w, "relaxed W_y"), _verdict(t_qft, n_db, w, "shaped W_y")]
-        ax.semilogx(w, t_qft, "C1", lw=2, label="QFT $C_\\beta$ + ATD, nominal: " + "; ".join(verdicts))
+        ax.semilogx(w, t_qft, "C1", lw=2, label=f"{name}, nominal: " + "; ".join(verdicts))
         wd = design.design_omega[(design.design_omega >= w[0]) & (design.design_omega <= w[-1])]
         ax.semilogx(wd, db(closedloop.frequency_response(design.closed_loop, wd, out)), "o", color="C4", ms=4,
                     label="QFT at the design frequencies")
@@ -170,7 +177,19 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
          "ATD loop $C_{atd} P''_{z,\\beta}$ (pitch loop closed)"),
     ):
         plant = template.systems[template.nominal]
-        nichols.draw(_bounds_at(bounds, template, picks), loop=c * plant, ax=ax, omega=w, ylim=ylim)
+        if _is_zero(c):  # no loop here (a pitch-only design)
+            ax.text(0.5, 0.5, "no ATD loop: pitch-only design", ha="center", va="center", transform=ax.transAxes)
+            ax.set_xlabel("Open-loop phase [deg]")
+            ax.set_ylabel("Open-loop magnitude [dB]")
+        else:
+            nichols.draw(_bounds_at(bounds, template, picks), loop=c * plant, ax=ax, omega=w, ylim=ylim)
         ax.set_title(f"{title}, {design.wind_speed:g} m/s")
     fig.tight_layout()
     return fig
+
+
+def _is_zero(c):
+    import control
+
+    s = control.ss(c)
+    return s.nstates == 0 and not np.any(np.asarray(s.D))
