@@ -1,8 +1,11 @@
 """``python -m specdesign demo``: the complete 19 m/s design loop, end to end.
 
 1. sensitivity: ΔD%(ω) of the ROSCO loop (tower damping off) for the tower-base moment;
-2. specification: notches on T_{MyT,w} promising a damage reduction (Eq. 10 and exact);
-3. controller: QFT pitch controller + active tower damping meeting the specifications;
+2. specification: the feasible specification pair that promises the target DEL reduction,
+   certified over the neighbouring operating points (``method="target"``, the default), or
+   notches on T_{MyT,w} promising a damage reduction (``method="notch"``);
+3. controller: the QFT design that meets that specification at every plant case (a reduced
+   certificate, pitch only), or the fixed-structure pitch controller + active tower damping;
 4. validation: paired-seed nonlinear simulations, rainflow DEL vs the linear prediction.
 
 Writes ``summary.md``, the tables (Markdown and CSV) and the figures into ``out``.
@@ -14,6 +17,7 @@ import os
 import time
 from pathlib import Path
 
+import control as ct
 import numpy as np
 
 __all__ = ["run_demo"]
@@ -25,7 +29,7 @@ def _say(msg):
 
 def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False, wind_speed: float = 19.0,
              spec_reduction: float = 15.0, target_reduction: float = 25.0, n_seeds: int | None = None,
-             duration: float | None = None) -> dict:
+             duration: float | None = None, method: str = "target") -> dict:
     """Run the design loop at one wind speed and write its tables and figures into ``out``.
 
     Writes ``summary.md``, ``table2.md/.csv``, ``table3.md/.csv``, the designed controllers
@@ -42,13 +46,18 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     wind_speed : float, default 19.0
         Operating point (m/s).
     spec_reduction : float, default 15.0
-        Damage reduction the tower specification promises (%).
+        Damage reduction the notch specification promises (%; ``method="notch"`` only).
     target_reduction : float, default 25.0
-        Predicted tower-base DEL reduction the QFT design aims at (%).
+        Tower-base DEL reduction (%): the specification's promise (``"target"``) or the QFT
+        design's DEL target (``"notch"``).
     n_seeds : int, optional
         Paired seeds of the validation (overrides ``fast``).
     duration : float, optional
         Recorded time per run (s; overrides ``fast``).
+    method : {"target", "notch"}, default "target"
+        ``"target"``: specification-driven (:func:`specdesign.feasibility.specification_for_target`,
+        then ``design_qft(spec=...)``); ``"notch"``: the notch specification and the
+        fixed-structure QFT design with a DEL target.
 
     Returns
     -------
@@ -57,7 +66,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     """
     from matplotlib.figure import Figure  # figures only written to files: no pyplot, no backend
 
-    from . import qft, spec, validate
+    from . import feasibility, qft, spec, validate
     from .plots.fatigue import plot_sensitivity
     from .plots.qft import plot_design_bode, plot_design_nichols
     from .plots.spec import plot_specification
@@ -66,6 +75,8 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     from .simulate import scheduled
     from .turbine import iea15mw
 
+    if method not in ("target", "notch"):
+        raise ValueError(f"method={method!r} must be 'target' (specification-driven) or 'notch'")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     n_seeds = n_seeds or (8 if fast else 50)
@@ -85,24 +96,44 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     fig.tight_layout()
     fig.savefig(out / "1_sensitivity.png", dpi=120)
 
-    _say(f"[2/4] specification promising {spec_reduction:g} % less damage (notches above 0.6 rad/s)")
-    shaped = spec.shape_to_target(base, spec_reduction, keep_below=0.6)
-    for n in shaped.notches:
-        _say(f"      notch {n.omega_n:.3f} rad/s, {n.depth_db:.2f} dB, width {n.width:.3f}")
-    p = shaped.promise
+    if method == "target":
+        _say(f"[2/4] specification promising {target_reduction:g} % less tower-base DEL, certified over "
+             f"{v - 1:g}-{v + 1:g} m/s")
+        target = feasibility.specification_for_target(model, v, target_reduction)
+        spec_text = (f"the target specification: W_Ω = ROSCO's speed map + {target.speed_relax_db:.2f} dB, W_MyT = "
+                     f"a certified design's tower map + {target.slack_db:.2f} dB (of which {target.robustness_db:.2f} "
+                     "dB for the neighbouring operating points)")
+        _say("      " + spec_text)
+        tower, p = target.tower, target.promise
+    else:
+        _say(f"[2/4] specification promising {spec_reduction:g} % less damage (notches above 0.6 rad/s)")
+        shaped = spec.shape_to_target(base, spec_reduction, keep_below=0.6)
+        for n in shaped.notches:
+            _say(f"      notch {n.omega_n:.3f} rad/s, {n.depth_db:.2f} dB, width {n.width:.3f}")
+        spec_text = f"{len(shaped.notches)} notch(es)"
+        tower, p = shaped.specification, shaped.promise
     _say(f"      promise: damage −{p.exact_damage:.2f} % (Eq. 10: −{p.predicted_damage:.2f} %), DEL −{p.exact_del:.2f} %")
     fig = Figure(figsize=(7, 3.5))
     ax = fig.subplots()
-    plot_specification(base, shaped.specification, ax=ax)
+    plot_specification(base, tower, ax=ax)
     ax.set_title(f"Tower-load specification W_MyT at {v:g} m/s")
     fig.tight_layout()
     fig.savefig(out / "2_specification.png", dpi=120)
 
-    _say(f"[3/4] QFT design: pitch controller + active tower damping, target −{target_reduction:g} % DEL")
-    design = qft.design_qft(model, v, target_reduction=target_reduction, spec_reduction=spec_reduction)
+    if method == "target":
+        _say("[3/4] QFT design meeting that specification at every plant case (the certificate, reduced; pitch only)")
+        design = qft.design_qft(model, v, spec=target)
+    else:
+        _say(f"[3/4] QFT design: pitch controller + active tower damping, target −{target_reduction:g} % DEL")
+        design = qft.design_qft(model, v, target_reduction=target_reduction, spec_reduction=spec_reduction)
     _say("      " + design.summary())
-    _say(f"      C_β(s) = {_tf_text(design.pitch_controller)}")
-    _say(f"      C_ATD(s) = {_tf_text(design.atd_controller)}")
+    # the controllers as the transfer functions written to controller_qft.json, so that
+    # `specdesign validate` simulates exactly what the demo simulated
+    pitch = ct.tf(design.pitch_controller)
+    atd = None if _is_zero(design.atd_controller) else ct.tf(design.atd_controller)
+    _say(f"      C_β(s) = {_tf_text(pitch)}")
+    if atd is not None:
+        _say(f"      C_ATD(s) = {_tf_text(atd)}")
     fig = Figure(figsize=(14, 5.5))
     plot_design_nichols(design, axes=fig.subplots(1, 2))
     fig.savefig(out / "3_nichols.png", dpi=120)
@@ -113,7 +144,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     _say(f"[4/4] validation: {n_seeds} paired seeds × {duration:g} s, nonlinear model, rainflow DEL")
     controllers = {
         "ROSCO": rosco_baseline(model, v),
-        "QFT": scheduled(model, {v: design.pitch_controller}, atd={v: design.atd_controller}, name="QFT"),
+        "QFT": scheduled(model, {v: pitch}, atd=None if atd is None else {v: atd}, name="QFT"),
     }
     camp = validate.run_campaign(controllers, [v], np.arange(n_seeds), model=model, duration=duration, keep_series=True,
                                  linear_twin=True, volterra=3)
@@ -137,7 +168,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     # the designed controllers and a campaign file, so `python -m specdesign validate` can rerun
     # or extend the validation (more seeds, other wind speeds) without redesigning
     (out / "controller_qft.json").write_text(json.dumps(
-        {"pitch": _tf_dict(design.pitch_controller), "atd": _tf_dict(design.atd_controller)}, indent=1))
+        {"pitch": _tf_dict(pitch)} | ({} if atd is None else {"atd": _tf_dict(atd)}), indent=1))
     (out / "validate.toml").write_text(
         f"# python -m specdesign validate {out / 'validate.toml'}  (schema: docs/validation.md)\n"
         f'turbine = "iea15mw"\nwind_speeds = [{v:g}]\nseeds = {list(range(n_seeds))}\nduration = {duration:g}\n'
@@ -169,7 +200,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         f"# specdesign demo: {v:g} m/s design loop",
         "",
         f"- baseline (ROSCO, tower damping off) tower-base DEL, 1 Hz, m = 4: {summary['baseline_del_MNm']:.2f} MN·m",
-        f"- specification: {len(shaped.notches)} notch(es), promises −{p.exact_damage:.2f} % damage "
+        f"- specification: {spec_text}, promises −{p.exact_damage:.2f} % damage "
         f"(Eq. 10: −{p.predicted_damage:.2f} %), −{p.exact_del:.2f} % DEL",
         f"- QFT controller: {design.summary()}",
         f"- validation over {n_seeds} paired seeds of {duration:g} s: linear prediction −{summary['predicted_del_pct']:.2f} % DEL, "
@@ -193,6 +224,11 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     (out / "summary.md").write_text("\n".join(lines) + "\n")
     _say(f"done in {elapsed:.0f} s: {out.resolve()}/summary.md")
     return summary
+
+
+def _is_zero(c):
+    s = ct.ss(c)
+    return s.nstates == 0 and not np.any(np.asarray(s.D))
 
 
 def _tf_dict(tf):

