@@ -148,6 +148,13 @@ def closed_loop_poles(plant, num, den) -> np.ndarray:
     return np.linalg.eigvals(A).astype(complex)
 
 
+def _where(omega):
+    """Design frequencies for a title: a short list, or how many and their range."""
+    if omega.size <= 3:
+        return "ω = " + ", ".join(f"{x:.3g}" for x in omega) + " rad/s"
+    return f"{omega.size} frequencies in {omega.min():.3g}-{omega.max():.3g} rad/s"
+
+
 class Designer:
     """Loop shaping by elements against ``bounds``, nominal plant taken from ``plant``.
 
@@ -555,12 +562,12 @@ class Designer:
         elif st.bounds_met:
             head = f"all bounds met, all {n} plant case(s) stable"
         else:
-            w = self.bounds.omega[~st.design_allowed]
-            head = f"{n} plant case(s) stable; bounds violated at ω = " + ", ".join(f"{x:.3g}" for x in w) + " rad/s"
-        specs = "; ".join(f"{name}: " + ("met" if v.size == 0 else "violated at " + ", ".join(f"{x:.3g}" for x in v))
+            head = f"{n} plant case(s) stable; bounds violated at " + _where(self.bounds.omega[~st.design_allowed])
+        specs = "; ".join(f"{name}: " + ("met" if v.size == 0 else "violated at " + _where(v))
                           for name, v in st.spec_violations.items())
         g = textwrap.fill(textwrap.shorten(f"G = {self.controller}", width=230, placeholder=" …"), 120)
-        return f"{head}\nspecs checked: {specs}\n{g}"
+        specs = textwrap.fill(f"specs checked: {specs}", 130)
+        return f"{head}\n{specs}\n{g}"
 
     # -- widgets
     def widget(self):

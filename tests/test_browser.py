@@ -244,6 +244,8 @@ def test_notebook_04_designer_gain_edit_redraws_the_figure(lab, browser):
         exact.press("Enter")
         page.wait_for_function("(el) => JSON.parse(el.value).elements[0].params.k === -0.0123456789",
                                arg=json_box.element_handle(), timeout=20_000)
+        _, changed = _wait_changed(canvas, after)
+        assert changed > 0.001, f"the Designer's figure did not change after a typed gain ({changed:.4%} of pixels)"
         cell.screenshot(path=str(SHOTS / "04_designer_typed_gain.png"))
         not_run, errors = _saved_errors(page, root, "04_qft_design.ipynb")
         assert not not_run and not errors, (not_run, errors)
