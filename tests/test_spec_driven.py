@@ -185,3 +185,20 @@ def test_the_figures_say_which_specification_the_design_meets(model, chain19):
     plot_design_nichols(d, axes=axes)
     assert "pitch-only" in axes[1].texts[0].get_text() and not axes[1].lines  # no ATD loop drawn
     assert axes[0].lines  # the pitch loop and its bounds are
+
+
+def test_a_hand_edited_specification_is_recertified(model, chain19):
+    # the designer edits the pair; it stays feasible while the certificate meets it at every case
+    from specdesign import spec
+
+    ts, _ = chain19
+    bump = fz.recertify(model, ts, tower=ts.tower.add(spec.Notch(2.5, -3.0, 0.3)))  # +3 dB room at 2.5 rad/s
+    assert bump.promise.exact_del <= ts.promise.exact_del and bump.design is ts.design
+    d = design_qft(model, 19.0, spec=bump)
+    assert d.success and d.del_reduction >= bump.promise.exact_del - 0.1
+    with pytest.raises(ValueError, match=r"exceeds the edited W_MyT by .* dB at .* rad/s for the plant case"):
+        fz.recertify(model, ts, tower=ts.tower.add(spec.Gain(-2.0)))
+    with pytest.raises(ValueError, match="exceeds the edited W_Ω"):
+        fz.recertify(model, ts, speed=spec.speed_specification(model, 19.0, margin_db=-1.0))
+    with pytest.raises(TypeError, match="TargetSpecification"):
+        fz.recertify(model, (ts.tower, ts.speed))

@@ -51,8 +51,8 @@ Units: ω in rad/s, magnitudes linear (dB only in messages), DEL reductions in %
 from .achievable import YOULA_PAIRS, YOULA_REAL_POLES, AchievablePitch, YoulaProblem, achievable_pitch
 from .conditions import (PitchChecker, PitchFeasibility, combine, pitch_checkers, pitch_feasibility, pitch_frontier,
                          sensitivity_disks)
-from .target import TargetSpecification, specification_for_target
+from .target import TargetSpecification, recertify, specification_for_target
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
            "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks",
-           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem"]
+           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify"]

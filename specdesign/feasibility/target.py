@@ -7,7 +7,7 @@ import numpy as np
 
 from .achievable import AchievablePitch, YoulaProblem
 
-__all__ = ["TargetSpecification", "specification_for_target", "DEFAULT_CASE_OFFSETS", "RELAX_LADDER_DB"]
+__all__ = ["TargetSpecification", "specification_for_target", "recertify", "DEFAULT_CASE_OFFSETS", "RELAX_LADDER_DB"]
 
 
 #: Wind-speed offsets (m/s) of the plant cases a target specification is certified on: the
@@ -328,3 +328,95 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     speed = spec.speed_specification(model, float(wind_speed), margin_db=relax)
     return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, total, design, target,
                                tuple(speeds), robust, speed_slack)
+
+
+def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> TargetSpecification:
+    """A hand-edited specification pair, re-checked against the certificate over the plant cases.
+
+    A designer may edit the pair of a :class:`TargetSpecification` (e.g.
+    ``target.tower.add(spec.Notch(...))`` or another relaxation); the pair stays feasible by
+    construction only while the certificate still meets it at every plant case. This checks
+    that on the dense grid (refined around the lightly damped roots of both specifications and
+    of the certificate's maps) and returns the edited record with its new promise, or says
+    where the certificate no longer meets it.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine the target was made on.
+    target : TargetSpecification
+        The certified pair.
+    tower, speed : specdesign.spec.Specification, optional
+        The edited W_MyT and W_Ω at the nominal speed (default: unchanged).
+    dense_omega : array_like, optional
+        Grid of the check, rad/s (default 600 points, 0.005-20, refined).
+
+    Returns
+    -------
+    TargetSpecification
+        The edited pair, its promise (exact Dirlik against ROSCO) and the same certificate;
+        ``slack_db`` is then the smallest margin (dB) between the certificate's nominal tower map
+        and the edited W_MyT, ``robustness_db`` the plant cases' part of the original.
+
+    Raises
+    ------
+    TypeError
+        If ``target`` is not a TargetSpecification.
+    ValueError
+        If the certificate violates an edited specification at some plant case (the message
+        names the case, the specification, the frequency and the excess).
+
+    Examples
+    --------
+    >>> from specdesign import spec
+    >>> from specdesign.turbine import iea15mw
+    >>> model = iea15mw()
+    >>> t = specification_for_target(model, 19.0, 25.0)
+    >>> looser = recertify(model, t, tower=t.tower.add(spec.Gain(0.5)))   # 0.5 dB more room
+    >>> bool(looser.promise.exact_del < t.promise.exact_del)
+    True
+    """
+    import warnings
+
+    from .. import spec
+    from .._checks import as_omega
+    from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response, system_roots
+
+    if not isinstance(target, TargetSpecification):
+        raise TypeError(f"target must be a TargetSpecification, got {type(target).__name__}")
+    tower = target.tower if tower is None else tower
+    speed = target.speed if speed is None else speed
+    for name, x in (("tower", tower), ("speed", speed)):
+        if not hasattr(x, "response"):
+            raise TypeError(f"{name} must be a specification with response(omega), got {type(x).__name__}")
+    v = target.design.wind_speed
+    speeds = tuple(target.case_speeds) or (v,)
+    cases = _Cases(model, speeds, v)
+    controller = target.design.controller(model)
+    if cases._unstable(controller):
+        raise ValueError("the certificate destabilises a plant case of this model: was the target made on another model?")
+    dense = (np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None
+             else as_omega(dense_omega, "dense_omega", allow_zero=False))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cl0 = closed_loop(cases.plants[cases.nom], controller, warn=False)
+    roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
+    roots += [system_roots(x.baseline) for x in (tower, speed) if isinstance(x, spec.Specification)]
+    w, (R, rt, rs) = cases._on_refined(dense, refine_grid(dense, lightly_damped(np.concatenate(roots))))
+    c = siso_response(controller, w)[:, None]
+    nom = cases.nom
+    for label, spec_like, ref, out in (("W_MyT", tower, rt, "tower_base_my"), ("W_Ω", speed, rs, "gen_speed")):
+        # each case's bound: ROSCO's map at its speed times the nominal ratio W/T^ROSCO
+        bound = ref * (np.abs(np.asarray(spec_like.response(w))) / ref[:, nom])[:, None]
+        excess = 20 * np.log10(np.abs(closed_map(R, c, 0.0, out)) / bound)
+        k, i = np.unravel_index(np.argmax(excess), excess.shape)
+        if excess[k, i] > 1e-9:
+            raise ValueError(f"the certificate exceeds the edited {label} by {excess[k, i]:.2f} dB at {w[k]:.4g} rad/s "
+                             f"for the plant case at {speeds[i]:g} m/s: the edit asks for more than the certified "
+                             "design gives there (relax it there, or make a new target specification)")
+    t0 = np.abs(closed_map(R, c, 0.0, "tower_base_my")[:, nom])
+    margin = float(20 * np.log10(np.min(np.abs(np.asarray(tower.response(w))) / t0)))
+    base = spec.baseline_analysis(model, v, omega=target.design.omega)
+    relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs[:, nom])))
+    return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, target.design,
+                               target.target_reduction, speeds, target.robustness_db, target.speed_slack_db)
