@@ -140,6 +140,65 @@ class Session:
         if not isinstance(self.notes, str):
             raise TypeError(f"notes must be a string, got {type(self.notes).__name__}")
 
+    @classmethod
+    def from_qft(cls, design: Any, *, model: Any = "iea15mw", designer: Any = None, campaign: Mapping | None = None,
+                 results: Mapping | None = None, notes: str = "") -> "Session":
+        """The session of one :func:`specdesign.qft.design_qft` design.
+
+        Its wind speed, the specifications (``"notch"``: the unrelaxed notch specification of
+        ``design.shaping``, whose promise the paper's Table 3 lists; ``"tower"``: the (relaxed)
+        ``design.tower_spec`` the controller meets, both of the tower-base moment; ``"speed"``:
+        ``design.speed_spec``, generator speed; m = 4), both controllers (``"pitch"``,
+        ``"atd"``), the QFT settings (``wind_speed``, ``target_reduction``, ``options``) and a
+        results summary (promised and predicted DEL reductions, %, margins, ``success``),
+        merged with ``results``.
+
+        Parameters
+        ----------
+        design : specdesign.qft.QFTDesign
+            The design.
+        model : str or dict
+            The model reference the design was made on (see :class:`Session`).
+        designer : loopshaping.interactive.Designer or dict, optional
+            A Designer (its ``to_state()`` is kept) or a saved state.
+        campaign : dict, optional
+            A validation campaign configuration.
+        results : dict, optional
+            More results (JSON values), added to the design's summary.
+        notes : str
+            Free text.
+
+        Returns
+        -------
+        Session
+            The session.
+
+        Raises
+        ------
+        TypeError
+            If ``design`` is not a QFTDesign.
+        """
+        from .qft import QFTDesign
+
+        if not isinstance(design, QFTDesign):
+            raise TypeError(f"design must be a specdesign.qft.QFTDesign (from design_qft), got {type(design).__name__}")
+        v = float(design.wind_speed)
+        state = designer.to_state() if hasattr(designer, "to_state") else dict(designer or {})
+        summary = {"notch_spec_promised_del_pct": float(design.shaping.promise.exact_del),
+                   "tower_spec_promised_del_pct": float(design.promise.exact_del),
+                   "predicted_del_pct": float(design.del_reduction),
+                   "gain_margin_db": float(design.gain_margin_db), "phase_margin_deg": float(design.phase_margin_deg),
+                   "success": bool(design.success), "message": str(design.message)}
+        options = json.loads(json.dumps(design.options, default=float))  # tuples → lists, numpy scalars → floats
+        tower = {"wind_speed": v, "output": "tower_base_my", "m": 4.0}
+        return cls(model=model, wind_speeds=(v,),
+                   specifications={"notch": design.shaping.specification, "tower": design.tower_spec,
+                                   "speed": design.speed_spec},
+                   spec_context={"notch": tower, "tower": dict(tower), "speed": {"wind_speed": v, "output": "gen_speed", "m": 4.0}},
+                   controllers={"pitch": design.pitch_controller, "atd": design.atd_controller},
+                   qft={"wind_speed": v, "target_reduction": float(design.target_reduction), "options": options},
+                   designer=state, campaign=dict(campaign or {}), results={**summary, **dict(results or {})}, notes=notes)
+
     def turbine(self):
         """The turbine model the session refers to.
 

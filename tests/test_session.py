@@ -179,3 +179,45 @@ def test_a_session_on_an_openfast_deck_reloads_its_model_by_reference(tmp_path):
         back.linearization()
     with pytest.raises(ValueError, match="an OpenFAST deck"):
         Session(model={"fst": "a.fst", "turbsim": "b.inp"})
+
+
+@pytest.mark.slow  # one design_qft at 19 m/s (~10 s)
+def test_the_session_of_a_qft_design_reloads_bitwise_and_reopens_the_designer(tmp_path):
+    import warnings
+
+    from loopshaping.controller import Controller
+    from loopshaping.interactive import Designer
+    from specdesign import qft
+    from specdesign.plots.spec import NotchExplorer
+
+    model = iea15mw()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        d = qft.design_qft(model, 19.0, target_reduction=25.0)
+    designer = Designer(d.pitch_bounds, d.pitch_template, Controller.from_tf(d.pitch_controller))
+    designer.set_param(0, k=1.1 * designer.controller.elements[0].params["k"])
+    s = Session.from_qft(d, designer=designer, results={"note": "gain +10 %"})
+    back = load_session(save_session(tmp_path / "qft.json", s))
+    w = d.dense_omega
+    for name, c in (("pitch", d.pitch_controller), ("atd", d.atd_controller)):
+        np.testing.assert_array_equal(back.controllers[name](1j * w), c(1j * w))
+    for name, sp in (("notch", d.shaping.specification), ("tower", d.tower_spec), ("speed", d.speed_spec)):
+        np.testing.assert_array_equal(back.specifications[name].response(w), sp.response(w))
+    # the notch specification's promise, recomputed from the reloaded session: bitwise the one of
+    # the specification before saving, and the design's own (computed from the notch response
+    # instead of W/T: equal to rounding)
+    promise = spec.promise_of(back.specifications["notch"], back.baseline("notch"))
+    assert promise == spec.promise_of(d.shaping.specification, d.baseline)
+    assert promise.exact_del == pytest.approx(d.shaping.promise.exact_del, rel=1e-12)
+    assert back.results["notch_spec_promised_del_pct"] == d.shaping.promise.exact_del
+    assert back.results["note"] == "gain +10 %" and back.results["success"] == d.success
+    assert back.qft["options"]["template_offsets"] == list(d.options["template_offsets"])
+    again = Designer.from_session(back, d.pitch_bounds, d.pitch_template)
+    assert again.controller == designer.controller
+    np.testing.assert_array_equal(again.state().rightmost_pole, designer.state().rightmost_pole)
+    assert NotchExplorer.from_session(back, "notch").notch == d.shaping.notches[0]
+    with pytest.raises(TypeError, match="QFTDesign"):
+        Session.from_qft(s)
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
