@@ -550,8 +550,13 @@ def _batched(P, w, outputs):
     ii = [ss.input_labels.index(i) for i in PLANT_INPUTS]
     a, b = np.asarray(ss.A), np.asarray(ss.B)[:, ii]
     c, d = np.asarray(ss.C)[oi], np.asarray(ss.D)[np.ix_(oi, ii)]
-    x = np.linalg.solve(1j * w[:, None, None] * np.eye(a.shape[0]) - a, np.broadcast_to(b, (w.size,) + b.shape))
-    y = c @ x + d
+    lam, v = np.linalg.eig(a)
+    if np.linalg.cond(v) < 1e6:  # diagonalisable, well-conditioned: C·V·diag(1/(jω − λ))·V⁻¹·B
+        cv, vb = c @ v, np.linalg.solve(v, b)
+        y = (cv[None, :, :] * (1.0 / (1j * w[:, None] - lam[None, :]))[:, None, :]) @ vb + d
+    else:  # defective or ill-conditioned eigenvectors: one solve per frequency
+        x = np.linalg.solve(1j * w[:, None, None] * np.eye(a.shape[0]) - a, np.broadcast_to(b, (w.size,) + b.shape))
+        y = c @ x + d
     return {(o, i): y[:, k, j] for k, o in enumerate(outputs) for j, i in enumerate(PLANT_INPUTS)}
 
 
