@@ -20,7 +20,7 @@ import numpy as np
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
 from .freqresp import check_grid, evaluate
-from .nichols import draw, loop_nichols
+from .nichols import draw, loop_nichols, wrap_phase
 from .templates import Template
 
 __all__ = ["DesignState", "Designer", "closed_loop_poles"]
@@ -448,9 +448,13 @@ class Designer:
             fig.canvas.header_visible = False
         draw(self.bounds, loop=None, ax=ax_n, legend=False)
         st = self.state()
-        (loop,) = ax_n.plot(st.phase_deg, st.magnitude_db, "k-", lw=1.5, label="nominal loop $L_0$")
+        # the loop and the markers wrapped into the chart's phase window, as the bounds repeat
+        # every 360° (a design point past −360° stays on the chart)
+        self._window = tuple(ax_n.get_xlim())
+        (loop,) = ax_n.plot(*wrap_phase(st.phase_deg, st.magnitude_db, self._window), "k-", lw=1.5,
+                            label="nominal loop $L_0$")
         i = self._design_idx
-        marks = ax_n.scatter(st.phase_deg[i], st.magnitude_db[i], s=50, zorder=5,
+        marks = ax_n.scatter(self._wrapped(st.phase_deg[i]), st.magnitude_db[i], s=50, zorder=5,
                              c=self._marker_colours(st), edgecolors="k", label="design frequencies (green: met)")
         # the loop, the markers and what solid/dashed bounds mean; not one entry per design
         # frequency (a turbine loop has dozens)
@@ -506,9 +510,9 @@ class Designer:
         st = self.state()
         if self.figure is not None:
             a = self._artists
-            a["loop"].set_data(st.phase_deg, st.magnitude_db)
+            a["loop"].set_data(*wrap_phase(st.phase_deg, st.magnitude_db, self._window))
             i = self._design_idx
-            a["marks"].set_offsets(np.column_stack([st.phase_deg[i], st.magnitude_db[i]]))
+            a["marks"].set_offsets(np.column_stack([self._wrapped(st.phase_deg[i]), st.magnitude_db[i]]))
             a["marks"].set_facecolors(self._marker_colours(st))
             a["T"].set_ydata(st.worst_T_db)
             a["S"].set_ydata(st.worst_S_db)
@@ -525,6 +529,10 @@ class Designer:
                     self._blit_artists()
                     canvas.blit(self.figure.bbox)
         return st
+
+    def _wrapped(self, phase_deg):
+        low = self._window[0]
+        return low + np.mod(phase_deg - low, 360.0)
 
     def _marker_colours(self, st):
         return np.where(st.design_allowed, "tab:green", "tab:red")

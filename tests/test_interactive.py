@@ -156,3 +156,22 @@ def test_notebooks_with_live_controls_enable_the_widget_backend():
             first = next(i for i, s in enumerate(code) if ".widget()" in s)
             assert any('run_line_magic("matplotlib", "widget")' in s for s in code[:first]), path.name
     assert {"00_qft_toolbox_example", "03_specification", "04_qft_design"} <= set(interactive)
+
+
+def test_design_points_past_minus_360_degrees_stay_on_the_chart():
+    # P = 1/(s+1)^5: at 10 rad/s the loop phase is −5·atan(10) = −420.5°, drawn at −60.5° (the
+    # bounds repeat every 360°); the numbers in the state keep the unwrapped phase
+    P = ct.tf([1.0], np.poly([-1.0] * 5))
+    w = np.array([0.1, 1.0, 10.0])
+    tmpl = qft.Template.from_systems([P], w)
+    d = Designer(qft.bounds(tmpl, "stability", 2.0), tmpl, lc.Controller((lc.gain(0.5),)))
+    d.draw()
+    st = d.state()
+    want = -5 * np.degrees(np.arctan(w))
+    np.testing.assert_allclose(st.phase_deg[d._design_idx], want, atol=1e-9)
+    x = d._artists["marks"].get_offsets()[:, 0]
+    np.testing.assert_allclose(x, np.where(want < -360, want + 360, want), atol=1e-9)
+    lo, hi = d.figure.axes[0].get_xlim()
+    loop_x = d._artists["loop"].get_xdata()
+    assert np.all((loop_x[np.isfinite(loop_x)] >= lo) & (loop_x[np.isfinite(loop_x)] <= hi))
+    plt.close("all")
