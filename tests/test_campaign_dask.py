@@ -62,3 +62,12 @@ def test_campaign_through_the_client_executor_with_a_store(client, setup, tmp_pa
     # read back from the store without the cluster: nothing is left to run
     assert_bitwise_equal(run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, store=store, progress=False,
                                       **KW), local)
+
+
+def test_the_same_campaign_twice_on_the_client(client, setup):
+    # the Client's futures are keyed by their arguments: the second, identical campaign gets
+    # the same task keys right after the first one released them
+    model, ctrls, local = setup
+    for _ in range(2):
+        again = run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, executor=client, progress=False, **KW)
+        assert_bitwise_equal(again, local)

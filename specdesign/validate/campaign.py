@@ -399,7 +399,10 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                     finish(futs[f], f.result())
             finally:  # on an error or an interrupt, do not leave the rest running on the cluster
                 for f in futs:
-                    f.cancel()
+                    # only the unfinished: cancelling a finished dask future releases its key
+                    # on the scheduler, which would cancel an identical task submitted next
+                    if not f.done():
+                        f.cancel()
     finally:
         bar.close()
     return _assemble(records, names, vs, seeds, settings)
