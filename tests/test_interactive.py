@@ -21,6 +21,7 @@ from loopshaping.interactive import Designer, closed_loop_poles  # noqa: E402
 
 @pytest.fixture
 def loop():
+    plt.close("all")  # figure counts in the tests are theirs
     P = [ct.tf([k], [1, 31, 30]) for k in (1.0, 5.0, 10.0)]
     tmpl = qft.Template.from_systems(P, np.array([0.1, 5.0, 100.0]))
     yield P, tmpl, qft.bounds(tmpl, "stability", 1.2, name="margins |S| ≤ 1.2")
@@ -30,6 +31,7 @@ def loop():
 def test_bounds_met_but_unstable_is_shown_red_naming_the_case_and_the_pole():
     # L = −100/(s + 1): |S| = |(s+1)/(s−99)| < 1.2 at every design frequency, yet 1 + L = 0 at
     # s = +99 (the sign error behind "all bounds met" with a pole at +322 in issue 18)
+    plt.close("all")  # the figure count below is this test's
     P = ct.tf([1.0], [1.0, 1.0])
     tmpl = qft.Template.from_systems([P, 2 * P], np.array([0.1, 1.0, 5.0]))
     b = qft.bounds(tmpl, "stability", 1.2)
@@ -110,6 +112,7 @@ def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
     from specdesign.plots.spec import NotchExplorer
     from specdesign.turbine import iea15mw
 
+    plt.close("all")
     base = spec.baseline_analysis(iea15mw(), 19.0)
     start = spec.Notch(1.0712345678, 7.8312345, 0.23456789)
     ex = NotchExplorer(base, start)
