@@ -18,6 +18,8 @@ Modules, in the order they build on each other:
 - :mod:`~specdesign.validate.campaign`: controllers × wind speeds × paired seeds, simulated
   and post-processed (:class:`Campaign`), with the up-front checks.
 - :mod:`~specdesign.validate.tables`: the paper's Tables 2-3 and the acceptance of a design.
+- :mod:`~specdesign.validate.surrogate`: a Gaussian-process surrogate of a campaign's DEL over
+  its conditions, against the look-up table.
 
 Per wind speed, seeds are pooled the way fatigue adds up: DEL over S seeds of equal length
 is (mean_s DEL_s^m)^{1/m} (the DEL of the concatenated damage), SDs are pooled as
@@ -43,6 +45,8 @@ from .metrics import INDICATORS, Indicators, indicators
 from .prediction import LinearPrediction, closed_loop_response, linear_prediction, prediction_grid
 from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, weibull_weights,
                     welch_psd)
+from .surrogate import (CONDITIONS, DelData, GPSurrogate, LookupTable, SurrogateComparison, SurrogatePrediction,
+                        compare_surrogates, del_data, fit_gp, fit_lut)
 from .tables import Acceptance, Table, acceptance, table2, table3
 from .volterra import VolterraPrediction, volterra_prediction, volterra_response
 
@@ -59,6 +63,9 @@ __all__ = [
     "volterra_response", "VolterraPrediction", "volterra_prediction",
     # campaign
     "Campaign", "run_campaign", "concat_campaigns", "seeds_from", "check_plant_step", "check_campaign_step",
+    # surrogate
+    "CONDITIONS", "DelData", "del_data", "SurrogatePrediction", "GPSurrogate", "fit_gp", "LookupTable", "fit_lut",
+    "SurrogateComparison", "compare_surrogates",
     # tables
     "Table", "table2", "table3", "Acceptance", "acceptance",
 ]
