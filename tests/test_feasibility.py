@@ -230,3 +230,19 @@ def test_the_notch_explorer_shows_the_verdict_of_pitch_feasibility(model):
         assert explorer.verdict.feasible == direct.feasible == ok
         assert explorer.verdict.binding == direct.binding
         assert ("INFEASIBLE" in explorer.ax_mag.get_title()) != ok
+
+
+def test_the_notch_explorer_shows_the_qft_bounds_verdict(model):
+    # the explorer's QFT line is the bounds checker's verdict on ROSCO's map × the notch
+    from specdesign.plots.spec import NotchExplorer
+    from specdesign.qft.boundscheck import bounds_checker
+
+    base = spec.baseline_analysis(model, 19.0)
+    bc = bounds_checker(model, 19.0)
+    explorer = NotchExplorer(base, bounds_checker=bc)
+    for args in ((1.02, 3.0, 0.3), (0.05, 25.0, 0.8)):  # a mild notch at the tower mode; a deep one at low ω
+        explorer.update(*args, redraw=False)
+        direct = bc.check(spec.Specification(base.system, (spec.Notch(*args),)))
+        assert np.array_equal(explorer.bounds_verdict.empty, direct.empty)
+        assert direct.summary() in explorer.ax_mag.get_title()
+    assert not direct.feasible  # 25 dB at 0.05 rad/s asks for what integral action cannot give

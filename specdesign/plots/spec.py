@@ -95,6 +95,10 @@ class NotchExplorer:
         With a generator-speed specification fixed (:func:`specdesign.feasibility.pitch_checkers`),
         every update also says, in the title, whether ROSCO's map × the notch can be met
         through the pitch at all (:attr:`verdict`).
+    bounds_checker : specdesign.qft.boundscheck.BoundsChecker, optional
+        The pitch loop's QFT problem at the same speed (:func:`specdesign.qft.boundscheck.bounds_checker`):
+        every update also says whether the QFT bounds of ROSCO's map × the notch are empty
+        anywhere (:attr:`bounds_verdict`).
 
     Attributes
     ----------
@@ -104,6 +108,8 @@ class NotchExplorer:
         Its promise against ``base``, %.
     verdict : specdesign.feasibility.PitchFeasibility or None
         The feasibility verdict of the last update (with a ``checker``).
+    bounds_verdict : specdesign.qft.boundscheck.BoundsVerdict or None
+        The QFT bounds' verdict of the last update (with a ``bounds_checker``).
     fig : matplotlib.figure.Figure
         The figure.
 
@@ -118,12 +124,15 @@ class NotchExplorer:
     damage −28.4 %
     """
 
-    def __init__(self, base: Baseline, notch: Notch | None = None, *, scale: float = 1e-3, checker: Any = None):
+    def __init__(self, base: Baseline, notch: Notch | None = None, *, scale: float = 1e-3, checker: Any = None,
+                 bounds_checker: Any = None):
         import matplotlib.pyplot as plt
 
         self.base = base
         self.checker = checker
         self.verdict = None
+        self.bounds_checker = bounds_checker
+        self.bounds_verdict = None
         self.notch = notch or Notch(1.05, 6.0, 0.2)
         # not shown by pyplot at the end of the cell: widget() shows it once, with the sliders
         with plt.ioff():
@@ -186,6 +195,10 @@ class NotchExplorer:
                 bad = c.omega[np.array(self.verdict.binding) != ""]
                 where = f"{bad.min():.3g}-{bad.max():.3g} rad/s" if bad.size else "the RHP zero"
                 title += f"\npitch: INFEASIBLE at {where}"
+        if self.bounds_checker is not None:
+            b = self.bounds_checker
+            self.bounds_verdict = b.check(b.rosco_nominal * self.notch.response(b.template.omega))
+            title += "\n" + self.bounds_verdict.summary()
         self.ax_mag.set_title(title, fontsize=9)
         self.ax_mag.legend(fontsize=8, loc="lower left")
         if self._sliders is not None:  # a call from code: the sliders follow (not a move)
