@@ -124,7 +124,8 @@ def curve(label, xs, run, budget):
         t = _timed(lambda: run(x))
         done.append(x)
         times.append(t)
-        print(f"  {label} = {x:>6g}: {t:8.2f} s  ({1e3 * t / x:8.2f} ms per unit)", flush=True)
+        print(f"  {label} = {x:>6g}: {t:8.2f} s  ({1e3 * t / x:8.2f} ms per unit; load average now "
+              f"{os.getloadavg()[0]:.1f})", flush=True)
     return np.array(done, float), np.array(times)
 
 
