@@ -5,7 +5,7 @@ name in a module's ``__all__`` is documented without editing the site: a leaf mo
 rendered by mkdocstrings (its ``__all__`` decides the members); a package's page shows its
 docstring and, for each name it re-exports from a submodule, a link to the one place that
 name is documented (rendering it twice would give two anchors for one object).
-``tests/test_docs_site.py`` checks that every name of every ``__all__`` has an anchor.
+``tests/test_site.py`` checks that every name of every ``__all__`` has an anchor.
 """
 from __future__ import annotations
 
@@ -130,6 +130,32 @@ def notebooks() -> list[Path]:
     return sorted((ROOT / "notebooks").glob("*.ipynb"))
 
 
+#: Where tests/test_notebooks.py writes each notebook it executed (with its outputs), under
+#: ``notebooks/``; the site shows that copy while it is fresh (executed from the notebook as it is).
+EXECUTED = ROOT / "build" / "executed"
+
+
+def source_digest(path: Path) -> str:
+    """SHA-256 of a notebook file's bytes: an executed copy records the digest of its source."""
+    import hashlib
+
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def executed_copy(nb: Path) -> Path | None:
+    """The executed copy of ``nb`` if it was executed from the notebook as it is now, else None."""
+    import json
+
+    copy = EXECUTED / "notebooks" / nb.name
+    if not copy.is_file():
+        return None
+    try:
+        meta = json.loads(copy.read_text()).get("metadata", {}).get("specdesign", {})
+    except (OSError, ValueError):
+        return None
+    return copy if meta.get("source_sha256") == source_digest(nb) else None
+
+
 # before mkdocs-jupyter's on_files (priority 0), which turns the notebooks added here into pages
 @event_priority(50)
 def on_files(files, config):
@@ -138,6 +164,8 @@ def on_files(files, config):
     for m in modules:
         files.append(File.generated(config, _page_path(m), content=_page(m, modules)))
     for nb in notebooks():
-        files.append(File(f"notebooks/{nb.name}", src_dir=str(ROOT), dest_dir=config["site_dir"],
+        # with its outputs when the tests executed this very notebook, else as stored (no outputs)
+        src = EXECUTED if executed_copy(nb) is not None else ROOT
+        files.append(File(f"notebooks/{nb.name}", src_dir=str(src), dest_dir=config["site_dir"],
                           use_directory_urls=config["use_directory_urls"]))
     return files

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import html
 import importlib
+import json
 import os
 import pkgutil
 import re
@@ -50,6 +51,45 @@ def test_site_builds_strict_without_warnings(site):
         assert (out / page / "index.html").is_file(), page
     for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
         assert (out / "notebooks" / nb.stem / "index.html").is_file(), f"notebook {nb.name} is not in the gallery"
+
+
+def _hooks():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("api_pages", ROOT / "docs" / "hooks" / "api_pages.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.slow
+def test_the_gallery_shows_the_executed_notebooks_outputs(site):
+    # tests/test_notebooks.py (which runs before this file) writes each notebook it executed,
+    # figures included, to build/executed/; the gallery shows that copy while it is fresh
+    out = site[0]
+    hooks = _hooks()
+    fresh = [nb for nb in hooks.notebooks() if hooks.executed_copy(nb) is not None]
+    if not fresh:
+        pytest.skip("no executed notebook copies: run tests/test_notebooks.py first (the full suite does)")
+    for nb in fresh:
+        page = (out / "notebooks" / nb.stem / "index.html").read_text()
+        assert "jp-OutputArea-output" in page, f"{nb.name}: executed, but its page shows no output"
+    n_png = sum(json.loads(hooks.executed_copy(nb).read_text()).__str__().count("image/png") for nb in fresh)
+    assert n_png > 0  # at least one figure among the executed notebooks
+    # a notebook changed after its execution is shown as stored, not with stale outputs (on copies)
+    import shutil
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "src" / fresh[0].name
+        src.parent.mkdir()
+        shutil.copy(fresh[0], src)
+        (Path(tmp) / "exec" / "notebooks").mkdir(parents=True)
+        shutil.copy(hooks.executed_copy(fresh[0]), Path(tmp) / "exec" / "notebooks" / fresh[0].name)
+        hooks.EXECUTED = Path(tmp) / "exec"
+        assert hooks.executed_copy(src) is not None
+        src.write_bytes(src.read_bytes() + b"\n")
+        assert hooks.executed_copy(src) is None
 
 
 def _public_names():
