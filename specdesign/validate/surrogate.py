@@ -283,7 +283,8 @@ def fit_gp(conditions, values, *, names=None, kernel: str = "matern", n_restarts
     """Fit a Gaussian process to per-run values over conditions.
 
     Kernel: ConstantKernel(1, (1e-3, 1e3)) · k(scaled x) + WhiteKernel(0.1, (1e-6, 10)) with k
-    an anisotropic Matérn (ν = 5/2) or RBF, length scales 1 in (1e-2, 1e2) per axis; the
+    an anisotropic Matérn (ν = 5/2) or RBF, length scales 1 in (g, 1e2) per axis, g the
+    smallest gap between the axis's training values (scaled, at least 1e-2); the
     marginal likelihood is maximised by L-BFGS-B from the initial values and ``n_restarts``
     random ones (``random_state``).
 
@@ -332,10 +333,14 @@ def fit_gp(conditions, values, *, names=None, kernel: str = "matern", n_restarts
         raise ValueError(f"names {names} must name the {x.shape[1]} condition axes")
     gpm = _sklearn()
     k = gpm.kernels
-    ls = np.ones(x.shape[1])
-    base = (k.Matern(ls, (1e-2, 1e2), nu=2.5) if kernel == "matern" else k.RBF(ls, (1e-2, 1e2)))
-    kern = k.ConstantKernel(1.0, (1e-3, 1e3)) * base + k.WhiteKernel(0.1, (1e-6, 10.0))
     lo, hi = x.min(axis=0), x.max(axis=0)
+    ls = np.ones(x.shape[1])
+    # a length scale below the gap between training values is not identified by the data:
+    # the GP would fall back to its mean between bins, worse than the table it replaces
+    gaps = [np.diff(np.unique((x[:, j] - lo[j]) / (hi[j] - lo[j]))).min() for j in range(x.shape[1])]
+    bounds = np.array([[max(g, 1e-2), 1e2] for g in gaps])
+    base = (k.Matern(ls, bounds, nu=2.5) if kernel == "matern" else k.RBF(ls, bounds))
+    kern = k.ConstantKernel(1.0, (1e-3, 1e3)) * base + k.WhiteKernel(0.1, (1e-6, 10.0))
     s = y.shape[1]
     xs = np.repeat((x - lo) / (hi - lo), s, axis=0)
     reg = gpm.GaussianProcessRegressor(kern, normalize_y=True, n_restarts_optimizer=int(n_restarts),
