@@ -21,8 +21,10 @@ def test_notebook_executes(path, tmp_path, monkeypatch):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     monkeypatch.setenv("SPECDESIGN_FAST", "1")
-    # static figures, embedded as PNG in the executed copy (the documentation's gallery shows them)
+    # static figures, embedded as PNG in the executed copy (the documentation's gallery shows them);
+    # the interactive notebooks keep ipympl off when told so
     monkeypatch.setenv("MPLBACKEND", "module://matplotlib_inline.backend_inline")
+    monkeypatch.setenv("SPECDESIGN_STATIC_FIGURES", "1")
     # the kernel imports this checkout even when the package is not installed
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
     nb = nbformat.read(path, as_version=4)
