@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["as_omega", "as_psd", "as_signal", "as_real", "positive_scalar"]
+__all__ = ["as_omega", "as_psd", "as_signal", "as_real", "positive_scalar", "distinct_keys"]
 
 
 def as_real(x, name: str) -> np.ndarray:
@@ -105,3 +105,27 @@ def representable(value, positive, what: str, hint: str) -> np.ndarray:
     if np.any(bad_under):
         raise OverflowError(f"{what} underflows float64's range (a nonzero value below ~2.2e-308); {hint}")
     return v
+
+
+def distinct_keys(make_error=None):
+    """A ``json.loads`` object_pairs_hook that refuses a repeated key (json keeps the last silently).
+
+    Parameters
+    ----------
+    make_error : callable, optional
+        key → the exception to raise (default ``ValueError("key 'k' appears twice")``).
+
+    Returns
+    -------
+    callable
+        The hook.
+    """
+    def pairs(items):
+        out = {}
+        for k, v in items:
+            if k in out:
+                raise make_error(k) if make_error is not None else ValueError(f"key {k!r} appears twice")
+            out[k] = v
+        return out
+
+    return pairs

@@ -330,16 +330,13 @@ def _wind_speeds(vs, model, path, key) -> list:
 
 def _load_json(text: bytes, path: Path, what: str):
     """JSON with every object's keys distinct (a repeated key would silently keep the last)."""
-    def pairs(items):
-        out = {}
-        for k, v in items:
-            if k in out:
-                raise ConfigError(f"{path}: key {k!r} appears twice in one object; keep one")
-            out[k] = v
-        return out
+    from ._checks import distinct_keys
+
+    def repeated(k):
+        return ConfigError(f"{path}: key {k!r} appears twice in one object; keep one")
 
     try:
-        return json.loads(text, object_pairs_hook=pairs)
+        return json.loads(text, object_pairs_hook=distinct_keys(repeated))
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise ConfigError(f"{path}: {what} must be valid UTF-8 JSON ({e})") from None
 

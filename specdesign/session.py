@@ -498,18 +498,11 @@ def load_session(path: str | os.PathLike) -> Session:
         If it is not JSON, repeats a key, or is not a design session of a version this
         specdesign reads (the message names the file).
     """
+    from ._checks import distinct_keys
+
     path = Path(path)
-
-    def pairs(items):
-        out = {}
-        for k, v in items:
-            if k in out:
-                raise ValueError(f"key {k!r} appears twice")
-            out[k] = v
-        return out
-
     try:
-        data = json.loads(path.read_text(encoding="utf-8"), object_pairs_hook=pairs)
+        data = json.loads(path.read_text(encoding="utf-8"), object_pairs_hook=distinct_keys())
         model = data.get("model") if isinstance(data, dict) else None
         if isinstance(model, dict):
             def here(p):
