@@ -232,10 +232,11 @@ class _Cases:
     """The plant cases and ROSCO's loops on them, for the certificate's robustness check."""
 
     def __init__(self, model, speeds, v):
-        from ..rosco import rosco_baseline
+        from ..rosco import rosco_baseline, rosco_gain_schedule
 
         self.plants = [model.linearize(s) for s in speeds]
-        self.rosco = [rosco_baseline(model, s) for s in speeds]
+        schedule = rosco_gain_schedule(model)  # once for every case (the same fit each call would redo)
+        self.rosco = [rosco_baseline(model, s, schedule=schedule) for s in speeds]
         self.nom = speeds.index(v)
         self._grid = {}
 
