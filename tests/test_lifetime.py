@@ -181,6 +181,30 @@ def test_unstable_controller_gives_nan_and_is_named():
     assert "UNSTABLE: designed at 17 m/s" in r.summary()
 
 
+def test_lifetime_of_a_tiny_real_campaign():
+    """ROSCO vs ROSCO + the paper's ATD, 13-25 m/s, 4 seeds × 120 s: the record against the runs' DELs."""
+    import dataclasses
+
+    import control
+
+    from specdesign import simulate as sm, turbine
+    from specdesign.validate import run_campaign
+
+    model = turbine.iea15mw()
+    rosco = sm.rosco_scheduled(model)
+    atd = control.tf([-0.014187, -0.014187 * 4.357], [1, 0.3276])  # the paper's C_ATD (as in test_validate)
+    ctrls = {"ROSCO": rosco, "ATD": dataclasses.replace(rosco, atd=tuple(atd for _ in rosco.pitch), name="ATD")}
+    camp = run_campaign(ctrls, SPEEDS, seeds=range(1, 5), model=model, duration=120.0, transient=30.0,
+                        predict=False, progress=False)
+    climate = weibull_bins()
+    r = lifetime(camp, climate)
+    p = climate.probabilities[5:]  # bins 13..25 m/s
+    for c in range(2):
+        assert r.del_life[c, 0] == pytest.approx(hand_lifetime(camp.values["tower_del"][c], p, 4.0, range(4)), rel=1e-12)
+    assert r.missing_speeds.tolist() == [3.0, 5.0, 7.0, 9.0, 11.0]
+    assert np.all(np.isfinite(r.se)) and r.se[0, 0] > 0 and r.change_se[1, 0] > 0
+
+
 # ----------------------------------------------------------------------------- figure
 def test_damage_figure_labels_and_legend():
     import matplotlib.pyplot as plt

@@ -235,7 +235,7 @@ def plot_lifetime_damage(life, channel: str = "tower_base_my", *, ax=None):
         ax.bar(v + (i - (n - 1) / 2) * width, 100.0 * life.damage_share[i, j], width=width, color=f"C{i}",
                label=label)
     ax.set_xlabel("wind-speed bin centre (m/s)")
-    ax.set_ylabel(f"share of {life.baseline}'s lifetime damage (%)")
+    ax.set_ylabel(f"share of {life.baseline}'s damage over the simulated bins (%)")
     title = f"{_UNITS.get(channel, (channel,))[0]}, m = {life.m:g}"
     if life.missing_speeds.size:
         title += (f"\nbins not simulated: {', '.join(f'{x:g}' for x in life.missing_speeds.tolist())} m/s "
