@@ -171,6 +171,21 @@ def test_lifetime_refuses_speeds_off_the_bin_centres_and_bad_climates():
         lifetime({"tower_del": 1}, weibull_bins())
 
 
+def test_bootstrap_se_is_close_to_the_jackknife():
+    # both estimate the same sampling SD; with 40 seeds they agree to within sampling noise
+    camp = synthetic(n_seeds=40)
+    j = lifetime(camp, weibull_bins())
+    b = lifetime(camp, weibull_bins(), method="bootstrap", n_boot=400)
+    assert b.method == "bootstrap" and j.change[1, 0] == b.change[1, 0]
+    assert 0.7 < b.change_se[1, 0] / j.change_se[1, 0] < 1.4
+
+
+def test_repeated_bin_is_refused():
+    camp = synthetic(speeds=np.array([13.0, 13.0000001]))
+    with pytest.raises(ValueError, match="repeat a bin"):
+        lifetime(camp, weibull_bins())
+
+
 def test_unstable_controller_gives_nan_and_is_named():
     camp = synthetic()
     camp.values["tower_del"][1, 2] = np.nan

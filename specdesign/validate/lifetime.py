@@ -369,6 +369,8 @@ def lifetime(campaign, wind_climate, *, controllers=None, channels=("tower_base_
     if np.any(off):
         raise ValueError(f"campaign wind speeds {vs[off].tolist()} m/s are no bin centre of wind_climate "
                          f"({_speeds(centres)} m/s): use a climate whose bins are centred on the simulated speeds")
+    if np.unique(bin_of).size != bin_of.size:  # would weight one bin twice
+        raise ValueError(f"campaign wind speeds {vs.tolist()} m/s repeat a bin of wind_climate")
     covered = np.zeros(centres.size, bool)
     covered[bin_of] = True
     p = climate.probabilities[bin_of]
