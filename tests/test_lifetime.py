@@ -1,4 +1,4 @@
-"""Lifetime DEL (specdesign.validate.lifetime, issue 16 part 2).
+"""Lifetime DEL (specdesign.validate.lifetime_del, issue 16 part 2).
 
 Expected numbers come from independent computations written out here: scipy.stats.weibull_min's
 CDF for the bin probabilities, explicit loops over bins and deleted seeds for the lifetime DEL

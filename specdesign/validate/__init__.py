@@ -18,7 +18,7 @@ Modules, in the order they build on each other:
 - :mod:`~specdesign.validate.campaign`: controllers × wind speeds × paired seeds, simulated
   and post-processed (:class:`Campaign`), with the up-front checks.
 - :mod:`~specdesign.validate.tables`: the paper's Tables 2-3 and the acceptance of a design.
-- :mod:`~specdesign.validate.lifetime`: per-bin DELs combined over a Weibull or user-given wind
+- :mod:`~specdesign.validate.lifetime_del`: per-bin DELs combined over a Weibull or user-given wind
   climate into the lifetime DEL, with paired-seed SEs and the bins a campaign lacks.
 - :mod:`~specdesign.validate.surrogate`: a Gaussian-process surrogate of a campaign's DEL over
   its conditions, against the look-up table.
@@ -43,7 +43,7 @@ from __future__ import annotations
 from ..closedloop import closed_loop_poles  # noqa: F401  (reachable here as before; not part of __all__)
 from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
 from .campaign import Campaign, check_campaign_step, check_plant_step, concat_campaigns, run_campaign, seeds_from
-from .lifetime import DEL_CHANNELS, LifetimeDEL, WindClimate, lifetime, weibull_bins, wind_climate
+from .lifetime_del import DEL_CHANNELS, LifetimeDEL, WindClimate, lifetime, weibull_bins, wind_climate
 from .metrics import INDICATORS, Indicators, indicators
 from .prediction import LinearPrediction, closed_loop_response, linear_prediction, prediction_grid
 from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, weibull_weights,
