@@ -19,7 +19,8 @@ from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_keywords
 
-__all__ = ["DEFAULT_PHASES_DEG", "as_siso", "check_grid", "check_phases", "evaluate", "grid_indices", "is_lti"]
+__all__ = ["DEFAULT_PHASES_DEG", "as_siso", "check_grid", "check_phases", "evaluate", "grid_indices", "is_lti",
+           "is_zero"]
 
 #: Default phase grid of QFT bounds, degrees: −360…0 in 1° steps (361 points).
 DEFAULT_PHASES_DEG = np.linspace(-360.0, 0.0, 361)
@@ -47,6 +48,31 @@ def is_lti(obj: object) -> bool:
     import control as ct
 
     return isinstance(obj, ct.LTI)
+
+
+def is_zero(sys: object) -> bool:
+    """True if ``sys`` is the zero system: no states and a zero feedthrough (an absent loop).
+
+    Parameters
+    ----------
+    sys : control.LTI
+        A python-control LTI system.
+
+    Returns
+    -------
+    bool
+        Whether every response of ``sys`` is identically 0.
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> is_zero(ct.tf([0.0], [1.0])), is_zero(ct.tf([1.0], [1.0, 1.0]))
+    (True, False)
+    """
+    import control as ct
+
+    s = ct.ss(sys)
+    return s.nstates == 0 and not np.any(np.asarray(s.D))
 
 
 def as_siso(sys: object, name: str = "system", *, proper: bool = True) -> "control.TransferFunction | control.StateSpace":

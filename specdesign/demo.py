@@ -66,6 +66,8 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     """
     from matplotlib.figure import Figure  # figures only written to files: no pyplot, no backend
 
+    from loopshaping.freqresp import is_zero
+
     from . import feasibility, qft, spec, validate
     from .plots.fatigue import plot_sensitivity
     from .plots.qft import plot_design_bode, plot_design_nichols
@@ -130,7 +132,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     # the controllers as the transfer functions written to controller_qft.json, so that
     # `specdesign validate` simulates exactly what the demo simulated
     pitch = ct.tf(design.pitch_controller)
-    atd = None if _is_zero(design.atd_controller) else ct.tf(design.atd_controller)
+    atd = None if is_zero(design.atd_controller) else ct.tf(design.atd_controller)
     _say(f"      C_β(s) = {_tf_text(pitch)}")
     if atd is not None:
         _say(f"      C_ATD(s) = {_tf_text(atd)}")
@@ -224,11 +226,6 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     (out / "summary.md").write_text("\n".join(lines) + "\n")
     _say(f"done in {elapsed:.0f} s: {out.resolve()}/summary.md")
     return summary
-
-
-def _is_zero(c):
-    s = ct.ss(c)
-    return s.nstates == 0 and not np.any(np.asarray(s.D))
 
 
 def _tf_dict(tf):

@@ -164,6 +164,7 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
     import matplotlib.pyplot as plt
 
     from loopshaping import nichols
+    from loopshaping.freqresp import is_zero
 
     if axes is None:
         fig, axes = plt.subplots(1, 2, figsize=(14, 5.5))
@@ -177,7 +178,7 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
          "ATD loop $C_{atd} P''_{z,\\beta}$ (pitch loop closed)"),
     ):
         plant = template.systems[template.nominal]
-        if _is_zero(c):  # no loop here (a pitch-only design)
+        if is_zero(c):  # no loop here (a pitch-only design)
             ax.text(0.5, 0.5, "no ATD loop: pitch-only design", ha="center", va="center", transform=ax.transAxes)
             ax.set_xlabel("Open-loop phase [deg]")
             ax.set_ylabel("Open-loop magnitude [dB]")
@@ -186,10 +187,3 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
         ax.set_title(f"{title}, {design.wind_speed:g} m/s")
     fig.tight_layout()
     return fig
-
-
-def _is_zero(c):
-    import control
-
-    s = control.ss(c)
-    return s.nstates == 0 and not np.any(np.asarray(s.D))

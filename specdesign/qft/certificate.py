@@ -22,6 +22,7 @@ import control as ct
 import numpy as np
 
 from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response
+from .checks import spec_ratio, spec_roots
 
 __all__ = ["design_from_certificate"]
 
@@ -85,11 +86,11 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
     wd = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
     wdense = (np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None
               else lqft.check_grid(dense_omega, "dense_omega"))
-    tower_shaping = _ratio(target.tower, base.system)
-    speed_shaping = _ratio(target.speed, sp.speed_specification(model, v).baseline)
+    tower_shaping = spec_ratio(target.tower, base.system)
+    speed_shaping = spec_ratio(target.speed, sp.speed_specification(model, v).baseline)
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, 0.0, max_sensitivity, base,
                          speed_shaping=speed_shaping, response_method="batched")
-    roots = lightly_damped(np.concatenate([_roots(target.tower.baseline), _roots(target.speed.baseline)]))
+    roots = lightly_damped(np.concatenate([spec_roots(target.tower), spec_roots(target.speed)]))
     sharp = np.abs(roots[roots.imag > 0])
     sharp = sharp[(sharp >= wdense[0]) & (sharp <= wdense[-1])]
     if sharp.size:
@@ -108,23 +109,6 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
                            options=dict(structure="certificate", template_offsets=target.template_offsets,
                                         speed_relax_db=target.speed_relax_db, tower_slack_db=target.slack_db,
                                         max_sensitivity=max_sensitivity, min_decay=min_decay))
-
-
-def _ratio(spec_like, ref):
-    """ω → spec_like.response(ω)/ref(jω): the nominal ratio W/T^ROSCO each case is scaled by."""
-    def f(omega):
-        w = np.asarray(omega, float)
-        return np.asarray(spec_like.response(w)) / siso_response(ref, w, "reference")
-
-    return f
-
-
-def _roots(sys):
-    s = ct.ss(sys)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        r = np.r_[np.asarray(s.poles(), complex), np.asarray(s.zeros(), complex)]
-    return r[np.isfinite(r)]
 
 
 def _lowest_order(prob, full, omega, min_order, ms, min_decay):

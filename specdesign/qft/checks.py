@@ -9,7 +9,7 @@ import numpy as np
 
 from ..closedloop import close_responses, general_coefficients, partial_loop, plant_responses, siso_response
 
-__all__ = ["loop_checks", "bounds_met"]
+__all__ = ["loop_checks", "bounds_met", "spec_ratio", "spec_roots"]
 
 
 def _callable(fn, key):
@@ -119,3 +119,62 @@ def bounds_met(bounds, controller, template, omega):
     with np.errstate(divide="ignore"):  # a zero loop (no ATD) lies at −∞ dB
         ok = bounds.is_allowed(template.omega, np.degrees(np.angle(L0)), 20 * np.log10(np.abs(L0)))
     return bool(np.all(ok))
+
+
+def spec_ratio(spec_like, ref):
+    """ω → W(jω)/T^ROSCO(jω): a given specification relative to ROSCO's map at the nominal speed.
+
+    Each plant case's weight is its own ROSCO map times this ratio (a given pair's convention).
+
+    Parameters
+    ----------
+    spec_like : object with ``response(omega)``
+        The specification W at the nominal speed.
+    ref : control.LTI
+        ROSCO's closed-loop map at the nominal speed.
+
+    Returns
+    -------
+    callable
+        ω (rad/s) → complex ratio (-).
+    """
+    def f(omega):
+        w = np.asarray(omega, float)
+        return np.asarray(spec_like.response(w)) / siso_response(ref, w, "reference")
+
+    return f
+
+
+def spec_roots(spec_like) -> np.ndarray:
+    """Poles and zeros (1/s) of a Specification's baseline and elements; none for other objects.
+
+    The baseline's from its state space (accurate at high order): the dense checks refine their
+    grid around the lightly damped ones, where a narrow dip of W could hide between points.
+
+    Parameters
+    ----------
+    spec_like : object
+        A :class:`specdesign.spec.Specification` (else an empty array is returned).
+
+    Returns
+    -------
+    numpy.ndarray
+        Finite complex roots, 1/s.
+    """
+    import warnings
+
+    import control
+
+    from ..spec import Specification
+
+    if not isinstance(spec_like, Specification):
+        return np.zeros(0, complex)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        b = control.ss(spec_like.baseline)
+        out = [np.asarray(b.poles(), complex), np.asarray(b.zeros(), complex)]
+    for e in spec_like.elements:
+        t = e.tf()
+        out += [np.asarray(t.poles(), complex), np.asarray(t.zeros(), complex)]
+    r = np.concatenate(out)
+    return r[np.isfinite(r)]

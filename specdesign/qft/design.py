@@ -16,7 +16,7 @@ import numpy as np
 
 from .._checks import positive_scalar
 from ..closedloop import check_stability, closed_loop, lightly_damped, plant_responses, refine_grid, siso_response
-from .checks import bounds_met, loop_checks
+from .checks import bounds_met, loop_checks, spec_ratio, spec_roots
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
 
@@ -443,35 +443,6 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     return design
 
 
-def _ratio(spec_like, ref):
-    """ω → spec_like.response(ω)/ref(jω): a given specification relative to ROSCO's map."""
-    from ..closedloop import siso_response
-
-    def f(omega):
-        w = np.asarray(omega, float)
-        return np.asarray(spec_like.response(w)) / siso_response(ref, w, "reference")
-
-    return f
-
-
-def _spec_roots(spec_like) -> np.ndarray:
-    """Poles and zeros (1/s) of a Specification's baseline (from its state space: accurate at
-    high order) and elements; none for other objects."""
-    import control
-
-    from ..spec import Specification
-
-    if not isinstance(spec_like, Specification):
-        return np.zeros(0, complex)
-    b = control.ss(spec_like.baseline)
-    out = [np.asarray(b.poles(), complex), np.asarray(b.zeros(), complex)]
-    for e in spec_like.elements:
-        t = e.tf()
-        out += [np.asarray(t.poles(), complex), np.asarray(t.zeros(), complex)]
-    r = np.concatenate(out)
-    return r[np.isfinite(r)]
-
-
 def _given_spec(spec):
     """(tower, speed) of a TargetSpecification or a pair, each with ``response(omega)``."""
     from ..spec import specification_pair
@@ -522,8 +493,8 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
         # a given pair: each case gets ROSCO's map times the nominal ratio W/T^ROSCO
         tower_spec, speed_spec = given
         t_ref, s_ref = base.system, sp.speed_specification(model, v).baseline
-        tower_shaping = _ratio(tower_spec, t_ref)
-        speed_shaping = _ratio(speed_spec, s_ref)
+        tower_shaping = spec_ratio(tower_spec, t_ref)
+        speed_shaping = spec_ratio(speed_spec, s_ref)
         shaping = sp.ShapingResult((), sp.promise_of(tower_shaping(base.omega), base), float("nan"), "del", True,
                                    "given specification",
                                    tower_spec if isinstance(tower_spec, sp.Specification) else None)
@@ -542,7 +513,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
         # a near-axis zero of a designed closed loop) are design frequencies, and the dense
         # check is refined around them as H∞'s assessment is: a dip between grid points hid a
         # 1.3 dB violation
-        roots = np.concatenate([_spec_roots(x_) for x_ in given])
+        roots = np.concatenate([spec_roots(x_) for x_ in given])
         light = lightly_damped(roots)
         sharp = np.unique(np.r_[sharp, np.abs(light[light.imag > 0])])
         sharp = sharp[(sharp >= 0.005) & (sharp <= 20.0)]
