@@ -1,0 +1,248 @@
+"""Quadratic (tracking) MPC on the linearised turbine: the "finely tuned quadratic MPC" baseline
+of seed 000.
+
+At every sample k, from the Kalman estimate (x̂, d̂) of :mod:`specdesign.mpc.base` and the
+previous command u₋₁ (all deviations from the trim), solve over N steps::
+
+    min_u  Σ_{j=1..N} [ q_Ω (Ω_j / Ω_rated)² + q_T (ẋ_top,j / 1 m/s)² ]
+           + q_Δ Σ_{j=0..N−1} ((u_j − u_{j−1}) / (β̇_max T_s))²
+    s.t.   z = Φ x̂ + Γ u + Ψ d̂                       (prediction, wind held at d̂)
+           β_min − β₀ ≤ u_j ≤ β_max − β₀              (pitch position)
+           |u_j − u_{j−1}| ≤ β̇_max T_s                (pitch rate)
+
+and apply u₀ (receding horizon, zero-order hold over T_s). The speed error is made
+dimensionless by Ω_rated, the tower-top velocity by 1 m/s and the pitch move by the largest
+move the rate limit allows, so the weights q are comparable numbers.
+
+The QP is a cvxpy problem with Parameters (x̂, d̂, u₋₁), compiled once per operating point
+(DPP) and solved by OSQP (warm-started). The unconstrained minimiser is linear in the
+parameters, u* = K [x̂; d̂; u₋₁]; when it satisfies every constraint it *is* the QP's solution
+(the QP is strictly convex), so the controller uses it and calls the solver only when a
+constraint is active (``shortcut=True``, exact; ``shortcut=False`` solves every step, for
+timing the solver).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .._checks import positive_scalar
+from .base import MEASURED, DiscreteTurbine, SampledController, prediction_matrices
+
+__all__ = ["QuadraticMPC", "quadratic_qp", "OSQP_OPTIONS"]
+
+#: OSQP settings of the constrained QP: tolerances well under the 1e-6 relative accuracy the
+#: first move needs, and solution polishing (an active-set refinement: exact active constraints).
+OSQP_OPTIONS = {"eps_abs": 1e-9, "eps_rel": 1e-9, "polishing": True, "max_iter": 20000}
+
+
+def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float, float], rated_speed: float,
+                 rate_limit: float, pitch_limits: tuple[float, float]) -> dict:
+    """The condensed QP of :class:`QuadraticMPC` at one operating point, as arrays and as cvxpy.
+
+    Parameters
+    ----------
+    dm : DiscreteTurbine
+        The discrete model.
+    horizon : int
+        N steps.
+    weights : tuple of float
+        (q_Ω, q_T, q_Δ) ≥ 0, dimensionless (module docstring).
+    rated_speed : float
+        Ω_rated (rad/s), the speed scale.
+    rate_limit : float
+        β̇_max (rad/s).
+    pitch_limits : tuple of float
+        (β_min, β_max) absolute pitch (rad).
+
+    Returns
+    -------
+    dict
+        ``H`` (N, N) Hessian and ``G`` (N, n+2) with the cost ½uᵀHu + (G p)ᵀu for
+        p = [x̂; d̂; u₋₁]; ``K`` = −H⁻¹G (the unconstrained minimiser u* = K p); ``lower``,
+        ``upper`` (N,) position bounds on u; ``step`` the largest move (rad); and the cvxpy
+        ``problem`` with parameters ``x0``, ``d``, ``uprev`` and variable ``v`` = u/step.
+
+    Raises
+    ------
+    ValueError
+        For negative weights, or all of q_Δ zero with a singular Hessian.
+    """
+    import cvxpy as cp
+
+    qw, qt, qd = (float(w) for w in weights)
+    if min(qw, qt, qd) < 0 or not np.all(np.isfinite([qw, qt, qd])):
+        raise ValueError(f"weights={weights!r} must be finite and >= 0 (speed, tower, pitch activity)")
+    N = int(horizon)
+    Phi, Gam, Psi = prediction_matrices(dm, ("gen_speed", "tower_top_vel"), N)
+    step = float(rate_limit) * dm.ts
+    wz = np.tile([np.sqrt(qw) / rated_speed, np.sqrt(qt)], N)  # row scaling of z
+    Dm = np.eye(N) - np.eye(N, k=-1)  # Δu = Dm u − e₁ u₋₁
+    e1 = np.zeros(N)
+    e1[0] = 1.0
+    sd = np.sqrt(qd) / step
+    # ½uᵀHu + (G p)ᵀu with p = [x0; d; uprev]
+    Wg = wz[:, None] * Gam
+    H = 2.0 * (Wg.T @ Wg + sd**2 * Dm.T @ Dm)
+    G = 2.0 * np.hstack([Wg.T @ (wz[:, None] * Phi), (Wg.T @ (wz * Psi))[:, None], -(sd**2) * (Dm.T @ e1)[:, None]])
+    if np.linalg.cond(H) > 1e12:
+        raise ValueError("the MPC Hessian is singular: give a positive pitch-activity weight")
+    K = -np.linalg.solve(H, G)
+    lower = np.full(N, pitch_limits[0] - dm.pitch0)
+    upper = np.full(N, pitch_limits[1] - dm.pitch0)
+
+    n = dm.A.shape[0]
+    x0, d, uprev = cp.Parameter(n, name="x0"), cp.Parameter(1, name="d"), cp.Parameter(1, name="uprev")
+    # the variable is the command in units of the largest move (O(1) numbers: OSQP converges
+    # in a few iterations; in radians the scaled cost spans 1e8 and it stalls)
+    v = cp.Variable(N, name="v")
+    z = Phi @ x0 + (Gam * step) @ v + Psi[:, None] @ d
+    dv = Dm @ v - e1[:, None] @ uprev / step
+    cost = cp.sum_squares(cp.multiply(wz, z)) + qd * cp.sum_squares(dv)
+    cons = [v >= lower / step, v <= upper / step, cp.abs(dv) <= 1.0]
+    problem = cp.Problem(cp.Minimize(cost), cons)
+    return {"H": H, "G": G, "K": K, "lower": lower, "upper": upper, "step": step, "problem": problem,
+            "x0": x0, "d": d, "uprev": uprev, "v": v}
+
+
+class QuadraticMPC(SampledController):
+    """Quadratic MPC of the pitch on the linearised turbine, a callable controller for ``simulate``.
+
+    See the module docstring for the problem, :mod:`specdesign.mpc.base` for the observer and
+    the sampling. The generator torque stays at its trim (constant-torque region above rated).
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine (e.g. :func:`specdesign.turbine.iea15mw`).
+    ts : float, default 0.1
+        Sample time (s), a whole multiple of the simulation step.
+    horizon : int, default 50
+        Prediction horizon N (steps): 5 s at 0.1 s, close to the tower's period (5.9 s).
+    speed_weight, tower_weight, activity_weight : float
+        q_Ω, q_T, q_Δ of the module docstring (dimensionless, ≥ 0). Defaults (100, 100, 0.1) tuned on
+        the IEA 15 MW at 19 m/s so the generator-speed SD is close to ROSCO's (docs/mpc.md).
+    measured : sequence of str, optional
+        Outputs the Kalman filter reads (default generator speed, tower-top acceleration, pitch).
+    shortcut : bool, default True
+        Use the unconstrained minimiser when it is feasible (exactly the QP's solution).
+    solver : str, default "OSQP"
+        cvxpy solver of the constrained QP.
+    name : str, default "quadratic MPC"
+        Label.
+
+    Attributes
+    ----------
+    solve_times : list of float
+        CPU time (s) of every policy evaluation (one per run per sample), since the last pickle.
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> from specdesign.simulate import simulate
+    >>> m = iea15mw()
+    >>> r = simulate(m, QuadraticMPC(m), [19.0], seeds=[1], duration=5.0, transient=1.0)
+    >>> r["pitch_cmd"].shape
+    (1, 1, 50)
+    """
+
+    def __init__(self, model, ts: float = 0.1, horizon: int = 50, *, speed_weight: float = 100.0,
+                 tower_weight: float = 100.0, activity_weight: float = 0.1, measured=MEASURED, shortcut: bool = True,
+                 solver: str = "OSQP", name: str = "quadratic MPC"):
+        if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+            raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 1")
+        self.horizon = int(horizon)
+        self.weights = (float(speed_weight), float(tower_weight), float(activity_weight))
+        if min(self.weights) < 0 or not np.all(np.isfinite(self.weights)):
+            raise ValueError(f"speed_weight, tower_weight, activity_weight must be finite and >= 0, got {self.weights}")
+        if self.weights[2] == 0:
+            raise ValueError("activity_weight must be > 0 (it keeps the QP strictly convex)")
+        self.shortcut = bool(shortcut)
+        self.solver = str(solver)
+        super().__init__(model, ts, measured, name)
+        positive_scalar(model.pitch_rate_limit, "model.pitch_rate_limit")
+
+    def build(self, dm: DiscreteTurbine) -> dict:
+        """The QP at one operating point (:func:`quadratic_qp`).
+
+        Parameters
+        ----------
+        dm : DiscreteTurbine
+            The discrete model.
+
+        Returns
+        -------
+        dict
+            ``{"qp": ...}``.
+        """
+        return {"qp": quadratic_qp(dm, self.horizon, self.weights, float(self.model.rated_rotor_speed),
+                                   float(self.model.pitch_rate_limit),
+                                   (float(self.model.pitch_min), float(self.model.pitch_max)))}
+
+    def solve(self, qp: dict, x0: np.ndarray, d: float, uprev: float) -> np.ndarray:
+        """The optimal command sequence for one run (the constrained QP, by cvxpy).
+
+        Parameters
+        ----------
+        qp : dict
+            :func:`quadratic_qp`'s result.
+        x0 : numpy.ndarray
+            (n,) state estimate (deviations, SI).
+        d : float
+            Wind deviation estimate (m/s).
+        uprev : float
+            Previous command deviation (rad).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) command deviations (rad).
+
+        Raises
+        ------
+        RuntimeError
+            If the solver does not return an optimal solution.
+        """
+        qp["x0"].value, qp["d"].value, qp["uprev"].value = np.asarray(x0, float), np.array([d]), np.array([uprev])
+        opts = OSQP_OPTIONS if self.solver == "OSQP" else {}
+        qp["problem"].solve(solver=self.solver, warm_start=True, **opts)
+        if qp["problem"].status not in ("optimal", "optimal_inaccurate"):
+            raise RuntimeError(f"{self.name}: the QP is {qp['problem'].status} (a start outside the rate limit?)")
+        return np.asarray(qp["v"].value, float) * qp["step"]
+
+    def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
+        """First move of the QP of every run at one operating point.
+
+        Parameters
+        ----------
+        pt : dict
+            :meth:`point` of the operating point.
+        xhat : numpy.ndarray
+            (G, n+1) state and wind estimates.
+        uprev : numpy.ndarray
+            (G,) previous command deviations (rad).
+
+        Returns
+        -------
+        numpy.ndarray
+            (G,) command deviations (rad).
+        """
+        qp = pt["qp"]
+        out = np.empty(uprev.size)
+        for g in range(uprev.size):
+            t0 = time.process_time()
+            p = np.append(xhat[g], uprev[g])
+            u = qp["K"] @ p if self.shortcut else None
+            tol = 1e-9
+            if u is None or np.any(u < qp["lower"] - tol) or np.any(u > qp["upper"] + tol) or \
+                    np.any(np.abs(np.diff(np.concatenate([[uprev[g]], u]))) > qp["step"] + tol):
+                u = self.solve(qp, xhat[g, :-1], xhat[g, -1], uprev[g])
+                # OSQP's tolerance may leave a move a hair past the rate limit: the first move
+                # is the only one applied, and it must respect the actuator's limits exactly
+                u0 = min(max(u[0], uprev[g] - qp["step"], qp["lower"][0]), uprev[g] + qp["step"], qp["upper"][0])
+            else:
+                u0 = u[0]
+            out[g] = u0
+            self.solve_times.append(time.process_time() - t0)
+        return out
