@@ -27,9 +27,32 @@ reuses the rest:
 - ``p`` is the flat float64 parameter array of :meth:`specdesign.turbine.TurbineModel.kernel_params`: a header of
   :data:`HEADER_SIZE` scalars (indices ``P_*`` in this module) followed by the bicubic Cp and Ct
   patch coefficients, each of shape (n_tsr − 1, n_pitch − 1, 4, 4) flattened in C order.
-- ``y`` (float64[6], written) follows :data:`OUTPUT_NAMES`: generator speed (rad/s), tower-base
+- ``y`` (float64[7], written) follows :data:`OUTPUT_NAMES`: generator speed (rad/s), tower-base
   fore-aft moment (N·m, deviation of the modal part: k_My · x_top), tower-top acceleration (m/s²),
-  tower-top velocity (m/s), pitch (rad), electrical power (W = η_gen · T_gen · Ω).
+  tower-top velocity (m/s), pitch (rad), electrical power (W = η_gen · T_gen · Ω), blade-root
+  flapwise moment (N·m, collective, quasi-static: below).
+
+Blade-root flapwise moment (``blade_root_my``, appended last so the other indices keep their
+places): each of the :data:`BLADE_COUNT` blades carries T/N_b of the rotor thrust T at the
+radial centre of thrust r_T(β) = R·(c₀ + c₁β + c₂β²) (:data:`THRUST_CENTRE_COEFFS`, β in rad)::
+
+    M_flap = r_T(β) · T / N_b
+
+The thrust is the one the tower mode feels, recovered from the state derivative,
+T = m_t·ẍ_top + k_t·x_top + c_t·ẋ_top (so kernels that replace the aerodynamics, and the
+additive thrust input of the load linearisation, move it too). c₀ ≈ 2/3 is the ideal rotor's
+centre (thrust per unit span ∝ r); pitching to feather unloads the tip first, which moves the
+centre inboard. The coefficients are a least-squares fit to OpenFAST's mean RootMyc (blade-root
+out-of-plane moment, mean over the three blades and twelve azimuths) divided by T/3, with T from
+this model's Ct table at OpenFAST's operating point (wind, pitch, rotor speed), over the
+operating points 7-24 m/s (pitch 0-21.7°) of the IEA-15-240-RWT UMaineSemi linearisation deck
+shipped with the ``rosco`` package (``Examples/Test_Cases/IEA-15-240-RWT/IEA-15-240-RWT-UMaineSemi/
+linearizations``); the fitted moment is within 2.7 % of OpenFAST's from 7 to 24 m/s
+(``tests/test_blade_moment.py`` checks it where the deck is installed). OpenFAST's RootMyc also
+carries the blades' weight and centrifugal terms, which the fit absorbs at the mean only; the
+fluctuation is that of the thrust (no blade dynamics: the blade's first flap mode, ~4 rad/s, is
+far above the tower mode and the pitch loop). The same fraction of R serves other rotors (an
+approximation: c₀ is generic, c₁ and c₂ are the IEA 15 MW's).
 
 Pitch actuator: β̈ = ω_a²(β_cmd − β) − 2ζ_a ω_a β̇ₛ with ω_a = 3.14 rad/s, ζ_a = 0.707; the
 pitch moves at β̇ₛ = clip(β̇, ±rate_limit) and stops at the position limits; the internal rate
@@ -46,6 +69,8 @@ __all__ = [
     "INPUT_NAMES",
     "OUTPUT_NAMES",
     "HEADER_SIZE",
+    "BLADE_COUNT",
+    "THRUST_CENTRE_COEFFS",
     "P_RHO", "P_RADIUS", "P_INERTIA", "P_TWR_MASS", "P_TWR_STIFF", "P_TWR_DAMP", "P_MY_PER_M", "P_ACT_OMEGA",
     "P_ACT_ZETA", "P_RATE_LIM", "P_PITCH_MIN", "P_PITCH_MAX", "P_GEN_EFF", "P_N_TSR", "P_TSR0", "P_DTSR",
     "P_N_PITCH", "P_PITCH0", "P_DPITCH",
@@ -55,11 +80,18 @@ __all__ = [
     "rhs",
     "outputs_from",
     "outputs",
+    "thrust_centre",
 ]
 
 STATE_NAMES = ("rotor_speed", "tower_top_disp", "tower_top_vel", "pitch", "pitch_rate")
 INPUT_NAMES = ("wind", "pitch_cmd", "gen_torque")
-OUTPUT_NAMES = ("gen_speed", "tower_base_my", "tower_top_acc", "tower_top_vel", "pitch", "power")
+OUTPUT_NAMES = ("gen_speed", "tower_base_my", "tower_top_acc", "tower_top_vel", "pitch", "power", "blade_root_my")
+
+#: Number of blades sharing the thrust in ``blade_root_my``.
+BLADE_COUNT = 3
+#: (c₀, c₁, c₂): radial centre of thrust r_T/R = c₀ + c₁β + c₂β² (β in rad), fitted to OpenFAST
+#: (module docstring; the fit: ``python benchmarks/health_mpc.py --fit-centre``).
+THRUST_CENTRE_COEFFS = (0.67280, 0.15642, -1.85570)
 
 # Header of the flat kernel parameter array.
 P_RHO, P_RADIUS, P_INERTIA = 0, 1, 2
@@ -225,6 +257,31 @@ def rhs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.n
 
 
 @njit(cache=True)
+def thrust_centre(pitch: float) -> float:
+    """Radial centre of thrust as a fraction of the rotor radius, r_T/R = c₀ + c₁β + c₂β².
+
+    Coefficients :data:`THRUST_CENTRE_COEFFS` (fitted to OpenFAST, see the module docstring).
+
+    Parameters
+    ----------
+    pitch : float
+        Collective blade pitch β (rad).
+
+    Returns
+    -------
+    float
+        r_T/R (-).
+
+    Examples
+    --------
+    >>> round(thrust_centre(0.0), 4)
+    0.6728
+    """
+    c0, c1, c2 = THRUST_CENTRE_COEFFS
+    return c0 + pitch * (c1 + pitch * c2)
+
+
+@njit(cache=True)
 def outputs_from(x: np.ndarray, dx: np.ndarray, gen_torque: float, p: np.ndarray, y: np.ndarray) -> None:
     """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``.
 
@@ -239,7 +296,7 @@ def outputs_from(x: np.ndarray, dx: np.ndarray, gen_torque: float, p: np.ndarray
     p : numpy.ndarray
         Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
     y : numpy.ndarray
-        Output: float64[6], the outputs (written, SI).
+        Output: float64[7], the outputs (written, SI).
     """
     y[0] = x[0]
     y[1] = p[P_MY_PER_M] * x[1]
@@ -247,6 +304,10 @@ def outputs_from(x: np.ndarray, dx: np.ndarray, gen_torque: float, p: np.ndarray
     y[3] = x[2]
     y[4] = x[3]
     y[5] = p[P_GEN_EFF] * gen_torque * x[0]
+    # the thrust as the tower mode's equation of motion sees it (mechanics: dx[2])
+    damp = p[P_TWR_DAMP]
+    thrust = p[P_TWR_MASS] * dx[2] + p[P_TWR_STIFF] * x[1] + damp * x[2]
+    y[6] = thrust_centre(x[3]) * p[P_RADIUS] * thrust / BLADE_COUNT
 
 
 @njit(cache=True)
@@ -266,8 +327,8 @@ def outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: 
     p : numpy.ndarray
         Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
     y : numpy.ndarray
-        Output: float64[6], written: gen_speed (rad/s), tower_base_my (N·m), tower_top_acc
-        (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical).
+        Output: float64[7], written: gen_speed (rad/s), tower_base_my (N·m), tower_top_acc
+        (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical), blade_root_my (N·m).
     """
     dx = np.empty(5)
     rhs(x, wind, pitch_cmd, gen_torque, p, dx)
