@@ -76,7 +76,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     model = iea15mw()
-    designs = design_schedule(model, args.speeds)
+    designs = design_schedule(model, args.speeds, specification="notch")
     t_design = time.perf_counter() - t0
     seeds = np.arange(args.seeds)
     points, independent = [], []

@@ -240,7 +240,7 @@ def _design_key(model, v) -> str:
             versions.append(f"{lib} {md.version(lib)}")
         except md.PackageNotFoundError:
             versions.append(f"{lib} -")
-    h.update(f"design_qft(model, {float(v)!r}) {'; '.join(versions)}".encode())
+    h.update(f"design_qft(model, {float(v)!r}, spec='notch') {'; '.join(versions)}".encode())
     return h.hexdigest()
 
 
@@ -265,7 +265,7 @@ def designs_for(model, v):
             return tuple(control.tf(data[k]["num"], data[k]["den"]) for k in ("pitch", "atd"))
         except (ValueError, KeyError, TypeError) as e:
             print(f"cache file {f} is unreadable ({e}); designing again")
-    d = design_qft(model, v)
+    d = design_qft(model, v, spec="notch")
     out = (d.pitch_controller, d.atd_controller)
     f.parent.mkdir(parents=True, exist_ok=True)
     tmp = f.with_name(f"{f.name}.{os.getpid()}.tmp")  # written whole, then renamed: no half-written cache file

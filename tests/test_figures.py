@@ -43,7 +43,7 @@ def design(model):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a short tuning may miss a spec; figures still apply
-        return design_qft(model, 19.0, speed_relax_db=6.0, refine=0, maxfev=150,
+        return design_qft(model, 19.0, spec="notch", speed_relax_db=6.0, refine=0, maxfev=150,
                           design_omega=[0.01, 0.05, 0.1, 0.3, 0.6, 1.0, 1.06, 1.5, 3.0],
                           dense_omega=np.logspace(-2, 1, 100))
 

@@ -193,7 +193,7 @@ def test_the_session_of_a_qft_design_reloads_bitwise_and_reopens_the_designer(tm
     model = iea15mw()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        d = qft.design_qft(model, 19.0, target_reduction=25.0)
+        d = qft.design_qft(model, 19.0, target_reduction=25.0, spec="notch")
     designer = Designer(d.pitch_bounds, d.pitch_template, Controller.from_tf(d.pitch_controller))
     designer.set_param(0, k=1.1 * designer.controller.elements[0].params["k"])
     s = Session.from_qft(d, designer=designer, results={"note": "gain +10 %"})
@@ -218,6 +218,15 @@ def test_the_session_of_a_qft_design_reloads_bitwise_and_reopens_the_designer(tm
     assert NotchExplorer.from_session(back, "notch").notch == d.shaping.notches[0]
     with pytest.raises(TypeError, match="QFTDesign"):
         Session.from_qft(s)
+    # design_qft's default (specification-driven: the certificate, reduced; no ATD, a static zero
+    # whose timebase python-control leaves unspecified) saves and reloads as well
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # cvxpy: "solution may be inaccurate" on some rungs
+        t = qft.design_qft(model, 19.0)
+    back_t = load_session(save_session(tmp_path / "target.json", Session.from_qft(t)))
+    for name, c in (("pitch", t.pitch_controller), ("atd", t.atd_controller)):
+        np.testing.assert_array_equal(back_t.controllers[name](1j * w), c(1j * w))
+    np.testing.assert_array_equal(back_t.specifications["tower"].response(w), t.tower_spec.response(w))
     import matplotlib.pyplot as plt
 
     plt.close("all")

@@ -161,7 +161,7 @@ def _scan(model, ts, tower, w0):
 def test_a_specification_driven_schedule(model):
     from specdesign.qft import design_schedule
 
-    (d,) = design_schedule(model, (25.0,), specification="target", progress=False)
+    (d,) = design_schedule(model, (25.0,), progress=False)  # specification-driven by default
     assert d.success and d.promise.exact_del >= 24.5 and d.del_reduction >= d.promise.exact_del - 0.1
     assert d.options["structure"] == "certificate"
     with pytest.raises(ValueError, match="specification"):
@@ -202,3 +202,20 @@ def test_a_hand_edited_specification_is_recertified(model, chain19):
         fz.recertify(model, ts, speed=spec.speed_specification(model, 19.0, margin_db=-1.0))
     with pytest.raises(TypeError, match="TargetSpecification"):
         fz.recertify(model, (ts.tower, ts.speed))
+
+
+def test_the_default_design_is_specification_driven(model, chain19):
+    # Issue 14: design_qft's default specification is the feasible one for target_reduction,
+    # so the default design is exactly the chain specification_for_target → design_qft(spec=).
+    ts, d = chain19
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # cvxpy, as in _chain
+        default = design_qft(model, 19.0, 25.0)
+    assert default.options["structure"] == "certificate"
+    assert default.promise.exact_del == pytest.approx(ts.promise.exact_del, abs=1e-9)
+    assert default.del_reduction == pytest.approx(d.del_reduction, abs=1e-9)
+    # the fixed-structure tuner's options are refused by name, with the way to reach them
+    with pytest.raises(TypeError, match=r"\['maxfev', 'speed_relax_db'\].*spec='notch'"):
+        design_qft(model, 19.0, speed_relax_db=4.5, maxfev=10)
+    with pytest.raises(ValueError, match="spec='W' must be"):
+        design_qft(model, 19.0, spec="W")

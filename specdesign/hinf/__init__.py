@@ -7,7 +7,7 @@ synthesis, well-posedness checks and reduction are :mod:`loopshaping.hinf`'s.
 The specifications of :mod:`specdesign.spec` are upper bounds on closed-loop maps from the
 rotor-effective wind: |T_{MyT,w}(jω)| ≤ |W_MyT(jω)| (tower-base load, the baseline reshaped by
 notches) and |T_{Ω,w}(jω)| ≤ |W_Ω(jω)| (generator speed, the baseline's T_{Ω,w}); by default
-:func:`design_hinf` takes them as :func:`specdesign.qft.design_qft` does (:func:`qft_specifications`:
+:func:`design_hinf` takes them as ``specdesign.qft.design_qft(spec="notch")`` does (:func:`qft_specifications`:
 the tower spec relaxed above ≈ 1.3 rad/s, the speed spec relaxed by QFT's dB ladder), so H∞ and
 QFT are compared on the same specifications. Dividing each
 output by its specification gives performance outputs whose H∞ norm is ≤ 1 exactly when

@@ -310,7 +310,7 @@ def design_hinf(
         Operating point, m/s, above rated.
     specs : "qft", "rosco", specdesign.qft.QFTDesign, TargetSpecification or (W_MyT, W_Ω)
         Which specifications are the weights (``w_tower``/``w_speed``, when given, override).
-        ``"qft"`` (default): those of :func:`specdesign.qft.design_qft`
+        ``"qft"`` (default): those of ``specdesign.qft.design_qft(spec="notch")``
         (:func:`qft_specifications`): the notch spec relaxed by ``tower_relax_db`` above
         ≈ ``tower_relax_omega`` and ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``; given a
         sequence (default :data:`QFT_SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
@@ -399,6 +399,11 @@ def design_hinf(
     specdesign.closedloop.ClosedLoopUnstableWarning
         When a reduced controller does not stabilise the turbine (before the RuntimeError, or
         before the next relaxation is tried).
+    RuntimeWarning
+        With given specifications (a TargetSpecification or a pair) that the reduced design
+        does not meet on the nominal plant's refined grid: by how much, where (also in
+        ``notes``). The synthesis bounds the root-sum-square of the weighted outputs, not each
+        ratio, and cannot follow a certified pair's narrow tower-mode pattern; see docs/hinf.md.
 
     Examples
     --------
@@ -553,6 +558,17 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, 
     Kj = np.asarray(ct.frequency_response(K, omega).complex).reshape(1, len(measurements), -1)[0]
     L_u = -sum(Kj[i] * closedloop.frequency_response(plant, omega, y, "pitch_cmd")
                for i, y in enumerate(measurements))
+    notes = gp.notes + res.notes
+    tower_ratio = 20 * np.log10(np.abs(t_tower) / np.abs(wt_resp))
+    if label == "given" and (speed_excess > 0 or tower_ratio.max() > 0):
+        # a given pair is a promise to the user: say where the reduced design leaves it
+        i, j = int(np.argmax(tower_ratio)), int(np.argmax(20 * np.log10(np.abs(t_speed) / np.abs(ws_resp))))
+        missed = (f"the given specifications are not met at {v:g} m/s (nominal plant): tower load by "
+                  f"{tower_ratio[i]:+.2f} dB at {omega[i]:.3g} rad/s, generator speed by {speed_excess:+.2f} dB at "
+                  f"{omega[j]:.3g} rad/s; a pair made by specification_for_target is met by "
+                  "qft.design_qft(spec=...), see docs/hinf.md")
+        notes = notes + (missed,)
+        warnings.warn(missed, RuntimeWarning, stacklevel=3)
     p = np.asarray(cl.poles())
     osc = p[np.abs(p.imag) > 1e-6]
     zeta = -osc.real / np.abs(osc)
@@ -565,7 +581,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, 
         pitch_std=std(t_pitch), pitch_std_baseline=std(t_pitch0), omega=omega,
         check=_qft_check(plant, parts[0], w_tower, w_speed, omega) if len(parts) == 1 else None,
         discrete_controller=None if dt is None else lhinf.discretize(K, dt, prewarp_frequency=wt_mode),
-        notes=gp.notes + res.notes,
+        notes=notes,
         zeta_min=float(zeta.min()) if zeta.size else 1.0,
         zeta_min_frequency=float(np.abs(osc[np.argmin(zeta)])) if zeta.size else float("nan"),
         peak_sensitivity=float(np.max(np.abs(1.0 / (1.0 + L_u)))),

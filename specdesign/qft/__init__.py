@@ -6,7 +6,12 @@ parameter vector), :mod:`~specdesign.qft.tuner` (objective, constraints, the tun
 algebra they use (general form, sequential closure) is :mod:`specdesign.closedloop`'s.
 
 The seed paper's Sect. 4 on the embedded turbine model, as a deterministic automatic
-procedure. Sign convention (WORKBENCH.md, :mod:`specdesign.closedloop`):
+procedure, in two forms. :func:`design_qft`'s default is specification-driven: the certified
+specification pair for a DEL target (:func:`specdesign.feasibility.specification_for_target`),
+then its certificate reduced to the lowest order that meets the pair at every plant case
+(:mod:`~specdesign.qft.certificate`), checked as below. ``design_qft(spec="notch")`` is the
+fixed-structure design of the sections below (notch specification, DEL target, tuner).
+Sign convention (WORKBENCH.md, :mod:`specdesign.closedloop`):
 
     β_cmd = −C_β·Ω_g − C_atd·z,    z = tower-top fore-aft velocity (m/s),
 

@@ -300,12 +300,17 @@ def _template_speeds(model, v, offsets):
 
 
 def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
-               speed_relax_db: float | Sequence[float] = (3.0, 4.5, 6.0, 8.0), spec: Any = None,
+               speed_relax_db: float | Sequence[float] | None = None, spec: Any = "target",
                structure: str | None = None, **kwargs: Any) -> QFTDesign:
-    """QFT design of C_β and C_atd at ``wind_speed`` (m/s) against the fatigue-based specs.
+    """QFT design at ``wind_speed`` (m/s) that meets a fatigue-based specification pair.
 
-    The automatic procedure of :mod:`specdesign.qft`: fixed structures started from ROSCO,
-    tuned against the bounds of every plant case, checked on a dense grid (5-60 s).
+    By default specification-driven (the method's centre, seed paper Sect. 3-4): the feasible
+    specification pair for ``target_reduction`` first
+    (:func:`specdesign.feasibility.specification_for_target`, certified over the plant cases),
+    then the controller that meets it at every plant case on the dense check (its certificate
+    reduced to the lowest order that does, 2-5 s). ``spec="notch"`` is the earlier automatic
+    procedure: fixed structures (PI + notch + low-pass and an ATD) started from ROSCO, tuned
+    against the bounds of every plant case with a DEL-target penalty (5-60 s).
 
     Parameters
     ----------
@@ -314,13 +319,19 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     wind_speed : float
         Operating point, m/s (above rated, inside ``model.wind_range``).
     target_reduction : float
-        Predicted tower-base DEL reduction (1 Hz, m = 4) vs ROSCO to reach, % (0-100).
-    speed_relax_db : float or sequence of float
-        Relaxation of the generator-speed spec in dB (≥ 0), or an increasing sequence tried
-        in turn (default 3, 4.5, 6, 8 dB): the design with the smallest relaxation that meets
-        every spec is returned (else the last attempt, with a warning). Not used with ``spec``.
-    spec : TargetSpecification or (tower, speed), optional
-        The specification pair to meet instead of the notch specification and the DEL target:
+        Tower-base DEL reduction (1 Hz, m = 4) vs ROSCO, % (0-100): with ``spec="target"`` the
+        promise of the specification that is made and met; with ``spec="notch"`` the predicted
+        reduction the tuner must reach. Not used with a given specification.
+    speed_relax_db : float or sequence of float, optional
+        Only with ``spec="notch"``: relaxation of the generator-speed spec in dB (≥ 0), or an
+        increasing sequence tried in turn (default 3, 4.5, 6, 8 dB): the design with the
+        smallest relaxation that meets every spec is returned (else the last attempt, with a
+        warning). With a specification-driven design the certificate sets it.
+    spec : "target", "notch", TargetSpecification or (tower, speed)
+        ``"target"`` (default): ``specification_for_target(model, wind_speed,
+        target_reduction)``, then as for a TargetSpecification. ``"notch"``: the
+        fixed-structure design against the notch specification and the DEL target.
+        Otherwise the specification pair to meet:
         a :class:`specdesign.feasibility.TargetSpecification`, or two objects with a
         ``response(omega)`` (e.g. :class:`specdesign.spec.Specification`), W_MyT and W_Ω of
         the nominal case. Each plant case gets ROSCO's map at its speed times the nominal
@@ -329,12 +340,14 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         the dense check passed for every case, every loop stable.
     structure : {"certificate", "fixed"}, optional
         The controller designed. ``"fixed"``: the tuned fixed structures (PI + notch + low-pass
-        and a first-order ATD). ``"certificate"`` (only with a TargetSpecification; its
-        default): the specification's certificate reduced to the lowest order that meets it
-        over the plant cases (:func:`specdesign.qft.certificate.design_from_certificate`;
-        options ``max_sensitivity``, ``min_decay``, ``design_omega``, ``dense_omega``).
+        and a first-order ATD). ``"certificate"`` (only with ``"target"`` or a
+        TargetSpecification; their default): the specification's certificate reduced to the
+        lowest order that meets it over the plant cases
+        (:func:`specdesign.qft.certificate.design_from_certificate`; options
+        ``max_sensitivity``, ``min_decay``, ``design_omega``, ``dense_omega``).
     **kwargs
-        Options of each design attempt (keyword only):
+        Options of each design attempt (keyword only; the certificate takes only the four
+        named above, the fixed structures all of these):
 
         spec_reduction : float, default 15.0
             Damage reduction (%) the notch-shaped tower specification promises
@@ -370,12 +383,15 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     Raises
     ------
     TypeError
-        If ``model`` is not a :class:`specdesign.turbine.TurbineModel`, an option is unknown,
-        or both a deprecated and a current keyword (``design_omegas=``/``design_omega=``,
+        If ``model`` is not a :class:`specdesign.turbine.TurbineModel`, an option is unknown
+        (or belongs to the other design: ``speed_relax_db`` and the tuner's options need
+        ``spec="notch"`` or ``structure="fixed"``), or both a deprecated and a current keyword (``design_omegas=``/``design_omega=``,
         ``dense_omegas=``/``dense_omega=``) are given.
     ValueError
         If ``wind_speed`` is outside ``model.wind_range``; ``target_reduction`` is not
-        strictly between 0 and 100 %; a relaxation is negative or not finite;
+        strictly between 0 and 100 %; no certified specification reaches it ("infeasible
+        because ...", from :func:`specdesign.feasibility.specification_for_target`);
+        ``spec`` is an unknown string; a relaxation is negative or not finite;
         ``tower_relax_omega`` or ``min_decay`` is not positive; ``max_sensitivity`` ≤ 1;
         ``template_offsets`` is not a 1-D array of finite offsets; or a frequency grid is
         invalid.
@@ -394,6 +410,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     >>> from specdesign.qft import design_qft
     >>> d = design_qft(turbine.iea15mw(), 19.0)  # doctest: +SKIP
     >>> print(d.summary())  # doctest: +SKIP
+    >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
     """
     for old_name in ("design_omegas", "dense_omegas"):  # renamed: one name for frequency grids, omega
         if old_name in kwargs:
@@ -408,6 +425,21 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
     if unknown:  # named here, not as a TypeError of an internal function
         raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
+    from .. import turbine
+
+    if not isinstance(model, turbine.TurbineModel):
+        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()), got {type(model).__name__}")
+    if isinstance(spec, str) and spec not in ("target", "notch"):
+        raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
+                         "(tower, speed)")
+    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega"}
+    if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
+        named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
+        raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
+                        "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
+                        "takes max_sensitivity, min_decay, design_omega, dense_omega")
+    if speed_relax_db is None:
+        speed_relax_db = (3.0, 4.5, 6.0, 8.0)
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
     if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
@@ -417,8 +449,15 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
 
     if structure not in (None, "certificate", "fixed"):
         raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
+    if isinstance(spec, str) and spec == "target":
+        from ..feasibility import specification_for_target
+
+        spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction)
+    elif isinstance(spec, str):  # "notch"
+        spec = None
     if structure == "certificate" and not isinstance(spec, TargetSpecification):
-        raise ValueError("structure='certificate' needs spec=feasibility.TargetSpecification (it carries the certificate)")
+        raise ValueError("structure='certificate' needs spec='target' or a feasibility.TargetSpecification (it carries "
+                         "the certificate)")
     if isinstance(spec, TargetSpecification) and structure != "fixed":
         from .certificate import design_from_certificate
 
@@ -643,7 +682,7 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
 
 
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
-                    target_reduction: float | Sequence[float] = 25.0, *, specification: str = "notch",
+                    target_reduction: float | Sequence[float] = 25.0, *, specification: str = "target",
                     progress: bool = True, **kwargs: Any) -> tuple[QFTDesign, ...]:
     """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
 
@@ -655,11 +694,11 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         Operating points, m/s.
     target_reduction : float or sequence of float
         Tower-base DEL reduction to reach, %: one number, or one value per wind speed.
-    specification : {"notch", "target"}
-        ``"notch"``: the fixed-structure design against the notch specification and a DEL
-        target (:func:`design_qft` without ``spec``). ``"target"``: specification-driven, the
-        specification for the target first (:func:`specdesign.feasibility.specification_for_target`),
-        then ``design_qft(spec=...)``.
+    specification : {"target", "notch"}
+        ``"target"`` (default): specification-driven, the specification for the target first
+        (:func:`specdesign.feasibility.specification_for_target`), then the design that meets
+        it (:func:`design_qft`'s default). ``"notch"``: the fixed-structure design against the
+        notch specification and a DEL target (``design_qft(spec="notch")``).
     progress : bool
         Show a progress bar over the wind speeds (tqdm.auto: a widget in Jupyter).
     **kwargs
@@ -702,12 +741,7 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     out = []
     for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
                       disable=not progress):
-        if specification == "target":
-            from ..feasibility import specification_for_target
-
-            out.append(design_qft(model, float(v), spec=specification_for_target(model, float(v), float(tr)), **kwargs))
-        else:
-            out.append(design_qft(model, float(v), float(tr), **kwargs))
+        out.append(design_qft(model, float(v), float(tr), spec=specification, **kwargs))
     return tuple(out)
 
 
