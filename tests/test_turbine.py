@@ -199,10 +199,14 @@ def test_rosco_baseline_sign_and_stability(model):
 
 
 def test_validity_range_errors(model):
-    for v in (8.0, 10.9, 26.0):
+    for v in (2.0, 26.0):  # outside cut-in to cut-out (below rated: tests/test_below_rated.py)
         with pytest.raises(ValueError, match="wind_speed"):
             model.linearize(v)
-    wide = dataclasses.replace(model, wind_range=(3.0, 25.0))
+    bare = dataclasses.replace(model, torque_control=None)  # no torque law: the pitch-regulated range only
+    for v in (8.0, 10.9, 26.0):
+        with pytest.raises(ValueError, match="wind_speed"):
+            bare.linearize(v)
+    wide = dataclasses.replace(bare, wind_range=(3.0, 25.0))
     with pytest.raises(ValueError, match="below rated"):
         wide.trim(8.0)
     with pytest.raises(ValueError, match="x must be"):

@@ -6,6 +6,10 @@ schedules read from DISCON.IN files and the compiled ROSCO controller itself.
   :func:`speed_filter`, :func:`rosco_baseline`, :func:`rosco_scheduled`).
 - :mod:`specdesign.rosco.discon_file`: a DISCON.IN file read as the schedule
   :func:`rosco_scheduled` runs (:func:`from_discon`, :class:`DisconSchedule`).
+- :mod:`specdesign.rosco.torque`: ROSCO's generator-torque controller below rated
+  (:class:`TorqueLaw`, :func:`torque_law`, :func:`torque_law_from_discon`, its steady state
+  :func:`steady_state` and linearisation :func:`close_torque_loop`, the compiled
+  :func:`torque_step` the simulator runs).
 - :mod:`specdesign.rosco.discon`: ROSCO's compiled DISCON library (from the ``rosco``
   package, optional extra ``specdesign[rosco]``) as a controller of
   :func:`specdesign.simulate.simulate` (:class:`Discon`).
@@ -26,6 +30,16 @@ from .baseline import (
 )
 from .discon import Discon, DisconError, rosco_library, rosco_test_cases
 from .discon_file import DisconEntry, DisconSchedule, from_discon, iea15mw_discon, read_discon
+from .torque import (
+    TORQUE_MODES,
+    TORQUE_REGIONS,
+    TorqueLaw,
+    close_torque_loop,
+    steady_state,
+    torque_law,
+    torque_law_from_discon,
+    torque_step,
+)
 
 __all__ = [
     "RoscoSchedule",
@@ -43,4 +57,12 @@ __all__ = [
     "DisconError",
     "rosco_library",
     "rosco_test_cases",
+    "TORQUE_MODES",
+    "TORQUE_REGIONS",
+    "TorqueLaw",
+    "torque_law",
+    "torque_law_from_discon",
+    "steady_state",
+    "close_torque_loop",
+    "torque_step",
 ]

@@ -76,6 +76,11 @@ class KernelPlant:
     output_limits : dict, optional
         Output name → largest physically possible |y| (SI); a run whose output leaves it, or
         turns non-finite, has diverged and :func:`simulate` raises.
+    torque_law : specdesign.rosco.TorqueLaw, optional
+        The generator-torque controller below rated (``torque_control`` of :func:`simulate`);
+        the plant then needs outputs ``power`` (W) and ``pitch`` (rad).
+    rated_wind_speed : float, optional
+        Wind speed (m/s) below which ``torque_control="auto"`` runs ``torque_law``.
     """
 
     rhs: object
@@ -88,6 +93,8 @@ class KernelPlant:
     name: str = "plant"
     pitch_limits: tuple | None = None
     output_limits: dict = field(default_factory=dict)
+    torque_law: object = None
+    rated_wind_speed: float | None = None
 
     def index(self, name: str) -> int:
         """Position of output ``name`` in ``output_names``.
@@ -158,6 +165,8 @@ def turbine_plant(model: TurbineModel | KernelPlant | None = None) -> KernelPlan
         # of 10 m of tower-top deflection is far past the tower's strength
         output_limits={"gen_speed": 2.0 * float(model.rated_rotor_speed),
                        "tower_base_my": 10.0 * float(model.tower_base_moment_per_m)},
+        torque_law=getattr(model, "torque_control", None),
+        rated_wind_speed=None if getattr(model, "torque_control", None) is None else float(model.rated_wind_speed()),
     )
 
 
@@ -214,7 +223,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
              seeds: ArrayLike | None = None, wind: ArrayLike | None = None, duration: float = 600.0, dt: float = 0.02,
              record_dt: float = 0.1, transient: float = 60.0, wind_dt: float | None = None,
              turbulence_class: str = "B", linear: bool = False, wind_rotor_radius: float | None = None,
-             wind_mean_tol: float = WIND_MEAN_TOLERANCE) -> SimulationResult:
+             wind_mean_tol: float = WIND_MEAN_TOLERANCE, torque_control: object = "auto") -> SimulationResult:
     """Simulate the closed loop for every (wind speed, seed), all runs batched.
 
     Parameters
@@ -253,6 +262,13 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     wind_mean_tol : float, optional
         Largest |mean of a given wind record − its wind speed| (m/s) (default
         :data:`WIND_MEAN_TOLERANCE`).
+    torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, optional
+        Generator torque of the compiled loop (see :mod:`specdesign.simulate`): "auto" runs
+        the plant's torque law (the model's ``torque_control``) in the runs below rated and
+        holds the trim torque above; "rosco" runs it in every run; a TorqueLaw runs that one
+        in every run; None holds the trim torque everywhere. Ignored with ``linear=True``
+        (the linearisation closes the law below rated) and for a callable controller (it
+        commands the torque itself, or holds the trim torque).
 
     Returns
     -------
@@ -363,6 +379,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     i_speed, i_vel = plant.index("gen_speed"), plant.index("tower_top_vel")
 
     check_step(plant, vs, dt)
+    TQ, above = _torque_params(plant, torque_control, vs, S, linear)
     trims = [plant.trim(v) for v in vs]
     beta0 = np.repeat([t[1] for t in trims], S)
     torque = np.repeat([t[2] for t in trims], S)
@@ -395,12 +412,16 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
 
     if callable(controller) and not is_lti_like(controller) and not isinstance(controller, ScheduledController):
         label = getattr(controller, "__name__", "callable")
+        if torque_control == "rosco" or TQ[:, 0].any() and torque_control != "auto":
+            raise ValueError("a callable controller commands the generator torque itself (or holds the trim torque): "
+                             "torque_control must be 'auto' or None with it")
         run_callable(controller, step_all, outputs_all, kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y,
                       plant.output_names, lim_idx, lim_val, status)
         _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
     else:
         label = getattr(controller, "name", "controller")
-        warn_unstable(plant, controller, vs, dt)
+        # below rated the pitch loop is open (its PI sits at the minimum pitch): not checked there
+        warn_unstable(plant, controller, vs[above], dt)
         sched_pitch, mats, fw, pi = controller_bank(controller, dt)
         K = sched_pitch.size
         nc = max(1, max(m[0].shape[0] for m in mats))
@@ -425,7 +446,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
                   beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on,
                   *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim, cmd_lim)),
-                  lim_idx, lim_val, Rq, Ns, status)
+                  lim_idx, lim_val, Rq, Ns, status, TQ, *_torque_outputs(plant, TQ))
     _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
 
     skip = int(round(transient / record_dt))
@@ -440,6 +461,40 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         time=idx_t - idx_t[0], wind_speeds=vs, seeds=seeds, outputs=outs, dt=record_dt, sim_dt=dt,
         linear=linear, controller=str(label),
     )
+
+
+def _torque_params(plant, torque_control, vs, S, linear):
+    """(R, TORQUE_PARAMS) torque-law parameters per run (mode 0: torque held) and the mask of
+    wind speeds where the pitch loop is active (not below rated under the torque law)."""
+    from ..rosco.torque import TORQUE_PARAMS, TorqueLaw
+
+    rated = plant.rated_wind_speed
+    above = np.ones(vs.size, dtype=bool) if rated is None else vs >= rated
+    on = np.zeros(vs.size, dtype=bool)
+    law = plant.torque_law
+    if isinstance(torque_control, TorqueLaw):
+        law, on[:] = torque_control, True
+    elif torque_control == "rosco":
+        if law is None:
+            raise ValueError("torque_control='rosco' needs a plant with a torque law (a TurbineModel with "
+                             "torque_control, e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw instead")
+        on[:] = True
+    elif torque_control == "auto":
+        on = ~above if law is not None else on
+    elif torque_control is not None:
+        raise ValueError(f"torque_control={torque_control!r} must be 'auto', 'rosco', None or a specdesign.rosco.TorqueLaw")
+    if linear:
+        on[:] = False
+    TQ = np.zeros((vs.size * S, TORQUE_PARAMS))
+    if on.any():
+        TQ[np.repeat(on, S)] = law.params()
+    return TQ, above
+
+
+def _torque_outputs(plant, TQ):
+    if not TQ[:, 0].any():
+        return 0, 0
+    return plant.index("power"), plant.index("pitch")
 
 
 def _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, label, linear):

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:  # pragma: no cover
     import control
 
+from ..rosco.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
 from ..turbine import outputs as _turbine_outputs
 from ..turbine import rhs as _turbine_rhs
 
@@ -199,9 +200,10 @@ NONFINITE = 63
 @njit(cache=True)
 def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
              beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
-             cmd_lim, lim_idx, lim_val, Rq, Ns):
+             cmd_lim, lim_idx, lim_val, Rq, Ns, tq, i_power, i_pitch):
     """One run; returns −1, or 64·step + code at the first step where it diverged (code: the
-    index of the output limit exceeded, or NONFINITE)."""
+    index of the output limit exceeded, or NONFINITE). ``tq``: the torque law's parameters
+    (mode 0: the torque held at ``torque``)."""
     nx = x.size
     nc = Ad.shape[1]
     nf = Af.shape[0]
@@ -236,6 +238,9 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
     fu2 = beta0
     fy1 = beta0
     fy2 = beta0
+    tq_on = tq[T_MODE] != 0.0
+    tst = np.zeros(TORQUE_STATES)
+    tst[S_TQ] = torque  # the torque law's last command: the trim torque, as ROSCO measures it at start
     j = 0
     for k in range(nsteps):
         t = k * dt
@@ -252,7 +257,11 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
             Yr[ny, j] = bcmd
             j += 1
         # Both loops feed back with a minus sign: β = −C_β·ΔΩ_g − C_atd·ẋ_top.
-        e = -(y[i_speed] - omega_ref)
+        if tq_on:  # ROSCO's torque law; its setpoint smoother moves the pitch reference
+            torque, wref = torque_step(tq, tst, y[i_speed], y[i_power], y[i_pitch], dt, k == 0)
+            e = -(y[i_speed] - wref)
+        else:
+            e = -(y[i_speed] - omega_ref)
         v = -y[i_vel]
         slow = False
         for q in range(K):
@@ -355,7 +364,7 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
 @njit(cache=True, parallel=True)
 def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
                beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
-               cmd_lim, lim_idx, lim_val, Rq, Ns, status):
+               cmd_lim, lim_idx, lim_val, Rq, Ns, status, TQ, i_power, i_pitch):
     """All runs, one per prange iteration; the controller bank is shared by the batch.
     ``status[r]``: −1, or where run r diverged (see :func:`_run_one`)."""
     K = sched_pitch.size
@@ -363,7 +372,7 @@ def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched
         x = X0[r].copy()
         status[r] = _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
                              beta0[r], omega_ref[r], torque[r], sfilt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf,
-                             Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq, Ns)
+                             Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq, Ns, TQ[r], i_power, i_pitch)
 
 
 @njit(cache=True)

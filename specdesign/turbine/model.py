@@ -113,7 +113,14 @@ class TurbineModel:
     ct_table : numpy.ndarray
         (n_tsr, n_pitch) thrust coefficients (-).
     wind_range : tuple of float, optional
-        (low, high) mean wind speeds (m/s) where the above-rated model is valid.
+        (low, high) mean wind speeds (m/s) of the pitch-regulated design range (above rated):
+        :meth:`check_wind_speed` and the design tools keep to it.
+    operating_range : tuple of float, optional
+        (cut-in, cut-out) mean wind speeds (m/s) where :meth:`trim` and :meth:`linearize`
+        hold when the model has a ``torque_control``.
+    torque_control : specdesign.rosco.TorqueLaw, optional
+        The generator-torque controller below rated (ROSCO's law); without one the model is
+        the constant-torque, pitch-regulated model of ``wind_range`` only.
     """
 
     name: str
@@ -138,6 +145,8 @@ class TurbineModel:
     cp_table: np.ndarray = field(repr=False)
     ct_table: np.ndarray = field(repr=False)
     wind_range: tuple = (11.0, 25.0)
+    operating_range: tuple = (3.0, 25.0)
+    torque_control: object = None
 
     state_names = STATE_NAMES
     input_names = INPUT_NAMES
@@ -307,16 +316,33 @@ class TurbineModel:
         x = np.array([omega, 0.0, 0.0, pitch, 0.0])
         return self.derivatives(x, wind, pitch, 0.0)[0] * self.drivetrain_inertia
 
-    def trim(self, wind_speed: float) -> OperatingPoint:
-        """Steady operating point above rated.
+    def _operating_speed(self, wind_speed):
+        """The wind speed checked against ``operating_range`` (with a torque law) or ``wind_range``."""
+        if self.torque_control is None:
+            return self.check_wind_speed(wind_speed)
+        v = positive_scalar(wind_speed, "wind_speed")
+        lo, hi = self.operating_range
+        if not lo <= v <= hi:
+            raise ValueError(f"wind_speed={v!r} m/s is outside the operating range {lo}-{hi} m/s (cut-in to cut-out)")
+        return v
 
-        Rated rotor speed, rated generator torque, the pitch that balances aerodynamic and
-        generator torque, tower at static deflection.
+    @cached_property
+    def _rated_v(self) -> float:
+        return self.rated_wind_speed()
+
+    def trim(self, wind_speed: float) -> OperatingPoint:
+        """Steady operating point: above rated pitch-regulated, below rated under the torque law.
+
+        Above rated (``region`` "3"): rated rotor speed, rated generator torque, the pitch that
+        balances aerodynamic and generator torque, tower at static deflection. Below rated
+        (a model with ``torque_control``, from cut-in): fine pitch and the rotor speed and torque
+        the torque law holds (:func:`specdesign.rosco.steady_state`; regions "1.5", "2",
+        "2.5", "2.5s").
 
         Parameters
         ----------
         wind_speed : float
-            Mean wind speed (m/s), within ``wind_range``.
+            Mean wind speed (m/s), within ``operating_range`` (with a torque law) or ``wind_range``.
 
         Returns
         -------
@@ -326,18 +352,22 @@ class TurbineModel:
         Raises
         ------
         ValueError
-            Outside ``wind_range`` or when the wind is below rated (no pitch ≥ ``pitch_min``
-            balances the torque).
+            Outside the range, or below rated for a model without ``torque_control`` (no
+            pitch ≥ ``pitch_min`` balances the torque).
 
         Examples
         --------
         >>> op = iea15mw().trim(19.0)
         >>> bool(0.2 < op.pitch < 0.3)
         True
+        >>> iea15mw().trim(8.0).region
+        '2'
         """
         from scipy.optimize import brentq
 
-        v = self.check_wind_speed(wind_speed)
+        v = self._operating_speed(wind_speed)
+        if self.torque_control is not None and v < self._rated_v:
+            return self._trim_below(v)
         omega = self.rated_rotor_speed
         torque = self.rated_generator_torque
 
@@ -378,6 +408,21 @@ class TurbineModel:
             tsr=float(tsr),
             cp=cp,
             ct=ct,
+        )
+
+    def _trim_below(self, v):
+        from ..rosco.torque import steady_state
+
+        omega, torque, beta, region = steady_state(self, self.torque_control, v)
+        tsr = omega * self.rotor_radius / v
+        cp, ct = (float(c) for c in self.rotor_coefficients(tsr, beta))
+        thrust = 0.5 * self.air_density * np.pi * self.rotor_radius**2 * v**2 * ct
+        x = np.array([omega, thrust / self.tower_modal_stiffness, 0.0, beta, 0.0])
+        x.flags.writeable = False
+        return OperatingPoint(
+            wind_speed=v, rotor_speed=omega, pitch=float(beta), gen_torque=float(torque), x=x, thrust=float(thrust),
+            aero_power=float(self._aero_torque(v, omega, beta) * omega),
+            power=float(self.generator_efficiency * torque * omega), tsr=float(tsr), cp=cp, ct=ct, region=region,
         )
 
     def jacobians(self, op: OperatingPoint) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -440,10 +485,17 @@ class TurbineModel:
         :data:`OUTPUT_NAMES` (SI) and states :data:`STATE_NAMES`, all deviations from the trim.
         Index it by name: ``sys['gen_speed', 'wind']``.
 
+        Below rated (a model with ``torque_control``) the torque loop is closed
+        (:func:`specdesign.rosco.close_torque_loop`): the law's dT/dΩ enters A (region 2:
+        2KΩ; regions 1.5 and 2.5: the transition PI, its integral an extra state
+        ``torque_pi``), and ``gen_torque`` is a torque added to the law's. The pitch loop is
+        open there: ROSCO's pitch PI sits at its minimum below rated.
+
         Parameters
         ----------
         wind_speed : float
-            Mean wind speed (m/s), within ``wind_range`` (11-25).
+            Mean wind speed (m/s), within ``wind_range`` (11-25), or from cut-in to cut-out
+            (``operating_range``) with a torque law.
         load_inputs : bool, optional
             Also take :data:`LOAD_INPUT_NAMES`, disturbances added to the aerodynamic torque
             (N·m) and thrust (N): the inputs through which the higher-order aerodynamic terms
@@ -457,25 +509,33 @@ class TurbineModel:
         Raises
         ------
         ValueError
-            Outside ``wind_range``.
+            Outside the range (see :meth:`trim`).
 
         Examples
         --------
         >>> iea15mw().linearize(19.0).nstates
         5
+        >>> iea15mw().linearize(5.0).nstates  # region 1.5: the torque PI's integral, a 6th state
+        6
         """
         import control
 
         op = self.trim(wind_speed)
         A, B, C, D = self.jacobians(op)
-        inputs = list(INPUT_NAMES)
+        inputs, states = list(INPUT_NAMES), list(STATE_NAMES)
+        if op.region != "3":
+            from ..rosco.torque import close_torque_loop
+
+            A, B, C, D, extra = close_torque_loop(A, B, C, D, self.torque_control, op.rotor_speed, op.region)
+            states += extra
         if load_inputs:
             BL, DL = self._load_jacobians(op)
+            BL = np.vstack([BL, np.zeros((len(states) - BL.shape[0], BL.shape[1]))])
             B, D = np.hstack([B, BL]), np.hstack([D, DL])
             inputs += list(LOAD_INPUT_NAMES)
         return control.ss(
             A, B, C, D,
-            inputs=inputs, outputs=list(OUTPUT_NAMES), states=list(STATE_NAMES),
+            inputs=inputs, outputs=list(OUTPUT_NAMES), states=states,
             name=f"{self.name}@{op.wind_speed:g}mps".replace(".", "p"),
         )
 
@@ -561,7 +621,10 @@ def iea15mw() -> TurbineModel:
 
     Tower: first fore-aft mode of the finite-element model with gravity (modal mass and
     stiffness, 1.081 rad/s), 1 % damping, tower-base moment at z = 15 m per metre of
-    tower-top deflection. Generator efficiency 0.95756 (electrical power = η·T·Ω).
+    tower-top deflection. Generator efficiency 0.95756 (electrical power = η·T·Ω). Below
+    rated, ROSCO's torque law (``VS_ControlMode`` 1) tuned on this model
+    (:func:`specdesign.rosco.torque_law`: minimum speed 0.5236 rad/s, ω_vs = 0.12 rad/s,
+    ζ_vs = 0.85): trim and linearisation from cut-in (3 m/s) to cut-out (25 m/s).
 
     Returns
     -------
@@ -573,9 +636,13 @@ def iea15mw() -> TurbineModel:
     >>> iea15mw().name
     'IEA-15-240-RWT'
     """
+    import dataclasses
+
+    from ..rosco.torque import torque_law
+
     par = json.loads(read_text("parameters.json"))
     tsr, pitch_deg, cp, ct = read_rotor_table()
-    return TurbineModel(
+    model = TurbineModel(
         name="IEA-15-240-RWT",
         air_density=par["air_density_kg_m3"],
         rotor_radius=par["rotor_radius_m"],
@@ -598,3 +665,7 @@ def iea15mw() -> TurbineModel:
         cp_table=cp,
         ct_table=ct,
     )
+    law = torque_law(model, min_speed=par["min_rotor_speed_rad_s"], max_torque=par["max_generator_torque_Nm"],
+                     max_rate=par["max_generator_torque_rate_Nm_s"], omega_vs=par["rosco_tuning"]["omega_vs_rad_s"],
+                     zeta_vs=par["rosco_tuning"]["zeta_vs"])
+    return dataclasses.replace(model, torque_control=law)

@@ -44,6 +44,9 @@ class OperatingPoint:
         Power coefficient (-).
     ct : float
         Thrust coefficient (-).
+    region : str, optional
+        Control region: "3" above rated (pitch-regulated), below rated one of
+        :data:`specdesign.rosco.TORQUE_REGIONS` ("1.5", "2", "2.5", "2.5s").
     """
 
     wind_speed: float
@@ -57,6 +60,7 @@ class OperatingPoint:
     tsr: float
     cp: float
     ct: float
+    region: str = "3"
 
     @property
     def u(self) -> np.ndarray:
