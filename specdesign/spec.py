@@ -46,6 +46,8 @@ __all__ = [
     "Baseline",
     "Promise",
     "ShapingResult",
+    "baseline_controller",
+    "baseline_controllers",
     "baseline_analysis",
     "baseline_from_response",
     "promise_of",
@@ -725,6 +727,72 @@ def default_omega(n: int = 400, lo: float = 0.01, hi: float = 10.0) -> np.ndarra
     return np.logspace(np.log10(lo), np.log10(hi), n)
 
 
+def baseline_controller(model, wind_speed: float) -> ct.LTI:
+    """The baseline pitch controller C_β of ``model`` at ``wind_speed`` (ROSCO's PI, tower damping off).
+
+    A model that carries its own baseline (a :class:`specdesign.openfast.LinearTurbine`:
+    ROSCO's pole placement on its linearisations) gives it through its
+    ``baseline_controller(wind_speed)``; a :class:`specdesign.turbine.TurbineModel` gets
+    :func:`specdesign.rosco.rosco_baseline`.
+
+    Parameters
+    ----------
+    model : TurbineModel or LinearTurbine
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+
+    Returns
+    -------
+    control.LTI
+        C_β from ``gen_speed`` (rad/s) to ``pitch_cmd`` (rad), β = −C_β·Ω_g.
+
+    Examples
+    --------
+    >>> from specdesign.spec import baseline_controller
+    >>> from specdesign.turbine import iea15mw
+    >>> baseline_controller(iea15mw(), 19.0).name
+    'ROSCO_PI@19mps'
+    """
+    own = getattr(model, "baseline_controller", None)
+    if callable(own):
+        return own(wind_speed)
+    from . import turbine
+
+    return turbine.rosco_baseline(model, wind_speed)
+
+
+def baseline_controllers(model, wind_speeds: Sequence[float]) -> list:
+    """:func:`baseline_controller` at several wind speeds, ROSCO's schedule fitted once.
+
+    Parameters
+    ----------
+    model : TurbineModel or LinearTurbine
+        The turbine.
+    wind_speeds : sequence of float
+        Operating points, m/s.
+
+    Returns
+    -------
+    list of control.LTI
+        One C_β per speed, as :func:`baseline_controller` gives it (for a TurbineModel
+        :func:`specdesign.rosco.rosco_baseline` on one :func:`specdesign.rosco.rosco_gain_schedule`).
+
+    Examples
+    --------
+    >>> from specdesign.spec import baseline_controllers
+    >>> from specdesign.turbine import iea15mw
+    >>> [c.name for c in baseline_controllers(iea15mw(), (17.0, 19.0))]
+    ['ROSCO_PI@17mps', 'ROSCO_PI@19mps']
+    """
+    if callable(getattr(model, "baseline_controller", None)):
+        return [model.baseline_controller(float(v)) for v in wind_speeds]
+    from .rosco import rosco_baseline, rosco_gain_schedule
+
+    schedule = rosco_gain_schedule(model)  # once for every speed (the same fit each call would redo)
+    return [rosco_baseline(model, float(v), schedule=schedule) for v in wind_speeds]
+
+
 def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tower_base_my", *, m: float = 4.0,
                       omega: ArrayLike | None = None, controller: ct.LTI | None = None, turbulence_class: str = "B",
                       method: str = "dirlik", reduction: float = 0.01) -> Baseline:
@@ -735,8 +803,9 @@ def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tow
 
     Parameters
     ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine (its ``linearize`` and ``rotor_radius``).
+    model : specdesign.turbine.TurbineModel or specdesign.openfast.LinearTurbine
+        The turbine (its ``linearize`` and ``rotor_radius``; the baseline of
+        :func:`baseline_controller`).
     wind_speed : float
         Operating point, m/s.
     output : str
@@ -747,7 +816,7 @@ def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tow
         Frequency grid, rad/s, positive (default :func:`default_omega`: 400 points, 0.01-10).
     controller : control.LTI, optional
         Pitch controller C_β (rad per rad/s, β = −C_β·Ω_g); default ROSCO's PI
-        (:func:`specdesign.rosco.rosco_baseline`).
+        (:func:`baseline_controller`).
     turbulence_class : str
         IEC turbulence class of the wind spectrum ("A", "B", "C", ...).
     method : str
@@ -775,11 +844,11 @@ def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tow
     >>> print(f"{base.output}: DEL {base.del_1hz / 1e6:.1f} MN·m, ΣΔD% = {base.sensitivity.sum():.2f}")
     tower_base_my: DEL 32.2 MN·m, ΣΔD% = 2.00
     """
-    from . import closedloop, turbine, wind
+    from . import closedloop, wind
 
     omega = default_omega() if omega is None else as_omega(omega, allow_zero=False)
     plant = model.linearize(wind_speed)
-    c = turbine.rosco_baseline(model, wind_speed) if controller is None else controller
+    c = baseline_controller(model, wind_speed) if controller is None else controller
     cl = closedloop.closed_loop(plant, c)
     t_sys = cl[output, "wind"]
     t = closedloop.frequency_response(cl, omega, output, "wind")
@@ -1091,10 +1160,10 @@ def speed_specification(model: TurbineModel, wind_speed: float, *, margin_db: fl
     >>> speed_specification(iea15mw(), 19.0, margin_db=3.0).elements
     (Gain(gain_db=3.0),)
     """
-    from . import closedloop, turbine
+    from . import closedloop
 
     plant = model.linearize(wind_speed)
-    c = turbine.rosco_baseline(model, wind_speed) if controller is None else controller
+    c = baseline_controller(model, wind_speed) if controller is None else controller
     cl = closedloop.closed_loop(plant, c)
     elements = (Gain(float(margin_db)),) if margin_db else ()
     return Specification(cl["gen_speed", "wind"], elements, name="W_gen_speed")

@@ -3,6 +3,8 @@
 - :func:`read_linearization` (``.lin`` files → azimuth-averaged, MBC-transformed named LTI)
 - :func:`read_outputs` (``.out`` / ``.outb`` → named channels with units)
 - :func:`series_from_openfast` (outputs → the workbench's SI series, :data:`OPENFAST_CHANNELS`)
+- :class:`LinearTurbine` (``.lin`` sets at several wind speeds → a model the design loop takes;
+  signals by channel description, :data:`DEFAULT_SIGNALS`, :func:`plant_from_linearization`)
 """
 from __future__ import annotations
 
@@ -13,6 +15,12 @@ _LAZY = {
     "OpenFASTOutput": ".outputs",
     "series_from_openfast": ".series",
     "OPENFAST_CHANNELS": ".series",
+    "LinearTurbine": ".linear_turbine",
+    "LinearOperatingPoint": ".linear_turbine",
+    "RotorModelSchedule": ".linear_turbine",
+    "rotor_speed_model": ".linear_turbine",
+    "DEFAULT_SIGNALS": ".signals",
+    "plant_from_linearization": ".signals",
 }
 
 __all__ = list(_LAZY)

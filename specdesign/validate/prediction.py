@@ -10,7 +10,29 @@ from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind, unstable_message, unstable_poles
 from ._loop import rotor_radius
 
-__all__ = ["closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction"]
+__all__ = ["loop_plant", "closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction"]
+
+
+def loop_plant(model):
+    """The plant whose linearised loop :mod:`specdesign.closedloop` analyses.
+
+    A model that provides its own (``kernel_plant()``: a :class:`specdesign.openfast.LinearTurbine`)
+    gives it; anything else goes through :func:`specdesign.simulate.turbine_plant`.
+
+    Parameters
+    ----------
+    model : TurbineModel, KernelPlant, LinearTurbine or None
+        The turbine (None: the embedded IEA 15 MW).
+
+    Returns
+    -------
+    KernelPlant
+        The plant.
+    """
+    from ..simulate import turbine_plant
+
+    own = getattr(model, "kernel_plant", None)
+    return own() if callable(own) else turbine_plant(model)
 
 
 def closed_loop_response(model, controller, wind_speed: float, omega, output: str = "tower_base_my") -> np.ndarray:
@@ -22,8 +44,8 @@ def closed_loop_response(model, controller, wind_speed: float, omega, output: st
 
     Parameters
     ----------
-    model : TurbineModel or KernelPlant
-        The plant (:func:`specdesign.simulate.turbine_plant` accepts it).
+    model : TurbineModel, KernelPlant or LinearTurbine
+        The plant (:func:`loop_plant`).
     controller : LTI, Controller or ScheduledController
         Any controller with a linear form the simulator runs.
     wind_speed : float
@@ -38,16 +60,14 @@ def closed_loop_response(model, controller, wind_speed: float, omega, output: st
     numpy.ndarray
         Complex response (output SI unit per m/s), shaped like ``omega``.
     """
-    from ..simulate import turbine_plant
-
     w = np.asarray(omega, dtype=float)
-    plant = turbine_plant(model)
+    plant = loop_plant(model)
     G = np.asarray(plant.linearize(wind_speed)(1j * w))  # (ny, nu, nw), inputs wind, pitch_cmd, gen_torque
     names = list(plant.output_names)
     # by position: a user KernelPlant's linearisation need not carry signal names
     P = {(o, u): G[names.index(o), j] for o in {output, "gen_speed", "tower_top_vel"}
          for j, u in enumerate(("wind", "pitch_cmd"))}
-    cb, ca = local_response(model, controller, wind_speed, 1j * w)
+    cb, ca = local_response(plant, controller, wind_speed, 1j * w)
     return t_output_wind(P, cb, w, output, atd_controller=ca, atd_measurement="tower_top_vel")
 
 
@@ -110,8 +130,9 @@ def linear_prediction(model, controller, wind_speed: float, *, output: str = "to
 
     Parameters
     ----------
-    model : TurbineModel
-        The turbine (its rotor radius sets the rotor-effective wind spectrum).
+    model : TurbineModel or LinearTurbine
+        The turbine (its rotor radius sets the rotor-effective wind spectrum; the loop is
+        that of :func:`loop_plant`).
     controller : LTI, Controller or ScheduledController
         Any controller with a linear form (:func:`closed_loop_response`).
     wind_speed : float
@@ -140,7 +161,7 @@ def linear_prediction(model, controller, wind_speed: float, *, output: str = "to
     """
     from .. import spectral, wind
 
-    bad = unstable_poles(model, controller, wind_speed)
+    bad = unstable_poles(loop_plant(model), controller, wind_speed)
     if bad.size:
         raise ValueError(unstable_message(controller, wind_speed, bad) + "; a linear prediction of an unstable loop is meaningless")
     w = prediction_grid() if omega is None else np.asarray(omega, dtype=float)

@@ -14,7 +14,7 @@ import numpy as np
 from .campaign import Campaign
 from .stats import WEIBULL_A, WEIBULL_K, paired_change, pool, resampled_se, weibull_weights
 
-__all__ = ["Table", "table2", "table3", "Acceptance", "acceptance"]
+__all__ = ["Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance"]
 
 _LABELS = {
     "gen_speed_sd": "Generator speed SD",
@@ -395,3 +395,82 @@ def table3(campaign: Campaign, designed: str, baseline: str, *, promised: Mappin
         row_fmt=tuple(pp),
         marks=_unstable_marks(campaign, designed, baseline),
     )
+
+
+def _at(controller, v, what):
+    if isinstance(controller, Mapping):
+        hit = [c for k, c in controller.items() if math.isclose(float(k), v, rel_tol=1e-9)]
+        if not hit:
+            raise ValueError(f"{what} has no controller for {v:g} m/s (its speeds: {sorted(float(k) for k in controller)})")
+        return hit[0]
+    return controller
+
+
+def linear_table3(model, designed, wind_speeds, *, baseline=None, promised: Mapping | None = None, m: float = 4.0,
+                  turbulence_class: str = "B", name: str = "designed") -> Table:
+    """The linear rows of the paper's Table 3, without simulation: promised and predicted DEL reduction.
+
+    For any model the design loop takes, a :class:`specdesign.openfast.LinearTurbine` too:
+    the reduction of the tower-base DEL that :func:`~specdesign.validate.linear_prediction`
+    (Dirlik on |T|²S_W) predicts for ``designed`` against ``baseline``, per wind speed, and
+    the specification's promise when given. The rainflow rows need simulations
+    (:func:`table3` on a :func:`~specdesign.validate.run_campaign`).
+
+    Parameters
+    ----------
+    model : TurbineModel or LinearTurbine
+        The turbine.
+    designed : controller or mapping
+        A controller with a linear form, or wind speed (m/s) → controller (one design per speed).
+    wind_speeds : sequence of float
+        Columns (m/s).
+    baseline : controller or mapping, optional
+        Default the model's baseline (:func:`specdesign.spec.baseline_controller`).
+    promised : mapping, optional
+        Wind speed (m/s) → promised DEL reduction (%).
+    m : float, default 4.0
+        Wöhler exponent of the DEL (-).
+    turbulence_class : {"A", "B", "C"}, default "B"
+        IEC NTM class of the wind spectrum.
+    name : str, default "designed"
+        The designed controller's name in the title.
+
+    Returns
+    -------
+    Table
+        Rows "Specification" (when ``promised``) and "Linear prediction" (%), Mean column.
+
+    Raises
+    ------
+    ValueError
+        A speed without a controller in a mapping, or a controller that destabilises the loop.
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> from specdesign.rosco import rosco_baseline
+    >>> model = iea15mw()
+    >>> t = linear_table3(model, rosco_baseline(model, 19.0), [19.0])   # the baseline against itself
+    >>> float(t.values()[0, 0])
+    0.0
+    """
+    from ..spec import baseline_controller
+    from .prediction import linear_prediction
+
+    vs = [float(v) for v in np.atleast_1d(np.asarray(wind_speeds, float))]
+    pred = []
+    for v in vs:
+        c0 = baseline_controller(model, v) if baseline is None else _at(baseline, v, "baseline")
+        d1 = linear_prediction(model, _at(designed, v, "designed"), v, m=m, turbulence_class=turbulence_class).del_
+        d0 = linear_prediction(model, c0, v, m=m, turbulence_class=turbulence_class).del_
+        pred.append(100.0 * (1.0 - d1 / d0))
+    rows = []
+    if promised is not None:
+        prom = {float(k): float(x) for k, x in promised.items()}
+        vals = [prom.get(v, float("nan")) for v in vs]
+        rows.append(("Specification", tuple(vals) + (float(np.mean(vals)),)))
+    rows.append(("Linear prediction", tuple(pred) + (float(np.mean(pred)),)))
+    return Table(title=f"Table 3 (linear rows): tower-base DEL reduction, {name} vs baseline, "
+                       f"{getattr(model, 'name', 'model')}",
+                 columns=_speed_columns(vs), rows=tuple(rows),
+                 note=f"Linear prediction by Dirlik on |T|²S_W (IEC class {turbulence_class}), m = {m:g}, 1 Hz.")
