@@ -147,3 +147,140 @@ def test_quadratic_mpc_bad_input(model):
         QuadraticMPC(model, measured=("rotor_azimuth",)).point(19.0)
     with pytest.raises(RuntimeError, match="start"):
         QuadraticMPC(model)(0.0, {})
+
+
+def test_controllers_pickle_and_run_through_a_campaign(model):
+    import pickle
+
+    from specdesign.validate import run_campaign
+
+    mpc = QuadraticMPC(model)
+    before = pickle.dumps(mpc)
+    camp = run_campaign({"qmpc": mpc, "rosco": rosco_baseline(model, 19.0)}, [19.0], [5, 6], model=model,
+                        duration=60.0, transient=10.0, predict=False)
+    # the same bytes after use (caches and timings are not state): a campaign store's
+    # fingerprint of the controller does not change by running it
+    assert pickle.dumps(mpc) == before
+    again = pickle.loads(before)
+    assert again.weights == mpc.weights and again.solve_times == []
+    sd = camp.values["gen_speed_sd"]  # (controller, speed, seed)
+    assert np.all(np.isfinite(sd)) and np.all(sd[0] <= sd[1])
+
+
+# ----------------------------------------------------------------------------- economic cost (Eq. 4)
+from specdesign.fatigue import VarianceDamageFit, fit_variance_damage  # noqa: E402
+from specdesign.mpc import (ClonedController, CloningRegressor, EconomicMPC, FatigueTerm, OpenLoopPlayback,  # noqa: E402
+                            clone, demonstrations, discretize_turbine, economic_open_loop, economic_problem,
+                            fit_fatigue_terms, surrogate_cost)
+from specdesign.wind import wind_series  # noqa: E402
+
+
+def test_surrogate_cost_is_equation_4_evaluated_directly():
+    rng = np.random.default_rng(1)
+    recs = [s * rng.standard_normal(3000) for s in (1e6, 2e6, 5e6)]
+    fit = fit_variance_damage(recs, 4.0, ultimate=3e7)
+    blade = VarianceDamageFit(4.9, 12.6, 10.0, 2e7, 0.0)
+    terms = [FatigueTerm("tower_base_my", fit, 2.0, 4e12), FatigueTerm("blade_root_my", blade, 0.5, 1e12)]
+    y = {"tower_base_my": rng.standard_normal((3, 400)) * 2e6, "blade_root_my": rng.standard_normal((3, 400)) * 1e6}
+    # Eq. 4 term by term: π e^b / L_ult^m · Var^a, Var by Eq. 2 (1/N Σz² − (1/N Σz)²)
+    direct = sum(t.price * np.exp(t.fit.b) / t.fit.ultimate ** t.fit.m
+                 * (np.mean(y[t.output] ** 2, -1) - np.mean(y[t.output], -1) ** 2) ** t.fit.a for t in terms)
+    np.testing.assert_allclose(surrogate_cost(terms, y), direct, rtol=1e-9)
+    with pytest.raises(ValueError, match="priced outputs"):
+        surrogate_cost(terms, {"tower_base_my": y["tower_base_my"]})
+
+
+@pytest.fixture(scope="module")
+def terms(model):
+    return fit_fatigue_terms(model, 19.0, 20.0, seeds=(1,), duration=200.0, prices={"tower_base_my": 1.0})
+
+
+def test_fitted_tower_surrogate_is_convex_and_near_gaussian(terms):
+    (t,) = terms
+    # Gaussian loads of one spectral shape give a = m/2 = 2 (fatigue.VarianceDamageFit); the
+    # seed paper fitted 2.19 for m = 4: a convex Var^a needs a >= 1
+    assert t.fit.m == 4.0 and 1.5 < t.fit.a < 2.6
+
+
+def test_open_loop_optimum_value_is_the_cost_of_its_trajectory(model, terms):
+    ts, qw, qd = 0.2, 100.0, 1.0
+    w = wind_series(model.rotor_radius, [19.0], [7], 20.2, ts)[0, 0]
+    r = economic_open_loop(model, 19.0, w, ts, terms, ts=ts, speed_weight=qw, activity_weight=qd)
+    # the trajectory again, stepping the discrete model by hand from the trim
+    dm = discretize_turbine(model, 19.0, ts)
+    u, N = r.pitch_cmd - dm.pitch0, r.pitch_cmd.size
+    x, ys = np.zeros(5), []
+    for k in range(N):
+        x = dm.A @ x + dm.Bu * u[k] + dm.Bw * (w[k] - 19.0)
+        ys.append(dm.C @ x + dm.Dw * (w[k] - 19.0) + dm.y0)
+    ys = np.array(ys)
+    i_my, i_w = dm.output_names.index("tower_base_my"), dm.output_names.index("gen_speed")
+    np.testing.assert_allclose(r.outputs["tower_base_my"], ys[:, i_my], rtol=1e-6, atol=1e-3 * ys[:, i_my].std())
+    fat = surrogate_cost(terms, {"tower_base_my": ys[:, i_my]})
+    np.testing.assert_allclose(r.surrogate, fat, rtol=1e-5)
+    t = terms[0]
+    scale = t.price * t.fit.predict(t.reference_variance)
+    step = model.pitch_rate_limit * ts
+    J = (fat / scale + qw * np.mean(((ys[:, i_w] - dm.y0[i_w]) / model.rated_rotor_speed) ** 2)
+         + qd * np.mean((np.diff(np.r_[0.0, u]) / step) ** 2))
+    np.testing.assert_allclose(r.cost, J, rtol=1e-5)
+    assert np.all(np.abs(np.diff(np.r_[dm.pitch0, r.pitch_cmd])) <= step * (1 + 1e-6))
+
+
+def test_convexity_needs_a_at_least_one(model):
+    dm = discretize_turbine(model, 19.0, 0.2)
+    bad = (FatigueTerm("tower_base_my", VarianceDamageFit(0.8, 1.0, 4.0, 1.0, 0.0), 1.0, 1e14),)
+    with pytest.raises(ValueError, match="not convex"):
+        economic_problem(dm, bad, 10, speed_weight=1.0, activity_weight=1.0, rated_speed=0.79, rate_limit=0.03,
+                         pitch_limits=(0.0, 1.5))
+    with pytest.raises(ValueError, match="horizon"):
+        economic_problem(dm, bad, 1, speed_weight=1.0, activity_weight=1.0, rated_speed=0.79, rate_limit=0.03,
+                         pitch_limits=(0.0, 1.5))
+    with pytest.raises(ValueError, match="priced output"):
+        fit_fatigue_terms(model, 19.0, 20.0, prices={"rotor_azimuth": 1.0})
+    with pytest.raises(TypeError, match="FatigueTerm"):
+        EconomicMPC(model, [])
+
+
+# ----------------------------------------------------------------------------- behavioural cloning
+@pytest.fixture(scope="module")
+def cloned(model, terms):
+    kw = dict(horizon=10.0, duration=60.0)
+    train = demonstrations(model, [19.0], [100, 101, 102, 103], terms, **kw)
+    held_out = demonstrations(model, [19.0], [200], terms, **kw)
+    return CloningRegressor().fit(train), held_out
+
+
+def test_clone_reproduces_the_expert_on_held_out_demonstrations(cloned):
+    reg, held_out = cloned
+    # acceptance (docs/mpc.md): R² >= 0.9 on the expert's *moves* u − u_prev from a wind record
+    # not trained on (the command itself is ~u_prev: its R² would pass for any fit)
+    assert reg.score(held_out) >= 0.9
+    assert reg.score(held_out, moves=False) >= reg.score(held_out)
+
+
+def test_clone_runs_in_closed_loop_like_its_teacher(model, terms, cloned):
+    reg, _ = cloned
+    bc, teacher = ClonedController(model, reg), EconomicMPC(model, terms, horizon=50)
+    kw = dict(seeds=[8], duration=60.0, transient=10.0)
+    rb, rt = simulate(model, bc, [19.0], **kw), simulate(model, teacher, [19.0], **kw)
+    # the clone regulates as its teacher does: generator-speed and tower-load SDs within 25 %
+    for out in ("gen_speed", "tower_base_my"):
+        np.testing.assert_allclose(rb[out].std(), rt[out].std(), rtol=0.25)
+    moves = np.abs(np.diff(rb["pitch_cmd"][0, 0, ::2]))  # records every 0.1 s, commands every 0.2 s
+    assert moves.max() <= model.pitch_rate_limit * 0.2 * (1 + 1e-9)
+    assert len(bc.solve_times) > 0
+
+
+def test_cloning_bad_input(model, terms, cloned):
+    with pytest.raises(TypeError, match="fitted CloningRegressor"):
+        ClonedController(model, CloningRegressor())
+    with pytest.raises(ValueError, match="rounds"):
+        clone(model, [19.0], [1], terms, rounds=0)
+    with pytest.raises(ValueError, match="whole multiple"):
+        demonstrations(model, [19.0], [1], terms, every=0.3)
+    with pytest.raises(RuntimeError, match="fit"):
+        CloningRegressor().predict(np.zeros((1, 8)))
+    p = OpenLoopPlayback([[0.3, 0.31]], 0.2)
+    with pytest.raises(ValueError, match="rows"):
+        p.start(0.02, [19.0, 19.0], [0.3, 0.3], [1.0, 1.0])

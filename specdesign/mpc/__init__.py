@@ -1,25 +1,48 @@
 """Model predictive and learned pitch controllers (seed 000): a quadratic MPC, the
-fatigue-oriented economic MPC of the variance-damage surrogate, and behavioural cloning of the
-long-horizon economic optimiser. All are callable controllers of
-:func:`specdesign.simulate.simulate` and :func:`specdesign.validate.run_campaign`.
+fatigue-oriented economic MPC of the variance-damage surrogate (Eq. 4), and behavioural
+cloning of the long-horizon economic optimiser. The controllers are callables of
+:func:`specdesign.simulate.simulate` and :func:`specdesign.validate.run_campaign` (picklable,
+so campaigns on executors take them). See docs/mpc.md.
 
 Layout
 ------
-- :mod:`specdesign.mpc.base`: the discretised linear model, the Kalman filter, the sampled loop.
+- :mod:`specdesign.mpc.base`: the linearised turbine discretised by zero-order hold, the
+  Kalman filter (states and wind estimate), the sampled loop (:class:`SampledController`).
 - :mod:`specdesign.mpc.quadratic`: :class:`QuadraticMPC`.
+- :mod:`specdesign.mpc.economic`: :func:`fit_fatigue_terms`, :func:`surrogate_cost`,
+  :func:`economic_open_loop`, :class:`EconomicMPC`.
+- :mod:`specdesign.mpc.cloning`: :func:`demonstrations`, :class:`CloningRegressor`,
+  :class:`ClonedController`, :class:`OpenLoopPlayback`.
 """
 from __future__ import annotations
 
 from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine, kalman_gain, prediction_matrices
+from .cloning import ClonedController, CloningRegressor, Demonstrations, OpenLoopPlayback, clone, demonstrations
+from .economic import (WOHLER, EconomicMPC, FatigueTerm, OpenLoopResult, economic_open_loop, economic_problem,
+                       fit_fatigue_terms, surrogate_cost)
 from .quadratic import QuadraticMPC, quadratic_qp
 
 __all__ = [
     "QuadraticMPC",
     "quadratic_qp",
+    "EconomicMPC",
+    "FatigueTerm",
+    "fit_fatigue_terms",
+    "surrogate_cost",
+    "economic_problem",
+    "economic_open_loop",
+    "OpenLoopResult",
+    "Demonstrations",
+    "demonstrations",
+    "CloningRegressor",
+    "clone",
+    "ClonedController",
+    "OpenLoopPlayback",
     "DiscreteTurbine",
     "SampledController",
     "discretize_turbine",
     "kalman_gain",
     "prediction_matrices",
     "MEASURED",
+    "WOHLER",
 ]

@@ -333,10 +333,27 @@ class SampledController:
     def _reset_caches(self):
         self._points = {}
         self.solve_times = []
+        self.trace = None
+
+    def record(self, on: bool = True) -> None:
+        """Record, from the next :meth:`start`, what the policy sees at every sample.
+
+        Parameters
+        ----------
+        on : bool, default True
+            Record (True) or stop (False).
+
+        Notes
+        -----
+        The record is :attr:`trace`: a list of ``(t, v, xhat, uprev)`` per sample and
+        operating point, ``xhat`` (G, n+1) the filtered states and wind estimate and ``uprev``
+        (G,) the previous command deviations; behavioural cloning labels these states.
+        """
+        self._recording = bool(on)
 
     def __getstate__(self):
         state = dict(self.__dict__)
-        for k in ("_points", "solve_times", "_run"):
+        for k in ("_points", "solve_times", "_run", "trace", "_recording"):
             state.pop(k, None)
         return state
 
@@ -435,6 +452,7 @@ class SampledController:
         for v, idx in groups.items():
             beta0[idx] = pts[v]["model"].pitch0
             y0[v] = pts[v]["model"].y0[pts[v]["model"].rows(self.measured)]
+        self.trace = [] if getattr(self, "_recording", False) else None
         self._run = {"every": every, "k": 0, "groups": groups, "points": pts, "beta0": beta0, "y0": y0,
                      "xprior": np.zeros((pitch.size, n1)), "u": pitch - beta0, "cmd": pitch.copy()}
 
@@ -472,6 +490,8 @@ class SampledController:
             Aa, Ba, Ca, L = pt["kf"]
             xp = run["xprior"][idx]
             xf = xp + (ym[idx] - run["y0"][v] - xp @ Ca.T) @ L.T
+            if self.trace is not None:
+                self.trace.append((t, v, xf.copy(), run["u"][idx].copy()))
             u = np.asarray(self.policy(pt, xf, run["u"][idx]), float)
             run["u"][idx] = u
             run["xprior"][idx] = xf @ Aa.T + u[:, None] * Ba

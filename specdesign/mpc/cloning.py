@@ -1,0 +1,483 @@
+"""Behavioural cloning of the long-horizon economic optimiser (seed 000, Section 4).
+
+The expert is the economic problem of :func:`~specdesign.mpc.economic_problem` over a long
+horizon (default 20 s; the paper's 10-100 s), solved open loop from a given state: its first
+move is the expert's command there. A controller in closed loop knows the present only (the
+simulator gives it no wind preview), so the expert is asked what a controller could ask:
+from the Kalman estimate (x̂_k, d̂_k) of :mod:`specdesign.mpc.base`, with the wind deviation
+held at d̂_k over the horizon, and the previous command u_{k−1}. Demonstrations pair::
+
+    features  X_k = [x̂_k (5 states, deviations), d̂_k (m/s), u_{k−1} (rad), v (m/s)]
+    target    Y_k = u*_k (rad, deviation from the trim pitch), the expert's first move
+
+at the states a closed loop visits: rollouts of a behaviour controller on the nonlinear
+turbine (:class:`~specdesign.mpc.QuadraticMPC` first), then, with ``rounds`` > 1, of the clone
+itself (DAgger: the clone's own state distribution, labelled by the expert, is added and the
+clone refitted). Cloning the paper's perfect-preview open-loop optimum instead
+(:func:`~specdesign.mpc.economic_open_loop`) gives a policy without enough speed feedback: its
+demonstrations never leave the optimal trajectory, and the clone lets the rotor run away in
+closed loop (docs/mpc.md). That optimum stays the reference the controllers are compared with.
+
+The regressor is the paper's two-stage fit (Eqs. 19-22): a linear regression f_L, then
+gradient-boosted trees f_NL (scikit-learn ``HistGradientBoostingRegressor``, depth ≤ 6, early
+stopping on a validation split) on its residual. Both learn the move u*_k − u_{k−1} (the command
+itself is dominated by u_{k−1}, which would make any fit look perfect); the predicted command
+is u_{k−1} + f_L + f_NL. The clone's command is saturated at the pitch rate and position limits
+(a safety layer the regressor cannot guarantee, counted in ``saturated``).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import positive_scalar
+from .base import MEASURED, SampledController, discretize_turbine
+from .economic import economic_problem
+
+__all__ = ["Demonstrations", "demonstrations", "CloningRegressor", "ClonedController", "OpenLoopPlayback", "clone",
+           "UPREV"]
+
+#: Column of the previous command u_{k−1} in the features.
+UPREV = 6
+
+
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
+class Demonstrations:
+    """Expert demonstrations: features, target commands and where they came from.
+
+    Parameters
+    ----------
+    features : numpy.ndarray
+        (n, 8) rows [x̂ (5 states), d̂ (m/s), u_prev (rad), v (m/s)] (module docstring).
+    targets : numpy.ndarray
+        (n,) expert commands u* (rad, deviations).
+    seeds : numpy.ndarray
+        (n,) seed of the wind record of each row.
+    ts : float
+        Sample time (s).
+    cpu_time : numpy.ndarray
+        CPU time of each expert solve (s).
+    """
+
+    features: np.ndarray
+    targets: np.ndarray
+    seeds: np.ndarray
+    ts: float
+    cpu_time: np.ndarray
+
+    def subset(self, seeds) -> Demonstrations:
+        """The rows of some seeds (a held-out split by wind record, not by sample).
+
+        Parameters
+        ----------
+        seeds : sequence of int
+            Seeds to keep.
+
+        Returns
+        -------
+        Demonstrations
+            The rows of those seeds.
+        """
+        keep = np.isin(self.seeds, np.asarray(seeds))
+        return Demonstrations(self.features[keep], self.targets[keep], self.seeds[keep], self.ts, self.cpu_time)
+
+    def join(self, other: Demonstrations) -> Demonstrations:
+        """These rows and ``other``'s (DAgger aggregates the rounds).
+
+        Parameters
+        ----------
+        other : Demonstrations
+            More rows, at the same ``ts``.
+
+        Returns
+        -------
+        Demonstrations
+            All rows.
+
+        Raises
+        ------
+        ValueError
+            For another sample time.
+        """
+        if abs(other.ts - self.ts) > 1e-12:
+            raise ValueError(f"cannot join demonstrations at ts={self.ts} and ts={other.ts} s")
+        return Demonstrations(np.vstack([self.features, other.features]), np.concatenate([self.targets, other.targets]),
+                              np.concatenate([self.seeds, other.seeds]), self.ts,
+                              np.concatenate([self.cpu_time, other.cpu_time]))
+
+
+def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon: float = 20.0, ts: float = 0.2,
+                   duration: float = 100.0, every: float = 0.6, transient: float = 20.0,
+                   speed_weight: float = 100.0, activity_weight: float = 1.0,
+                   turbulence_class: str = "B") -> Demonstrations:
+    """Roll out a behaviour controller, then label the states it visits with the expert's move.
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine.
+    wind_speeds : sequence of float
+        Mean wind speeds (m/s).
+    seeds : sequence of int
+        Wind seeds of the rollouts (:func:`specdesign.wind.wind_series`).
+    terms : sequence of FatigueTerm
+        Priced loads (:func:`~specdesign.mpc.fit_fatigue_terms`).
+    behaviour : SampledController, optional
+        Controller of the rollouts (default :class:`~specdesign.mpc.QuadraticMPC` at ``ts``).
+    horizon : float, default 20.0
+        Expert's horizon (s).
+    ts : float, default 0.2
+        Sample time (s), the behaviour controller's.
+    duration : float, default 100.0
+        Recorded length of each rollout (s).
+    every : float, default 0.6
+        Spacing of the labelled states (s), a multiple of ``ts`` (consecutive samples carry
+        little new information, and each label is one solve).
+    transient : float, default 20.0
+        Rollout time before the first labelled state (s).
+    speed_weight, activity_weight : float
+        The expert's q_Ω and q_Δ (:func:`~specdesign.mpc.economic_problem`).
+    turbulence_class : str, default "B"
+        IEC class of the wind.
+
+    Returns
+    -------
+    Demonstrations
+        One row per labelled state.
+
+    Raises
+    ------
+    ValueError
+        For ``every`` not a whole multiple of ``ts``, or a behaviour controller at another
+        sample time.
+    """
+    from ..simulate import SimulationDivergedError, simulate
+    from .quadratic import QuadraticMPC
+
+    horizon, ts, every = positive_scalar(horizon, "horizon"), positive_scalar(ts, "ts"), positive_scalar(every, "every")
+    stride = int(round(every / ts))
+    if stride < 1 or abs(stride * ts - every) > 1e-9 * every:
+        raise ValueError(f"every={every} s must be a whole multiple of ts={ts} s")
+    behaviour = QuadraticMPC(model, ts=ts) if behaviour is None else behaviour
+    if not isinstance(behaviour, SampledController) or abs(behaviour.ts - ts) > 1e-12:
+        raise ValueError(f"behaviour must be a SampledController (an MPC or a clone) at ts={ts} s")
+    N = int(round(horizon / ts))
+    behaviour.record(True)
+    feats, targs, sd, cpu = [], [], [], []
+    try:
+        for v in np.atleast_1d(np.asarray(wind_speeds, float)):
+            try:
+                simulate(model, behaviour, [float(v)], seeds=list(seeds), duration=duration, transient=transient)
+            except SimulationDivergedError:
+                pass  # an early clone may lose the rotor: the states it visited on the way are the lesson
+            trace = [rec for i, rec in enumerate(behaviour.trace) if rec[0] >= transient and i % stride == 0]
+            dm = discretize_turbine(model, float(v), ts)
+            pb = economic_problem(dm, terms, N, speed_weight=speed_weight, activity_weight=activity_weight,
+                                  rated_speed=float(model.rated_rotor_speed), rate_limit=float(model.pitch_rate_limit),
+                                  pitch_limits=(float(model.pitch_min), float(model.pitch_max)))
+            for _, vv, xhat, uprev in trace:
+                for g in range(uprev.size):
+                    t0 = time.process_time()
+                    pb["x0"].value, pb["d"].value = xhat[g, :-1], np.full(N, xhat[g, -1])
+                    pb["uprev"].value = uprev[g:g + 1]
+                    pb["problem"].solve(solver="CLARABEL")
+                    cpu.append(time.process_time() - t0)
+                    if pb["problem"].status not in ("optimal", "optimal_inaccurate"):
+                        continue  # an unlabelled state is left out, not guessed
+                    feats.append(np.concatenate([xhat[g], [uprev[g], vv]]))
+                    targs.append(float(pb["v"].value[0]) * pb["step"])
+                    sd.append(int(list(seeds)[g % len(seeds)]))
+    finally:
+        behaviour.record(False)
+    return Demonstrations(np.array(feats), np.array(targs), np.array(sd), ts, np.array(cpu))
+
+
+def clone(model, wind_speeds, seeds, terms, *, rounds: int = 2, ts: float = 0.2, **kw) -> tuple:
+    """Behavioural cloning with DAgger: demonstrations, fit, then ``rounds − 1`` rounds of the clone's own states.
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine.
+    wind_speeds : sequence of float
+        Mean wind speeds (m/s) of the rollouts.
+    seeds : sequence of int
+        Wind seeds of the rollouts (use other seeds to evaluate the clone).
+    terms : sequence of FatigueTerm
+        Priced loads of the expert.
+    rounds : int, default 2
+        1: the behaviour controller's states only; each further round rolls out the current
+        clone, labels its states and refits on everything.
+    ts : float, default 0.2
+        Sample time (s).
+    **kw
+        Options of :func:`demonstrations` (``horizon``, ``duration``, ``every``, ``transient``,
+        the weights, ``turbulence_class``).
+
+    Returns
+    -------
+    controller : ClonedController
+        The clone.
+    demos : Demonstrations
+        Every demonstration it was fitted on.
+
+    Raises
+    ------
+    ValueError
+        For ``rounds`` < 1.
+    """
+    if isinstance(rounds, bool) or not isinstance(rounds, (int, np.integer)) or rounds < 1:
+        raise ValueError(f"rounds={rounds!r} must be an integer >= 1")
+    demos = demonstrations(model, wind_speeds, seeds, terms, ts=ts, **kw)
+    ctrl = ClonedController(model, CloningRegressor().fit(demos), ts)
+    for _ in range(int(rounds) - 1):
+        demos = demos.join(demonstrations(model, wind_speeds, seeds, terms, behaviour=ctrl, ts=ts, **kw))
+        ctrl = ClonedController(model, CloningRegressor().fit(demos), ts)
+    return ctrl, demos
+
+
+class CloningRegressor:
+    """Linear regression plus gradient-boosted trees on its residual (seed 000, Eqs. 19-22).
+
+    Parameters
+    ----------
+    max_depth : int, default 6
+        Depth of the trees (the paper's 6).
+    max_iter : int, default 200
+        Most boosting iterations; early stopping on a 10 % validation split ends sooner.
+    random_state : int, default 0
+        Seed of the validation split.
+    """
+
+    def __init__(self, max_depth: int = 6, max_iter: int = 200, random_state: int = 0):
+        self.max_depth, self.max_iter, self.random_state = int(max_depth), int(max_iter), int(random_state)
+        self.linear = self.trees = None
+
+    def fit(self, demos: Demonstrations) -> CloningRegressor:
+        """Fit on demonstrations.
+
+        Parameters
+        ----------
+        demos : Demonstrations
+            Training rows.
+
+        Returns
+        -------
+        CloningRegressor
+            ``self``, fitted.
+
+        Raises
+        ------
+        ImportError
+            Without scikit-learn (``pip install "specdesign[mpc]"``).
+        ValueError
+            With fewer than 20 rows.
+        """
+        try:
+            from sklearn.ensemble import HistGradientBoostingRegressor
+            from sklearn.linear_model import LinearRegression
+        except ImportError as e:  # pragma: no cover - the mpc extra installs it
+            raise ImportError('behavioural cloning needs scikit-learn: pip install "specdesign[mpc]"') from e
+        if demos.targets.size < 20:
+            raise ValueError(f"demos has {demos.targets.size} rows; fit needs at least 20")
+        move = demos.targets - demos.features[:, UPREV]
+        self.linear = LinearRegression().fit(demos.features, move)
+        res = move - self.linear.predict(demos.features)
+        self.trees = HistGradientBoostingRegressor(max_depth=self.max_depth, max_iter=self.max_iter,
+                                                   early_stopping=True, validation_fraction=0.1,
+                                                   random_state=self.random_state).fit(demos.features, res)
+        return self
+
+    def predict(self, features: np.ndarray) -> np.ndarray:
+        """Commands (rad, deviations) for rows of features.
+
+        Parameters
+        ----------
+        features : numpy.ndarray
+            (n, 8) rows as in :class:`Demonstrations`.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n,) predicted commands.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`fit`.
+        """
+        if self.linear is None:
+            raise RuntimeError("CloningRegressor.fit(demos) must be called before predict")
+        features = np.asarray(features, float)
+        return features[:, UPREV] + self.linear.predict(features) + self.trees.predict(features)
+
+    def score(self, demos: Demonstrations, *, moves: bool = True) -> float:
+        """R² of the predictions on demonstrations (1 − SS_res/SS_tot).
+
+        Parameters
+        ----------
+        demos : Demonstrations
+            Rows to score (held out from the fit, for an honest figure).
+        moves : bool, default True
+            Score the moves u − u_prev (the demanding figure) rather than the commands u.
+
+        Returns
+        -------
+        float
+            The coefficient of determination.
+        """
+        y, p = demos.targets, self.predict(demos.features)
+        if moves:
+            y, p = y - demos.features[:, UPREV], p - demos.features[:, UPREV]
+        return float(1.0 - np.sum((y - p) ** 2) / np.sum((y - y.mean()) ** 2))
+
+
+class ClonedController(SampledController):
+    """The cloned expert as a callable controller of :func:`~specdesign.simulate.simulate`.
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine.
+    regressor : CloningRegressor
+        Fitted on :func:`demonstrations`.
+    ts : float, default 0.2
+        Sample time (s), that of the demonstrations.
+    measured : sequence of str, optional
+        Outputs the Kalman filter reads.
+    name : str, default "behavioural cloning"
+        Label.
+
+    Attributes
+    ----------
+    saturated : int
+        Commands the rate or position limits cut since the last :meth:`start`.
+    solve_times : list of float
+        CPU time (s) per sample (all runs of an operating point at once, divided by their number).
+    """
+
+    def __init__(self, model, regressor: CloningRegressor, ts: float = 0.2, measured=MEASURED,
+                 name: str = "behavioural cloning"):
+        if not isinstance(regressor, CloningRegressor) or regressor.linear is None:
+            raise TypeError("regressor must be a fitted CloningRegressor (CloningRegressor().fit(demos))")
+        self.regressor = regressor
+        self.saturated = 0
+        super().__init__(model, ts, measured, name)
+
+    def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
+        """Initialise the runs (see :meth:`SampledController.start`) and the saturation count.
+
+        Parameters
+        ----------
+        dt : float
+            Simulation step (s).
+        wind : numpy.ndarray
+            (R,) wind at t = 0 (m/s).
+        pitch : numpy.ndarray
+            (R,) initial pitch (rad).
+        torque : numpy.ndarray
+            (R,) generator torque (N·m).
+        """
+        self.saturated = 0
+        super().start(dt, wind, pitch, torque)
+
+    def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
+        """The regressor's command for every run at one operating point, within the actuator limits.
+
+        Parameters
+        ----------
+        pt : dict
+            :meth:`point` of the operating point.
+        xhat : numpy.ndarray
+            (G, n+1) state and wind estimates.
+        uprev : numpy.ndarray
+            (G,) previous command deviations (rad).
+
+        Returns
+        -------
+        numpy.ndarray
+            (G,) command deviations (rad).
+        """
+        t0 = time.process_time()
+        dm = pt["model"]
+        X = np.column_stack([xhat, uprev, np.full(uprev.size, dm.wind_speed)])
+        u = self.regressor.predict(X)
+        step = float(self.model.pitch_rate_limit) * self.ts
+        lo = np.maximum(uprev - step, float(self.model.pitch_min) - dm.pitch0)
+        hi = np.minimum(uprev + step, float(self.model.pitch_max) - dm.pitch0)
+        out = np.minimum(np.maximum(u, lo), hi)
+        self.saturated += int(np.count_nonzero(out != u))
+        self.solve_times.extend([(time.process_time() - t0) / max(uprev.size, 1)] * uprev.size)
+        return out
+
+
+class OpenLoopPlayback:
+    """Replays fixed pitch-command sequences (e.g. open-loop optima) through ``simulate``.
+
+    Parameters
+    ----------
+    commands : array_like
+        (R, N) absolute pitch commands (rad), one row per run, each held for ``ts``; the last
+        is held beyond.
+    ts : float
+        Sample time of the commands (s).
+    name : str, default "open-loop optimum"
+        Label.
+
+    Examples
+    --------
+    >>> p = OpenLoopPlayback([[0.1, 0.2]], 0.2)
+    >>> p.start(0.1, [19.0], [0.1], [1.0]); [float(p(t, {})[0]) for t in (0.0, 0.1, 0.2, 0.3, 0.4)]
+    [0.1, 0.1, 0.2, 0.2, 0.2]
+    """
+
+    def __init__(self, commands, ts: float, name: str = "open-loop optimum"):
+        self.commands = np.atleast_2d(np.asarray(commands, float))
+        if not np.all(np.isfinite(self.commands)):
+            raise ValueError("commands must be finite pitch angles (rad)")
+        self.ts = positive_scalar(ts, "ts")
+        self.__name__ = self.name = str(name)
+
+    def start(self, dt: float, wind, pitch, torque) -> None:
+        """Reset to the first command (called by the simulator).
+
+        Parameters
+        ----------
+        dt : float
+            Simulation step (s); ``ts`` must be a whole multiple of it.
+        wind, pitch, torque : array_like
+            (R,) per run (unused but for R).
+
+        Raises
+        ------
+        ValueError
+            If the number of runs is not the number of rows of ``commands``, or ``ts`` is not a
+            whole multiple of ``dt``.
+        """
+        if np.size(pitch) != self.commands.shape[0]:
+            raise ValueError(f"commands has {self.commands.shape[0]} rows but the simulation has {np.size(pitch)} runs")
+        self._every = int(round(self.ts / dt))
+        if self._every < 1 or abs(self._every * dt - self.ts) > 1e-9 * self.ts:
+            raise ValueError(f"ts={self.ts} s must be a whole multiple of the simulation step dt={dt} s")
+        self._k = 0
+
+    def __call__(self, t: float, y: dict) -> np.ndarray:
+        """The command of every run at step ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+        y : dict
+            Outputs (unused: open loop).
+
+        Returns
+        -------
+        numpy.ndarray
+            (R,) pitch commands (rad).
+        """
+        j = min(self._k // self._every, self.commands.shape[1] - 1)
+        self._k += 1
+        return self.commands[:, j].copy()
