@@ -21,6 +21,7 @@ Oracles:
 """
 import dataclasses
 import re
+from pathlib import Path
 
 import control
 import numpy as np
@@ -36,6 +37,7 @@ from specdesign.rosco import (
     rosco_scheduled,
     rosco_test_cases,
     torque_law_from_discon,
+    write_discon,
 )
 from specdesign.simulate import simulate
 from specdesign.turbine import iea15mw
@@ -208,14 +210,10 @@ def _oracle_discon(tmp_path, mode):
         deck = rosco_test_cases() / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile"
     except ModuleNotFoundError as e:
         pytest.skip(f"the rosco package is not installed ({e})")
-    text = (deck / "IEA-15-240-RWT-Monopile_DISCON.IN").read_text()
-    text, n1 = re.subn(r"^\d+(\s+! VS_ControlMode)", rf"{mode}\1", text, flags=re.M)
-    text, n2 = re.subn(r"^\d+(\s+! PS_Mode)", r"0\1", text, flags=re.M)
-    perf = (deck.parent / "IEA-15-240-RWT/Cp_Ct_Cq.IEA15MW.txt").resolve()
-    text, n3 = re.subn(r'"[^"]*"(\s+! PerfFileName)', f'"{perf}"\\1', text)
-    assert (n1, n2, n3) == (1, 1, 1)
-    p = tmp_path / f"DISCON_mode{mode}.IN"
-    p.write_text(text)
+    p = write_discon(deck / "IEA-15-240-RWT-Monopile_DISCON.IN", tmp_path / f"DISCON_mode{mode}.IN",
+                     VS_ControlMode=mode, PS_Mode=0)
+    entries, _ = read_discon(p)
+    assert Path(entries["PerfFileName"].values[0].strip('"')).is_file()
     return p
 
 

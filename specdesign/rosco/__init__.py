@@ -29,7 +29,7 @@ from .baseline import (
     speed_filter,
 )
 from .discon import Discon, DisconError, rosco_library, rosco_test_cases
-from .discon_file import DisconEntry, DisconSchedule, from_discon, iea15mw_discon, read_discon
+from .discon_file import DisconEntry, DisconSchedule, from_discon, iea15mw_discon, read_discon, write_discon
 from .torque import (
     TORQUE_MODES,
     TORQUE_REGIONS,
@@ -53,6 +53,7 @@ __all__ = [
     "iea15mw_discon",
     "read_discon",
     "from_discon",
+    "write_discon",
     "Discon",
     "DisconError",
     "rosco_library",

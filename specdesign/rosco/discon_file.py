@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["DisconEntry", "DisconSchedule", "iea15mw_discon", "read_discon", "from_discon"]
+__all__ = ["DisconEntry", "DisconSchedule", "iea15mw_discon", "read_discon", "from_discon", "write_discon"]
 
 
 def iea15mw_discon() -> Path:
@@ -310,3 +310,57 @@ def from_discon(path: str | Path) -> DisconSchedule:
         generator_efficiency=vals["VS_GenEff"] / 100.0, rated_generator_speed=vals["VS_RefSpd"],
         rotor_radius=vals["WE_BladeRadius"],
     )
+
+
+def write_discon(source: str | Path, target: str | Path, **values) -> Path:
+    """A copy of a DISCON.IN with some entries changed, runnable from another folder.
+
+    Quoted relative file names (``PerfFileName``) are made absolute from the source's folder,
+    where ROSCO would resolve them, so the copy runs wherever it is written.
+
+    Parameters
+    ----------
+    source : str or pathlib.Path
+        The DISCON.IN file.
+    target : str or pathlib.Path
+        The copy to write.
+    **values
+        Key → new value (written as given: ``VS_ControlMode=1``, ``PS_Mode=0``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``target``.
+
+    Raises
+    ------
+    ValueError
+        If a key of ``values`` is not an entry of ``source``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> out = write_discon(iea15mw_discon(), Path(tempfile.mkdtemp()) / "DISCON.IN", PS_Mode=0)
+    >>> read_discon(out)[0]["PS_Mode"].values
+    ('0',)
+    """
+    source, target = Path(source), Path(target)
+    entries, _ = read_discon(source)
+    missing = sorted(set(values) - set(entries))
+    if missing:
+        raise ValueError(f"{source}: no entries {missing} to change")
+    base = source.parent.resolve()
+    lines = source.read_text(errors="replace").splitlines()
+    for key, val in values.items():
+        n = entries[key].line - 1
+        left, sep, right = lines[n].partition("!")
+        lines[n] = f"{val!s:<20}" + sep + right
+    for n, raw in enumerate(lines):
+        left, sep, right = raw.partition("!")
+        if sep and '"' in left and not raw.lstrip().startswith("!"):
+            lines[n] = re.sub(r'"([^"]*)"', lambda m: '"' + (m.group(1) if not m.group(1) or Path(m.group(1)).is_absolute()
+                                                           or m.group(1) in ("unused", "DISCON")
+                                                           or "://" in m.group(1) else str(base / m.group(1))) + '"',
+                              left) + sep + right
+    target.write_text("\n".join(lines) + "\n")
+    return target

@@ -48,9 +48,31 @@ shaft, which the controller then commands; a ``start(dt, wind, pitch, torque)`` 
 has one, is called once before the first step; use it for MPC or other time-domain
 controllers, and for ROSCO's compiled controller, :class:`specdesign.rosco.Discon`).
 
+Generator torque (``simulate(..., torque_control=...)``): above rated the torque is held at
+the trim's (rated) torque, as ever. Below rated the compiled loop runs ROSCO's torque
+controller, :class:`specdesign.rosco.TorqueLaw` (the model's ``torque_control``, e.g. the one
+:func:`specdesign.turbine.iea15mw` carries, or one read from a DISCON.IN with
+:func:`specdesign.rosco.torque_law_from_discon`): each step
+:func:`specdesign.rosco.torque_step` filters the measured rotor speed as ROSCO does,
+applies K·Ω² with the region-1.5/2.5 PIs and ROSCO's state machine (``VS_ControlMode`` 1) or
+the TSR-tracking PI (3, 4), the setpoint smoother, the torque limits and rate limit, and
+commands the torque for the step; the smoother's shift of the pitch reference moves the
+pitch controller's speed reference (Ω_rated − ΔΩ_f when ΔΩ_f < 0). The pitch controller
+runs as above: below rated its error is negative and its command sits at the minimum pitch
+(ROSCO's form clamps its integrator there, an LTI controller's integrator is clamped or
+frozen, see :func:`simulate`), so the pitch is held at fine pitch as ROSCO holds it.
+``torque_control="auto"`` (default) runs the law in the runs whose wind speed is below rated
+and holds the trim torque in the others (bit for bit the results before the law existed);
+``"rosco"`` runs it in every run (region 3 is then rated torque, with the transitions);
+a ``TorqueLaw`` runs that law in every run; ``None`` holds the trim torque everywhere.
+The pitch loop's stability check (:func:`warn_unstable`) covers the speeds at or above rated
+only: below rated the pitch loop is open.
+
 A linear simulation of the same closed loop (``linear=True``) integrates the linearisation
 ``model.linearize(v)`` with the same loop, the same RK4 step and the same discrete
-controller, so differences between the two are the plant's nonlinearity only.
+controller, so differences between the two are the plant's nonlinearity only. Below rated
+the linearisation has the torque law closed in it (:meth:`specdesign.turbine.TurbineModel.linearize`)
+and its torque input is held at the trim.
 
 Layout
 ------
