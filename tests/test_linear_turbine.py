@@ -162,6 +162,34 @@ def test_lin_route_reads_the_file(sample, floating):
     assert not any("DOF_GeAz" in s and "derivative" not in s for s in p.state_labels)
 
 
+def _lin_copy(sample, path, wind_speed, azimuth=None):
+    lines = sample.read_text().splitlines()
+    for i, line in enumerate(lines):
+        if line.strip().startswith("Wind Speed:"):
+            lines[i] = f"   Wind Speed:                         {wind_speed:.4f} m/s"
+        if azimuth is not None and line.strip().startswith("Azimuth:"):
+            lines[i] = f"   Azimuth:                             {azimuth:.4f} rad"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_lin_files_grouped_by_wind_speed(sample, tmp_path):
+    # two azimuths at 17 m/s (averaged by read_linearization) and one at 21 m/s, read by a glob
+    a = _lin_copy(sample, tmp_path / "lin_17_a.lin", 17.0)
+    b = _lin_copy(sample, tmp_path / "lin_17_b.lin", 17.0, azimuth=2.0944)
+    c = _lin_copy(sample, tmp_path / "lin_21.lin", 21.0)
+    lt = LinearTurbine.from_lin_files(str(tmp_path / "lin_*.lin"))
+    assert lt.wind_speeds.tolist() == [17.0, 21.0] and lt.sources == (str(a), str(b), str(c))
+    ref, _ = plant_from_linearization(read_linearization([a, b]))
+    got = lt.linearize(17.0)
+    for k in "ABCD":
+        assert_allclose(getattr(got, k), getattr(ref, k), rtol=0, atol=0)
+    mid, hi = lt.linearize(19.0), lt.linearize(21.0)
+    assert_allclose(mid.A, 0.5 * (np.asarray(got.A) + np.asarray(hi.A)), rtol=1e-14, atol=1e-300)
+    with pytest.raises(ValueError, match="17-21 m/s"):
+        lt.linearize(16.0)
+
+
 def test_tower_top_velocity_is_the_derivative_of_the_deflection(sample):
     lt = LinearTurbine.from_lin_files(sample, signals={"tower_top_disp": "YawBrTDxt"})
     p = lt.linearize(19.0)
