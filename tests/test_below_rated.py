@@ -165,7 +165,8 @@ def test_torque_law_read_from_discon_in():
     assert float(entries["WE_GearboxRatio"].values[0]) == 1.0  # direct drive: no conversion
     with pytest.raises(ValueError, match=r"VS_ControlMode = 2 .*mode=3"):
         torque_law_from_discon(path)
-    law = torque_law_from_discon(path, mode=1)
+    with pytest.warns(UserWarning, match="PS_Mode = 1: peak shaving"):
+        law = torque_law_from_discon(path, mode=1)
     assert (law.k_opt, law.kp, law.ki, law.min_speed, law.reference_speed, law.rated_torque, law.transition_torque,
             law.max_rate, law.ss_corner) == tuple(raw.values())
 
@@ -177,7 +178,10 @@ def test_torque_law_gearbox_conversion(tmp_path):
     assert n == 1
     p = tmp_path / "DISCON.IN"
     p.write_text(text)
-    a, b = torque_law_from_discon(iea15mw_discon(), mode=1), torque_law_from_discon(p, mode=1)
+    with pytest.warns(UserWarning, match="PS_Mode"):
+        a, b = torque_law_from_discon(iea15mw_discon(), mode=1), torque_law_from_discon(p, mode=1)
+    with pytest.raises(ValueError, match="VS_ConstPower = 1 is not modelled"):
+        torque_law_from_discon(write_discon(p, tmp_path / "cp.IN", VS_ConstPower=1), mode=1)
     assert b.min_speed == pytest.approx(a.min_speed / 50) and b.rated_torque == pytest.approx(a.rated_torque * 50)
     assert b.k_opt == pytest.approx(a.k_opt * 50**3) and b.kp == pytest.approx(a.kp * 50**2)
     with pytest.raises(ValueError, match="mode"):

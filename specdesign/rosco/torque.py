@@ -302,13 +302,22 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
     Raises
     ------
     ValueError
-        For a missing or non-numeric key (file, line and key named), or a mode outside
-        :data:`TORQUE_MODES` (mode 2: pass ``mode=3``).
+        For a missing or non-numeric key (file, line and key named), a mode outside
+        :data:`TORQUE_MODES` (mode 2: pass ``mode=3``), or ``VS_ConstPower``, ``VS_FBP`` or
+        ``PRC_Mode`` not 0 (laws the workbench does not run).
+
+    Warns
+    -----
+    UserWarning
+        For ``PS_Mode`` not 0: peak shaving is not modelled (the pitch limit is the model's).
 
     Examples
     --------
+    >>> import warnings
     >>> from specdesign.rosco import iea15mw_discon
-    >>> law = torque_law_from_discon(iea15mw_discon(), mode=1)
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")  # its PS_Mode = 1
+    ...     law = torque_law_from_discon(iea15mw_discon(), mode=1)
     >>> law.mode, round(law.min_speed, 4)
     (1, 0.5236)
     """
@@ -325,6 +334,15 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
         raise ValueError(f"{p}: line {line}: VS_ControlMode = {use} is not run by the workbench (modes {TORQUE_MODES}); "
                          "mode 2 tracks the TSR from ROSCO's wind-speed estimator, which is not modelled: pass mode=3 "
                          "to run the file's PI on the power-based reference")
+    for key in ("VS_ConstPower", "VS_FBP", "PRC_Mode"):  # they change the law itself: not run here
+        if key in entries and int(f(key)) != 0:
+            raise ValueError(f"{p}: line {entries[key].line}: {key} = {int(f(key))} is not modelled (the workbench "
+                             "runs constant torque above rated, variable pitch, no power-reference tracking); set it to 0")
+    if "PS_Mode" in entries and int(f("PS_Mode")) != 0:
+        import warnings
+
+        warnings.warn(f"{p}: PS_Mode = {int(f('PS_Mode'))}: peak shaving (a minimum pitch from ROSCO's wind-speed "
+                      "estimate) is not modelled; the pitch limit is the model's", UserWarning, stacklevel=2)
     n = f("WE_GearboxRatio")
     if not n > 0:
         raise ValueError(f"{p}: line {entries['WE_GearboxRatio'].line}: WE_GearboxRatio must be positive")

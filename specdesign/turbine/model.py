@@ -3,7 +3,9 @@
 The model: rigid-drivetrain rotor (aerodynamic torque from Cp(λ, β), thrust from Ct(λ, β)),
 first tower fore-aft mode driven by thrust with the rotor seeing the relative wind U − ẋ_top,
 a 2nd-order pitch actuator with rate and position limits, and a generator torque that is an
-input (constant, ``rated_generator_torque``, above rated). Figures come from the shipped
+input (constant, ``rated_generator_torque``, above rated; below rated set by ROSCO's torque law,
+the model's ``torque_control``, :mod:`specdesign.rosco.torque`, closed in :meth:`TurbineModel.trim`
+and :meth:`TurbineModel.linearize` from cut-in to cut-out). Figures come from the shipped
 ``specdesign/data/iea15mw`` (IEA Wind Task 37 and NREL ROSCO, Apache-2.0; see NOTICE.md).
 
 The state, input and output vectors and the compiled kernel are those of
