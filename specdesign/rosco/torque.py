@@ -249,10 +249,14 @@ def torque_law(model: TurbineModel, *, mode: int = 1, omega_vs: float = 0.12, ze
         The law.
     """
     beta = float(model.pitch_min)
-    if tsr is None:
-        grid = np.linspace(model.tsr_grid[0], model.tsr_grid[-1], 2001)
-        cp = model.rotor_coefficients(grid, beta)[0]
-        tsr = float(grid[int(np.argmax(cp))])
+    if tsr is None:  # maximum Cp: a coarse grid, then refined around its best point
+        from scipy.optimize import minimize_scalar
+
+        grid = np.linspace(model.tsr_grid[0], model.tsr_grid[-1], 126)
+        i = int(np.argmax(model.rotor_coefficients(grid, beta)[0]))
+        lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+        tsr = float(minimize_scalar(lambda x: -float(model.rotor_coefficients(x, beta)[0]), bounds=(lo, hi),
+                                    method="bounded", options={"xatol": 1e-6}).x)
     cp_opt = float(model.rotor_coefficients(tsr, beta)[0])
     R = model.rotor_radius
     k = 0.5 * model.air_density * np.pi * R**5 * cp_opt / tsr**3
