@@ -91,9 +91,9 @@ def test_lpv_blend_is_convex_combination_of_vertices(model):
     op = model.trim(18.0)
     x, u = np.array(op.x), np.full(6, op.pitch + 0.01)
     one = LPVTurbine(lpv.wind_speeds[:1], 0.2, 6, lpv.output_names, *(a[:1] for a in (lpv.x_trim, lpv.pitch_trim,
-                     lpv.y_trim, lpv.Phi, lpv.Gamma, lpv.Psi)))
+                     lpv.y_trim, lpv.Phi, lpv.Gamma, lpv.Psi, lpv.C, lpv.Dw)))
     two = LPVTurbine(lpv.wind_speeds[1:2], 0.2, 6, lpv.output_names, *(a[1:2] for a in (lpv.x_trim, lpv.pitch_trim,
-                     lpv.y_trim, lpv.Phi, lpv.Gamma, lpv.Psi)))
+                     lpv.y_trim, lpv.Phi, lpv.Gamma, lpv.Psi, lpv.C, lpv.Dw)))
     # Eq. (10)-(11) of seed 002: α = (0.25, 0.75) at 18.5 m/s between the 17 and 19 m/s vertices
     assert lpv.alphas(18.5) == (0, 0.75)
     assert_allclose(lpv.predict(x, 18.5, u), 0.25 * one.predict(x, 18.5, u) + 0.75 * two.predict(x, 18.5, u))
@@ -137,7 +137,7 @@ def _two_state():
     N = 2
     Phi, Gam, Psi = prediction_matrices(dm, PREDICTED, N)
     lpv = LPVTurbine(np.array([10.0]), 0.1, N, PREDICTED, np.zeros((1, 2)), np.zeros(1), np.zeros((1, 3)),
-                     Phi[None], Gam[None], Psi[None])
+                     Phi[None], Gam[None], Psi[None], C[None], Dw[None])
     return A, Bu, Bw, C, Dw, lpv
 
 
@@ -198,14 +198,15 @@ def test_health_scale_by_hand():
 # ----------------------------------------------------------------------------- the controller
 def test_health_mpc_trades_speed_for_blade_damage(model):
     # the documented behaviour (docs/health_mpc.md): the health weight lowers the blade-root
-    # DEL and raises the generator-speed SD; the mean power stays at rated within 1 %
+    # DEL and raises the generator-speed SD; the mean power falls by less than 3 %
     res = {}
     for w in (0.0, 100.0):
         r = simulate(model, HealthMPC(model, health_weight=w), [19.0], seeds=[1], duration=200.0, transient=30.0)
         res[w] = (del_rainflow(r["blade_root_my"][0, 0], 10.0, 200.0), r["gen_speed"].std(), r["power"].mean())
     assert res[100.0][0] < 0.7 * res[0.0][0]
     assert res[100.0][1] > 1.5 * res[0.0][1]
-    assert abs(res[100.0][2] / model.rated_power - 1) < 0.01
+    assert abs(res[0.0][2] / model.rated_power - 1) < 0.002
+    assert 0.97 < res[100.0][2] / res[0.0][2] < 1.0
 
 
 def test_health_mpc_pickles_and_runs_in_campaign(model):

@@ -9,7 +9,8 @@ its current estimate. Mapped onto this workbench's reduced model:
 - **Plant and scheduling**: the LPV prediction of :mod:`specdesign.mpc.lpv` (vertices are the
   linearisations of the simulated equations every 1 m/s, blended by the estimated wind v̂),
   instead of the seed's Euler-discretised polytope. The state and the wind come from the
-  Kalman filter of :mod:`specdesign.mpc.base` (the seed assumes them measured).
+  Kalman filter of :mod:`specdesign.mpc.base` made LPV on the same vertices
+  (:class:`~specdesign.mpc.lpv.LPVObserver`; the seed assumes them measured).
 - **Blade load**: the seed's regression M_b = a₀ + a₁T_gω_r + a₂w becomes this model's
   ``blade_root_my`` (the quasi-static flapwise moment r_T(β)·T/3 of
   :mod:`specdesign.turbine.kernel`), predicted through the same LPV model.
@@ -19,7 +20,9 @@ its current estimate. Mapped onto this workbench's reduced model:
 
   * the seed's accumulated-stress term, ``stress_weight`` · Σ_j M_j /(N M_s): linear, it
     derates (more pitch, less thrust and less power), as in the seed's Table 2;
-  * the growth of the accumulated *fatigue* damage, ``health_weight`` · Σ_j ((M_j − M̄)/M_s)²:
+  * the growth of the accumulated *fatigue* damage, ``health_weight`` · Σ_j ((M_j − M̄)/M_s)²
+    (the predicted M_j shifted by the measured moment's difference from the model's moment
+    now, so that the linear model's bias is not taken for an excursion):
     for a Gaussian load the damage rate grows as σ_M^m (narrow band, range-based S-N curve),
     so the moment's excursions about its mean are what the blade pays for; penalising their
     predicted squares is the convex proxy that keeps the problem a QP. (Penalising the
@@ -55,12 +58,15 @@ import numpy as np
 
 from .._checks import positive_scalar
 from .base import MEASURED, SampledController
-from .lpv import PREDICTED, LPVTurbine, lpv_turbine
+from .lpv import LPVTurbine, lpv_observer, lpv_turbine
 
-__all__ = ["HealthMPC", "health_qp", "health_move", "health_scale", "HEALTH_OSQP"]
+__all__ = ["HealthMPC", "health_qp", "health_move", "health_scale", "HEALTH_OSQP", "REF_MARGIN"]
 
 #: OSQP settings of the constrained QP (tight tolerances, polishing for exact active sets).
 HEALTH_OSQP = {"eps_abs": 1e-9, "eps_rel": 1e-9, "polishing": True, "max_iter": 20000}
+
+#: Largest raise of the speed reference by the integral correction, as a fraction of rated.
+REF_MARGIN = 0.05
 
 
 def health_qp(n_rows: int, horizon: int) -> dict:
@@ -103,7 +109,8 @@ def health_qp(n_rows: int, horizon: int) -> dict:
 
 def health_move(lpv: LPVTurbine, x: np.ndarray, wind: float, pitch_ref: float, uprev: float, moment: float, *,
                 weights: tuple, rated_speed: float, step: float, pitch_limits: tuple, moment_scale: float,
-                speed_ref: float | None = None, qp: dict | None = None, solver: str = "OSQP") -> np.ndarray:
+                speed_ref: float | None = None, measured_moment: float | None = None, qp: dict | None = None,
+                solver: str = "OSQP") -> np.ndarray:
     """Optimal pitch commands of the health-aware QP (module docstring) at one sample.
 
     Parameters
@@ -133,6 +140,10 @@ def health_move(lpv: LPVTurbine, x: np.ndarray, wind: float, pitch_ref: float, u
         M_s (N·m).
     speed_ref : float, optional
         Speed reference (rad/s); default ``rated_speed``.
+    measured_moment : float, optional
+        The blade moment measured now (N·m): the predicted moments are shifted by its difference
+        from the model's moment now (offset-free: the linear model's bias does not count as an
+        excursion). Default: no shift.
     qp : dict, optional
         :func:`health_qp` of matching size; built here when a constraint is active and none is
         given.
@@ -155,6 +166,9 @@ def health_move(lpv: LPVTurbine, x: np.ndarray, wind: float, pitch_ref: float, u
     iw, im, iv = names.index("gen_speed"), names.index("blade_root_my"), names.index("tower_top_vel")
     z0, G = lpv.affine(np.asarray(x, float), float(wind), float(pitch_ref))
     zr, Gr = z0.reshape(N, q), (G * step).reshape(N, q, N)
+    if measured_moment is not None:
+        zr = zr.copy()
+        zr[:, im] += float(measured_moment) - lpv.current(np.asarray(x, float), float(wind))[im]
     Dm = np.eye(N) - np.eye(N, k=-1)
     e1 = np.zeros(N)
     e1[0] = 1.0
@@ -240,13 +254,16 @@ class HealthMPC(SampledController):
         Averaging time (s) of the running mean blade moment M̄.
     speed_integral_time : float or None, default 30
         T_I (s): the speed reference is corrected by the integral of the speed error,
-        Ω_ref ← min(Ω_ref − (T_s/T_I)(Ω − Ω_rated), Ω_rated), so the *mean* speed (and power)
-        does not exceed rated in turbulence, where the aerodynamics' asymmetry would otherwise
-        raise it as the health weight loosens the speed regulation; never above rated, so it
-        does not undo the derating of ``stress_weight``. None: off.
+        Ω_ref ← Ω_ref − (T_s/T_I)(Ω − Ω_rated), so the *mean* speed (and with the constant
+        torque the mean power) stays at rated in turbulence, where the aerodynamics' asymmetry
+        would otherwise shift it as the health weight loosens the speed regulation. The
+        reference stays ≤ (1 + :data:`REF_MARGIN`)·Ω_rated (anti-windup: with a large health
+        weight the speed follows it only loosely), and with ``stress_weight`` > 0 ≤ Ω_rated, so
+        the correction does not undo the derating asked for. None: off.
     lpv : bool, default True
-        Schedule the prediction on the estimated wind (LPV); False: the linearisation at the
-        run's mean wind speed only.
+        Schedule the prediction and the observer on the estimated wind (LPV,
+        :class:`~specdesign.mpc.lpv.LPVObserver`); False: the linearisation at the run's mean
+        wind speed and its fixed Kalman filter only.
     wind_speeds : array_like, optional
         LPV vertices (m/s); default every 1 m/s over the model's range.
     measured : sequence of str, optional
@@ -303,11 +320,12 @@ class HealthMPC(SampledController):
     def _reset_caches(self):
         super()._reset_caches()
         self._lpv = None
+        self._obs = None
         self._qp = None
 
     def __getstate__(self):
         state = super().__getstate__()
-        for k in ("_lpv", "_qp"):
+        for k in ("_lpv", "_obs", "_qp"):
             state.pop(k, None)
         return state
 
@@ -361,6 +379,13 @@ class HealthMPC(SampledController):
             mean[idx] = self._run["points"][v]["moment_scale"]
         self._run["mean_moment"] = mean
         self._run["speed_ref"] = np.full(mean.size, float(self.model.rated_rotor_speed))
+        if self.lpv:
+            if self._obs is None:
+                self._obs = lpv_observer(self.model, self.ts, self.measured, wind_speeds=self.wind_speeds)
+            z = np.empty((mean.size, self._obs.z_trim.shape[1]))
+            for v, idx in self._run["groups"].items():
+                z[idx] = np.append(self._run["points"][v]["x_trim"], v)
+            self._run["zprior"] = z
 
     @property
     def blade_damage(self) -> np.ndarray:
@@ -403,9 +428,10 @@ class HealthMPC(SampledController):
         run["mean_moment"] += min(self.ts / self.mean_time, 1.0) * (moment - run["mean_moment"])
         if self.speed_integral_time is not None:
             rated = float(self.model.rated_rotor_speed)
-            # never above rated: it removes overspeed on average, not a derating asked for
-            run["speed_ref"] = np.minimum(run["speed_ref"] - self.ts / self.speed_integral_time
-                                          * (np.asarray(y["gen_speed"], float) - rated), rated)
+            ref = run["speed_ref"] - self.ts / self.speed_integral_time * (np.asarray(y["gen_speed"], float) - rated)
+            # anti-windup at 5 % above rated; with a derating term never above rated: it must not
+            # undo the derating asked for
+            run["speed_ref"] = np.minimum(ref, rated if self.weights[4] > 0 else (1.0 + REF_MARGIN) * rated)
         elapsed = k * run["dt"]
         ym = np.stack([np.asarray(y[n], float) for n in self.measured], axis=1)
         model = self.model
@@ -414,7 +440,12 @@ class HealthMPC(SampledController):
         for v, idx in run["groups"].items():
             pt = run["points"][v]
             Aa, Ba, Ca, L = pt["kf"]
-            xf = run["xprior"][idx] + (ym[idx] - run["y0"][v] - run["xprior"][idx] @ Ca.T) @ L.T
+            if self.lpv:  # the LPV observer, absolute (states, wind)
+                zf = np.stack([self._obs.update(run["zprior"][r], ym[r]) for r in idx])
+                xs, winds = zf[:, :-1], zf[:, -1]
+            else:  # the fixed-point filter of SampledController, deviations from the run's trim
+                xf = run["xprior"][idx] + (ym[idx] - run["y0"][v] - run["xprior"][idx] @ Ca.T) @ L.T
+                xs, winds = pt["x_trim"] + xf[:, :-1], v + xf[:, -1]
             u = np.empty(idx.size)
             for g, r in enumerate(idx):
                 t0 = time.process_time()
@@ -424,15 +455,18 @@ class HealthMPC(SampledController):
                 if self._qp is None:
                     self._qp = health_qp(4 * self.horizon, self.horizon)
                 beta0 = pt["model"].pitch0
-                cmds = health_move(pt["lpv"], pt["x_trim"] + xf[g, :-1], v + xf[g, -1], beta0,
-                                   beta0 + run["u"][r], run["mean_moment"][r],
+                cmds = health_move(pt["lpv"], xs[g], winds[g], beta0, beta0 + run["u"][r], run["mean_moment"][r],
                                    weights=self.weights[:3] + (psi, self.weights[4]),
                                    rated_speed=float(model.rated_rotor_speed), step=step, pitch_limits=limits,
-                                   moment_scale=pt["moment_scale"], speed_ref=run["speed_ref"][r], qp=self._qp,
-                                   solver=self.solver)
+                                   moment_scale=pt["moment_scale"], speed_ref=run["speed_ref"][r],
+                                   measured_moment=moment[r], qp=self._qp, solver=self.solver)
                 u[g] = cmds[0] - beta0
                 self.solve_times.append(time.process_time() - t0)
             run["u"][idx] = u
-            run["xprior"][idx] = xf @ Aa.T + u[:, None] * Ba
+            if self.lpv:
+                for g, r in enumerate(idx):
+                    run["zprior"][r] = self._obs.predict(zf[g], pt["model"].pitch0 + u[g])
+            else:
+                run["xprior"][idx] = xf @ Aa.T + u[:, None] * Ba
         run["cmd"] = run["beta0"] + run["u"]
         return run["cmd"]

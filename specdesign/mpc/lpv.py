@@ -31,7 +31,7 @@ import numpy as np
 from .._checks import positive_scalar
 from .base import discretize_turbine, prediction_matrices
 
-__all__ = ["LPVTurbine", "lpv_turbine", "PREDICTED"]
+__all__ = ["LPVTurbine", "lpv_turbine", "LPVObserver", "lpv_observer", "PREDICTED"]
 
 #: Outputs the health-aware MPC predicts: generator speed (rad/s), blade-root flapwise moment
 #: (N·m) and tower-top fore-aft velocity (m/s).
@@ -61,6 +61,9 @@ class LPVTurbine:
     Phi, Gamma, Psi : numpy.ndarray
         (K, N·q, n), (K, N·q, N), (K, N·q) condensed predictions of every vertex (step-major rows:
         row j·q + i is output i at step j + 1).
+    C, Dw : numpy.ndarray
+        (K, q, n) and (K, q): the outputs' state and wind matrices of every vertex (the outputs
+        now, :meth:`current`).
     """
 
     wind_speeds: np.ndarray = field(repr=False)
@@ -73,6 +76,30 @@ class LPVTurbine:
     Phi: np.ndarray = field(repr=False)
     Gamma: np.ndarray = field(repr=False)
     Psi: np.ndarray = field(repr=False)
+    C: np.ndarray = field(repr=False)
+    Dw: np.ndarray = field(repr=False)
+
+    def current(self, x: np.ndarray, wind: float) -> np.ndarray:
+        """The predicted outputs at the current sample (step 0).
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            (n,) absolute state (SI).
+        wind : float
+            Wind estimate v̂ (m/s).
+
+        Returns
+        -------
+        numpy.ndarray
+            (q,) outputs (SI), :attr:`output_names`.
+        """
+        i, a = self.alphas(wind)
+        out = np.zeros(len(self.output_names))
+        for j, w in ((i, 1.0 - a), (min(i + 1, self.wind_speeds.size - 1), a)):
+            if w > 0.0:
+                out += w * (self.y_trim[j] + self.C[j] @ (x - self.x_trim[j]) + self.Dw[j] * (wind - self.wind_speeds[j]))
+        return out
 
     def alphas(self, wind: float) -> tuple[int, float]:
         """The active vertex pair and its weight: α_i = 1 − a, α_{i+1} = a.
@@ -89,12 +116,7 @@ class LPVTurbine:
         a : float
             Weight of vertex i + 1, in [0, 1] (held at the end vertices outside the grid).
         """
-        v = self.wind_speeds
-        if v.size == 1:
-            return 0, 0.0
-        i = int(np.clip(np.searchsorted(v, wind, side="right") - 1, 0, v.size - 2))
-        a = float(np.clip((wind - v[i]) / (v[i + 1] - v[i]), 0.0, 1.0))
-        return i, a
+        return _alphas(self.wind_speeds, wind)
 
     def affine(self, x: np.ndarray, wind: float, pitch_ref: float) -> tuple[np.ndarray, np.ndarray]:
         """Prediction as an affine map of the commands: z = z₀ + Γ(α)·(U − β_ref).
@@ -159,6 +181,154 @@ class LPVTurbine:
         return (z0 + G @ u).reshape(self.horizon, len(self.output_names))
 
 
+def _alphas(v, wind):
+    if v.size == 1:
+        return 0, 0.0
+    i = int(np.clip(np.searchsorted(v, wind, side="right") - 1, 0, v.size - 2))
+    return i, float(np.clip((wind - v[i]) / (v[i + 1] - v[i]), 0.0, 1.0))
+
+
+def _check_speeds(model, wind_speeds):
+    lo, hi = (float(v) for v in model.wind_range)
+    if wind_speeds is None:
+        wind_speeds = np.arange(np.ceil(lo), np.floor(hi) + 0.5, 1.0)
+    v = np.atleast_1d(np.asarray(wind_speeds, float))
+    if v.ndim != 1 or v.size < 1 or np.any(np.diff(v) <= 0) or v[0] < lo or v[-1] > hi:
+        raise ValueError(f"wind_speeds={wind_speeds!r} must be increasing, within the model's range {lo:g}-{hi:g} m/s")
+    return v
+
+
+@dataclass(frozen=True, eq=False)  # array fields: compare by identity
+class LPVObserver:
+    """The Kalman filter of :func:`specdesign.mpc.base.kalman_gain` made LPV, scheduled by its own wind estimate.
+
+    The augmented state ζ = (x, v) (the model's states and the rotor-effective wind, absolute,
+    SI) is filtered with the vertex models and gains blended by α(v̂), each vertex in affine
+    form about its trim ζ̄_i = (x̄_i, v_i), as the prediction model of :class:`LPVTurbine`::
+
+        ŷ   = Σ α_i (ȳ_i + C_i (ζ − ζ̄_i))                      (measured outputs)
+        ζ_f = ζ + (Σ α_i L_i)(y − ŷ)                          (update, α at the prior's v̂)
+        ζ⁺  = Σ α_i (ζ̄_i + A_i (ζ_f − ζ̄_i) + B_i (u − β̄_i))   (predict, α at the filtered v̂)
+
+    Observer and predictor then share one model, so the wind estimate that schedules the
+    prediction is the one that explains the measurements with it (a fixed-point filter's
+    estimate would be biased away from its linearisation point).
+
+    Parameters
+    ----------
+    wind_speeds : numpy.ndarray
+        (K,) vertex wind speeds (m/s).
+    measured : tuple of str
+        The q measured outputs.
+    z_trim : numpy.ndarray
+        (K, n+1) trim states with the vertex wind speed last.
+    pitch_trim : numpy.ndarray
+        (K,) trim pitch (rad).
+    y_trim : numpy.ndarray
+        (K, q) measured outputs at the trims (SI).
+    A, B, C, L : numpy.ndarray
+        (K, n+1, n+1), (K, n+1), (K, q, n+1), (K, n+1, q): augmented discrete model and
+        steady-state Kalman gain of every vertex (:func:`specdesign.mpc.base.kalman_gain`).
+    """
+
+    wind_speeds: np.ndarray = field(repr=False)
+    measured: tuple
+    z_trim: np.ndarray = field(repr=False)
+    pitch_trim: np.ndarray = field(repr=False)
+    y_trim: np.ndarray = field(repr=False)
+    A: np.ndarray = field(repr=False)
+    B: np.ndarray = field(repr=False)
+    C: np.ndarray = field(repr=False)
+    L: np.ndarray = field(repr=False)
+
+    def _pairs(self, wind):
+        i, a = _alphas(self.wind_speeds, wind)
+        return [(j, w) for j, w in ((i, 1.0 - a), (min(i + 1, self.wind_speeds.size - 1), a)) if w > 0.0]
+
+    def update(self, z: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Measurement update of one run.
+
+        Parameters
+        ----------
+        z : numpy.ndarray
+            (n+1,) prior estimate (states, wind; absolute SI).
+        y : numpy.ndarray
+            (q,) measured outputs (SI).
+
+        Returns
+        -------
+        numpy.ndarray
+            (n+1,) filtered estimate.
+        """
+        yhat = np.zeros(y.size)
+        gain = np.zeros(self.L.shape[1:])
+        for j, w in self._pairs(z[-1]):
+            yhat += w * (self.y_trim[j] + self.C[j] @ (z - self.z_trim[j]))
+            gain += w * self.L[j]
+        return z + gain @ (y - yhat)
+
+    def predict(self, z: np.ndarray, u: float) -> np.ndarray:
+        """Time update of one run over one sample.
+
+        Parameters
+        ----------
+        z : numpy.ndarray
+            (n+1,) filtered estimate (absolute SI).
+        u : float
+            Pitch command held over the sample (rad, absolute).
+
+        Returns
+        -------
+        numpy.ndarray
+            (n+1,) prior estimate at the next sample.
+        """
+        out = np.zeros(z.size)
+        for j, w in self._pairs(z[-1]):
+            out += w * (self.z_trim[j] + self.A[j] @ (z - self.z_trim[j]) + self.B[j] * (u - self.pitch_trim[j]))
+        return out
+
+
+def lpv_observer(model, ts: float, measured, *, wind_speeds=None) -> LPVObserver:
+    """Build the :class:`LPVObserver` of ``model`` (vertices at ``wind_speeds``).
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine.
+    ts : float
+        Sample time (s).
+    measured : sequence of str
+        Measured outputs (those of :func:`specdesign.mpc.base.kalman_gain`).
+    wind_speeds : array_like, optional
+        Vertex wind speeds (m/s); default every 1 m/s over the model's range.
+
+    Returns
+    -------
+    LPVObserver
+        The observer.
+
+    Raises
+    ------
+    ValueError
+        As :func:`lpv_turbine`, or for an unknown measured output.
+    """
+    from .base import kalman_gain
+
+    ts = positive_scalar(ts, "ts")
+    v = _check_speeds(model, wind_speeds)
+    measured = tuple(measured)
+    parts = {k: [] for k in ("z", "b", "y", "A", "B", "C", "L")}
+    for s in v:
+        dm = discretize_turbine(model, float(s), ts)
+        Aa, Ba, Ca, L = kalman_gain(dm, measured)
+        op = model.trim(float(s))
+        for k, val in zip(parts, (np.append(np.asarray(op.x, float), s), float(op.pitch), dm.y0[dm.rows(measured)],
+                                  Aa, Ba, Ca, L)):
+            parts[k].append(val)
+    st = {k: np.stack(val) if k != "b" else np.array(val) for k, val in parts.items()}
+    return LPVObserver(v, measured, st["z"], st["b"], st["y"], st["A"], st["B"], st["C"], st["L"])
+
+
 def lpv_turbine(model, ts: float, horizon: int, *, wind_speeds=None, outputs=PREDICTED) -> LPVTurbine:
     """Build the LPV prediction model of ``model`` (vertices at ``wind_speeds``).
 
@@ -188,20 +358,18 @@ def lpv_turbine(model, ts: float, horizon: int, *, wind_speeds=None, outputs=PRE
         ``ts`` or a horizon < 1.
     """
     ts = positive_scalar(ts, "ts")
-    lo, hi = (float(v) for v in model.wind_range)
-    if wind_speeds is None:
-        wind_speeds = np.arange(np.ceil(lo), np.floor(hi) + 0.5, 1.0)
-    v = np.atleast_1d(np.asarray(wind_speeds, float))
-    if v.ndim != 1 or v.size < 1 or np.any(np.diff(v) <= 0) or v[0] < lo or v[-1] > hi:
-        raise ValueError(f"wind_speeds={wind_speeds!r} must be increasing, within the model's range {lo:g}-{hi:g} m/s")
+    v = _check_speeds(model, wind_speeds)
     outputs = tuple(outputs)
-    mats, xs, bs, ys = [], [], [], []
+    mats, xs, bs, ys, cs, ds = [], [], [], [], [], []
     for s in v:
         dm = discretize_turbine(model, float(s), ts)
         mats.append(prediction_matrices(dm, outputs, horizon))
+        cs.append(dm.C[dm.rows(outputs)])
+        ds.append(dm.Dw[dm.rows(outputs)])
         op = model.trim(float(s))
         xs.append(np.asarray(op.x, float))
         bs.append(float(op.pitch))
         ys.append(dm.y0[dm.rows(outputs)])
     Phi, Gam, Psi = (np.stack([m[k] for m in mats]) for k in range(3))
-    return LPVTurbine(v, ts, int(horizon), outputs, np.stack(xs), np.array(bs), np.stack(ys), Phi, Gam, Psi)
+    return LPVTurbine(v, ts, int(horizon), outputs, np.stack(xs), np.array(bs), np.stack(ys), Phi, Gam, Psi,
+                      np.stack(cs), np.stack(ds))
