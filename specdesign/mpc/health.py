@@ -27,9 +27,8 @@ its current estimate. Mapped onto this workbench's reduced model:
     so the moment's excursions about its mean are what the blade pays for; penalising their
     predicted squares is the convex proxy that keeps the problem a QP. (Penalising the
     increments M_j − M_{j−1} instead does the opposite of what is wanted: with the wind held
-    over the horizon the increments are the pitch's own doing, and the controller stops
-    pitching against gusts; on the IEA 15 MW at 19 m/s a weight of 100 raised the blade DEL
-    by 15 %.)
+    over the horizon the increments are the pitch's own doing: the controller stops pitching
+    against gusts and the blade DEL rises instead of falling.)
 
   The health weight can follow the blades' measured health: with ``del_budget`` (a 1 Hz DEL
   the blade may accumulate, N·m), the online rainflow + Miner damage D(k) of the measured

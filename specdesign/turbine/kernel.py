@@ -50,8 +50,8 @@ shipped with the ``rosco`` package (``Examples/Test_Cases/IEA-15-240-RWT/IEA-15-
 linearizations``); the fitted moment is within 2.7 % of OpenFAST's from 7 to 24 m/s
 (``tests/test_blade_moment.py`` checks it where the deck is installed). OpenFAST's RootMyc also
 carries the blades' weight and centrifugal terms, which the fit absorbs at the mean only; the
-fluctuation is that of the thrust (no blade dynamics: the blade's first flap mode, ~4 rad/s, is
-far above the tower mode and the pitch loop). The same fraction of R serves other rotors (an
+fluctuation is that of the thrust (no blade dynamics: the blade's first flap mode is well above
+the tower mode and the pitch loop). The same fraction of R serves other rotors (an
 approximation: c₀ is generic, c₁ and c₂ are the IEA 15 MW's).
 
 Pitch actuator: β̈ = ω_a²(β_cmd − β) − 2ζ_a ω_a β̇ₛ with ω_a = 3.14 rad/s, ζ_a = 0.707; the
