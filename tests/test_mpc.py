@@ -11,9 +11,13 @@ import numpy as np
 import pytest
 import scipy.optimize
 
-from specdesign.mpc import DiscreteTurbine, QuadraticMPC, quadratic_qp
+from specdesign.fatigue import VarianceDamageFit, fit_variance_damage
+from specdesign.mpc import (ClonedController, CloningRegressor, DiscreteTurbine, EconomicMPC, FatigueTerm,
+                            OpenLoopPlayback, QuadraticMPC, clone, demonstrations, discretize_turbine,
+                            economic_open_loop, economic_problem, fit_fatigue_terms, quadratic_qp, surrogate_cost)
 from specdesign.simulate import simulate
 from specdesign.turbine import iea15mw, rosco_baseline
+from specdesign.wind import wind_series
 
 
 @pytest.fixture(scope="module")
@@ -168,11 +172,6 @@ def test_controllers_pickle_and_run_through_a_campaign(model):
 
 
 # ----------------------------------------------------------------------------- economic cost (Eq. 4)
-from specdesign.fatigue import VarianceDamageFit, fit_variance_damage  # noqa: E402
-from specdesign.mpc import (ClonedController, CloningRegressor, EconomicMPC, FatigueTerm, OpenLoopPlayback,  # noqa: E402
-                            clone, demonstrations, discretize_turbine, economic_open_loop, economic_problem,
-                            fit_fatigue_terms, surrogate_cost)
-from specdesign.wind import wind_series  # noqa: E402
 
 
 def test_surrogate_cost_is_equation_4_evaluated_directly():

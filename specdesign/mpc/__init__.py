@@ -19,7 +19,7 @@ from __future__ import annotations
 from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine, kalman_gain, prediction_matrices
 from .cloning import ClonedController, CloningRegressor, Demonstrations, OpenLoopPlayback, clone, demonstrations
 from .economic import (WOHLER, EconomicMPC, FatigueTerm, OpenLoopResult, economic_open_loop, economic_problem,
-                       fit_fatigue_terms, surrogate_cost)
+                       fit_fatigue_terms, solve_cone, surrogate_cost)
 from .quadratic import QuadraticMPC, quadratic_qp
 
 __all__ = [
@@ -29,6 +29,7 @@ __all__ = [
     "FatigueTerm",
     "fit_fatigue_terms",
     "surrogate_cost",
+    "solve_cone",
     "economic_problem",
     "economic_open_loop",
     "OpenLoopResult",

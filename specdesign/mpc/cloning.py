@@ -34,7 +34,7 @@ import numpy as np
 
 from .._checks import positive_scalar
 from .base import MEASURED, SampledController, discretize_turbine
-from .economic import economic_problem
+from .economic import economic_problem, solve_cone
 
 __all__ = ["Demonstrations", "demonstrations", "CloningRegressor", "ClonedController", "OpenLoopPlayback", "clone",
            "UPREV"]
@@ -182,9 +182,9 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
                     t0 = time.process_time()
                     pb["x0"].value, pb["d"].value = xhat[g, :-1], np.full(N, xhat[g, -1])
                     pb["uprev"].value = uprev[g:g + 1]
-                    pb["problem"].solve(solver="CLARABEL")
+                    ok = solve_cone(pb["problem"])
                     cpu.append(time.process_time() - t0)
-                    if pb["problem"].status not in ("optimal", "optimal_inaccurate"):
+                    if not ok:
                         continue  # an unlabelled state is left out, not guessed
                     feats.append(np.concatenate([xhat[g], [uprev[g], vv]]))
                     targs.append(float(pb["v"].value[0]) * pb["step"])
@@ -192,6 +192,18 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
     finally:
         behaviour.record(False)
     return Demonstrations(np.array(feats), np.array(targs), np.array(sd), ts, np.array(cpu))
+
+
+_POOLS = []
+
+
+def _threadpools():
+    """threadpoolctl's controller, built once (it scans the loaded libraries: milliseconds)."""
+    if not _POOLS:
+        from threadpoolctl import ThreadpoolController  # a scikit-learn dependency
+
+        _POOLS.append(ThreadpoolController())
+    return _POOLS[0]
 
 
 def clone(model, wind_speeds, seeds, terms, *, rounds: int = 2, ts: float = 0.2, **kw) -> tuple:
@@ -202,7 +214,8 @@ def clone(model, wind_speeds, seeds, terms, *, rounds: int = 2, ts: float = 0.2,
     model : TurbineModel
         The turbine.
     wind_speeds : sequence of float
-        Mean wind speeds (m/s) of the rollouts.
+        Mean wind speeds (m/s) of the rollouts; one regressor is fitted per speed, and the
+        clone runs at these speeds only (:class:`ClonedController`).
     seeds : sequence of int
         Wind seeds of the rollouts (use other seeds to evaluate the clone).
     terms : sequence of FatigueTerm
@@ -230,12 +243,20 @@ def clone(model, wind_speeds, seeds, terms, *, rounds: int = 2, ts: float = 0.2,
     """
     if isinstance(rounds, bool) or not isinstance(rounds, (int, np.integer)) or rounds < 1:
         raise ValueError(f"rounds={rounds!r} must be an integer >= 1")
-    demos = demonstrations(model, wind_speeds, seeds, terms, ts=ts, **kw)
-    ctrl = ClonedController(model, CloningRegressor().fit(demos), ts)
+    speeds = [float(v) for v in np.atleast_1d(np.asarray(wind_speeds, float))]
+    # one regressor per operating point, as gains are scheduled: the expert's feedback gains
+    # change with the wind speed more than one linear stage plus trees fit well
+    demos = {v: demonstrations(model, [v], seeds, terms, ts=ts, **kw) for v in speeds}
+    ctrl = ClonedController(model, {v: CloningRegressor().fit(d) for v, d in demos.items()}, ts)
     for _ in range(int(rounds) - 1):
-        demos = demos.join(demonstrations(model, wind_speeds, seeds, terms, behaviour=ctrl, ts=ts, **kw))
-        ctrl = ClonedController(model, CloningRegressor().fit(demos), ts)
-    return ctrl, demos
+        demos = {v: d.join(demonstrations(model, [v], seeds, terms, behaviour=ctrl, ts=ts, **kw))
+                 for v, d in demos.items()}
+        ctrl = ClonedController(model, {v: CloningRegressor().fit(d) for v, d in demos.items()}, ts)
+    every = list(demos.values())
+    joined = every[0]
+    for d in every[1:]:
+        joined = joined.join(d)
+    return ctrl, joined
 
 
 class CloningRegressor:
@@ -311,7 +332,10 @@ class CloningRegressor:
         if self.linear is None:
             raise RuntimeError("CloningRegressor.fit(demos) must be called before predict")
         features = np.asarray(features, float)
-        return features[:, UPREV] + self.linear.predict(features) + self.trees.predict(features)
+        # one thread: for the few rows of a control step, OpenMP's thread start-up costs ~50×
+        # the prediction itself (45 ms against 0.6 ms of CPU for 4 rows)
+        with _threadpools().limit(limits=1, user_api="openmp"):
+            return features[:, UPREV] + self.linear.predict(features) + self.trees.predict(features)
 
     def score(self, demos: Demonstrations, *, moves: bool = True) -> float:
         """R² of the predictions on demonstrations (1 − SS_res/SS_tot).
@@ -341,12 +365,16 @@ class ClonedController(SampledController):
     ----------
     model : TurbineModel
         The turbine.
-    regressor : CloningRegressor
-        Fitted on :func:`demonstrations`.
+    regressor : CloningRegressor or dict
+        Fitted on :func:`demonstrations`: one for every operating point, or wind speed (m/s)
+        → regressor, the nearest used at each run's wind speed (within ``max_gap``).
     ts : float, default 0.2
         Sample time (s), that of the demonstrations.
     measured : sequence of str, optional
         Outputs the Kalman filter reads.
+    max_gap : float, default 1.0
+        Largest distance (m/s) from a run's wind speed to the nearest trained speed: a clone
+        knows only the operating points it was shown.
     name : str, default "behavioural cloning"
         Label.
 
@@ -355,16 +383,46 @@ class ClonedController(SampledController):
     saturated : int
         Commands the rate or position limits cut since the last :meth:`start`.
     solve_times : list of float
-        CPU time (s) per sample (all runs of an operating point at once, divided by their number).
+        CPU time (s) per sample and run (the runs of an operating point are predicted at once;
+        their time is shared).
     """
 
-    def __init__(self, model, regressor: CloningRegressor, ts: float = 0.2, measured=MEASURED,
+    def __init__(self, model, regressor, ts: float = 0.2, measured=MEASURED, max_gap: float = 1.0,
                  name: str = "behavioural cloning"):
-        if not isinstance(regressor, CloningRegressor) or regressor.linear is None:
-            raise TypeError("regressor must be a fitted CloningRegressor (CloningRegressor().fit(demos))")
-        self.regressor = regressor
+        regs = regressor if isinstance(regressor, dict) else {None: regressor}
+        if not regs or not all(isinstance(r, CloningRegressor) and r.linear is not None for r in regs.values()):
+            raise TypeError("regressor must be a fitted CloningRegressor (CloningRegressor().fit(demos)) "
+                            "or a dict wind speed → fitted CloningRegressor")
+        self.regressors = {None if k is None else float(k): r for k, r in regs.items()}
+        self.max_gap = positive_scalar(max_gap, "max_gap")
         self.saturated = 0
         super().__init__(model, ts, measured, name)
+
+    def build(self, dm) -> dict:
+        """The regressor of the operating point.
+
+        Parameters
+        ----------
+        dm : DiscreteTurbine
+            The discrete model there.
+
+        Returns
+        -------
+        dict
+            ``{"regressor": ...}``.
+
+        Raises
+        ------
+        ValueError
+            If no regressor was trained within ``max_gap`` of its wind speed.
+        """
+        if None in self.regressors:
+            return {"regressor": self.regressors[None]}
+        near = min(self.regressors, key=lambda v: abs(v - dm.wind_speed))
+        if abs(near - dm.wind_speed) > self.max_gap:
+            raise ValueError(f"{self.name}: no clone trained within {self.max_gap:g} m/s of {dm.wind_speed:g} m/s "
+                             f"(trained at {sorted(self.regressors)}); clone at this wind speed too")
+        return {"regressor": self.regressors[near]}
 
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
         """Initialise the runs (see :meth:`SampledController.start`) and the saturation count.
@@ -403,7 +461,7 @@ class ClonedController(SampledController):
         t0 = time.process_time()
         dm = pt["model"]
         X = np.column_stack([xhat, uprev, np.full(uprev.size, dm.wind_speed)])
-        u = self.regressor.predict(X)
+        u = pt["regressor"].predict(X)
         step = float(self.model.pitch_rate_limit) * self.ts
         lo = np.maximum(uprev - step, float(self.model.pitch_min) - dm.pitch0)
         hi = np.minimum(uprev + step, float(self.model.pitch_max) - dm.pitch0)

@@ -35,11 +35,36 @@ from .._checks import positive_scalar
 from ..fatigue import VarianceDamageFit, economic_cost, fit_variance_damage
 from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine
 
-__all__ = ["FatigueTerm", "fit_fatigue_terms", "surrogate_cost", "economic_problem", "economic_open_loop",
-           "OpenLoopResult", "EconomicMPC", "WOHLER"]
+__all__ = ["solve_cone", "FatigueTerm", "fit_fatigue_terms", "surrogate_cost", "economic_problem",
+           "economic_open_loop", "OpenLoopResult", "EconomicMPC", "WOHLER"]
 
 #: Wöhler exponents of the priced components: steel tower (4), glass-fibre blade root (10).
 WOHLER = {"tower_base_my": 4.0, "blade_root_my": 10.0}
+
+
+def solve_cone(problem) -> bool:
+    """Solve a compiled cvxpy cone problem by Clarabel, SCS if Clarabel fails numerically.
+
+    Parameters
+    ----------
+    problem : cvxpy.Problem
+        The problem, parameters set.
+
+    Returns
+    -------
+    bool
+        Whether an optimal (or optimal-inaccurate) solution was found.
+    """
+    import cvxpy as cp
+
+    for solver, opts in (("CLARABEL", {}), ("SCS", {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iters": 20000})):
+        try:
+            problem.solve(solver=solver, **opts)
+        except cp.error.SolverError:
+            continue  # Clarabel's rare numerical breakdowns on a far-off state: the first-order solver still converges
+        if problem.status in ("optimal", "optimal_inaccurate"):
+            return True
+    return False
 
 
 @dataclass(frozen=True)
@@ -84,8 +109,11 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
     seeds : sequence of int, optional
         Turbulence seeds per class.
     prices : dict, optional
-        Output → π (default {"tower_base_my": 1.0}, plus "blade_root_my": 1.0 when the model
-        has that output). Each output needs a Wöhler exponent in :data:`WOHLER`.
+        Output → π, currency per unit damage. Default: the tower base and, when the model has
+        that output, the blade root, each priced 1/D_ref (D_ref its predicted damage at the
+        fitting records' mean variance), so J̃_fat = Σ D_i/D_ref,i weighs each component's
+        damage relative to ROSCO's and needs no ultimate loads. Each output needs a Wöhler
+        exponent in :data:`WOHLER`.
     ultimate : dict, optional
         Output → L_ult (load units; default 1.0: only the ratios π_i/L_ult,i^{m_i} between
         priced components matter).
@@ -113,10 +141,9 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
     if window > duration / 2:
         raise ValueError(f"window={window} s must be at most half of duration={duration} s (two records per run)")
     names = tuple(model.output_names)
-    if prices is None:
-        prices = {"tower_base_my": 1.0}
-        if "blade_root_my" in names:
-            prices["blade_root_my"] = 1.0
+    relative = prices is None
+    if relative:
+        prices = {o: 1.0 for o in ("tower_base_my", "blade_root_my") if o in names}
     for out in prices:
         if out not in names:
             raise ValueError(f"priced output {out!r} is not an output of the model {names}")
@@ -135,7 +162,8 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
         if fit.a < 1:
             raise ValueError(f"the fitted exponent a={fit.a:.3f} of {out!r} is below 1: Var^a is not convex "
                              "(module docstring); fit on more varied records or another window")
-        terms.append(FatigueTerm(out, fit, float(price), float(np.mean([np.var(x) for x in recs]))))
+        ref = float(np.mean([np.var(x) for x in recs]))
+        terms.append(FatigueTerm(out, fit, 1.0 / float(fit.predict(ref)) if relative else float(price), ref))
     return tuple(terms)
 
 
@@ -238,7 +266,8 @@ def economic_problem(dm: DiscreteTurbine, terms, horizon: int, *, speed_weight: 
         # a (1,) vector: cvxpy's exact power cone refuses a scalar argument (shape mismatch)
         var = cp.reshape(cp.sum_squares(y - cp.sum(y) / N) / N, (1,), order="C")  # Var(y) / Var_ref (Eq. 2)
         # π e^b Var^a / L^m = (π D(Var_ref)) · (Var/Var_ref)^a, divided by J̃_ref
-        fatigue = fatigue + (t.price * t.fit.predict(t.reference_variance) / scale) * cp.sum(cp.power(var, t.fit.a, approx=False))
+        weight = t.price * float(t.fit.predict(t.reference_variance)) / scale
+        fatigue = fatigue + weight * cp.sum(cp.power(var, t.fit.a, approx=False))
     w = dm.rows(["gen_speed"])[0]
     speed = cp.sum_squares((dm.C[w] @ x[:, 1:]) / rated_speed) / N
     cost = fatigue + float(speed_weight) * speed + float(activity_weight) * cp.sum_squares(dv) / N
@@ -344,8 +373,7 @@ def economic_open_loop(model, wind_speed: float, wind, wind_dt: float, terms, *,
     problem["x0"].value = np.zeros(dm.A.shape[0])
     problem["d"].value = w[:N] - dm.wind_speed
     problem["uprev"].value = np.zeros(1)
-    problem["problem"].solve(solver="CLARABEL")
-    if problem["problem"].status not in ("optimal", "optimal_inaccurate"):
+    if not solve_cone(problem["problem"]):
         raise RuntimeError(f"the economic open-loop problem is {problem['problem'].status}")
     u = np.asarray(problem["v"].value, float) * problem["step"]
     X = np.asarray(problem["x"].value, float).T
@@ -444,8 +472,7 @@ class EconomicMPC(SampledController):
             pb["x0"].value = xhat[g, :-1]
             pb["d"].value = np.full(self.horizon, xhat[g, -1])
             pb["uprev"].value = np.array([uprev[g]])
-            pb["problem"].solve(solver="CLARABEL")
-            if pb["problem"].status not in ("optimal", "optimal_inaccurate"):
+            if not solve_cone(pb["problem"]):
                 raise RuntimeError(f"{self.name}: the economic problem is {pb['problem'].status}")
             step = pb["step"]
             # the interior-point solution sits a hair inside the bounds; the applied move is
