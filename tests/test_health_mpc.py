@@ -229,3 +229,18 @@ def test_health_mpc_errors(model):
         HealthMPC(model, health_weight=-1.0)
     with pytest.raises(RuntimeError, match="start"):
         HealthMPC(model)(0.0, {})
+
+
+def test_health_weight_follows_the_damage_budget(model):
+    # with a blade DEL budget far below what the blade accumulates (≈ 5 MN·m at 19 m/s), the
+    # health factor DEL(k)/budget (health_scale, from the online D(k)) grows above 1, the
+    # weight with it, and the blade DEL falls below that of the same weight without a budget
+    dels, factors = {}, {}
+    for budget in (None, 1e6):
+        mpc = HealthMPC(model, health_weight=3.0, del_budget=budget, budget_prior=10.0)
+        r = simulate(model, mpc, [19.0], seeds=[1], duration=120.0, transient=20.0)
+        dels[budget] = del_rainflow(r["blade_root_my"][0, 0], 10.0, 120.0)
+        if budget is not None:
+            factors[budget] = health_scale(mpc.blade_damage[0], 140.0, 10.0, 10.0)
+    assert factors[1e6] > 2.0
+    assert dels[1e6] < 0.9 * dels[None]
