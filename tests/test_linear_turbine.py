@@ -88,6 +88,16 @@ def test_linear_prediction_matches_the_model(model, lt, v):
     assert_allclose(got.psd, ref.psd, rtol=1e-10, atol=1e-14 * ref.psd.max())
 
 
+def test_scheduled_controller_is_blended_at_the_sets_trim_pitch(model, lt):
+    # ROSCO's gain-scheduled form: the blend weights come from trim(v).pitch, the model's here
+    from specdesign.rosco import rosco_scheduled
+
+    c = rosco_scheduled(model)
+    for v in (17.0, 21.0):
+        ref, got = linear_prediction(model, c, v), linear_prediction(lt, c, v)
+        assert got.del_ == pytest.approx(ref.del_, rel=1e-12)
+
+
 def test_plants_dict_route_equals_model_route(model, lt):
     from specdesign.rosco import rosco_gain_schedule
 
