@@ -388,8 +388,9 @@ class HealthMPC(SampledController):
 
     @property
     def blade_damage(self) -> np.ndarray:
-        """(R,) online Miner damage D(k) of each run's blade moment (closed cycles; S_ref =
-        ``del_budget``, or 1 MN·m without one)."""
+        """(R,) online Miner damage D(k) of each run's blade moment since the simulation started
+        (the discarded transient included; closed cycles; S_ref = ``del_budget``, or 1 MN·m
+        without one)."""
         run = getattr(self, "_run", None)
         return np.array([] if run is None else [d.damage for d in run["damage"]])
 
