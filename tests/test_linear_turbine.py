@@ -278,18 +278,13 @@ def test_plant_from_linearization_reports_signals(sample):
     assert plant.output_labels[:2] == ["gen_speed", "tower_base_my"]
 
 
-# ----------------------------------------------------------------------------- designs (need the diffs of the report)
+# ----------------------------------------------------------------------------- designs
 @pytest.fixture(scope="module")
 def cases_lt(model):
     # the designs' plant cases are v ± 0.5, ± 1 m/s: stored, not interpolated, so the oracle is exact
     return LinearTurbine.from_model(model, (18.0, 18.5, 19.0, 19.5, 20.0))
 
 
-_DIFF = ("needs the model-dispatch diff of issue 15 part 2's report (qft/hinf/feasibility call rosco_baseline / "
-         "rosco_gain_schedule on the model, or check isinstance TurbineModel)")
-
-
-@pytest.mark.xfail(strict=True, reason=_DIFF)
 def test_pitch_feasibility_on_floating(floating):
     from specdesign.feasibility import pitch_feasibility
 
@@ -297,7 +292,6 @@ def test_pitch_feasibility_on_floating(floating):
     assert pitch_feasibility(floating, 19.0, ds.base.system, ds.speed).feasible  # the baseline meets its own
 
 
-@pytest.mark.xfail(strict=True, reason=_DIFF)
 def test_specification_for_target_on_linear_turbine(model, cases_lt):
     # oracle: the same plants and baseline through the model's route give the same specification
     from specdesign.feasibility import specification_for_target
@@ -308,7 +302,6 @@ def test_specification_for_target_on_linear_turbine(model, cases_lt):
     assert got.promise.exact_del == pytest.approx(ref.promise.exact_del, rel=1e-6)
 
 
-@pytest.mark.xfail(strict=True, reason=_DIFF)
 def test_design_qft_on_linear_turbine(model, cases_lt):
     from specdesign.qft import design_qft
 
@@ -316,7 +309,6 @@ def test_design_qft_on_linear_turbine(model, cases_lt):
     assert got.success == ref.success and got.del_reduction == pytest.approx(ref.del_reduction, rel=1e-6)
 
 
-@pytest.mark.xfail(strict=True, reason=_DIFF)
 def test_design_hinf_on_linear_turbine(model, cases_lt):
     from specdesign.hinf import design_hinf
 

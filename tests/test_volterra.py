@@ -70,6 +70,9 @@ def test_load_inputs_of_the_linearisation(model):
     assert_allclose(sys.B[:, 3:], b, rtol=1e-6, atol=1e-15)
     d = np.zeros((len(turbine.OUTPUT_NAMES), 2))
     d[turbine.OUTPUT_NAMES.index("tower_top_acc"), 1] = 1 / model.tower_modal_mass
+    # blade_root_my = r_T(β)·T/3: an added thrust moves it by r_T(β₀)·R/3 (specdesign.turbine.kernel)
+    from specdesign.turbine.kernel import thrust_centre
+    d[turbine.OUTPUT_NAMES.index("blade_root_my"), 1] = thrust_centre(model.trim(V).pitch) * model.rotor_radius / 3
     assert_allclose(sys.D[:, 3:], d, rtol=1e-6, atol=1e-15)
 
 

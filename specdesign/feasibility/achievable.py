@@ -186,7 +186,6 @@ class YoulaProblem:
 
         from .. import spec
         from ..closedloop import frequency_response, siso_response
-        from ..rosco import rosco_baseline
         from ..spectral import trapezoid_weights
 
         kappa = positive_scalar(max_pitch_rate_ratio, "max_pitch_rate_ratio")
@@ -222,7 +221,7 @@ class YoulaProblem:
         # pitch-rate activity: the rate spectrum |ω·T_{β,w}|²S_W, T_{β,w} = −P_{Ω,w}Y, integrated
         # (trapezoid weights), at most κ² times ROSCO's
         tw = trapezoid_weights(w)
-        c_ref = siso_response(rosco_baseline(model, self.wind_speed), w)
+        c_ref = siso_response(spec.baseline_controller(model, self.wind_speed), w)
         rate_ref = float(np.sum(tw * np.abs(w * c_ref * self.ow / (1 + c_ref * self.ob)) ** 2 * base.wind_psd))
         rl = (w * self.ow)[:, None] * phi_o * np.sqrt(tw * base.wind_psd / rate_ref)[:, None]  # scaled to ROSCO's: O(1)
         constraints.append(cp.sum_squares(rl.real @ y) + cp.sum_squares(rl.imag @ y) <= kappa ** 2)

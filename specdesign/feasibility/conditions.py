@@ -53,9 +53,10 @@ def _rhp_zeros(plant):
     import control
 
     sub = control.ss(plant)["gen_speed", "pitch_cmd"]
-    z = np.asarray(control.tf(sub).zeros(), complex)
-    # the numerator of a channel carries spurious huge roots (leading coefficients ~ 0)
-    return z[(z.real > 0) & (np.abs(z) < 1e6)]
+    # state-space (invariant) zeros: a transfer function's numerator of an OpenFAST-sized plant
+    # (~100 states) has spurious roots, and leading coefficients ~ 0 give huge ones
+    z = np.asarray(sub.zeros(), complex)
+    return z[(z.real > 0) & np.isfinite(z) & (np.abs(z) < 1e6)]
 
 
 def _poisson_kernel(z):
@@ -288,7 +289,6 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=
     """
     from .. import spec
     from ..closedloop import refine_grid, t_tower_wind
-    from ..rosco import rosco_baseline
 
     v = float(wind_speed)
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
@@ -299,7 +299,7 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=
     if omega is None and zeros0.size:
         w = refine_grid(w, zeros0, rel_width=0.2, rel_step=2e-4)
     ws = _magnitude(speed_spec, w, "speed_spec")
-    t_rosco = np.abs(t_tower_wind(model.linearize(v), rosco_baseline(model, v), w))
+    t_rosco = np.abs(t_tower_wind(model.linearize(v), spec.baseline_controller(model, v), w))
     out = []
     for plant in plants:
         d = sensitivity_disks(plant, w, np.ones(w.shape), ws, max_sensitivity)

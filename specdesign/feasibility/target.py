@@ -232,11 +232,10 @@ class _Cases:
     """The plant cases and ROSCO's loops on them, for the certificate's robustness check."""
 
     def __init__(self, model, speeds, v):
-        from ..rosco import rosco_baseline, rosco_gain_schedule
+        from ..spec import baseline_controllers
 
         self.plants = [model.linearize(s) for s in speeds]
-        schedule = rosco_gain_schedule(model)  # once for every case (the same fit each call would redo)
-        self.rosco = [rosco_baseline(model, s, schedule=schedule) for s in speeds]
+        self.rosco = baseline_controllers(model, speeds)  # ROSCO's schedule fitted once for every case
         self.nom = speeds.index(v)
         self._grid = {}
 

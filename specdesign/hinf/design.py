@@ -491,7 +491,7 @@ def design_hinf(
 def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, measurements, order, w_pitch, m,
                  suboptimality, reduction_method, dt, min_damping, decay_rate, integral_corner, **plant_options):
     """One synthesis, reduction and assessment of :func:`design_hinf` on fixed specifications."""
-    from .. import closedloop, spec, spectral, turbine, wind
+    from .. import closedloop, spec, spectral, wind
 
     plant = model.linearize(v)
     Wt, Ws = siso_weight(w_tower, "w_tower"), siso_weight(w_speed, "w_speed")
@@ -525,7 +525,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, 
             f"the {order}-state reduced controller does not stabilise the turbine at {v:g} m/s "
             f"(reduction error {red.error_hinf:.3g}); raise order"
         )
-    rosco = turbine.rosco_baseline(model, v)
+    rosco = spec.baseline_controller(model, v)
     cl0 = closedloop.closed_loop(plant, rosco, warn=False)
     cl_full = closed_loop_mimo(plant, K_full, measurements)
     omega = refine_grid(base.omega, [

@@ -160,7 +160,7 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     from loopshaping import qft as lqft
 
     from .. import spec as sp
-    from ..rosco import rosco_baseline, rosco_gain_schedule
+    from ..spec import baseline_controllers
     from .design import DEFAULT_DESIGN_OMEGA
 
     if not max_sensitivity > 1:
@@ -172,8 +172,7 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     w = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
     plants = [model.linearize(s) for s in speeds]
     R = plant_responses(plants, w, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
-    schedule = rosco_gain_schedule(model)
-    c = np.stack([siso_response(rosco_baseline(model, s, schedule=schedule), w) for s in speeds], axis=1)
+    c = np.stack([siso_response(c, w) for c in baseline_controllers(model, speeds)], axis=1)
     t_tower, t_speed = closed_map(R, c, 0.0, "tower_base_my"), closed_map(R, c, 0.0, "gen_speed")
     if speed_spec is None:
         speed_spec = sp.speed_specification(model, v, margin_db=3.0)

@@ -427,8 +427,9 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
     from .. import turbine
 
-    if not isinstance(model, turbine.TurbineModel):
-        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()), got {type(model).__name__}")
+    if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
+        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
+                        f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
     if isinstance(spec, str) and spec not in ("target", "notch"):
         raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
                          "(tower, speed)")
@@ -503,8 +504,9 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
     from .. import spec as sp
     from .. import turbine
 
-    if not isinstance(model, turbine.TurbineModel):
-        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()), got {type(model).__name__}")
+    if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
+        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
+                        f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
     v = model.check_wind_speed(wind_speed)
     t = None if given is not None else float(target_reduction)
     if t is not None and not 0 < t < 100:

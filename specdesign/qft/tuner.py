@@ -111,12 +111,12 @@ class TuningProblem:
                  tower_shaping: Callable[[np.ndarray], np.ndarray], speed_relax_db: float, max_sensitivity: float,
                  base: Baseline, speed_shaping: Callable[[np.ndarray], np.ndarray] | None = None,
                  response_method: str = "python-control") -> None:
-        from .. import turbine
+        from ..spec import baseline_controllers
 
         self.v, self.speeds, self.nom = v, speeds, nominal
         self.response_method = response_method  # plant_responses' method, for every evaluation of the plants
         self.plants = [model.linearize(s) for s in speeds]
-        self.rosco = [turbine.rosco_baseline(model, s) for s in speeds]
+        self.rosco = baseline_controllers(model, speeds)
         self.tower_shaping = tower_shaping  # callable ω → complex shaping (notches × relaxation)
         self.speed_gain = 10 ** (speed_relax_db / 20)
         self.speed_shaping = speed_shaping  # callable ω → W_Ω/T^ROSCO_{Ω,w} (nominal), or None: speed_gain

@@ -267,7 +267,7 @@ class TurbineModel:
         Returns
         -------
         numpy.ndarray
-            (6,) outputs (:data:`OUTPUT_NAMES`, SI).
+            (7,) outputs (:data:`OUTPUT_NAMES`, SI).
 
         Raises
         ------
@@ -441,7 +441,7 @@ class TurbineModel:
         Returns
         -------
         A, B, C, D : numpy.ndarray
-            (5, 5), (5, 3), (6, 5), (6, 3) matrices of :func:`specdesign.turbine.rhs` /
+            (5, 5), (5, 3), (7, 5), (7, 3) matrices of :func:`specdesign.turbine.rhs` /
             :func:`specdesign.turbine.outputs` in (state, input) (SI).
         """
         x0 = np.array(op.x, dtype=float)

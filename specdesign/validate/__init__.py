@@ -45,12 +45,12 @@ from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
 from .campaign import Campaign, check_campaign_step, check_plant_step, concat_campaigns, run_campaign, seeds_from
 from .lifetime_del import DEL_CHANNELS, LifetimeDEL, WindClimate, lifetime, weibull_bins, wind_climate
 from .metrics import INDICATORS, Indicators, indicators
-from .prediction import LinearPrediction, closed_loop_response, linear_prediction, prediction_grid
+from .prediction import LinearPrediction, closed_loop_response, linear_prediction, loop_plant, prediction_grid
 from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, weibull_weights,
                     welch_psd)
 from .surrogate import (CONDITIONS, DelData, GPSurrogate, LookupTable, SurrogateComparison, SurrogatePrediction,
                         compare_surrogates, del_data, fit_gp, fit_lut)
-from .tables import Acceptance, Table, acceptance, table2, table3
+from .tables import Acceptance, Table, acceptance, linear_table3, table2, table3
 from .volterra import VolterraPrediction, volterra_prediction, volterra_response
 
 __all__ = [
@@ -61,7 +61,7 @@ __all__ = [
     # OpenFAST outputs (home: specdesign.openfast)
     "OPENFAST_CHANNELS", "series_from_openfast",
     # prediction
-    "closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction",
+    "closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction", "loop_plant",
     # volterra
     "volterra_response", "VolterraPrediction", "volterra_prediction",
     # campaign
@@ -70,7 +70,7 @@ __all__ = [
     "CONDITIONS", "DelData", "del_data", "SurrogatePrediction", "GPSurrogate", "fit_gp", "LookupTable", "fit_lut",
     "SurrogateComparison", "compare_surrogates",
     # tables
-    "Table", "table2", "table3", "Acceptance", "acceptance",
+    "Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance",
     # lifetime
     "DEL_CHANNELS", "WindClimate", "weibull_bins", "wind_climate", "LifetimeDEL", "lifetime",
 ]
