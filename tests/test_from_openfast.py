@@ -13,7 +13,14 @@ import shutil
 import numpy as np
 import pytest
 
-from specdesign.rosco import from_discon, read_discon, rosco_gain_schedule, rosco_scheduled, rosco_test_cases
+from specdesign.rosco import (
+    from_discon,
+    read_discon,
+    rosco_gain_schedule,
+    rosco_scheduled,
+    rosco_test_cases,
+    write_discon,
+)
 from specdesign.turbine import TurbineModel, from_openfast
 
 
@@ -115,3 +122,34 @@ def test_simulate_synthesises_the_wind_for_the_models_rotor(nrel5mw):
     given = simulate(nrel5mw, c, [19.0], wind_rotor_radius=63.0, **kw)
     other = simulate(nrel5mw, c, [19.0], wind_rotor_radius=120.97, **kw)
     assert np.array_equal(own["wind"], given["wind"]) and not np.array_equal(own["wind"], other["wind"])
+
+
+# ----------------------------------------------------------------------------- below rated
+def test_torque_law_of_the_discon_is_attached_and_trims_from_cut_in(cases, tmp_path):
+    # the NREL 5 MW's own DISCON.IN runs constant power above rated (VS_ConstPower = 1), which
+    # the workbench does not model: the model stays above rated only, and says so
+    with pytest.warns(UserWarning, match="VS_ConstPower.*above rated only"):
+        plain = from_openfast(cases / "NREL-5MW/NREL-5MW.fst")
+    assert plain.torque_control is None
+    with pytest.raises(ValueError):
+        plain.trim(7.0)
+    # the same DISCON.IN with constant torque above rated and no peak shaving: its law
+    # (VS_ControlMode 2, run as 3: TSR tracking on the measured rotor speed) is attached
+    discon = write_discon(cases / "NREL-5MW/DISCON.IN", tmp_path / "DISCON.IN", VS_ConstPower=0, PS_Mode=0)
+    m = from_openfast(cases / "NREL-5MW/NREL-5MW.fst", discon=discon)
+    assert m.torque_control is not None and m.torque_control.mode == 3
+    # published (Jonkman et al. 2009): cut-in 3 m/s, rated 11.4 m/s, optimal TSR 7.55
+    # (DISCON's VS_TSRopt 7.5); above rated the trim is the model without the law
+    assert m.rated_wind_speed() == pytest.approx(11.4, abs=0.1)
+    regions = []
+    for v in np.arange(3.0, 25.01, 1.0):
+        op = m.trim(v)
+        regions.append(op.region)
+        dx = m.derivatives(op.x, v, op.pitch, op.gen_torque)
+        assert np.all(np.abs(dx[[0, 2]]) < 1e-9), (v, dx)  # an equilibrium of the deck's model
+        if op.region == "2":
+            assert op.rotor_speed * m.rotor_radius / v == pytest.approx(7.5, rel=0.03)
+    assert regions[0] in ("1.5", "2") and regions[-1] == "3" and "2" in regions
+    for v in (13.0, 19.0, 25.0):
+        assert m.trim(v).pitch == plain.trim(v).pitch
+    assert m.linearize(7.0).nstates >= plain.linearize(19.0).nstates  # linearised below rated too

@@ -78,7 +78,12 @@ def loop_parts(model: TurbineModel | KernelPlant | None, controller: Any,
     G = control.ss(plant.linearize(wind_speed))
     names = list(plant.output_names)
     rows = [names.index("gen_speed"), names.index("tower_top_vel")]
-    if isinstance(controller, ScheduledController):
+    open_pitch = plant.rated_wind_speed is not None and wind_speed < plant.rated_wind_speed
+    if open_pitch:
+        # below rated the pitch PI sits at fine pitch (saturated): the pitch loop is open, the
+        # torque loop (closed in the linearisation) alone acts
+        cb = ca = control.ss([], [], [], [[0.0]])
+    elif isinstance(controller, ScheduledController):
         w = trim_weights(plant, controller, wind_speed)
         parts = [(w[q], controller.local(q)) for q in range(len(w)) if w[q] != 0]
         # blend as the simulator runs the locals: the integrators (split_integrator) summed into
@@ -176,10 +181,16 @@ def local_response(model: TurbineModel | KernelPlant | None, controller: Any, wi
     from ..simulate import ScheduledController, as_lti, turbine_plant
 
     s = np.asarray(s)
+    plant = turbine_plant(model)
+    if plant.rated_wind_speed is not None and wind_speed < plant.rated_wind_speed:
+        # below rated the pitch loop is open (the PI saturated at fine pitch): as loop_parts
+        if not isinstance(controller, ScheduledController):
+            as_lti(controller, "controller")  # the same type checks as above rated
+        return np.zeros_like(s, dtype=complex), np.zeros_like(s, dtype=complex)
     with warnings.catch_warnings(), np.errstate(divide="ignore", invalid="ignore"):
         warnings.simplefilter("ignore", RuntimeWarning)
         if isinstance(controller, ScheduledController):
-            w = trim_weights(turbine_plant(model), controller, wind_speed)
+            w = trim_weights(plant, controller, wind_speed)
             K = len(w)
             cb = sum(w[q] * np.asarray(controller.pitch[q](s)) for q in range(K) if w[q] != 0)
             ca = 0.0 if controller.atd is None else sum(w[q] * np.asarray(controller.atd[q](s)) for q in range(K)

@@ -245,7 +245,12 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     -------
     TurbineModel
         The model, named after the ``.fst`` file, wind range from the first 0.1 m/s above
-        rated to 25 m/s.
+        rated to 25 m/s. With ROSCO's torque law of the DISCON.IN attached as its
+        ``torque_control`` (:func:`specdesign.rosco.torque_law_from_discon`;
+        ``VS_ControlMode`` 2 run as 3, TSR tracking on the measured rotor speed),
+        :meth:`~specdesign.turbine.TurbineModel.trim` and ``linearize`` hold from cut-in
+        (``operating_range``, 3-25 m/s). A DISCON.IN whose law the workbench does not run
+        (e.g. ``VS_ConstPower`` = 1) leaves the model above rated only, with a UserWarning.
 
     Raises
     ------
@@ -310,9 +315,30 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     try:
         model = _model(fst_path, rho, tip, inertia, mass, stiff, zeta, my_per_m, pa, ds, gb, tsr, pitch, cp, ct)
         # from the first 0.1 m/s above rated: ROSCO's schedule starts just above rated
-        return dataclasses.replace(model, wind_range=(math.ceil(10 * model.rated_wind_speed() + 1e-9) / 10, 25.0))
+        model = dataclasses.replace(model, wind_range=(math.ceil(10 * model.rated_wind_speed() + 1e-9) / 10, 25.0))
     except ValueError as e:
         raise ValueError(f"{fst.path} (rotor table {cp_table}): {e}") from None
+    return _with_torque_law(model, discon, entries)
+
+
+def _with_torque_law(model, discon, entries):
+    """The model with ROSCO's torque law of its DISCON.IN attached (trim and linearize from
+    cut-in), or unchanged with a warning when the workbench does not run that DISCON's law."""
+    import warnings
+
+    from ..rosco.torque import torque_law_from_discon
+
+    e = entries.get("VS_ControlMode")
+    try:
+        # mode 2 tracks the TSR from ROSCO's wind-speed estimator (not modelled): its power-based
+        # TSR tracking (mode 3) is the same law on the measured rotor speed
+        mode = 3 if e is not None and int(float(e.values[0])) == 2 else None
+        law = torque_law_from_discon(discon, mode=mode)
+    except ValueError as err:
+        warnings.warn(f"{discon}: ROSCO's torque law below rated is not modelled ({err}); the model is above rated "
+                      "only (trim and linearize from rated to 25 m/s)", UserWarning, stacklevel=3)
+        return model
+    return dataclasses.replace(model, torque_control=law)
 
 
 def _model(fst_path, rho, tip, inertia, mass, stiff, zeta, my_per_m, pa, ds, gb, tsr, pitch, cp, ct):

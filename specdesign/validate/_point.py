@@ -34,12 +34,14 @@ def _nan_point(out, omega, n_seeds, linear_twin, volterra):
 
 
 def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
-                    turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0):
+                    turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0, torque_control="auto"):
     """One wind speed, every controller, the same seeds: indicators, per-seed spectra, predictions.
 
     The results of a seed do not depend on the other seeds of the call (the wind of a run
     depends on (v, seed) only and the runs of a batch do not interact), which is what lets
-    a resumed campaign run only its missing seeds.
+    a resumed campaign run only its missing seeds. ``torque_control`` goes to the simulator
+    for the compiled controllers; a callable one commands the torque itself (or holds the
+    trim torque), so it runs with "auto" unless None is asked.
     """
     from .. import wind as wmod
     from ..closedloop import ClosedLoopUnstableWarning
@@ -60,9 +62,10 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
                           ClosedLoopUnstableWarning, stacklevel=3)
         r = None
         if not bad.size:  # an unstable loop is not simulated: nothing of it would be a result
+            tc = torque_control if has_linear_form(c) or torque_control is None else "auto"
             try:
                 r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
-                             record_dt=record_dt, transient=transient)
+                             record_dt=record_dt, transient=transient, torque_control=tc)
             except SimulationDivergedError as err:
                 warnings.warn(f"{err}; campaign results of {name!r} at {v:g} m/s are NaN", ClosedLoopUnstableWarning,
                               stacklevel=3)

@@ -245,7 +245,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                  record_dt: float = 0.1, transient: float = 60.0, m: float = 4.0, predict: bool = True,
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
                  volterra: int = 0, executor=None, progress: bool | None = None,
-                 nperseg: int | None = None, store=None) -> Campaign:
+                 nperseg: int | None = None, store=None, torque_control="auto") -> Campaign:
     """Run every controller at every wind speed on the same seeds and post-process.
 
     Parameters
@@ -311,6 +311,13 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         resumes, and one given more seeds, speeds or controllers runs only those. The
         result is bitwise that of an uninterrupted run. A store holding other settings,
         another model or another controller under the same name is refused.
+    torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, default "auto"
+        Generator torque of the simulations (:func:`specdesign.simulate.simulate`): "auto"
+        runs the model's torque law below rated and holds the trim torque above; "rosco"
+        runs the law at every wind speed (near rated, where gusts cross into region 2.5, as
+        ROSCO does: docs/validation.md "Below rated"). Callable controllers command the
+        torque themselves: they run with "auto" (or None when None is asked). The linear
+        twin and the predictions use the linearisation (the law closed below rated).
 
     Returns
     -------
@@ -323,7 +330,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         ``controllers`` is not a non-empty dict, or ``volterra`` asks for a model without
         ``aero_expansion``.
     ValueError
-        Invalid seeds or ``volterra``, a step too large (:func:`check_campaign_step`) or a
+        Invalid seeds, ``volterra`` or ``torque_control``, a step too large (:func:`check_campaign_step`) or a
         store of another campaign, before the first simulation; errors of
         :func:`specdesign.simulate.simulate`.
     """
@@ -347,7 +354,13 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                 # True (every seed) stays True: a store grown by more seeds keeps theirs too
                 "turbulence_class": turbulence_class, "keep_series": True if keep_series is True else n_keep,
                 "linear_twin": bool(linear_twin),
-                "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg)}
+                "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg),
+                "torque_control": _torque_setting(torque_control)}
+    from ..simulate import turbine_plant
+
+    if torque_control == "rosco" and turbine_plant(model).torque_law is None:
+        raise ValueError("torque_control='rosco' needs a model with a torque law (a TurbineModel with torque_control, "
+                         "e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw or torque_control='auto'")
     wanted = [(float(v), int(s), n) for v in vs for s in seeds for n in names]
     records, st = {}, None
     if store is not None:
@@ -379,7 +392,8 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         v, todo, group = task
         # the kept seeds are a prefix of the task's seeds (both in campaign order)
         return (model, {n: controllers[n] for n in group}, v, todo, duration, dt, record_dt, transient, m, predict,
-                turbulence_class, sum(s in kept for s in todo.tolist()), nperseg, bool(linear_twin), int(volterra))
+                turbulence_class, sum(s in kept for s in todo.tolist()), nperseg, bool(linear_twin), int(volterra),
+                torque_control)
 
     def finish(task, point):
         new = _cells(task, point)
@@ -406,6 +420,19 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     finally:
         bar.close()
     return _assemble(records, names, vs, seeds, settings)
+
+
+def _torque_setting(torque_control):
+    """``torque_control`` as a JSON-serialisable store setting (a law by its fingerprint), checked up front."""
+    from ..rosco.torque import TorqueLaw
+
+    if isinstance(torque_control, TorqueLaw):
+        from .store import fingerprint
+
+        return "law:" + fingerprint(torque_control)
+    if torque_control is None or (isinstance(torque_control, str) and torque_control in ("auto", "rosco")):
+        return torque_control
+    raise ValueError(f"torque_control={torque_control!r} must be 'auto', 'rosco', None or a specdesign.rosco.TorqueLaw")
 
 
 def _as_completed(futures):
