@@ -319,6 +319,13 @@ class SampledController:
         Outputs the observer reads (default :data:`MEASURED`).
     name : str, optional
         Label in campaign tables.
+
+    Attributes
+    ----------
+    solve_times : list of float
+        CPU time (s) of the policy per run and sample, since construction or unpickling.
+    trace : list or None
+        What the policy saw at every sample of the last run, after :meth:`record`.
     """
 
     def __init__(self, model, ts: float, measured=MEASURED, name: str = "controller"):
