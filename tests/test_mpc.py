@@ -104,6 +104,33 @@ def test_first_move_matches_slsqp_with_an_active_rate_bound(model):
     np.testing.assert_allclose(mpc.policy(pt, np.r_[x0, d][None], np.array([uprev])), u_ref[:1], atol=1e-9 * step)
 
 
+def test_preview_of_a_constant_wind_is_the_held_estimate(model):
+    dm = DiscreteTurbine(19.0, 0.1, *(_two_state().A, _two_state().Bu, _two_state().Bw), np.eye(2),
+                         np.array([0.0, 0.3]), ("gen_speed", "tower_top_vel"), 0.3, 1.0, np.zeros(2))
+    held = quadratic_qp(dm, N, WEIGHTS, RATED, RATE, LIMITS)
+    seq = quadratic_qp(dm, N, WEIGHTS, RATED, RATE, LIMITS, preview=True)
+    x0, d, uprev = np.array([0.002, -0.001]), 0.4, 0.001
+    # the preview's wind matrix sums, over a constant sequence, to the held wind's column
+    np.testing.assert_allclose(seq["K"] @ np.r_[x0, np.full(N, d), uprev], held["K"] @ np.r_[x0, d, uprev],
+                               rtol=1e-10, atol=1e-14)
+    mpc = QuadraticMPC(model, horizon=N)
+    x0 = np.array([0.5, 0.0])  # constrained: the solver path
+    np.testing.assert_allclose(mpc.solve(seq, x0, np.full(N, d), uprev), mpc.solve(held, x0, d, uprev), atol=1e-8)
+
+
+def test_wind_preview_helps_on_the_linear_model(model):
+    t = np.arange(0.0, 90.0 + 0.1, 0.1)
+    wind = wind_series(model.rotor_radius, [19.0], [9], t.size * 0.1, 0.1)
+    kw = dict(wind=wind, wind_dt=0.1, duration=80.0, transient=10.0, linear=True)
+    blind = simulate(model, QuadraticMPC(model), [19.0], **kw)
+    seeing = simulate(model, QuadraticMPC(model, preview=(wind, 0.1)), [19.0], **kw)
+    # the same weights with the future wind known (seed 000's assumption for its MPC): the
+    # speed is regulated better, as a feedforward of the coming wind allows
+    assert seeing["gen_speed"].std() < 0.8 * blind["gen_speed"].std()
+    with pytest.raises(ValueError, match="runs"):
+        simulate(model, QuadraticMPC(model, preview=(np.vstack([wind[0], wind[0]]), 0.1)), [19.0], **kw)
+
+
 # ----------------------------------------------------------------------------- closed loop
 @pytest.fixture(scope="module")
 def closed_loop(model):

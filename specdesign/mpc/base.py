@@ -499,6 +499,7 @@ class SampledController:
             xf = xp + (ym[idx] - run["y0"][v] - xp @ Ca.T) @ L.T
             if self.trace is not None:
                 self.trace.append((t, v, xf.copy(), run["u"][idx].copy()))
+            run["now"] = (t, idx)  # for a policy that reads per-run data (a wind preview)
             u = np.asarray(self.policy(pt, xf, run["u"][idx]), float)
             run["u"][idx] = u
             run["xprior"][idx] = xf @ Aa.T + u[:, None] * Ba

@@ -23,6 +23,7 @@ timing the solver).
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -38,7 +39,7 @@ OSQP_OPTIONS = {"eps_abs": 1e-9, "eps_rel": 1e-9, "polishing": True, "max_iter":
 
 
 def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float, float], rated_speed: float,
-                 rate_limit: float, pitch_limits: tuple[float, float]) -> dict:
+                 rate_limit: float, pitch_limits: tuple[float, float], preview: bool = False) -> dict:
     """The condensed QP of :class:`QuadraticMPC` at one operating point, as arrays and as cvxpy.
 
     Parameters
@@ -55,12 +56,16 @@ def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float,
         β̇_max (rad/s).
     pitch_limits : tuple of float
         (β_min, β_max) absolute pitch (rad).
+    preview : bool, default False
+        The wind deviation is a sequence d₀..d_{N−1} over the horizon (parameter ``d`` of
+        shape (N,)) instead of one value held (shape (1,)); an output's wind feedthrough uses
+        the wind of its step, the last held for the last step.
 
     Returns
     -------
     dict
-        ``H`` (N, N) Hessian and ``G`` (N, n+2) with the cost ½uᵀHu + (G p)ᵀu for
-        p = [x̂; d̂; u₋₁]; ``K`` = −H⁻¹G (the unconstrained minimiser u* = K p); ``lower``,
+        ``H`` (N, N) Hessian and ``G`` (N, n+n_d+1) with the cost ½uᵀHu + (G p)ᵀu for
+        p = [x̂; d; u₋₁] (n_d = 1, or N with preview); ``K`` = −H⁻¹G (the unconstrained minimiser u* = K p); ``lower``,
         ``upper`` (N,) position bounds on u; ``step`` the largest move (rad); and the cvxpy
         ``problem`` with parameters ``x0``, ``d``, ``uprev`` and variable ``v`` = u/step.
 
@@ -75,7 +80,15 @@ def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float,
     if min(qw, qt, qd) < 0 or not np.all(np.isfinite([qw, qt, qd])):
         raise ValueError(f"weights={weights!r} must be finite and >= 0 (speed, tower, pitch activity)")
     N = int(horizon)
-    Phi, Gam, Psi = prediction_matrices(dm, ("gen_speed", "tower_top_vel"), N)
+    names = ("gen_speed", "tower_top_vel")
+    Phi, Gam, Psi = prediction_matrices(dm, names, N)
+    Psi = Psi[:, None]
+    if preview:
+        # the wind enters as the command does, through B_w: the same condensed matrix
+        _, Psi, _ = prediction_matrices(dataclasses.replace(dm, Bu=dm.Bw), names, N)
+        Dw, q = dm.Dw[dm.rows(names)], len(names)
+        for j in range(N):  # feedthrough of the output at step j+1: the wind of that step
+            Psi[j * q:(j + 1) * q, min(j + 1, N - 1)] += Dw
     step = float(rate_limit) * dm.ts
     wz = np.tile([np.sqrt(qw) / rated_speed, np.sqrt(qt)], N)  # row scaling of z
     Dm = np.eye(N) - np.eye(N, k=-1)  # Δu = Dm u − e₁ u₋₁
@@ -85,7 +98,7 @@ def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float,
     # ½uᵀHu + (G p)ᵀu with p = [x0; d; uprev]
     Wg = wz[:, None] * Gam
     H = 2.0 * (Wg.T @ Wg + sd**2 * Dm.T @ Dm)
-    G = 2.0 * np.hstack([Wg.T @ (wz[:, None] * Phi), (Wg.T @ (wz * Psi))[:, None], -(sd**2) * (Dm.T @ e1)[:, None]])
+    G = 2.0 * np.hstack([Wg.T @ (wz[:, None] * Phi), Wg.T @ (wz[:, None] * Psi), -(sd**2) * (Dm.T @ e1)[:, None]])
     if np.linalg.cond(H) > 1e12:
         raise ValueError("the MPC Hessian is singular: give a positive pitch-activity weight")
     K = -np.linalg.solve(H, G)
@@ -93,11 +106,11 @@ def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float,
     upper = np.full(N, pitch_limits[1] - dm.pitch0)
 
     n = dm.A.shape[0]
-    x0, d, uprev = cp.Parameter(n, name="x0"), cp.Parameter(1, name="d"), cp.Parameter(1, name="uprev")
+    x0, d, uprev = cp.Parameter(n, name="x0"), cp.Parameter(Psi.shape[1], name="d"), cp.Parameter(1, name="uprev")
     # the variable is the command in units of the largest move (O(1) numbers: OSQP converges
     # in a few iterations; in radians the scaled cost spans 1e8 and it stalls)
     v = cp.Variable(N, name="v")
-    z = Phi @ x0 + (Gam * step) @ v + Psi[:, None] @ d
+    z = Phi @ x0 + (Gam * step) @ v + Psi @ d
     dv = Dm @ v - e1[:, None] @ uprev / step
     cost = cp.sum_squares(cp.multiply(wz, z)) + qd * cp.sum_squares(dv)
     cons = [v >= lower / step, v <= upper / step, cp.abs(dv) <= 1.0]
@@ -129,6 +142,13 @@ class QuadraticMPC(SampledController):
         Use the unconstrained minimiser when it is feasible (exactly the QP's solution).
     solver : str, default "OSQP"
         cvxpy solver of the constrained QP.
+    preview : tuple, optional
+        ``(wind, wind_dt)``: rotor-effective wind known in advance (a perfect LiDAR, as seed
+        000 assumes for its MPC): (R, n_w) or (W, S, n_w) absolute wind (m/s) of the runs
+        every ``wind_dt`` s from the start of the simulation (the ``wind`` given to
+        :func:`~specdesign.simulate.simulate`, transient included). The horizon's wind is
+        then d_j = wind(t + j T_s) − v (linear interpolation, the last sample held past the
+        record's end) instead of the estimate d̂ held. Default None: no preview.
     name : str, default "quadratic MPC"
         Label.
 
@@ -149,7 +169,7 @@ class QuadraticMPC(SampledController):
 
     def __init__(self, model, ts: float = 0.1, horizon: int = 50, *, speed_weight: float = 100.0,
                  tower_weight: float = 100.0, activity_weight: float = 0.1, measured=MEASURED, shortcut: bool = True,
-                 solver: str = "OSQP", name: str = "quadratic MPC"):
+                 solver: str = "OSQP", preview=None, name: str = "quadratic MPC"):
         if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 1")
         self.horizon = int(horizon)
@@ -160,6 +180,16 @@ class QuadraticMPC(SampledController):
             raise ValueError("activity_weight must be > 0 (it keeps the QP strictly convex)")
         self.shortcut = bool(shortcut)
         self.solver = str(solver)
+        self.preview = None
+        if preview is not None:
+            if not (isinstance(preview, tuple) and len(preview) == 2):
+                raise TypeError("preview must be a tuple (wind array in m/s, wind_dt in s)")
+            w = np.asarray(preview[0], float)
+            w = w.reshape(-1, w.shape[-1]) if w.ndim == 3 else w
+            if w.ndim != 2 or w.shape[1] < 2 or not np.all(np.isfinite(w)):
+                raise ValueError(f"preview wind must be a finite (R, n_w) or (W, S, n_w) array in m/s, got shape "
+                                 f"{np.shape(preview[0])}")
+            self.preview = (w, positive_scalar(preview[1], "preview wind_dt"))
         super().__init__(model, ts, measured, name)
         positive_scalar(model.pitch_rate_limit, "model.pitch_rate_limit")
 
@@ -178,7 +208,46 @@ class QuadraticMPC(SampledController):
         """
         return {"qp": quadratic_qp(dm, self.horizon, self.weights, float(self.model.rated_rotor_speed),
                                    float(self.model.pitch_rate_limit),
-                                   (float(self.model.pitch_min), float(self.model.pitch_max)))}
+                                   (float(self.model.pitch_min), float(self.model.pitch_max)),
+                                   preview=self.preview is not None)}
+
+    def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
+        """Initialise the runs (:meth:`SampledController.start`), checking the preview's runs.
+
+        Parameters
+        ----------
+        dt : float
+            Simulation step (s).
+        wind : numpy.ndarray
+            (R,) wind at t = 0 (m/s).
+        pitch : numpy.ndarray
+            (R,) initial pitch (rad).
+        torque : numpy.ndarray
+            (R,) generator torque (N·m).
+
+        Raises
+        ------
+        ValueError
+            If the preview has another number of runs, or does not start with the
+            simulation's wind.
+        """
+        if self.preview is not None:
+            w = self.preview[0]
+            if w.shape[0] != np.size(pitch):
+                raise ValueError(f"preview has {w.shape[0]} runs but the simulation has {np.size(pitch)}")
+            if not np.allclose(w[:, 0], np.asarray(wind, float), rtol=0, atol=1e-9):
+                raise ValueError("preview wind does not start with the simulation's wind: pass the same records")
+        super().start(dt, wind, pitch, torque)
+
+    def _horizon_wind(self, dm: DiscreteTurbine, xhat: np.ndarray) -> np.ndarray:
+        """(G, n_d) wind deviations over the horizon: the estimate held, or the preview."""
+        if self.preview is None:
+            return xhat[:, -1:]
+        t, idx = self._run["now"]
+        w, wdt = self.preview
+        grid = np.arange(w.shape[1]) * wdt
+        times = t + self.ts * np.arange(self.horizon)
+        return np.stack([np.interp(times, grid, w[r]) for r in idx]) - dm.wind_speed
 
     def solve(self, qp: dict, x0: np.ndarray, d: float, uprev: float) -> np.ndarray:
         """The optimal command sequence for one run (the constrained QP, by cvxpy).
@@ -189,8 +258,8 @@ class QuadraticMPC(SampledController):
             :func:`quadratic_qp`'s result.
         x0 : numpy.ndarray
             (n,) state estimate (deviations, SI).
-        d : float
-            Wind deviation estimate (m/s).
+        d : float or numpy.ndarray
+            Wind deviation (m/s): the estimate held, or the (N,) previewed sequence.
         uprev : float
             Previous command deviation (rad).
 
@@ -204,7 +273,8 @@ class QuadraticMPC(SampledController):
         RuntimeError
             If the solver does not return an optimal solution.
         """
-        qp["x0"].value, qp["d"].value, qp["uprev"].value = np.asarray(x0, float), np.array([d]), np.array([uprev])
+        qp["x0"].value, qp["d"].value = np.asarray(x0, float), np.atleast_1d(np.asarray(d, float))
+        qp["uprev"].value = np.array([uprev])
         opts = OSQP_OPTIONS if self.solver == "OSQP" else {}
         qp["problem"].solve(solver=self.solver, warm_start=True, **opts)
         if qp["problem"].status not in ("optimal", "optimal_inaccurate"):
@@ -230,14 +300,15 @@ class QuadraticMPC(SampledController):
         """
         qp = pt["qp"]
         out = np.empty(uprev.size)
+        dw = self._horizon_wind(pt.get("model"), xhat)
         for g in range(uprev.size):
             t0 = time.process_time()
-            p = np.append(xhat[g], uprev[g])
+            p = np.concatenate([xhat[g, :-1], dw[g], [uprev[g]]])
             u = qp["K"] @ p if self.shortcut else None
             tol = 1e-9
             if u is None or np.any(u < qp["lower"] - tol) or np.any(u > qp["upper"] + tol) or \
                     np.any(np.abs(np.diff(np.concatenate([[uprev[g]], u]))) > qp["step"] + tol):
-                u = self.solve(qp, xhat[g, :-1], xhat[g, -1], uprev[g])
+                u = self.solve(qp, xhat[g, :-1], dw[g], uprev[g])
                 # OSQP's tolerance may leave a move a hair past the rate limit: the first move
                 # is the only one applied, and it must respect the actuator's limits exactly
                 u0 = min(max(u[0], uprev[g] - qp["step"], qp["lower"][0]), uprev[g] + qp["step"], qp["upper"][0])
