@@ -63,6 +63,16 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--method", choices=("target", "notch"), default="target",
                       help="target: the specification for a 25 %% DEL target and the design that meets it "
                            "(default); notch: the notch specification and the fixed-structure design")
+    demo.add_argument("--lifetime", action="store_true",
+                      help="instead: ROSCO vs the scheduled QFT designs from cut-in to cut-out over a Weibull climate, "
+                           "the lifetime tower-base DEL change with its SE")
+    demo.add_argument("--seeds", type=int, default=None, help="--lifetime: paired seeds per wind bin (default 6; 3 with --fast)")
+    demo.add_argument("--duration", type=float, default=None,
+                      help="--lifetime: recorded seconds per run (default 600; 300 with --fast)")
+    demo.add_argument("--bin-width", type=float, default=2.0,
+                      help="--lifetime: wind bin width in m/s, dividing cut-out minus cut-in (default: %(default)s)")
+    demo.add_argument("--design-speeds", default=None,
+                      help="--lifetime: comma-separated wind speeds of the QFT designs in m/s (default 15,17,...,25)")
     val = sub.add_parser("validate", help="run an offline validation campaign described by a TOML/JSON file")
     val.add_argument("config", help="TOML or JSON campaign file (schema: docs/validation.md)")
     val.add_argument("--out", default=None, help="output folder (default: from the config file)")
@@ -73,7 +83,22 @@ def main(argv: list[str] | None = None) -> int:
             from specdesign.demo import run_demo
 
             output_folder(args.out, "--out")
-            run_demo(out=args.out, fast=args.fast, method=args.method)
+            if args.lifetime:
+                from specdesign.demo import LIFETIME_DESIGN_SPEEDS, run_lifetime_demo
+                from specdesign.validate import weibull_bins
+
+                if args.seeds is not None and args.seeds < 2:
+                    raise ConfigError(f"--seeds={args.seeds}: the lifetime change's SE needs at least 2 paired seeds")
+                try:
+                    weibull_bins(bin_width=args.bin_width)
+                except ValueError as e:
+                    raise ConfigError(f"--bin-width: {e}") from None
+
+                run_lifetime_demo(out=args.out, fast=args.fast, n_seeds=args.seeds, duration=args.duration,
+                                  bin_width=args.bin_width,
+                                  design_speeds=_speeds_arg(args.design_speeds, LIFETIME_DESIGN_SPEEDS))
+            else:
+                run_demo(out=args.out, fast=args.fast, method=args.method)
         else:
             run_config(args.config, out=args.out, echo=True)
     except (ConfigError, OSError) as e:
@@ -92,6 +117,16 @@ def main(argv: list[str] | None = None) -> int:
 _DESCRIPTION = ("Fatigue-based pitch-controller design: 'specdesign demo' runs the 19 m/s design loop, "
                 "'specdesign validate CONFIG' reruns an offline validation campaign from a TOML/JSON file "
                 "(also 'python -m specdesign').")
+
+
+def _speeds_arg(text, default):
+    """``--design-speeds`` as floats (m/s); a malformed list is the user's error (ConfigError)."""
+    if text is None:
+        return default
+    try:
+        return tuple(float(x) for x in text.split(","))
+    except ValueError:
+        raise ConfigError(f"--design-speeds={text!r} must be comma-separated wind speeds in m/s, e.g. 15,19,23") from None
 
 
 def _choose_backend() -> None:

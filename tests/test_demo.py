@@ -72,3 +72,52 @@ def test_validate_config_written_by_the_demo_reproduces_its_validation(demo):
     assert _row(table3, "Volterra prediction (order 3, rainflow, same seeds)")[0] == pytest.approx(
         s["volterra_del_pct"], abs=1e-6)
     assert np.array_equal(camp.seeds, np.arange(3)) and camp.volterra_order == 3
+
+
+# ----------------------------------------------------------------------------- demo --lifetime
+def test_lifetime_demo_prints_the_lifetime_change_recomputed_from_its_runs(tmp_path, capsys):
+    """``specdesign demo --lifetime`` at reduced size (one design at 19 m/s, 11 m/s bins, 2 seeds
+    × 60 s). Oracle: the lifetime change recomputed by hand from the per-run DELs it wrote,
+    with the bin probabilities from scipy's Weibull CDF (the seed paper's k = 2.2, A = 11.29 m/s)."""
+    import math
+    import re
+
+    from scipy.stats import weibull_min
+
+    from specdesign.cli import main
+
+    out = tmp_path / "life"
+    assert main(["demo", "--lifetime", "--out", str(out), "--design-speeds", "19", "--bin-width", "11",
+                 "--seeds", "2", "--duration", "60"]) == 0
+    text = capsys.readouterr().out
+    got = re.search(r"Lifetime tower-base DEL change, QFT vs ROSCO: ([-+]\d+\.\d+) % ± (\d+\.\d+) %", text)
+    assert got, text
+    change, se = float(got.group(1)), float(got.group(2))
+    runs = {}
+    with open(out / "lifetime_runs.csv") as f:
+        next(f)
+        for row in csv.reader(f):
+            runs.setdefault(row[0], {}).setdefault(float(row[1]), []).append(float(row[3]))
+    speeds = sorted(runs["ROSCO"])
+    assert speeds == [3.0, 14.0, 25.0]  # cut-in to cut-out
+    edges = [(3.0, 8.5), (8.5, 19.5), (19.5, 25.0)]
+    p = [weibull_min.cdf(hi, 2.2, scale=11.29) - weibull_min.cdf(lo, 2.2, scale=11.29) for lo, hi in edges]
+
+    def life(name):
+        return (sum(pb * np.mean(np.array(runs[name][v]) ** 4) for pb, v in zip(p, speeds)) / sum(p)) ** 0.25
+
+    assert change == pytest.approx(100 * (life("QFT") / life("ROSCO") - 1), abs=0.006)  # printed to 2 decimals
+    assert se > 0 and math.isfinite(se)
+    assert (out / "lifetime_damage.png").stat().st_size > 0
+    assert "| Tower base DEL |" in (out / "table2_lifetime.md").read_text()
+    assert f"{change:+.2f} % ± {se:.2f} %" in (out / "lifetime.md").read_text()
+
+
+def test_lifetime_demo_options_are_checked(tmp_path, capsys):
+    from specdesign.cli import main
+
+    assert main(["demo", "--lifetime", "--out", str(tmp_path), "--seeds", "1"]) == 2
+    assert main(["demo", "--lifetime", "--out", str(tmp_path), "--bin-width", "5"]) == 2
+    assert main(["demo", "--lifetime", "--out", str(tmp_path), "--design-speeds", "19,x"]) == 2
+    err = capsys.readouterr().err
+    assert "--seeds=1" in err and "--bin-width" in err and "--design-speeds" in err

@@ -239,3 +239,37 @@ def test_damage_figure_labels_and_legend():
     with pytest.raises(ValueError, match="channel"):
         plot_lifetime_damage(r, "gen_speed")
     plt.close("all")
+
+
+# ----------------------------------------------------------------------------- Table 2's lifetime column
+def test_table2_lifetime_column_is_lifetime_and_the_energy_change():
+    from specdesign.validate import INDICATORS, table2
+
+    rng = np.random.default_rng(3)
+    speeds = np.arange(3.0, 25.1, 2.0)  # every bin of weibull_bins(): cut-in to cut-out
+    c0 = synthetic(seed=1, n_seeds=5, speeds=speeds)
+    values = {k: rng.uniform(0.5, 1.5, c0.values["tower_del"].shape) for k in INDICATORS}
+    values["tower_del"] = 1e7 * values["tower_del"]  # N·m
+    camp = Campaign(c0.controllers, speeds, c0.seeds, 600.0, 0.1, 4.0, values, np.zeros((2, speeds.size)),
+                    np.zeros(3), {}, {})
+    climate = weibull_bins(k=2.2, scale=11.29)
+    plain = table2(camp, "designed", "rosco")
+    t = table2(camp, "designed", "rosco", climate=climate)
+    assert t.columns == plain.columns + ("Lifetime",)
+    np.testing.assert_array_equal(t.values()[:, :-1], plain.values())  # the per-speed and Mean columns unchanged
+    life = lifetime(camp, climate, baseline="rosco")
+    rows = {label: vals for label, vals in zip([r[0] for r in t.rows], t.values())}
+    assert rows["Tower base DEL"][-1] == pytest.approx(life.change[1, 0], rel=1e-12)
+    # mean power: the energy over the bins, hand-summed
+    p = climate.probabilities
+    pw = values["mean_power"].mean(axis=-1)
+    assert rows["Mean power"][-1] == pytest.approx(100 * (np.sum(p * pw[1]) / np.sum(p * pw[0]) - 1), rel=1e-12)
+    # a standard deviation: the lifetime variance Σ p_b·mean_s SD² / Σ p_b, hand-summed
+    var = [sum(pb * np.mean(values["pitch_sd"][c, b] ** 2) for b, pb in enumerate(p)) / p.sum() for c in (0, 1)]
+    assert rows["Pitch activity (SD)"][-1] == pytest.approx(100 * (math.sqrt(var[1] / var[0]) - 1), rel=1e-12)
+    assert f"{life.change[1, 0]:+.2f} ± {life.change_se[1, 0]:.2f} %" in t.note and "MISSING" not in t.note
+    # a campaign short of bins (13-25 m/s): the note names the missing ones
+    part = Campaign(camp.controllers, speeds[5:], camp.seeds, 600.0, 0.1, 4.0, {k: v[:, 5:] for k, v in values.items()},
+                    np.zeros((2, 7)), np.zeros(3), {}, {})
+    assert "MISSING bins (not simulated, excluded): 3, 5, 7, 9, 11 m/s" in table2(part, "designed", "rosco",
+                                                                                 climate=climate).note

@@ -321,3 +321,25 @@ def test_a_scheduled_pi_without_its_own_limits_takes_the_plants(model, floor_run
     sc = dataclasses.replace(sm.rosco_scheduled(model, [V_FLOOR]), pitch_limits=None)
     r = sm.simulate(model, sc, [V_FLOOR], **KW)
     np.testing.assert_array_equal(r["pitch_cmd"], floor_runs["rosco"]["pitch_cmd"])
+
+
+@pytest.mark.parametrize("v", [5.0, 9.0])
+def test_below_rated_the_pitch_loop_is_open(model, v):
+    # the simulator's pitch PI sits at fine pitch below rated: the loop the checks and the
+    # prediction see is the plant's linearisation (torque loop closed in it) alone. Oracle:
+    # the linearisation's own poles and its open-loop wind-to-moment response.
+    from specdesign.closedloop import local_response
+
+    sched = sm.rosco_scheduled(model)
+    G = model.linearize(v)
+    for c in (sched, turbine.rosco_baseline(model, 19.0), 100.0 * turbine.rosco_baseline(model, 19.0)):
+        np.testing.assert_allclose(np.sort_complex(va.closed_loop_poles(model, c, v)),
+                                   np.sort_complex(np.linalg.eigvals(np.asarray(G.A))), rtol=1e-10, atol=1e-12)
+        cb, ca = local_response(model, c, v, 1j * np.array([0.1, 1.0]))
+        assert not np.any(cb) and not np.any(ca)
+    omega = np.array([0.3, 1.1])
+    k = list(G.output_labels).index("tower_base_my")
+    open_loop = np.array([G(1j * w)[k, 0] for w in omega])
+    np.testing.assert_allclose(va.closed_loop_response(model, sched, v, omega, "tower_base_my"), open_loop, rtol=1e-9)
+    # above rated nothing changes: the same controller closes the loop
+    assert va.closed_loop_poles(model, sched, 13.0).size > G.nstates

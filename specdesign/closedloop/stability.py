@@ -3,7 +3,10 @@
 The loop is β = −C_β·Ω_g − C_atd·ẋ_top around the linearisation at a wind speed, with a
 scheduled controller blended at the trim pitch of that wind speed (:func:`loop_parts`,
 :func:`local_response`); the simulator (:mod:`specdesign.simulate`) warns and the validation
-refuses where :func:`unstable_poles` finds any.
+refuses where :func:`unstable_poles` finds any. Below rated (a model with a torque law, at a
+wind speed under its rated wind speed) the pitch loop is open, as the simulator runs it (the
+pitch command sits at fine pitch): the controller counts as zero there and the loop is the
+linearisation, with the torque loop closed in it.
 """
 from __future__ import annotations
 
@@ -37,7 +40,8 @@ def loop_parts(model: TurbineModel | KernelPlant | None, controller: Any,
 
     A ScheduledController is blended at the trim pitch of ``wind_speed`` (as
     :func:`specdesign.validate.closed_loop_response` blends it), its locals' integrators
-    summed into one (:func:`specdesign.simulate.split_integrator`).
+    summed into one (:func:`specdesign.simulate.split_integrator`). Below the rated wind speed
+    of a plant with a torque law the pitch loop is open: ``K`` is zero.
 
     Parameters
     ----------
@@ -137,7 +141,8 @@ def local_response(model: TurbineModel | KernelPlant | None, controller: Any, wi
                    s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """A controller's responses (C_β(s), C_atd(s)) at the complex frequencies ``s``.
 
-    A ScheduledController is blended at ``wind_speed`` as the simulator blends it.
+    A ScheduledController is blended at ``wind_speed`` as the simulator blends it. Below the
+    rated wind speed of a plant with a torque law both are zero (the pitch loop is open).
 
     Parameters
     ----------

@@ -128,8 +128,18 @@ def _unstable_marks(campaign, *names):
     return tuple("unstable" if b else "" for b in bad) + ("unstable" if np.any(bad) else "",)
 
 
-def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBULL_K, scale: float = WEIBULL_A) -> Table:
+def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBULL_K, scale: float = WEIBULL_A,
+           climate=None) -> Table:
     """The paper's Table 2: relative change (%) of each indicator, designed vs baseline.
+
+    With a wind ``climate`` the table gains a "Lifetime" column: each indicator pooled over the
+    time in the covered bins (bin b's share p_b/Σp) the way it adds up, as the seeds of one speed
+    are (:func:`~specdesign.validate.pool`), then compared: the tower-base DEL's row is the
+    lifetime DEL change of :func:`~specdesign.validate.lifetime` (damage-weighted), the mean
+    power's the change of the energy Σ_b p_b·P̄_b, a standard deviation's the change of
+    √(Σ_b p_b·mean_s SD²/Σp) (defined where one bin's SD is 0 for both controllers, as the pitch's
+    below rated). The note gives the lifetime DEL change's standard error and names the climate's
+    bins the campaign did not simulate.
 
     Parameters
     ----------
@@ -141,30 +151,69 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
         Weibull shape of the Mean column's weights (:func:`~specdesign.validate.weibull_weights`).
     scale : float, default WEIBULL_A
         Weibull scale (m/s).
+    climate : WindClimate or tuple, optional
+        Wind-speed bins and their probabilities (:func:`~specdesign.validate.weibull_bins`,
+        :func:`~specdesign.validate.wind_climate`, or a (centres, probabilities) pair) whose
+        centres include the campaign's wind speeds: adds the "Lifetime" column.
 
     Returns
     -------
     Table
-        One row per indicator, one column per wind speed and the Weibull-weighted mean.
+        One row per indicator, one column per wind speed, the Weibull-weighted mean, and with
+        ``climate`` the lifetime change.
 
     Raises
     ------
     ValueError
-        A controller name that is not in the campaign.
+        A controller name that is not in the campaign; with ``climate``, as
+        :func:`~specdesign.validate.lifetime` (e.g. a campaign wind speed that is no bin centre).
     """
     w = weibull_weights(campaign.wind_speeds, k, scale)
+    life = None
+    if climate is not None:
+        from .lifetime_del import lifetime
+
+        life = lifetime(campaign, climate, controllers=(baseline, designed), m=campaign.m)
     rows = []
     for ind in ("gen_speed_sd", "mean_power", "tower_del", "pitch_sd", "pitch_rate_sd"):
-        ch = campaign.change(designed, baseline, ind).change
-        rows.append((_LABELS[ind], tuple(ch) + (float(w @ ch),)))
-    return Table(
-        title=f"Table 2: change of the indicators, {designed} vs {baseline}",
-        columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
-        note=f"Relative change 100·(X_{designed}/X_{baseline} − 1) over {campaign.seeds.size} paired seeds of "
-             f"{campaign.duration:g} s; DEL with m = {campaign.m:g}, 1 Hz. Mean: weighted by the Weibull pdf "
-             f"(k = {k}, A = {scale} m/s) at the operating points, normalised.",
-        marks=_unstable_marks(campaign, designed, baseline),
-    )
+        with np.errstate(invalid="ignore"):  # 0/0: the pitch held at fine pitch by both (below rated), shown empty
+            ch = campaign.change(designed, baseline, ind).change
+        row = tuple(ch) + (float(w @ ch),)
+        if life is not None:
+            row += (_lifetime_cell(campaign, designed, baseline, ind, life),)
+        rows.append((_LABELS[ind], row))
+    note = (f"Relative change 100·(X_{designed}/X_{baseline} − 1) over {campaign.seeds.size} paired seeds of "
+            f"{campaign.duration:g} s; DEL with m = {campaign.m:g}, 1 Hz. Mean: weighted by the Weibull pdf "
+            f"(k = {k}, A = {scale} m/s) at the operating points, normalised.")
+    marks = _unstable_marks(campaign, designed, baseline)
+    columns = _speed_columns(campaign.wind_speeds)
+    if life is not None:
+        columns += ("Lifetime",)
+        marks += (marks[-1],)
+        note += (f" Lifetime ({life.climate}; covered probability {life.covered_probability:.4g}): tower-base DEL "
+                 f"change of the lifetime DEL {life.change[1, 0]:+.2f} ± {life.change_se[1, 0]:.2f} % (SE, "
+                 f"{life.method}); mean power: change of the energy Σ p_b·P̄_b; standard deviations: change of "
+                 "√(Σ p_b·mean SD² / Σ p_b).")
+        if life.missing_speeds.size:
+            note += (f" MISSING bins (not simulated, excluded): {', '.join(f'{x:g}' for x in life.missing_speeds)} "
+                     f"m/s, probability {float(life.missing_probability.sum()):.4g}.")
+    return Table(title=f"Table 2: change of the indicators, {designed} vs {baseline}", columns=columns,
+                 rows=tuple(rows), note=note, marks=marks)
+
+
+def _lifetime_cell(campaign, designed, baseline, ind, life):
+    """The Lifetime column's entry of one indicator (see :func:`table2`)."""
+    if ind == "tower_del":
+        return float(life.change[1, 0])
+    # pooled over the covered time as each adds up (a bin's share of it is p_b): the energy for
+    # the power, √(mean variance) for a standard deviation; lifetime() keeps the campaign's order
+    p = life.probabilities / life.probabilities.sum()
+    x = [np.asarray(campaign.values[ind][campaign.index(c)], dtype=float) for c in (designed, baseline)]
+    if ind == "mean_power":
+        des, base = (p @ a.mean(axis=-1) for a in x)
+    else:
+        des, base = (np.sqrt(p @ (a**2).mean(axis=-1)) for a in x)
+    return float(100.0 * (des / base - 1.0))
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
