@@ -176,7 +176,7 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
         life = lifetime(campaign, climate, controllers=(baseline, designed), m=campaign.m)
     rows = []
     for ind in ("gen_speed_sd", "mean_power", "tower_del", "pitch_sd", "pitch_rate_sd"):
-        with np.errstate(invalid="ignore"):  # 0/0: the pitch held at fine pitch by both (below rated), shown empty
+        with np.errstate(invalid="ignore", divide="ignore"):  # 0/0: the pitch held at fine pitch by both (below rated), shown empty
             ch = campaign.change(designed, baseline, ind).change
         row = tuple(ch) + (float(w @ ch),)
         if life is not None:
