@@ -72,11 +72,35 @@ def loop_parts(model: TurbineModel | KernelPlant | None, controller: Any,
     TypeError
         If the controller is neither an LTI system, a Controller nor a ScheduledController.
     """
+    from ..simulate import turbine_plant
+
+    plant = turbine_plant(model)  # one plant per model: the model and its plant share the cache
+    key = (id(plant), id(controller), float(wind_speed))
+    hit = _PARTS.get(key)
+    if hit is not None and hit[0] is plant and hit[1] is controller:
+        G, rows, K2 = hit[2]
+        return G, list(rows), K2
+    G, rows, K2 = _loop_parts(plant, controller, wind_speed)
+    if len(_PARTS) >= _PARTS_SIZE:
+        _PARTS.pop(next(iter(_PARTS)))
+    # plant and controller held with the entry, so their ids cannot be reused while it lives
+    _PARTS[key] = (plant, controller, (G, tuple(rows), K2))
+    return G, rows, K2
+
+
+# (id(plant), id(controller), v) → (plant, controller, parts): a campaign checks every loop
+# up front, again before simulating it and in the simulator; built once. The objects are
+# frozen records and python-control systems, which the workbench never changes in place.
+_PARTS: dict = {}
+_PARTS_SIZE = 256
+
+
+def _loop_parts(plant, controller, wind_speed):
+    """:func:`loop_parts` computed."""
     import control
 
-    from ..simulate import ScheduledController, as_lti, turbine_plant
+    from ..simulate import ScheduledController, as_lti
 
-    plant = turbine_plant(model)
     if plant.linearize is None:
         raise ValueError(f"plant {plant.name!r} has no linearisation: its closed-loop poles are unknown")
     G = control.ss(plant.linearize(wind_speed))

@@ -146,12 +146,22 @@ def turbine_plant(model: TurbineModel | KernelPlant | None = None) -> KernelPlan
         model = turbine.iea15mw()
     if isinstance(model, KernelPlant):
         return model
+    hit = _PLANTS.get(id(model))
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    trims = {}
 
     def trim(v):
-        op = model.trim(v)
-        return np.array(op.x, dtype=float), float(op.pitch), float(op.gen_torque)
+        # a campaign asks for the same trims many times (checks, prediction, simulation): each
+        # solved once per plant; the state returned as a copy, so no caller shares it
+        v = float(v)
+        if v not in trims:
+            op = model.trim(v)
+            trims[v] = (np.array(op.x, dtype=float), float(op.pitch), float(op.gen_torque))
+        x, pitch, torque = trims[v]
+        return x.copy(), pitch, torque
 
-    return KernelPlant(
+    plant = KernelPlant(
         rhs=turbine.rhs,
         outputs=turbine.outputs,
         params=np.ascontiguousarray(model.kernel_params(), dtype=float),
@@ -168,6 +178,17 @@ def turbine_plant(model: TurbineModel | KernelPlant | None = None) -> KernelPlan
         torque_law=getattr(model, "torque_control", None),
         rated_wind_speed=None if getattr(model, "torque_control", None) is None else float(model.rated_wind_speed()),
     )
+    if len(_PLANTS) >= _PLANTS_SIZE:
+        _PLANTS.pop(next(iter(_PLANTS)))
+    # the model is held with its plant, so its id cannot be reused while the entry lives
+    _PLANTS[id(model)] = (model, plant)
+    return plant
+
+
+# id(model) → (model, plant): one plant per model (and its trims, and the loop checks keyed on
+# it, :func:`specdesign.closedloop.loop_parts`) for the models in use, oldest dropped first
+_PLANTS: dict = {}
+_PLANTS_SIZE = 16
 
 
 
