@@ -90,14 +90,14 @@ def timings(model, ctrls, quick):
     row("48 runs, no linear predictions",
         _timed(lambda m, c: va.run_campaign(two_of(c), SPEEDS, [1, 2, 3, 4], model=m, predict=False, **run48), 3), 0.5)
     with tempfile.TemporaryDirectory() as tmp:
-        # the store's fingerprints are of the model and controllers, not of the objects: the
-        # fresh ones of the second call find the first call's cells
+        # the same controller objects for both calls: a store compares pickles, and two
+        # python-control systems built alike in one process get different automatic names
         row("48 runs, no predictions, every run stored (store=)",
-            _timed(lambda m, c: va.run_campaign(two_of(c), SPEEDS, [1, 2, 3, 4], model=m, predict=False,
+            _timed(lambda m, c: va.run_campaign(two_of(ctrls), SPEEDS, [1, 2, 3, 4], model=model, predict=False,
                                                 store=Path(tmp) / "s", **run48)),
             None, "48 NetCDF cells written")
         row("  the same rerun: all 48 cells read back, nothing simulated",
-            _timed(lambda m, c: va.run_campaign(two_of(c), SPEEDS, [1, 2, 3, 4], model=m, predict=False,
+            _timed(lambda m, c: va.run_campaign(two_of(ctrls), SPEEDS, [1, 2, 3, 4], model=model, predict=False,
                                                 store=Path(tmp) / "s", **run48), 3))
     try:
         import distributed
