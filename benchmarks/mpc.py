@@ -91,7 +91,9 @@ def open_loop_table(model, terms, terms_mpc, bc, seeds, horizon=100.0, v=19.0):
     kw = dict(wind=held, wind_dt=dt, duration=horizon, transient=0.0, linear=True, dt=dt, record_dt=0.1)
     ctrls = {"ROSCO": turbine.rosco_baseline(model, v), "open-loop optimum (preview)":
              mpc.OpenLoopPlayback(np.stack([o.pitch_cmd for o in opt]), TS),
-             "quadratic MPC": mpc.QuadraticMPC(model), "economic MPC": mpc.EconomicMPC(model, terms_mpc, ts=TS),
+             "quadratic MPC": mpc.QuadraticMPC(model),
+             "quadratic MPC (preview)": mpc.QuadraticMPC(model, preview=(held, dt)),
+             "economic MPC": mpc.EconomicMPC(model, terms_mpc, ts=TS),
              "behavioural cloning": bc}
     res = {}
     for name, c in ctrls.items():
