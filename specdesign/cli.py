@@ -186,7 +186,8 @@ def output_folder(folder: str | os.PathLike, key: str, *, source: str | os.PathL
 # checked, at every level, before the first simulation: a typo or a wrong type is an error
 # naming the file and the key, not a traceback after minutes of simulation.
 _TOP_KEYS = ("turbine", "wind_speeds", "seeds", "duration", "dt", "record_dt", "transient", "wohler_exponent",
-             "turbulence_class", "controllers", "baseline", "designed", "promised", "output", "linear_twin", "volterra")
+             "turbulence_class", "controllers", "baseline", "designed", "promised", "output", "linear_twin", "volterra",
+             "torque_control")
 _CONTROLLER_KEYS = {"rosco": {"kind", "wind_speeds", "name"}, "file": {"kind", "file", "name"}}
 
 
@@ -350,11 +351,20 @@ def load_controller(spec: dict, base: str | os.PathLike, model, *, config: str |
                       "(docs/validation.md)")
 
 
-def _wind_speeds(vs, model, path, key) -> list:
-    """Distinct wind speeds (m/s) inside the model's range, or ConfigError naming ``key``."""
+def _wind_speeds(vs, model, path, key, operating=False) -> list:
+    """Distinct wind speeds (m/s) inside the model's range, or ConfigError naming ``key``;
+    ``operating``: the model's operating range (cut-in to cut-out) when it has a torque law
+    (a campaign's speeds), else its design range (a controller's schedule)."""
     _need(isinstance(vs, list) and vs and all(_is_number(v) for v in vs), path, key,
           "a non-empty list of wind speeds in m/s")
     _need(len({float(v) for v in vs}) == len(vs), path, key, f"a list of distinct wind speeds, got {vs}")
+    if operating and getattr(model, "torque_control", None) is not None:
+        lo, hi = model.operating_range
+        for v in vs:
+            if not lo <= float(v) <= hi:
+                raise ConfigError(f"{path}: {key}: wind_speed={v!r} m/s is outside the operating range {lo:g}-{hi:g} "
+                                  "m/s (cut-in to cut-out)")
+        return [float(v) for v in vs]
     for v in vs:
         try:
             model.check_wind_speed(v)
@@ -456,7 +466,7 @@ def read_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -
             raise ConfigError(f"{path}: missing required key {key!r}")
     _need(cfg.get("turbine", "iea15mw") == "iea15mw", path, "turbine", "\"iea15mw\" (the only embedded model)")
     model = turbine.iea15mw()
-    vs = _wind_speeds(cfg["wind_speeds"], model, path, "wind_speeds")
+    vs = _wind_speeds(cfg["wind_speeds"], model, path, "wind_speeds", operating=True)
     seeds = _checked_seeds(cfg["seeds"], path)
     kw = dict(duration=_number(cfg, "duration", path, 600.0), dt=_number(cfg, "dt", path, 0.02),
               record_dt=_number(cfg, "record_dt", path, 0.1), transient=_number(cfg, "transient", path, 60.0, positive=False),
@@ -478,6 +488,10 @@ def read_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -
     vol = cfg.get("volterra", 0)
     _need(isinstance(vol, int) and not isinstance(vol, bool) and vol in (0, 1, 2, 3), path, "volterra",
           "0 (none) or an order 1, 2 or 3 (an integer)")
+    torque = cfg.get("torque_control", "auto")
+    _need(torque in ("auto", "rosco", "none"), path, "torque_control",
+          "\"auto\" (ROSCO's torque law below rated, torque held above), \"rosco\" (the law in every run) or "
+          "\"none\" (torque held)")
     ctrl = cfg["controllers"]
     _need(isinstance(ctrl, dict) and ctrl, path, "controllers", "a table of named controllers ([controllers.NAME])")
     controllers = {str(n): load_controller(spec, path.parent, model, config=path, name=str(n)) for n, spec in ctrl.items()}
@@ -514,7 +528,8 @@ def read_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -
         folder = output_folder(out, "--out", source=path)
     else:
         folder = output_folder(path.parent / output, "output", source=path)
-    kw.update(turbulence_class=tc, linear_twin=twin, volterra=int(vol), model=model)
+    kw.update(turbulence_class=tc, linear_twin=twin, volterra=int(vol), model=model,
+              torque_control=None if torque == "none" else torque)
     return dict(controllers=controllers, wind_speeds=vs, seeds=seeds, kwargs=kw, baseline=baseline,
                 designed=designed, promised=promised, out=folder)
 

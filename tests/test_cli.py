@@ -120,3 +120,36 @@ def test_validate_prints_tables_3_and_2_and_the_files_it_wrote(tmp_path, capsys)
     files = sorted(str(p) for p in out.iterdir())
     assert sorted(listed) == files  # every file written is listed, and only those
     assert f"wrote {len(files)} files to {out}" in stdout
+
+
+def test_campaign_file_torque_control_and_speeds_below_rated(tmp_path):
+    """``torque_control`` and wind speeds from cut-in in a campaign file: the campaign it runs is
+    run_campaign's with the same arguments (the oracle: the direct call, compared bitwise)."""
+    import numpy as np
+    import pytest
+
+    from specdesign import simulate as sm
+    from specdesign import turbine
+    from specdesign.cli import ConfigError, read_config, run_config
+    from specdesign.validate import run_campaign
+
+    def config(extra, speeds="[7.0, 19.0]"):
+        p = tmp_path / "c.toml"
+        p.write_text(f'wind_speeds = {speeds}\nseeds = 1\nduration = 30.0\ntransient = 5.0\n{extra}'
+                     '[controllers.ROSCO]\nkind = "rosco"\n')
+        return p
+
+    assert read_config(config('torque_control = "rosco"\n'))["kwargs"]["torque_control"] == "rosco"
+    assert read_config(config(""))["kwargs"]["torque_control"] == "auto"
+    with pytest.raises(ConfigError, match="torque_control must be"):
+        read_config(config('torque_control = "on"\n'))
+    with pytest.raises(ConfigError, match="wind_speeds: wind_speed=2.0 m/s is outside the operating range 3-25 m/s"):
+        read_config(config("", speeds="[2.0]"))
+    camp = run_config(config('torque_control = "none"\n', speeds="[7.0]"), tmp_path / "out")
+    model = turbine.iea15mw()
+    direct = run_campaign({"ROSCO": sm.rosco_scheduled(model)}, [7.0], 1, model=model, duration=30.0, transient=5.0,
+                          torque_control=None, progress=False)
+    np.testing.assert_array_equal(camp.values["tower_del"], direct.values["tower_del"])
+    auto = run_campaign({"ROSCO": sm.rosco_scheduled(model)}, [7.0], 1, model=model, duration=30.0, transient=5.0,
+                        progress=False)
+    assert not np.array_equal(auto.values["tower_del"], direct.values["tower_del"])
