@@ -14,8 +14,13 @@ The design loop, one module a step:
 - :mod:`specdesign.qft`: QFT design of the pitch and tower-damping controllers against the specs.
 - :mod:`specdesign.hinf`: H∞ design with the fatigue-based specifications as weights.
 - :mod:`specdesign.simulate`: batched nonlinear time-domain simulation.
-- :mod:`specdesign.validate`: rainflow validation, indicators, the paper's tables.
-- :mod:`specdesign.openfast`: OpenFAST file adapters (.lin, .out/.outb).
+- :mod:`specdesign.validate`: rainflow validation, indicators, the paper's tables, lifetime DEL,
+  campaigns, the GP surrogate.
+- :mod:`specdesign.mpc`: the related methods as controllers: quadratic MPC, fatigue-oriented
+  economic MPC (seed 000 Eq. 4), behavioural cloning, health-aware LPV-MPC (seed 002).
+- :mod:`specdesign.fatigue_online`: streaming rainflow + Miner (accumulated damage D(k)).
+- :mod:`specdesign.openfast`: OpenFAST file adapters (.lin, .out/.outb) and
+  :class:`~specdesign.openfast.LinearTurbine` (designs on OpenFAST linearisations).
 - :mod:`specdesign.demo`: the 19 m/s design loop behind ``python -m specdesign demo``.
 - :mod:`specdesign.cli`: the command line (``specdesign demo``, ``specdesign validate CONFIG``).
 

@@ -13,6 +13,10 @@ Layout
   :func:`economic_open_loop`, :class:`EconomicMPC`.
 - :mod:`specdesign.mpc.cloning`: :func:`demonstrations`, :class:`CloningRegressor`,
   :class:`ClonedController`, :class:`OpenLoopPlayback`.
+- :mod:`specdesign.mpc.lpv`: the wind-scheduled LPV prediction model and observer (seed 002).
+- :mod:`specdesign.mpc.health`: :class:`HealthMPC`, the health-aware MPC trading speed tracking
+  against blade damage growth (docs/health_mpc.md); :mod:`specdesign.mpc.health_report`: its
+  energy / damage trade-off.
 """
 from __future__ import annotations
 
@@ -20,6 +24,9 @@ from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbi
 from .cloning import ClonedController, CloningRegressor, Demonstrations, OpenLoopPlayback, clone, demonstrations
 from .economic import (WOHLER, EconomicMPC, FatigueTerm, OpenLoopResult, economic_open_loop, economic_problem,
                        fit_fatigue_terms, solve_cone, surrogate_cost)
+from .health import HEALTH_OSQP, REF_MARGIN, HealthMPC, health_move, health_qp, health_scale
+from .health_report import TradeoffPoint, health_tradeoff, plot_tradeoff
+from .lpv import PREDICTED, LPVObserver, LPVTurbine, lpv_observer, lpv_turbine
 from .quadratic import QuadraticMPC, quadratic_qp
 
 __all__ = [
@@ -46,4 +53,18 @@ __all__ = [
     "prediction_matrices",
     "MEASURED",
     "WOHLER",
+    "HealthMPC",
+    "health_qp",
+    "health_move",
+    "health_scale",
+    "HEALTH_OSQP",
+    "REF_MARGIN",
+    "TradeoffPoint",
+    "health_tradeoff",
+    "plot_tradeoff",
+    "LPVTurbine",
+    "lpv_turbine",
+    "LPVObserver",
+    "lpv_observer",
+    "PREDICTED",
 ]
