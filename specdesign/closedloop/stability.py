@@ -82,7 +82,10 @@ def loop_parts(model: TurbineModel | KernelPlant | None, controller: Any,
         return G, list(rows), K2
     G, rows, K2 = _loop_parts(plant, controller, wind_speed)
     if len(_PARTS) >= _PARTS_SIZE:
-        _PARTS.pop(next(iter(_PARTS)))
+        try:  # another thread (a threaded dask worker) may have changed it meanwhile: drop any entry
+            _PARTS.pop(next(iter(_PARTS)), None)
+        except (RuntimeError, StopIteration):
+            pass
     # plant and controller held with the entry, so their ids cannot be reused while it lives
     _PARTS[key] = (plant, controller, (G, tuple(rows), K2))
     return G, rows, K2

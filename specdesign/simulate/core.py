@@ -179,7 +179,10 @@ def turbine_plant(model: TurbineModel | KernelPlant | None = None) -> KernelPlan
         rated_wind_speed=None if getattr(model, "torque_control", None) is None else float(model.rated_wind_speed()),
     )
     if len(_PLANTS) >= _PLANTS_SIZE:
-        _PLANTS.pop(next(iter(_PLANTS)))
+        try:  # another thread (a threaded dask worker) may have changed it meanwhile: drop any entry
+            _PLANTS.pop(next(iter(_PLANTS)), None)
+        except (RuntimeError, StopIteration):
+            pass
     # the model is held with its plant, so its id cannot be reused while the entry lives
     _PLANTS[id(model)] = (model, plant)
     return plant
