@@ -249,9 +249,10 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     (:func:`specdesign.rosco.rosco_scheduled`, tower damping off). Both run ROSCO's torque law in
     every run (``torque_control="rosco"``, the transitions through rated included), on the same
     seeds at every bin centre of the Weibull climate (:func:`specdesign.validate.weibull_bins`);
-    :func:`specdesign.validate.lifetime` combines the bins. Writes ``lifetime.md`` (the
+    :func:`specdesign.validate.lifetime` combines the bins, the rainflow DELs and the linear
+    predictions alike. Writes ``lifetime.md`` (the
     lifetime summary and Table 2 with its Lifetime column), ``table2_lifetime.md/.csv``,
-    ``lifetime_runs.csv`` (every run's tower-base DEL) and ``lifetime_damage.png`` (damage per
+    ``lifetime_runs.csv`` (every run's tower-base DEL and its bin's linear prediction) and ``lifetime_damage.png`` (damage per
     bin).
 
     Parameters
@@ -279,7 +280,8 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     -------
     dict
         ``change_pct`` and ``change_se_pp`` (the designed controller's lifetime tower-base DEL
-        change vs ROSCO, % and its SE), ``del_life_MNm`` (controller → lifetime DEL, MN·m),
+        change vs ROSCO, % and its SE), ``predicted_change_pct`` (the same from the linear
+        predictions, Dirlik on |T|²S_W per bin, %), ``del_life_MNm`` (controller → lifetime DEL, MN·m),
         ``wind_speeds`` (bin centres, m/s), ``probabilities``, ``n_seeds``, ``duration``,
         ``seconds``.
 
@@ -321,27 +323,28 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     vs = climate.centres
     _say(f"[2/3] {vs.size} wind bins {vs[0]:g}-{vs[-1]:g} m/s × {n_seeds} paired seeds × {duration:g} s × 2 "
          "controllers, ROSCO's torque law in every run")
-    camp = validate.run_campaign(controllers, vs, n_seeds, model=model, duration=duration, predict=False,
-                                 torque_control="rosco")
+    camp = validate.run_campaign(controllers, vs, n_seeds, model=model, duration=duration, torque_control="rosco")
     _say(f"[3/3] lifetime DEL over {climate.description}")
     life = validate.lifetime(camp, climate, baseline="ROSCO")
     t2 = validate.table2(camp, "QFT", "ROSCO", climate=climate)
     t2.to_csv(out / "table2_lifetime.csv")
     (out / "table2_lifetime.md").write_text(t2.to_markdown())
     with open(out / "lifetime_runs.csv", "w") as f:
-        f.write("controller,wind_speed_m_s,seed,tower_del_Nm\n")
+        f.write("controller,wind_speed_m_s,seed,tower_del_Nm,predicted_tower_del_Nm\n")
         for i, name in enumerate(camp.controllers):
             for w, v in enumerate(vs):
                 for j, seed in enumerate(camp.seeds):
-                    f.write(f"{name},{v:g},{seed},{float(camp.values['tower_del'][i, w, j])!r}\n")
+                    f.write(f"{name},{v:g},{seed},{float(camp.values['tower_del'][i, w, j])!r},"
+                            f"{float(camp.predicted_del[i, w])!r}\n")
     fig = Figure(figsize=(9, 4.5))
     plot_lifetime_damage(life, ax=fig.subplots())
     fig.tight_layout()
     fig.savefig(out / "lifetime_damage.png", dpi=120)
     i = life.controllers.index("QFT")
     change, se = float(life.change[i, 0]), float(life.change_se[i, 0])
+    predicted = float(life.predicted_change[i, 0])
     headline = (f"Lifetime tower-base DEL change, QFT vs ROSCO: {change:+.2f} % ± {se:.2f} % (SE, {life.method} "
-                f"over {n_seeds} paired seeds per bin)")
+                f"over {n_seeds} paired seeds per bin); linear prediction {predicted:+.2f} %")
     _say(life.summary())
     _say(headline)
     elapsed = time.perf_counter() - t_start
@@ -354,7 +357,7 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
         "Figure: lifetime_damage.png (damage per wind bin). Per-run DELs: lifetime_runs.csv.", "",
         f"Run time: {elapsed:.0f} s."]) + "\n")
     _say(f"done in {elapsed:.0f} s: {out.resolve()}/lifetime.md")
-    return {"change_pct": change, "change_se_pp": se,
+    return {"change_pct": change, "change_se_pp": se, "predicted_change_pct": predicted,
             "del_life_MNm": {n: float(life.del_life[c, 0]) / 1e6 for c, n in enumerate(life.controllers)},
             "wind_speeds": vs.tolist(), "probabilities": life.probabilities.tolist(), "n_seeds": int(n_seeds),
             "duration": float(duration), "seconds": elapsed}

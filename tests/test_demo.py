@@ -90,14 +90,16 @@ def test_lifetime_demo_prints_the_lifetime_change_recomputed_from_its_runs(tmp_p
     assert main(["demo", "--lifetime", "--out", str(out), "--design-speeds", "19", "--bin-width", "11",
                  "--seeds", "2", "--duration", "60"]) == 0
     text = capsys.readouterr().out
-    got = re.search(r"Lifetime tower-base DEL change, QFT vs ROSCO: ([-+]\d+\.\d+) % ± (\d+\.\d+) %", text)
+    got = re.search(r"Lifetime tower-base DEL change, QFT vs ROSCO: ([-+]\d+\.\d+) % ± (\d+\.\d+) % .*; "
+                    r"linear prediction ([-+]\d+\.\d+) %", text)
     assert got, text
-    change, se = float(got.group(1)), float(got.group(2))
-    runs = {}
+    change, se, predicted = float(got.group(1)), float(got.group(2)), float(got.group(3))
+    runs, preds = {}, {}
     with open(out / "lifetime_runs.csv") as f:
         next(f)
         for row in csv.reader(f):
             runs.setdefault(row[0], {}).setdefault(float(row[1]), []).append(float(row[3]))
+            preds.setdefault(row[0], {})[float(row[1])] = float(row[4])
     speeds = sorted(runs["ROSCO"])
     assert speeds == [3.0, 14.0, 25.0]  # cut-in to cut-out
     edges = [(3.0, 8.5), (8.5, 19.5), (19.5, 25.0)]
@@ -107,6 +109,11 @@ def test_lifetime_demo_prints_the_lifetime_change_recomputed_from_its_runs(tmp_p
         return (sum(pb * np.mean(np.array(runs[name][v]) ** 4) for pb, v in zip(p, speeds)) / sum(p)) ** 0.25
 
     assert change == pytest.approx(100 * (life("QFT") / life("ROSCO") - 1), abs=0.006)  # printed to 2 decimals
+
+    def life_pred(name):
+        return (sum(pb * preds[name][v] ** 4 for pb, v in zip(p, speeds)) / sum(p)) ** 0.25
+
+    assert predicted == pytest.approx(100 * (life_pred("QFT") / life_pred("ROSCO") - 1), abs=0.006)
     assert se > 0 and math.isfinite(se)
     assert (out / "lifetime_damage.png").stat().st_size > 0
     assert "| Tower base DEL |" in (out / "table2_lifetime.md").read_text()

@@ -273,3 +273,22 @@ def test_table2_lifetime_column_is_lifetime_and_the_energy_change():
                     np.zeros((2, 7)), np.zeros(3), {}, {})
     assert "MISSING bins (not simulated, excluded): 3, 5, 7, 9, 11 m/s" in table2(part, "designed", "rosco",
                                                                                  climate=climate).note
+
+
+def test_lifetime_of_the_linear_predictions_by_hand():
+    c = synthetic(seed=4)
+    rng = np.random.default_rng(5)
+    pred = 1e7 * rng.uniform(1.0, 2.0, (2, SPEEDS.size))  # N·m, per controller and speed
+    c = Campaign(c.controllers, c.wind_speeds, c.seeds, 600.0, 0.1, 4.0, c.values, pred, np.zeros(3), {}, {})
+    climate = weibull_bins()
+    r = lifetime(c, climate)
+    p = climate.probabilities[5:]  # bins 13..25 m/s
+    hand = [(sum(pb * d**4 for pb, d in zip(p, pred[i])) / p.sum()) ** 0.25 for i in range(2)]
+    np.testing.assert_allclose(r.predicted_del_life[:, 0], hand, rtol=1e-12)
+    assert r.predicted_change[1, 0] == pytest.approx(100 * (hand[1] / hand[0] - 1), rel=1e-12)
+    assert "linear prediction" in r.summary()
+    # without predictions (NaN, as a campaign run with predict=False holds): NaN, not in the summary
+    none = Campaign(c.controllers, c.wind_speeds, c.seeds, 600.0, 0.1, 4.0, c.values, np.full((2, SPEEDS.size), np.nan),
+                    np.zeros(3), {}, {})
+    r0 = lifetime(none, climate)
+    assert np.all(np.isnan(r0.predicted_del_life)) and "linear prediction" not in r0.summary()

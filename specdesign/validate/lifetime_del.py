@@ -212,6 +212,12 @@ class LifetimeDEL:
         "jackknife" or "bootstrap".
     climate : str
         Description of the wind climate.
+    predicted_del_life : numpy.ndarray, optional
+        (C, K) the same lifetime DEL from the campaign's linear predictions (Dirlik on
+        |T|²S_W per bin, ``Campaign.predicted_del``, N·m): no seeds, no SE; NaN for a channel
+        without predictions or a controller without a linear form.
+    predicted_change : numpy.ndarray, optional
+        (C, K) its change vs the baseline (%).
 
     See Also
     --------
@@ -237,6 +243,8 @@ class LifetimeDEL:
     n_seeds: int
     method: str
     climate: str
+    predicted_del_life: np.ndarray | None = None
+    predicted_change: np.ndarray | None = None
 
     @property
     def covered_probability(self) -> float:
@@ -272,6 +280,8 @@ class LifetimeDEL:
                 row = f"  {name:<16} DEL_life {self.del_life[i, j] / 1e6:10.4g} ± {self.se[i, j] / 1e6:.2g} MN·m"
                 if name != self.baseline:
                     row += f"   change vs {self.baseline} {self.change[i, j]:+.2f} ± {self.change_se[i, j]:.2f} %"
+                    if self.predicted_change is not None and np.isfinite(self.predicted_change[i, j]):
+                        row += f" (linear prediction {self.predicted_change[i, j]:+.2f} %)"
                 lines.append(row)
         return "\n".join(lines)
 
@@ -396,6 +406,14 @@ def lifetime(campaign, wind_climate, *, controllers=None, channels=("tower_base_
     C, K = len(names), len(chans)
     e_bins = p * dm.mean(axis=-1)  # (C, K, W)
     unstable_all = np.asarray(getattr(campaign, "unstable", np.zeros((len(campaign.controllers), vs.size), bool)))
+    # the linear predictions (tower-base DEL per controller and speed) combined the same way
+    pred = np.full((C, K), np.nan)
+    pd = getattr(campaign, "predicted_del", None)
+    for k, ch in enumerate(chans):
+        if ch == "tower_base_my" and pd is not None and np.shape(pd) == (len(campaign.controllers), vs.size):
+            pred[:, k] = (p @ (np.asarray(pd, dtype=float)[ci].T ** m) / p.sum()) ** (1.0 / m)
+    with np.errstate(invalid="ignore", divide="ignore"):  # no prediction (NaN, or 0 in a hand-made record)
+        pred_change = 100.0 * (pred / pred[b] - 1.0)
     return LifetimeDEL(
         controllers=names, channels=chans, baseline=base, m=m, availability=availability, wind_speeds=vs.copy(),
         probabilities=p, del_life=est[:C * K].reshape(C, K), se=se[:C * K].reshape(C, K),
@@ -404,7 +422,8 @@ def lifetime(campaign, wind_climate, *, controllers=None, channels=("tower_base_
         damage_share=e_bins / e_bins[b].sum(axis=-1)[None, :, None],
         missing_speeds=centres[~covered], missing_probability=climate.probabilities[~covered],
         unstable={n: vs[unstable_all[i]].tolist() for n, i in zip(names, ci)},
-        n_seeds=S, method=method, climate=climate.description)
+        n_seeds=S, method=method, climate=climate.description, predicted_del_life=pred,
+        predicted_change=pred_change)
 
 
 def _as_climate(wc) -> WindClimate:
