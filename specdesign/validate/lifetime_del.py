@@ -9,8 +9,10 @@ The lifetime DEL over the bins a campaign covers is
 
 the 1 Hz equivalent range of the operating time in those bins. Bins of the climate that the
 campaign did not simulate are never dropped silently: :class:`LifetimeDEL` lists them with
-their probability mass, and :meth:`LifetimeDEL.summary` says so. A campaign that adds bins
-(below rated, once the workbench simulates there) covers them with no change to this API.
+their probability mass, and :meth:`LifetimeDEL.summary` says so. A campaign at every bin
+centre from cut-in to cut-out (below rated under the model's torque law, e.g.
+``run_campaign(..., weibull_bins().centres, ..., torque_control="rosco")``) covers the whole
+climate; ``python -m specdesign demo --lifetime`` runs one.
 """
 from __future__ import annotations
 
