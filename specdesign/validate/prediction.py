@@ -35,6 +35,17 @@ def loop_plant(model):
     return own() if callable(own) else turbine_plant(model)
 
 
+def _frequency_response(sys, w):
+    """C(jωI − A)⁻¹B + D at every ω in one batched solve, (ny, nu, nw): python-control's call
+    solves frequency by frequency, half of a small campaign's time (the results agree to ~1e-11)."""
+    A, B, C, D = (np.asarray(getattr(sys, k), float) for k in "ABCD")
+    n = A.shape[0]
+    if n == 0:
+        return np.broadcast_to(D[..., None], D.shape + (w.size,)).astype(complex)
+    X = np.linalg.solve(1j * w[:, None, None] * np.eye(n) - A, np.broadcast_to(B.astype(complex), (w.size,) + B.shape))
+    return np.einsum("ij,wjk->ikw", C, X) + D[..., None]
+
+
 def closed_loop_response(model, controller, wind_speed: float, omega, output: str = "tower_base_my") -> np.ndarray:
     """T_{y,w}(jω) from rotor-effective wind (m/s) to ``output`` (SI) in closed loop.
 
@@ -62,7 +73,7 @@ def closed_loop_response(model, controller, wind_speed: float, omega, output: st
     """
     w = np.asarray(omega, dtype=float)
     plant = loop_plant(model)
-    G = np.asarray(plant.linearize(wind_speed)(1j * w))  # (ny, nu, nw), inputs wind, pitch_cmd, gen_torque
+    G = _frequency_response(plant.linearize(wind_speed), w)  # (ny, nu, nw), inputs wind, pitch_cmd, gen_torque
     names = list(plant.output_names)
     # by position: a user KernelPlant's linearisation need not carry signal names
     P = {(o, u): G[names.index(o), j] for o in {output, "gen_speed", "tower_top_vel"}
