@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage"]
+__all__ = ["plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage", "plot_comparison"]
 
 _UNITS = {"gen_speed": ("Generator speed", "(rad/s)²/(rad/s)"), "tower_base_my": ("Tower-base fore-aft moment", "(N·m)²/(rad/s)")}
 
@@ -244,3 +244,64 @@ def plot_lifetime_damage(life, channel: str = "tower_base_my", *, ax=None):
     ax.legend(fontsize="small")
     ax.grid(True, axis="y", alpha=0.3)
     return ax
+
+
+def plot_comparison(changes, indicators=("tower_del", "blade_del"), *, axes=None):
+    """DEL change vs the baseline per controller and wind speed, with standard-error bars.
+
+    Parameters
+    ----------
+    changes : mapping
+        Controller name → {indicator → :class:`~specdesign.validate.PairedChange`} (the
+        changes of ``benchmarks/comparison.py``); each change's ``wind_speeds`` (m/s) place
+        its points, so a controller run on fewer speeds shows fewer points.
+    indicators : sequence of str, default ("tower_del", "blade_del")
+        One panel per indicator (:data:`~specdesign.validate.INDICATORS`).
+    axes : sequence of matplotlib.axes.Axes, optional
+        One per indicator; new axes side by side if omitted.
+
+    Returns
+    -------
+    numpy.ndarray
+        The panels' axes (change in %, wind speed in m/s, one series per controller, legend).
+
+    Raises
+    ------
+    ValueError
+        No controllers, or an ``axes`` of another length than ``indicators``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.validate import paired_change
+    >>> ch = {"A": {"tower_del": paired_change([[9.0, 10.0]], [[10.0, 11.0]], wind_speeds=[19.0])}}
+    >>> ax = plot_comparison(ch, ("tower_del",))
+    >>> ax[0].get_ylabel()
+    'tower-base DEL change vs baseline (%)'
+    """
+    names = list(changes)
+    if not names:
+        raise ValueError("changes is empty: give controller name → {indicator → PairedChange}")
+    inds = tuple(indicators)
+    if axes is None:
+        import matplotlib.pyplot as plt
+
+        _, axes = plt.subplots(1, len(inds), figsize=(5.5 * len(inds), 4.0), squeeze=False)
+        axes = axes[0]
+    axes = np.atleast_1d(np.asarray(axes, dtype=object))
+    if axes.size != len(inds):
+        raise ValueError(f"axes has {axes.size} entries; give one per indicator ({len(inds)})")
+    labels = {"tower_del": "tower-base DEL", "blade_del": "blade-root DEL", "gen_speed_sd": "generator-speed SD",
+              "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD"}
+    width = 0.8 / len(names)
+    for ax, ind in zip(axes, inds):
+        for i, n in enumerate(names):
+            ch = changes[n][ind]
+            x = np.asarray(ch.wind_speeds, dtype=float) + (i - (len(names) - 1) / 2) * width
+            ax.errorbar(x, ch.change, yerr=ch.se, fmt="o", capsize=3, label=n)
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_xlabel("mean wind speed (m/s)")
+        ax.set_ylabel(f"{labels.get(ind, ind)} change vs baseline (%)")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize="small")
+    return axes

@@ -124,7 +124,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
 def _volterra_indicators(model, controller, v, wind, wdt, order, transient, sim, m):
     """Indicators of the Volterra prediction over the records of the simulation ``sim``
     (same wind, same window: the wind sample at ``transient`` is the first record sample)."""
-    outs = ("tower_base_my", "gen_speed", "power", "pitch")
+    outs = ("tower_base_my", "gen_speed", "power", "pitch") + (("blade_root_my",) if "blade_root_my" in sim.outputs else ())
     terms = volterra_response(model, controller, v, wind, wdt, order=order, outputs=outs)
     op = model.trim(v)
     y0 = dict(zip(model.output_names, model.evaluate_outputs(op.x, v, op.pitch, op.gen_torque)))

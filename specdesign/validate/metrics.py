@@ -1,5 +1,5 @@
-"""Per-run indicators: tower-base DEL by rainflow, generator-speed SD, mean power, pitch and
-pitch-rate SD, from arrays (a simulation's outputs or :func:`specdesign.openfast.series_from_openfast`)."""
+"""Per-run indicators: tower-base DEL (m = 4 by default) and blade-root DEL (m = 10) by
+rainflow, generator-speed SD, mean power, pitch and pitch-rate SD, from arrays (a simulation's outputs or :func:`specdesign.openfast.series_from_openfast`)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -9,10 +9,13 @@ import numpy as np
 
 from .._checks import positive_scalar
 
-__all__ = ["INDICATORS", "Indicators", "indicators"]
+__all__ = ["INDICATORS", "BLADE_M", "Indicators", "indicators"]
 
 #: Names of the indicators, in the order of :meth:`Indicators.as_dict` and of the output files.
-INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd")
+INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "blade_del")
+
+#: Wöhler exponent of the blade-root DEL (composite blade root, the usual m = 10).
+BLADE_M = 10.0
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
@@ -31,8 +34,12 @@ class Indicators:
         Standard deviation of the blade pitch (rad).
     pitch_rate_sd : numpy.ndarray
         Standard deviation of the pitch rate (rad/s).
+    blade_del : numpy.ndarray
+        Blade-root flapwise DEL (N·m, a range, 1 Hz convention, Wöhler exponent
+        :data:`BLADE_M` = 10) of the output ``blade_root_my``; NaN where the series has no
+        such output (e.g. an OpenFAST file without it).
     m : float
-        Wöhler exponent of the DEL.
+        Wöhler exponent of the tower-base DEL.
     duration : float
         Record length used for the equivalent cycle count N_eq (s).
 
@@ -46,11 +53,12 @@ class Indicators:
     mean_power: np.ndarray
     pitch_sd: np.ndarray
     pitch_rate_sd: np.ndarray
+    blade_del: np.ndarray
     m: float
     duration: float
 
     def as_dict(self) -> dict[str, np.ndarray]:
-        """The five indicators by name (:data:`INDICATORS`), without ``m`` and ``duration``.
+        """The six indicators by name (:data:`INDICATORS`), without ``m`` and ``duration``.
 
         Returns
         -------
@@ -68,11 +76,13 @@ def indicators(series: Mapping, dt: float, m: float = 4.0) -> Indicators:
     series : mapping
         ``tower_base_my`` (N·m), ``gen_speed`` (rad/s), ``power`` (W) and ``pitch`` (rad),
         each shaped (..., n) (a :class:`~specdesign.simulate.SimulationResult` qualifies, as
-        does the first result of :func:`specdesign.openfast.series_from_openfast`).
+        does the first result of :func:`specdesign.openfast.series_from_openfast`); optionally
+        ``blade_root_my`` (N·m, same shape) for ``blade_del`` (NaN without it).
     dt : float
         Sample spacing (s).
     m : float, default 4.0
-        Wöhler exponent of the tower-base DEL (S-N curve with S the range).
+        Wöhler exponent of the tower-base DEL (S-N curve with S the range); the blade-root
+        DEL always uses :data:`BLADE_M`.
 
     Returns
     -------
@@ -109,12 +119,22 @@ def indicators(series: Mapping, dt: float, m: float = 4.0) -> Indicators:
     duration = n * dt
     flat = my.reshape(-1, n)
     dels = np.array([del_rainflow(row, m, duration) for row in flat]).reshape(my.shape[:-1])
+    blade = np.full(my.shape[:-1], np.nan)
+    try:
+        bm = np.asarray(get("blade_root_my"), dtype=float)
+    except KeyError:  # e.g. an OpenFAST file without the channel: the indicator is NaN, not a guess
+        bm = None
+    if bm is not None:
+        if bm.shape != my.shape:
+            raise ValueError(f"series['blade_root_my'] must have the shape {my.shape} of the other series; got {bm.shape}")
+        blade = np.array([del_rainflow(row, BLADE_M, duration) for row in bm.reshape(-1, n)]).reshape(my.shape[:-1])
     return Indicators(
         tower_del=dels,
         gen_speed_sd=om.std(axis=-1),
         mean_power=pw.mean(axis=-1),
         pitch_sd=pb.std(axis=-1),
         pitch_rate_sd=(np.diff(pb, axis=-1) / dt).std(axis=-1),
+        blade_del=blade,
         m=m,
         duration=duration,
     )

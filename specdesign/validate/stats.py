@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
-from .metrics import INDICATORS
+from .metrics import BLADE_M, INDICATORS
 
 __all__ = ["WEIBULL_K", "WEIBULL_A", "weibull_weights", "welch_psd", "pool", "resampled_se", "PairedChange",
            "paired_change"]
@@ -135,7 +135,8 @@ def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        ``tower_del``: (mean DEL^m)^{1/m} (the DEL of the summed damage); ``mean_power``:
+        ``tower_del``: (mean DEL^m)^{1/m} (the DEL of the summed damage), ``blade_del``
+        the same with m = :data:`~specdesign.validate.metrics.BLADE_M`; ``mean_power``:
         the mean; a standard deviation: √(mean of the variances).
 
     Examples
@@ -146,6 +147,8 @@ def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
     """
     if indicator == "tower_del":
         return np.mean(x**m, axis=axis) ** (1.0 / m)
+    if indicator == "blade_del":  # its own S-N slope, whatever the campaign's tower m
+        return np.mean(x**BLADE_M, axis=axis) ** (1.0 / BLADE_M)
     if indicator == "mean_power":
         return np.mean(x, axis=axis)
     return np.sqrt(np.mean(x**2, axis=axis))

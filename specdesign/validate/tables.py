@@ -22,6 +22,7 @@ _LABELS = {
     "tower_del": "Tower base DEL",
     "pitch_sd": "Pitch activity (SD)",
     "pitch_rate_sd": "Pitch rate SD",
+    "blade_del": "Blade root DEL (m = 10)",
 }
 
 
