@@ -9,7 +9,7 @@ import numpy as np
 
 from .._checks import positive_scalar
 
-__all__ = ["INDICATORS", "BLADE_M", "Indicators", "indicators"]
+__all__ = ["BLADE_M", "INDICATORS", "Indicators", "indicators"]
 
 #: Names of the indicators, in the order of :meth:`Indicators.as_dict` and of the output files.
 INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "blade_del")

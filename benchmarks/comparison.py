@@ -1,0 +1,278 @@
+"""One comparison (issue 17 part 4): ROSCO, QFT, H∞, the quadratic MPC, behavioural cloning, the
+health-aware MPC and the economic MPC on the same wind speeds and paired seeds (docs/comparison.md).
+
+Controllers (IEA 15 MW reduced model, class-B turbulence, ``run_campaign``; one campaign per
+controller, each timed, all on the same (wind speed, seed) winds, so the runs are paired):
+
+- ROSCO: ``rosco_scheduled`` (gain-scheduled PI, tower damping off), the baseline of every change;
+- QFT: ``qft.design_schedule(model, speeds)`` (specification-driven), scheduled by
+  ``simulate.scheduled`` on the trim pitch with its ATD loops;
+- H∞: ``hinf.design_hinf(model, v)`` per design speed, its ``pitch_controller`` and
+  ``atd_controller`` scheduled the same way;
+- quadratic MPC (``mpc.QuadraticMPC``), behavioural cloning (``mpc.clone``: expert = the
+  economic problem, trained on seeds 100-103, never the evaluation seeds), health-aware MPC
+  (``mpc.HealthMPC(health_weight=10)``);
+- economic MPC (``mpc.EconomicMPC``, ~35 ms per step): on a documented subset of speeds and seeds.
+
+Indicators as changes vs ROSCO with the paired-seed jackknife SE (``validate.paired_change``):
+tower-base DEL (m = 4), blade-root DEL (m = 10), generator-speed SD, mean power, pitch SD and
+pitch-rate SD. CPU per control step: the MPCs' ``solve_times``; for every controller the
+campaign's CPU time per simulated step (plant included). For LTI controllers the linear
+prediction (``validate.linear_prediction``, Dirlik on |T|²S_W) and the Volterra prediction
+(``validate.volterra_prediction``, order 3) of the DEL changes.
+
+Writes the tables between the result markers of docs/comparison.md (the prose around them is
+kept) and the figure docs/figures/comparison.png.
+
+Run: python benchmarks/comparison.py [--quick --out /tmp/comparison.md --figure /tmp/comparison.png]
+(full size about 40 minutes on 2 shared cores; --quick: 2 speeds × 2 seeds × 60 s, about 1.5 min)
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+SPEEDS = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
+INDS = ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd")
+LABELS = {"tower_del": "tower DEL", "blade_del": "blade DEL", "gen_speed_sd": "speed SD",
+          "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD"}
+
+
+def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101, 102, 103), quick=False,
+                      say=print):
+    """The controllers of the comparison (name → controller) and their kinds ("lti"/"mpc")."""
+    import control as ct
+
+    from specdesign import hinf, mpc, qft
+    from specdesign.rosco import rosco_scheduled
+    from specdesign.simulate import scheduled
+
+    t0 = time.perf_counter()
+    out = {"ROSCO": rosco_scheduled(model)}
+    designs = qft.design_schedule(model, list(speeds))
+    out["QFT"] = scheduled(model, {d.wind_speed: d.pitch_controller for d in designs},
+                           atd={d.wind_speed: d.atd_controller for d in designs}, name="QFT")
+    say(f"QFT designs: {time.perf_counter() - t0:.0f} s")
+    t0 = time.perf_counter()
+    hd = {v: hinf.design_hinf(model, v) for v in speeds}
+    out["H∞"] = scheduled(model, {v: ct.ss(d.pitch_controller) for v, d in hd.items()},
+                          atd={v: ct.ss(d.atd_controller) for v, d in hd.items()}, name="H∞")
+    say(f"H∞ designs: {time.perf_counter() - t0:.0f} s")
+    out["quadratic MPC"] = mpc.QuadraticMPC(model)
+    t0 = time.perf_counter()
+    terms = mpc.fit_fatigue_terms(model, 19.0, 10.0, seeds=(1, 2))
+    cs = list(speeds if clone_speeds is None else clone_speeds)
+    bc, demos = mpc.clone(model, cs, list(clone_seeds), terms, rounds=1 if quick else 2, horizon=10.0,
+                          duration=20.0 if quick else 60.0)
+    say(f"clone: {demos.targets.size} demonstrations at {cs} m/s, {time.perf_counter() - t0:.0f} s")
+    out["behavioural cloning"] = bc
+    out["health MPC"] = mpc.HealthMPC(model, health_weight=10.0)
+    out["economic MPC"] = mpc.EconomicMPC(model, terms, ts=0.2)
+    kinds = {n: ("mpc" if hasattr(c, "solve_times") else "lti") for n, c in out.items()}
+    return out, kinds
+
+
+def run_all(model, controllers, speeds, seeds, duration, *, econ_speeds, econ_seeds, transient=30.0, say=print):
+    """One timed campaign per controller; the economic MPC on its subset (and ROSCO on it too)."""
+    from specdesign.validate import run_campaign
+
+    camps, cpu, wall = {}, {}, {}
+    for name, c in controllers.items():
+        vs, ss = (econ_speeds, econ_seeds) if name == "economic MPC" else (speeds, seeds)
+        if not len(vs):
+            continue
+        if hasattr(c, "solve_times"):
+            c.solve_times.clear()
+        t0, p0 = time.perf_counter(), time.process_time()
+        camps[name] = run_campaign({name: c}, list(vs), list(ss), model=model, duration=duration, transient=transient,
+                                   predict=False, progress=False)
+        wall[name], cpu[name] = time.perf_counter() - t0, time.process_time() - p0
+        say(f"{name}: {len(vs)} speeds × {len(ss)} seeds × {duration:g} s in {wall[name]:.0f} s wall")
+    if "economic MPC" in controllers:  # the baseline on the subset: the same winds, so paired
+        camps["ROSCO (subset)"] = run_campaign({"ROSCO": controllers["ROSCO"]}, list(econ_speeds), list(econ_seeds),
+                                               model=model, duration=duration, transient=transient, predict=False,
+                                               progress=False)
+    return camps, cpu, wall
+
+
+def changes(camps, baseline="ROSCO"):
+    """Per controller and indicator: (change (W,), SE (W,)) vs the baseline on the same seeds (%)."""
+    from specdesign.validate import paired_change
+
+    res = {}
+    for name, c in camps.items():
+        if name.startswith("ROSCO"):
+            continue
+        b = camps["ROSCO (subset)"] if name == "economic MPC" else camps[baseline]
+        res[name] = {k: paired_change(c.values[k][0], b.values[k][0], k, m=c.m, wind_speeds=c.wind_speeds)
+                     for k in INDS}
+    return res
+
+
+def predictions(model, controllers, kinds, speeds, *, volterra_seeds, duration):
+    """Linear (Dirlik) and Volterra (order 3) predicted DEL changes vs ROSCO for the LTI controllers."""
+    from specdesign.validate import (
+        linear_prediction,
+        prediction_grid,
+        volterra_prediction,
+    )
+
+    outs = (("tower_del", "tower_base_my", 4.0), ("blade_del", "blade_root_my", 10.0))
+    raw = {}
+    for name, c in controllers.items():
+        if kinds[name] != "lti":
+            continue
+        raw[name] = {}
+        for k, o, m in outs:
+            lin = np.array([linear_prediction(model, c, v, output=o, m=m, omega=prediction_grid(duration)).del_ for v in speeds])
+            vol = np.array([volterra_prediction(model, c, v, seeds=volterra_seeds, duration=duration, m=m,
+                                                output=o).del_ for v in speeds])
+            raw[name][k] = (lin, vol)
+    return {n: {k: tuple(100.0 * (x / raw["ROSCO"][k][i] - 1.0) for i, x in enumerate(r[k])) for k in r}
+            for n, r in raw.items() if n != "ROSCO"}
+
+
+def cpu_per_step(camps, controllers, cpu, duration, transient, dt=0.02):
+    """(ms of campaign CPU per simulated step, ms per control step of the MPC's own solve_times or NaN)."""
+    out = {}
+    for name, c in controllers.items():
+        if name not in camps:
+            continue
+        camp = camps[name]
+        steps = camp.wind_speeds.size * camp.seeds.size * (duration + transient) / dt
+        st = getattr(c, "solve_times", None)
+        out[name] = (1e3 * cpu[name] / steps, 1e3 * float(np.mean(st)) if st else float("nan"))
+    return out
+
+
+def fmt(x, se):
+    """"+1.2 ± 0.3" (empty for NaN)."""
+    return "–" if not np.isfinite(x) else (f"{x:+.1f} ± {se:.1f}" if np.isfinite(se) else f"{x:+.1f}")
+
+
+def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took):
+    """The tables of docs/comparison.md."""
+    lines = []
+    lines.append("| controller | " + " | ".join(f"{LABELS[k]} Δ% ± SE" for k in INDS)
+                 + " | CPU/step: campaign (ms) | CPU/step: controller solve (ms) |")
+    lines.append("|---" * (len(INDS) + 3) + "|")
+    for name, r in res.items():
+        cells = []
+        for k in INDS:
+            ch = r[k]
+            # mean over the speeds of the change; SE of the mean from the per-speed SEs (independent speeds)
+            cells.append(fmt(float(np.mean(ch.change)), float(np.sqrt(np.sum(ch.se**2))) / ch.change.size))
+        per, solve = cpu[name]
+        tag = " (subset)" if name == "economic MPC" else ""
+        sv = "compiled loop" if not np.isfinite(solve) else f"{solve:.2f}"
+        lines.append(f"| {name}{tag} | " + " | ".join(cells) + f" | {per:.3f} | {sv} |")
+    per_speed = ["", "Per wind speed (change vs ROSCO, %, ± paired-seed SE):", ""]
+    per_speed.append("| controller | indicator | " + " | ".join(f"{v:g} m/s" for v in speeds) + " |")
+    per_speed.append("|---|---|" + "---|" * len(speeds))
+    for name, r in res.items():
+        for k in ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd"):
+            ch = r[k]
+            cells = {float(v): fmt(c, s) for v, c, s in zip(ch.wind_speeds, ch.change, ch.se)}
+            per_speed.append(f"| {name} | {LABELS[k]} | " + " | ".join(cells.get(float(v), "") for v in speeds) + " |")
+    pred = ["", "Predictions of the DEL changes vs ROSCO (LTI controllers; %, per wind speed), beside the rainflow result:",
+            ""]
+    pred.append("| controller | DEL | source | " + " | ".join(f"{v:g} m/s" for v in speeds) + " |")
+    pred.append("|---|---|---|" + "---|" * len(speeds))
+    for name, p in preds.items():
+        for k in ("tower_del", "blade_del"):
+            lin, vol = p[k]
+            sim = res[name][k]
+            pred.append(f"| {name} | {LABELS[k]} | linear (Dirlik) | " + " | ".join(f"{x:+.1f}" for x in lin) + " |")
+            pred.append(f"| {name} | {LABELS[k]} | Volterra (order 3) | " + " | ".join(f"{x:+.1f}" for x in vol) + " |")
+            pred.append(f"| {name} | {LABELS[k]} | rainflow (simulated) | "
+                        + " | ".join(fmt(c, s) for c, s in zip(sim.change, sim.se)) + " |")
+    return "\n".join(lines + per_speed + pred)
+
+
+START, END = "<!-- comparison.py results: start -->", "<!-- comparison.py results: end -->"
+
+
+def splice(path, text):
+    """Write ``text`` between the result markers of ``path`` (the prose around is kept), or the
+    whole file when it has no markers."""
+    old = ""
+    if os.path.exists(path):
+        with open(path) as f:
+            old = f.read()
+    if START in old and END in old:
+        new = old[:old.index(START) + len(START)] + "\n" + text + "\n" + old[old.index(END):]
+    else:
+        new = START + "\n" + text + "\n" + END + "\n"
+    with open(path, "w") as f:
+        f.write(new)
+
+
+def figure(res, path):
+    """Tower and blade DEL change per controller per wind speed with SE bars."""
+    from specdesign.plots.validation import plot_comparison
+
+    axes = plot_comparison(res)
+    axes[0].figure.tight_layout()
+    axes[0].figure.savefig(path, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smoke test: 2 speeds, 2 seeds, 60 s records")
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--duration", type=float, default=600.0)
+    ap.add_argument("--econ-speeds", type=float, nargs="+", default=[15.0, 21.0])
+    ap.add_argument("--econ-seeds", type=int, default=4)
+    ap.add_argument("--out", default="docs/comparison.md", help="Markdown page; the results go between its markers")
+    ap.add_argument("--figure", default="docs/figures/comparison.png")
+    a = ap.parse_args()
+    from specdesign import turbine
+
+    if a.quick:
+        speeds, seeds, duration, econ_speeds, econ_seeds = (17.0, 21.0), list(range(2)), 60.0, (21.0,), [0]
+    else:
+        speeds, seeds, duration = SPEEDS, list(range(a.seeds)), a.duration
+        econ_speeds, econ_seeds = tuple(a.econ_speeds), list(range(a.econ_seeds))
+    load = os.getloadavg()
+    t_all = time.perf_counter()
+    model = turbine.iea15mw()
+    ctrls, kinds = build_controllers(model, speeds, quick=a.quick)
+    econ = {"economic MPC": ctrls.pop("economic MPC")}
+    camps, cpu, wall = run_all(model, ctrls, speeds, seeds, duration, econ_speeds=econ_speeds, econ_seeds=econ_seeds)
+    t0 = time.perf_counter()
+    preds = predictions(model, ctrls, kinds, speeds, volterra_seeds=range(1000, 1000 + (4 if a.quick else 40)),
+                        duration=duration)
+    print(f"predictions: {time.perf_counter() - t0:.0f} s")
+
+    def write(done_econ):
+        took = time.perf_counter() - t_all
+        load_end = os.getloadavg()
+        allc = {**ctrls, **econ} if done_econ else ctrls
+        head = (f"Command: `python benchmarks/comparison.py{' --quick' if a.quick else ''}`; {len(speeds)} speeds "
+                f"({', '.join(f'{v:g}' for v in speeds)} m/s) × {len(seeds)} paired seeds × {duration:g} s (after "
+                f"30 s of transient); economic MPC on {', '.join(f'{v:g}' for v in econ_speeds)} m/s × "
+                f"{len(econ_seeds)} seeds (vs ROSCO on the same subset)"
+                + ("" if done_econ else " NOT YET RUN (this file was written before its campaign)")
+                + f". Took {took:.0f} s wall; load average {load[0]:.1f} at the start, {load_end[0]:.1f} at the end "
+                "(2 cores, shared). Campaign wall times: " + ", ".join(f"{n} {t:.0f} s" for n, t in wall.items()) + ".")
+        text = head + "\n\n" + markdown(changes(camps), preds, cpu_per_step(camps, allc, cpu, duration, 30.0), speeds,
+                                        econ_speeds, a, load, took)
+        print(text)
+        splice(a.out, text)
+        figure(changes(camps), a.figure)
+        print(f"wrote {a.out}, {a.figure}")
+
+    write(False)
+    c2, cpu2, wall2 = run_all(model, {"ROSCO": ctrls["ROSCO"], **econ}, (), (), duration, econ_speeds=econ_speeds,
+                              econ_seeds=econ_seeds)
+    camps.update({k: v for k, v in c2.items() if k != "ROSCO"})
+    cpu.update({k: v for k, v in cpu2.items() if k != "ROSCO"})
+    wall.update({k: v for k, v in wall2.items() if k != "ROSCO"})
+    write(True)
+
+
+if __name__ == "__main__":
+    main()
