@@ -994,6 +994,11 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
                     width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5) -> ShapingResult:
     """Place and size notches where ΔD% is largest above ``keep_below`` to reach a target.
 
+    The seed paper's shaping: notches above a protected band, no feasibility guarantee. A
+    specification over the whole band, with the Bode-integral cost inside it and certified
+    over the plant cases, is :func:`specdesign.feasibility.element_specification` (in these
+    elements) or :func:`specdesign.feasibility.specification_for_target`.
+
     The problem solved (scipy SLSQP, exact Dirlik in the constraint): minimise the mean
     squared log-magnitude change of the specification, Σ_k w_k (20 log10 |N(jω_k)|)², with
     w_k = 1 above ``keep_below`` and 100 below, subject to reduction ≥ target. Notch centres

@@ -41,18 +41,22 @@ pointwise upper bound of condition 1 (the smallest |T_{MyT,w}| inside the speed 
 disks at every frequency): the true frontier lies between the two.
 :func:`specification_for_target` inverts the frontier: the smallest speed relaxation whose
 design promises a requested DEL reduction, and the specification pair it certifies.
+:func:`element_specification` writes such a certified tower specification as ROSCO's map times
+a few shaping elements (gain, lag, lead, notches and bumps) over the whole band, editable by hand.
 
 Modules: :mod:`~specdesign.feasibility.conditions` (the necessary conditions, the frontier),
 :mod:`~specdesign.feasibility.achievable` (the convex Youla design),
-:mod:`~specdesign.feasibility.target` (the specification for a target).
+:mod:`~specdesign.feasibility.target` (the specification for a target),
+:mod:`~specdesign.feasibility.elements` (the same in shaping elements).
 
 Units: ω in rad/s, magnitudes linear (dB only in messages), DEL reductions in %.
 """
 from .achievable import YOULA_PAIRS, YOULA_REAL_POLES, AchievablePitch, YoulaProblem, achievable_pitch
 from .conditions import (PitchChecker, PitchFeasibility, combine, pitch_checkers, pitch_feasibility, pitch_frontier,
                          sensitivity_disks)
+from .elements import element_specification
 from .target import TargetSpecification, recertify, specification_for_target
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
            "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks",
-           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify"]
+           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification"]
