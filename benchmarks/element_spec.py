@@ -59,8 +59,8 @@ v + (−1, −0.5, 0.5, 1) m/s: the result is a `TargetSpecification` like any o
 
 The element form costs speed regulation: the elements follow the certificate's *envelope*, not
 its narrow pole-zero pattern at the tower mode, which gives away 3-5 pp of promise, so the
-certificate behind it must promise more and needs a more relaxed speed map (at 19 m/s 6.55 dB
-instead of 1.44 dB). The designs meet the element specification and predict far more than it
+certificate behind it must promise more and needs a more relaxed speed map (the speed
+relaxation column against the transfer-function specification's). The designs meet the element specification and predict far more than it
 promises, as the certificate they are reduced from was made for the larger target.
 
 The elements at {v:g} m/s:
