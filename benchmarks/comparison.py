@@ -25,7 +25,7 @@ Writes the tables between the result markers of docs/comparison.md (the prose ar
 kept) and the figure docs/figures/comparison.png.
 
 Run: python benchmarks/comparison.py [--quick --out /tmp/comparison.md --figure /tmp/comparison.png]
-(full size about 40 minutes on 2 shared cores; --quick: 2 speeds × 2 seeds × 60 s, about 1.5 min)
+(full size about 25 minutes on 2 shared cores; --quick: 2 speeds × 2 seeds × 60 s, about 1.5 min)
 """
 from __future__ import annotations
 
