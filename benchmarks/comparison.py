@@ -6,7 +6,7 @@ controller, each timed, all on the same (wind speed, seed) winds, so the runs ar
 
 - ROSCO: ``rosco_scheduled`` (gain-scheduled PI, tower damping off), the baseline of every change;
 - QFT: ``qft.design_schedule(model, speeds)`` (specification-driven), scheduled by
-  ``simulate.scheduled`` on the trim pitch with its ATD loops;
+  ``simulate.scheduled`` on the trim pitch (pitch only: the certified designs have no ATD);
 - H∞: ``hinf.design_hinf(model, v)`` per design speed, its ``pitch_controller`` and
   ``atd_controller`` scheduled the same way;
 - quadratic MPC (``mpc.QuadraticMPC``), behavioural cloning (``mpc.clone``: expert = the

@@ -122,8 +122,8 @@ def test_clear_errors(campaign):
         fit_gp([[10.0, 0.1], [12.0, 0.1], [14.0, 0.1]], [1.0, 2.0, 3.0])
     with pytest.raises(ValueError, match="not in the campaign.*ROSCO"):
         del_data(campaign, "HINF")
-    with pytest.raises(ValueError, match="indicator='blade_del'"):
-        del_data(campaign, "ROSCO", "blade_del")
+    with pytest.raises(ValueError, match="indicator='root_del'"):
+        del_data(campaign, "ROSCO", "root_del")
     with pytest.raises(ValueError, match="turbulence class"):
         del_data({"Z": campaign}, "ROSCO")
     vals = dict(campaign.values)

@@ -50,7 +50,7 @@ from .metrics import INDICATORS
 __all__ = ["CampaignStore", "fingerprint"]
 
 #: version of the layout above; a store of another version is refused
-FORMAT = 1
+FORMAT = 2
 
 
 def fingerprint(obj) -> str:
