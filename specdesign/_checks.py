@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["as_omega", "as_psd", "as_signal", "as_real", "positive_scalar", "distinct_keys"]
+__all__ = ["as_omega", "as_psd", "as_signal", "as_real", "positive_scalar", "del_target", "distinct_keys"]
 
 
 def as_real(x, name: str) -> np.ndarray:
@@ -84,6 +84,14 @@ def positive_scalar(value, name: str) -> float:
     if not np.isfinite(v) or v <= 0:
         raise ValueError(f"{name}={value!r} must be finite and > 0")
     return v
+
+
+def del_target(value, name: str = "target_reduction") -> float:
+    """Validate a DEL-reduction target in % (0 < value < 100) and return it as a float."""
+    t = float(value)
+    if not 0 < t < 100:
+        raise ValueError(f"{name}={value!r} must be a DEL reduction in % strictly between 0 and 100")
+    return t
 
 
 def representable(value, positive, what: str, hint: str) -> np.ndarray:

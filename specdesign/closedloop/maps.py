@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 
 __all__ = ["frequency_response", "siso_response", "t_output_wind", "t_gen_speed_wind", "t_tower_wind", "output_psd",
            "closed_loop_del", "closed_map", "LoopMaps", "loop_maps", "plant_responses", "close_responses", "general_coefficients",
-           "general_form", "LOOP_OUTPUTS"]
+           "general_form", "LOOP_OUTPUTS", "state_space_response"]
 
 #: The plant outputs the pitch and ATD loops measure or shape by default.
 LOOP_OUTPUTS = ("gen_speed", "tower_base_my", "tower_top_vel", "pitch")
@@ -548,16 +548,46 @@ def _batched(P, w, outputs):
     ss = control.ss(P)
     oi = [ss.output_labels.index(o) for o in outputs]
     ii = [ss.input_labels.index(i) for i in PLANT_INPUTS]
-    a, b = np.asarray(ss.A), np.asarray(ss.B)[:, ii]
-    c, d = np.asarray(ss.C)[oi], np.asarray(ss.D)[np.ix_(oi, ii)]
-    lam, v = np.linalg.eig(a)
-    if np.linalg.cond(v) < 1e6:  # diagonalisable, well-conditioned: C·V·diag(1/(jω − λ))·V⁻¹·B
-        cv, vb = c @ v, np.linalg.solve(v, b)
-        y = (cv[None, :, :] * (1.0 / (1j * w[:, None] - lam[None, :]))[:, None, :]) @ vb + d
-    else:  # defective or ill-conditioned eigenvectors: one solve per frequency
-        x = np.linalg.solve(1j * w[:, None, None] * np.eye(a.shape[0]) - a, np.broadcast_to(b, (w.size,) + b.shape))
-        y = c @ x + d
+    y = state_space_response(np.asarray(ss.A), np.asarray(ss.B)[:, ii], np.asarray(ss.C)[oi],
+                             np.asarray(ss.D)[np.ix_(oi, ii)], w)
     return {(o, i): y[:, k, j] for k, o in enumerate(outputs) for j, i in enumerate(PLANT_INPUTS)}
+
+
+def state_space_response(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, omega: ArrayLike) -> np.ndarray:
+    """C(jωI − A)⁻¹B + D at every ω at once (python-control solves one frequency at a time).
+
+    Modal when A's eigenvectors are well conditioned (C·V·diag(1/(jω − λ))·V⁻¹·B), else one
+    batched solve per frequency.
+
+    Parameters
+    ----------
+    a, b, c, d : array_like
+        (n, n), (n, m), (p, n), (p, m) state-space matrices (SI units of the system).
+    omega : array_like
+        (nw,) frequencies, rad/s.
+
+    Returns
+    -------
+    numpy.ndarray
+        (nw, p, m) complex frequency response.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> y = state_space_response([[-1.0]], [[1.0]], [[1.0]], [[0.0]], [0.0, 1.0])
+    >>> np.round(y[:, 0, 0], 3)     # 1/(jω + 1)
+    array([1. +0.j , 0.5-0.5j])
+    """
+    a, b, c, d = (np.atleast_2d(np.asarray(x, float)) for x in (a, b, c, d))
+    w = np.asarray(omega, float)
+    if a.size == 0:  # a static gain
+        return np.broadcast_to(d, (w.size,) + d.shape).astype(complex)
+    lam, v = np.linalg.eig(a)
+    if np.linalg.cond(v) < 1e6:  # diagonalisable, well-conditioned
+        cv, vb = c @ v, np.linalg.solve(v, b)
+        return (cv[None, :, :] * (1.0 / (1j * w[:, None] - lam[None, :]))[:, None, :]) @ vb + d
+    x = np.linalg.solve(1j * w[:, None, None] * np.eye(a.shape[0]) - a, np.broadcast_to(b, (w.size,) + b.shape))
+    return c @ x + d
 
 
 def close_responses(R: Mapping[tuple[str, str], np.ndarray], k: ArrayLike, measurement: str,

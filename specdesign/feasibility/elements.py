@@ -186,11 +186,10 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     from scipy.ndimage import maximum_filter1d
 
     from .. import spec
+    from .._checks import del_target
     from .target import recertify, specification_for_target
 
-    t = float(target_reduction)
-    if not 0 < t < 100:
-        raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
+    t = del_target(target_reduction)
     heads = np.atleast_1d(np.asarray(headroom_pp, float))
     if heads.ndim != 1 or heads.size == 0 or not np.all(np.isfinite(heads)) or np.any(heads <= 0):
         raise ValueError(f"headroom_pp={headroom_pp!r} must be positive percentage points")

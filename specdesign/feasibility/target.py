@@ -152,11 +152,9 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     True
     """
     from .. import spec
-    from .._checks import as_omega
+    from .._checks import as_omega, del_target
 
-    t = float(target_reduction)
-    if not 0 < t < 100:
-        raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
+    t = del_target(target_reduction)
     slack = float(slack_db)
     if not (np.isfinite(slack) and slack >= 0):
         raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 import control as ct
 import numpy as np
 
-from .._checks import positive_scalar
+from .._checks import del_target, positive_scalar
 from ..closedloop import check_stability, closed_loop, lightly_damped, plant_responses, refine_grid, siso_response
 from .checks import bounds_met, loop_checks, spec_ratio, spec_roots
 from .structure import controllers, from_vector, rosco_start
@@ -314,7 +314,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
 
     Parameters
     ----------
-    model : specdesign.turbine.TurbineModel
+    model : specdesign.turbine.TurbineModel or specdesign.openfast.LinearTurbine
         The turbine, e.g. ``turbine.iea15mw()``.
     wind_speed : float
         Operating point, m/s (above rated, inside ``model.wind_range``).
@@ -502,15 +502,9 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
     from loopshaping import qft as lqft
 
     from .. import spec as sp
-    from .. import turbine
 
-    if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
-        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
-                        f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
-    v = model.check_wind_speed(wind_speed)
-    t = None if given is not None else float(target_reduction)
-    if t is not None and not 0 < t < 100:
-        raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % strictly between 0 and 100")
+    v = model.check_wind_speed(wind_speed)  # the model's type is checked by design_qft
+    t = None if given is not None else del_target(target_reduction)
     for name, val in (("speed_relax_db", speed_relax_db), ("tower_relax_db", tower_relax_db)):
         if not (np.isfinite(val) and val >= 0):
             raise ValueError(f"{name}={val!r} must be a finite relaxation ≥ 0 dB")
