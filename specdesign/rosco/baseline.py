@@ -272,12 +272,21 @@ def rosco_baseline(model: TurbineModel, wind_speed: float, *, omega_pc: float = 
     :func:`rosco_gain_schedule` (default grid) evaluated at ``wind_speed``; F_lpf is
     :func:`speed_filter`. Tower damping off, as in the paper's baseline.
 
+    From cut-in to cut-out (a model with a ``torque_control``, ``model.operating_range``) it is
+    ROSCO's pitch loop *linearised at the trim*: below rated (trim region other than "3") the
+    PI sits at fine pitch, its output and integrator clamped at the limit, so its linearisation
+    is zero, C = 0 (the pitch loop open; the torque loop is closed in the plant,
+    :meth:`~specdesign.turbine.TurbineModel.linearize`). From rated to the schedule's first
+    speed (ROSCO's grid starts one step above rated) the gains are the first entry's, as ROSCO's
+    ``interp1d`` holds the ends of its gain table.
+
     Parameters
     ----------
     model : TurbineModel
         The reduced turbine model.
     wind_speed : float
-        Mean wind speed (m/s), in ``model.wind_range``.
+        Mean wind speed (m/s), in ``model.wind_range``, or ``model.operating_range`` for a model
+        with a ``torque_control``.
     omega_pc : float, optional
         Closed-loop rotor-speed pole frequency (rad/s) of the schedule (when ``schedule`` is None).
     zeta_pc : float, optional
@@ -288,28 +297,41 @@ def rosco_baseline(model: TurbineModel, wind_speed: float, *, omega_pc: float = 
     Returns
     -------
     control.TransferFunction
-        C(s) from ``gen_speed`` (rad/s) to ``pitch_cmd`` (rad), named ``ROSCO_PI@<v>mps``.
+        C(s) from ``gen_speed`` (rad/s) to ``pitch_cmd`` (rad), named ``ROSCO_PI@<v>mps``
+        (``ROSCO_PI@<v>mps_fine_pitch``, C = 0, below rated).
 
     Raises
     ------
     ValueError
-        If ``wind_speed`` is outside the model's range or the schedule's.
+        If ``wind_speed`` is outside the model's range or above the schedule's.
 
     Examples
     --------
     >>> from specdesign.turbine import iea15mw
     >>> rosco_baseline(iea15mw(), 19.0).name
     'ROSCO_PI@19mps'
+    >>> c = rosco_baseline(iea15mw(), 8.0)  # below rated: at fine pitch, the loop open
+    >>> c.name, float(c.dcgain())
+    ('ROSCO_PI@8mps_fine_pitch', 0.0)
     """
     import control
 
-    v = model.check_wind_speed(wind_speed)
+    below = False
+    if getattr(model, "torque_control", None) is not None:
+        v = model.check_operating_speed(wind_speed)
+        below = model.trim(v).region != "3"
+    else:
+        v = model.check_wind_speed(wind_speed)
+    name = f"ROSCO_PI@{v:g}mps".replace(".", "p")
+    if below:
+        return control.tf([0.0], [1.0], inputs="gen_speed", outputs="pitch_cmd", name=f"{name}_fine_pitch")
     if schedule is None:
         schedule = rosco_gain_schedule(model, omega_pc=omega_pc, zeta_pc=zeta_pc)
-    kp, ki = (float(g) for g in schedule.gains(v))
+    lo = float(np.min(schedule.v))
+    kp, ki = (float(g) for g in schedule.gains(lo if model.rated_wind_speed() <= v < lo else v))
     pi = control.tf([kp, ki], [1.0, 0.0])
     c = pi * speed_filter()
-    return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=f"ROSCO_PI@{v:g}mps".replace(".", "p"))
+    return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=name)
 
 
 #: Scheduling filters of :func:`rosco_scheduled`: the workbench's first-order low-pass at

@@ -318,8 +318,33 @@ class TurbineModel:
         x = np.array([omega, 0.0, 0.0, pitch, 0.0])
         return self.derivatives(x, wind, pitch, 0.0)[0] * self.drivetrain_inertia
 
-    def _operating_speed(self, wind_speed):
-        """The wind speed checked against ``operating_range`` (with a torque law) or ``wind_range``."""
+    def check_operating_speed(self, wind_speed: float) -> float:
+        """``wind_speed`` as a float, checked to be where :meth:`trim` and :meth:`linearize` hold.
+
+        That is ``operating_range`` (cut-in to cut-out) for a model with a ``torque_control``,
+        ``wind_range`` (above rated) for one without.
+
+        Parameters
+        ----------
+        wind_speed : float
+            Mean wind speed (m/s).
+
+        Returns
+        -------
+        float
+            The wind speed (m/s).
+
+        Raises
+        ------
+        ValueError
+            Outside that range.
+
+        Examples
+        --------
+        >>> from specdesign.turbine import iea15mw
+        >>> iea15mw().check_operating_speed(5)
+        5.0
+        """
         if self.torque_control is None:
             return self.check_wind_speed(wind_speed)
         v = positive_scalar(wind_speed, "wind_speed")
@@ -367,7 +392,7 @@ class TurbineModel:
         """
         from scipy.optimize import brentq
 
-        v = self._operating_speed(wind_speed)
+        v = self.check_operating_speed(wind_speed)
         if self.torque_control is not None and v < self._rated_v:
             return self._trim_below(v)
         omega = self.rated_rotor_speed

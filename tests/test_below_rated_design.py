@@ -1,0 +1,79 @@
+"""The design loop below rated and through the transition (issue 16, part 1).
+
+Oracles:
+- the closed-loop map of ``spec.baseline_analysis`` from cut-in to cut-out against an
+  independent interconnection: the model's raw Jacobians at the trim (torque an input, no law
+  in them), ROSCO's torque law written here as its own LTI block from the law's parameters
+  (region 2: dT/dΩ = 2KΩ; region 1.5: the PI (k_p + k_i/s) on the speed error; 2.5s and 3:
+  torque held) and ROSCO's pitch loop (below rated: none, the PI sits at fine pitch; above
+  rated: ROSCO's PI), joined by python-control's ``interconnect``;
+- ROSCO's gain table held at its ends (ROSCO's ``interp1d``) between rated and the first
+  speed of ROSCO's grid.
+"""
+import control
+import numpy as np
+import pytest
+
+from specdesign.rosco import rosco_baseline, rosco_gain_schedule
+from specdesign.spec import baseline_analysis
+from specdesign.turbine import iea15mw
+
+
+@pytest.fixture(scope="module")
+def model():
+    return iea15mw()
+
+
+def _interconnected(model, v):
+    """wind → (gen_speed, tower_base_my) with the torque law and pitch loop as separate blocks."""
+    op = model.trim(v)
+    A, B, C, D = model.jacobians(op)
+    n = A.shape[0]
+    outs = ["gen_speed", "tower_base_my", "rotor_speed"]
+    Cr = np.vstack([C[:2], np.eye(n)[:1]])
+    Dr = np.vstack([D[:2], np.zeros((1, 3))])
+    plant = control.ss(A, B, Cr, Dr, inputs=["wind", "pitch_cmd", "gen_torque"], outputs=outs, name="plant")
+    law = model.torque_control
+    if op.region == "2":
+        torque = control.tf([2 * law.k_opt * op.rotor_speed], [1.0])
+    elif op.region in ("1.5", "2.5"):  # δT = −(k_p + k_i/s)·δΩ (ROSCO's sign: gains negative)
+        torque = control.tf([-law.kp, -law.ki], [1.0, 0.0])
+    else:
+        torque = control.tf([0.0], [1.0])
+    torque = control.ss(torque, inputs="rotor_speed", outputs="gen_torque", name="torque")
+    if op.region == "3":
+        c = rosco_gain_schedule(model)
+        kp, ki = c.gains(max(v, float(c.v.min())))
+        pitch = -control.tf([kp, ki], [1.0, 0.0]) * control.tf([1.0081**2], [1, 2 * 0.7 * 1.0081, 1.0081**2])
+    else:
+        pitch = control.tf([0.0], [1.0])
+    pitch = control.ss(pitch, inputs="gen_speed", outputs="pitch_cmd", name="pitch")
+    return control.interconnect([plant, torque, pitch], inplist=["wind"], outlist=outs[:2],
+                                inputs=["wind"], outputs=outs[:2])
+
+
+@pytest.mark.parametrize("v, region", [(4.0, "1.5"), (8.5, "2"), (10.5, "2.5s"), (10.8, "3"), (12.0, "3")])
+def test_baseline_analysis_closes_the_torque_loop_from_cut_in(model, v, region):
+    assert model.trim(v).region == region
+    w = np.logspace(-2, 1, 60)
+    ref = _interconnected(model, v)
+    for k, y in enumerate(("tower_base_my", "gen_speed")):
+        base = baseline_analysis(model, v, y, omega=w)
+        t_ref = np.asarray(ref(1j * w))[1 if y == "tower_base_my" else 0, 0]
+        np.testing.assert_allclose(base.t_response, t_ref, rtol=1e-7)
+        # ΣΔD% ≈ 2 for m = 4 (damage ∝ S_y^{m/2} for a uniform 1 % step): a meaningful map
+        assert base.sensitivity.sum() == pytest.approx(2.0, abs=0.01)
+
+
+def test_pitch_loop_is_open_below_rated_and_rosco_holds_its_first_gains_to_rated(model):
+    for v in (3.0, 7.0, 10.5):
+        c = rosco_baseline(model, v)
+        assert c.name.endswith("_fine_pitch") and np.all(np.asarray(c(1j * np.array([0.1, 1.0]))) == 0)
+    sched = rosco_gain_schedule(model)
+    lo = float(sched.v.min())
+    assert model.rated_wind_speed() < 10.8 < lo
+    w = 1j * np.array([0.05, 0.5, 2.0])
+    np.testing.assert_allclose(np.asarray(rosco_baseline(model, 10.8)(w)), np.asarray(rosco_baseline(model, lo)(w)),
+                               rtol=1e-12)
+    with pytest.raises(ValueError, match="operating range"):
+        rosco_baseline(model, 2.0)
