@@ -77,3 +77,36 @@ def test_pitch_loop_is_open_below_rated_and_rosco_holds_its_first_gains_to_rated
                                rtol=1e-12)
     with pytest.raises(ValueError, match="operating range"):
         rosco_baseline(model, 2.0)
+
+
+# ----------------------------------------------------------------------------- design requests below the design range
+@pytest.mark.parametrize("v, reason", [(8.0, "below rated"), (10.8, "between rated")])
+def test_pitch_design_below_the_design_range_is_refused_with_its_reason(model, v, reason):
+    from specdesign import qft
+
+    with pytest.raises(ValueError, match=reason):
+        qft.check_design_speed(model, v)
+    with pytest.raises(ValueError, match=reason):
+        qft.design_qft(model, v, 25.0)
+    with pytest.raises(ValueError, match=reason):  # before any design of the other speeds
+        qft.design_schedule(model, (15.0, v), progress=False)
+    assert qft.check_design_speed(model, 11.0) == 11.0
+
+
+@pytest.mark.slow
+def test_unstable_certificate_near_rated_is_not_a_success(model):
+    """At 11 m/s the certificate for 20 % (the Youla design, C = Y/(1 − P·Y)) has a pole pair
+    at +0.146 ± 2.38j 1/s (benchmarks/below_rated_design.py); in the lulls the pitch sits at
+    fine pitch, the loop opens and that pair grows (the 9-15 m/s campaign diverges): the
+    design must say so. Oracle: the roots of the controller's denominator (numpy)."""
+    import warnings
+
+    from specdesign import qft
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = qft.design_qft(model, 11.0, 20.0)
+    c = control.tf(d.pitch_controller)
+    growth = np.roots(c.den[0][0]).real.max()
+    assert growth > qft.UNSTABLE_CONTROLLER_RATE
+    assert not d.success and "controller itself is unstable" in d.message

@@ -78,7 +78,8 @@ fails are added to the design set and the tuning repeated (up to ``refine`` time
 from __future__ import annotations
 
 from ..closedloop import general_form, partial_loop
-from .design import DEFAULT_DESIGN_OMEGA, QFTDesign, design_qft, design_schedule, design_table, format_table
+from .design import (DEFAULT_DESIGN_OMEGA, UNSTABLE_CONTROLLER_RATE, QFTDesign, check_design_speed, design_qft, design_schedule, design_table,
+                     format_table)
 
 __all__ = [
     "QFTDesign",
@@ -86,9 +87,11 @@ __all__ = [
     "partial_loop",
     "design_qft",
     "design_schedule",
+    "check_design_speed",
     "design_table",
     "format_table",
     "DEFAULT_DESIGN_OMEGA",
+    "UNSTABLE_CONTROLLER_RATE",
 ]
 
 

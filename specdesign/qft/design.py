@@ -29,12 +29,17 @@ if TYPE_CHECKING:
     from ..turbine import TurbineModel
 
 __all__ = ["QFTDesign", "design_qft", "assemble_design", "design_schedule", "design_table", "format_table",
-           "DEFAULT_DESIGN_OMEGA"]
+           "DEFAULT_DESIGN_OMEGA", "check_design_speed", "UNSTABLE_CONTROLLER_RATE"]
 
 
 #: Default QFT design frequencies, rad/s: the wind band, the tower mode (~1.06 rad/s) and
 #: the actuator band.
 DEFAULT_DESIGN_OMEGA = np.unique(np.r_[0.005, 0.007, np.logspace(-2, 1, 37), 0.9, 0.95, 1.0, 1.03, 1.05, 1.07, 1.1, 1.15, 1.2])
+
+
+#: Growth rate (1/s) above which a controller pole counts as unstable in :func:`design_qft`'s
+#: checks: slower modes grow less than e-fold over a 10-minute record.
+UNSTABLE_CONTROLLER_RATE = 1e-3
 
 
 # ----------------------------------------------------------------------------- result
@@ -116,7 +121,9 @@ class QFTDesign:
     target_reduction : float
         The requested tower-base DEL reduction, %.
     success : bool
-        Every specification met: target (within 0.5 pp), bounds, dense checks, stability.
+        Every specification met: target (within 0.5 pp), bounds, dense checks, stability of
+        every closed loop and of the controller itself (no pole growing faster than
+        :data:`UNSTABLE_CONTROLLER_RATE`: a saturated pitch opens the loop).
     message : str
         ``"all specifications met"`` or what failed.
     parameters : dict of str to float
@@ -378,7 +385,8 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     -------
     QFTDesign
         The design; ``success`` is False (with a message, and a RuntimeWarning) when the
-        target, a bound, the dense check or stability is not met.
+        target, a bound, the dense check or stability (of the loops or of the controller
+        itself) is not met.
 
     Raises
     ------
@@ -430,6 +438,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
         raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
                         f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
+    check_design_speed(model, wind_speed)
     if isinstance(spec, str) and spec not in ("target", "notch"):
         raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
                          "(tower, speed)")
@@ -481,6 +490,56 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {ladder[-1]:g} dB): {design.message}",
                   RuntimeWarning, stacklevel=2)
     return design
+
+
+def check_design_speed(model, wind_speed: float) -> float:
+    """``wind_speed`` checked to be one where a pitch controller can be designed (``model.wind_range``).
+
+    Below it the reason is named: below rated ROSCO's pitch sits at fine pitch (the pitch
+    loop open, its linearisation zero, :func:`specdesign.rosco.rosco_baseline`) and the tower
+    load is the generator-torque loop's; docs/below_rated.md measures what a stiffer torque
+    loop buys for the tower there and what it costs in power.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel or specdesign.openfast.LinearTurbine
+        The turbine.
+    wind_speed : float
+        Operating point, m/s.
+
+    Returns
+    -------
+    float
+        The wind speed, m/s.
+
+    Raises
+    ------
+    ValueError
+        Outside ``model.wind_range``; below rated (a model with a ``torque_control``) with the
+        reason: no pitch loop to design there.
+
+    Examples
+    --------
+    >>> from specdesign.qft import check_design_speed
+    >>> from specdesign.turbine import iea15mw
+    >>> check_design_speed(iea15mw(), 11)
+    11.0
+    """
+    wind_speed = positive_scalar(wind_speed, "wind_speed")
+    law = getattr(model, "torque_control", None)
+    lo = model.wind_range[0]
+    if law is not None and model.operating_range[0] <= wind_speed < lo:
+        rated = model.rated_wind_speed()
+        where = (f"below rated ({rated:.2f} m/s): ROSCO's pitch sits at fine pitch there (the pitch loop is open, "
+                 "its linearisation zero), so there is no pitch loop to shape; the tower load below rated is the "
+                 "generator-torque loop's (ROSCO's torque law, closed in model.linearize). A stiffer torque loop "
+                 "lowers the tower DEL there at a cost in power: docs/below_rated.md"
+                 if wind_speed < rated else
+                 f"between rated ({rated:.2f} m/s) and the lowest design speed: in the lulls the pitch saturates at "
+                 "fine pitch and the plant changes fastest there (docs/below_rated.md)")
+        raise ValueError(f"wind_speed={wind_speed!r} m/s is {where}; pitch designs start at {lo:g} m/s "
+                         f"(model.wind_range), and a schedule holds its lowest design down to rated")
+    return model.check_wind_speed(wind_speed)
 
 
 def _given_spec(spec):
@@ -658,6 +717,12 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
         problems.append("dense check of the ATD loop failed: " + atd_check.summary().replace("\n", "; "))
     if not all_stable:
         problems.append(f"unstable closed loops at {[speeds[i] for i, s_ in enumerate(stable) if not s_]} m/s")
+    rhp = np.concatenate([ct.poles(cb), ct.poles(ca)])
+    rhp = rhp[rhp.real > UNSTABLE_CONTROLLER_RATE]
+    if rhp.size:
+        problems.append(f"the controller itself is unstable (poles {np.array2string(rhp, precision=4)} 1/s): wherever the "
+                        "pitch saturates (at fine pitch in the lulls near rated, at its rate limit) the loop opens and "
+                        "these modes grow (docs/below_rated.md)")
     success = not problems
     message = "all specifications met" if success else "; ".join(problems)
     if not success:
@@ -732,6 +797,8 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     targets = np.broadcast_to(np.asarray(target_reduction, float), vs.shape)
     if specification not in ("notch", "target"):
         raise ValueError(f"specification={specification!r} must be 'notch' or 'target'")
+    for v in vs:  # before any design: a speed below the design range is refused with its reason
+        check_design_speed(model, float(v))
     from tqdm.auto import tqdm
 
     out = []
