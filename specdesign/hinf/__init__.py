@@ -1,7 +1,9 @@
 """H∞ pitch control with the fatigue-based specifications as weights.
 
 Modules: :mod:`~specdesign.hinf.weights` (W⁻¹ of a specification), :mod:`~specdesign.hinf.plant`
-(the generalized plant), :mod:`~specdesign.hinf.design` (:func:`design_hinf` and its result); the
+(the generalized plant), :mod:`~specdesign.hinf.design` (:func:`design_hinf` and its result),
+:mod:`~specdesign.hinf.cases` (a certified pair at every plant case: :func:`check_pair` and the
+multi-model H∞ step :func:`refine_on_cases`); the
 synthesis, well-posedness checks and reduction are :mod:`loopshaping.hinf`'s.
 
 The specifications of :mod:`specdesign.spec` are upper bounds on closed-loop maps from the
@@ -28,11 +30,16 @@ from __future__ import annotations
 import warnings
 
 from ..closedloop import closed_loop_mimo, refine_grid
+from .cases import CHECK_OMEGA, CaseCheck, check_pair, refine_on_cases
 from .design import DEFAULT_DECAY_RATE, QFT_SPEED_RELAX_DB, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
 from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, inverse_weight, siso_weight
 
 __all__ = [
+    "CaseCheck",
+    "CHECK_OMEGA",
+    "check_pair",
+    "refine_on_cases",
     "GeneralizedPlant",
     "HinfDesign",
     "QFT_SPEED_RELAX_DB",

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike
 from loopshaping import hinf as lhinf
 
 from ..closedloop import closed_loop_mimo, refine_grid
+from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
 
@@ -118,6 +119,10 @@ class HinfDesign:
     speed_excess_baseline_db : float
         Maximum of 20·log10(|T_Ω,w|/|T^ROSCO_Ω,w|), dB: the speed excess over ROSCO's unrelaxed
         response (what a relaxed speed spec gives away).
+    case_check : specdesign.hinf.CaseCheck or None
+        With a certified pair (a TargetSpecification) and pitch only: the explicit check of
+        ``pitch_controller`` at every plant case the pair was certified on
+        (:func:`specdesign.hinf.check_pair`); None otherwise.
 
     Examples
     --------
@@ -159,6 +164,7 @@ class HinfDesign:
     notch_promised_del_reduction: float = float("nan")
     tower_notch_excess_db: float = float("nan")
     speed_excess_baseline_db: float = float("nan")
+    case_check: CaseCheck | None = None
 
 
 def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
@@ -277,7 +283,7 @@ def design_hinf(
     specs: str | Any = "qft",
     spec_reduction: float = 15.0,
     target_reduction: float | None = None,
-    measurements: Sequence[str] = ("gen_speed", "tower_top_vel"),
+    measurements: Sequence[str] | None = None,
     order: int = 8,
     w_tower: Specification | ct.LTI | None = None,
     w_speed: Specification | ct.LTI | None = None,
@@ -322,16 +328,23 @@ def design_hinf(
         a spec no well-damped loop can follow, docs/hinf.md). A
         :class:`specdesign.feasibility.TargetSpecification` or a pair (W_MyT, W_Ω): those
         specifications as given (label ``"given"``; the design is assessed against them).
+        A TargetSpecification with pitch only (the default measurement then) adds the
+        multi-model H∞ step :func:`specdesign.hinf.refine_on_cases`: the reduced controller
+        is adjusted until the pair holds at every plant case it was certified on, checked
+        by :func:`specdesign.hinf.check_pair` (``case_check``).
     spec_reduction : float
         % of tower-base damage the automatic notch specification
         (:func:`specdesign.spec.shape_to_target`) must promise (the name
         :func:`specdesign.qft.design_qft` uses).
     target_reduction : float, optional
-        Deprecated name of ``spec_reduction`` (in ``design_qft`` it means the controller's DEL
-        target, another quantity).
-    measurements : tuple of str
-        ``("gen_speed", "tower_top_vel")`` (default: 1×2 controller, pitch + active tower
-        damping) or ``("gen_speed",)`` (pitch only).
+        A tower-base DEL reduction target, % (as in :func:`specdesign.qft.design_qft`): the
+        weights are then the certified pair
+        ``specdesign.feasibility.specification_for_target(model, wind_speed, target_reduction)``
+        (``specs`` must be left at its default).
+    measurements : tuple of str, optional
+        ``("gen_speed", "tower_top_vel")`` (1×2 controller, pitch + active tower damping) or
+        ``("gen_speed",)`` (pitch only). Default: pitch only for a certified pair (its
+        certificate's actuator), pitch + ATD otherwise.
     order : int
         States of the reduced controller.
     w_tower, w_speed : Specification or SISO LTI, optional
@@ -400,10 +413,12 @@ def design_hinf(
         When a reduced controller does not stabilise the turbine (before the RuntimeError, or
         before the next relaxation is tried).
     RuntimeWarning
-        With given specifications (a TargetSpecification or a pair) that the reduced design
-        does not meet on the nominal plant's refined grid: by how much, where (also in
-        ``notes``). The synthesis bounds the root-sum-square of the weighted outputs, not each
-        ratio, and cannot follow a certified pair's narrow tower-mode pattern; see docs/hinf.md.
+        With a TargetSpecification and pitch only: when the multi-model step leaves the pair
+        missed at a plant case ("infeasible ... because": by how much, where, at which case;
+        also in ``notes``). With a pair or with pitch + ATD (no multi-model step): when the
+        reduced design does not meet it on the nominal plant's refined grid. The synthesis
+        alone bounds the root-sum-square of the weighted outputs, not each ratio, and does
+        not follow a certified pair's narrow tower-mode pattern; see docs/hinf.md.
 
     Examples
     --------
@@ -415,11 +430,16 @@ def design_hinf(
     """
     from .. import spec
 
-    if target_reduction is not None:  # one name, one meaning: design_qft's target_reduction is a DEL target
-        warnings.warn("design_hinf(target_reduction=...) is deprecated, use spec_reduction=", DeprecationWarning,
-                      stacklevel=2)
-        spec_reduction = target_reduction
+    from ..feasibility import TargetSpecification, specification_for_target
+
     v = float(wind_speed)
+    if target_reduction is not None:  # design_qft's meaning: a DEL target, met through its certified pair
+        if not (isinstance(specs, str) and specs == "qft"):
+            raise ValueError(f"give either target_reduction={target_reduction!r} or specs={specs!r}, not both")
+        specs = specification_for_target(model, v, target_reduction, m=m)
+    target = specs if isinstance(specs, TargetSpecification) and w_tower is None and w_speed is None else None
+    if measurements is None:
+        measurements = ("gen_speed",) if target is not None else ("gen_speed", "tower_top_vel")
     base = spec.baseline_analysis(model, v, m=m, omega=omega)
     notch_spec, ladder, label = None, [None], "custom"
     if not isinstance(specs, str) and not _is_design(specs):
@@ -469,7 +489,7 @@ def design_hinf(
             ws = spec.speed_specification(model, v) if ws is None else ws
         last = k == len(ladder) - 1
         try:
-            design = _design_once(model, v, base, wt, ws, notch_spec, label, relax, measurements=measurements,
+            design = _design_once(model, v, base, wt, ws, notch_spec, label, relax, target, measurements=measurements,
                                   order=order, w_pitch=w_pitch, m=m, suboptimality=suboptimality,
                                   reduction_method=reduction_method, dt=dt, min_damping=min_damping,
                                   decay_rate=decay_rate, integral_corner=integral_corner, **plant_options)
@@ -488,7 +508,7 @@ def design_hinf(
     return design
 
 
-def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, measurements, order, w_pitch, m,
+def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, target, *, measurements, order, w_pitch, m,
                  suboptimality, reduction_method, dt, min_damping, decay_rate, integral_corner, **plant_options):
     """One synthesis, reduction and assessment of :func:`design_hinf` on fixed specifications."""
     from .. import closedloop, spec, spectral, wind
@@ -518,7 +538,15 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, 
         f = gp.input_filter
         K_full = ct.series(ct.ss(K_full.A, K_full.B, K_full.C, K_full.D), ct.ss(f.A, f.B, f.C, f.D))
     red = lhinf.reduce(K_full, order, method=reduction_method)
-    K = red.controller
+    K, case_check, notes = red.controller, None, gp.notes + res.notes
+    if target is not None and len(measurements) == 1:
+        # the synthesis bounds the nominal root-sum-square with capped weights; the pair is a
+        # box at every plant case: the multi-model H∞ step (β = −C_β·Ω_g is −K)
+        c_beta, case_check = refine_on_cases(model, target, -ct.ss(K), decay_rate=max(decay_rate, 1e-3))
+        K = ct.ss(c_beta.A, c_beta.B, -c_beta.C, -c_beta.D)
+        notes = notes + (f"multi-model H∞ step on the {len(case_check.case_speeds)} plant cases of the pair: "
+                         f"worst tower excess {max(case_check.tower_excess_db):+.2f} dB, speed "
+                         f"{max(case_check.speed_excess_db):+.2f} dB",)
     cl = closed_loop_mimo(plant, K, measurements)
     if not closedloop.check_stability(cl, "H∞ closed loop (reduced controller)"):
         raise RuntimeError(
@@ -560,8 +588,17 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, 
     Kj = np.asarray(ct.frequency_response(K, omega).complex).reshape(1, len(measurements), -1)[0]
     L_u = -sum(Kj[i] * closedloop.frequency_response(plant, omega, y, "pitch_cmd")
                for i, y in enumerate(measurements))
-    notes = gp.notes + res.notes
-    if label == "given" and (speed_excess > 0 or tower_ratio.max() > 0):
+    if case_check is not None and not case_check.met:
+        i, j = int(np.argmax(case_check.tower_excess_db)), int(np.argmax(case_check.speed_excess_db))
+        missed = (f"the certified pair is not met at {v:g} m/s, infeasible for this H∞ design because the "
+                  f"multi-model step found no {K.nstates}-state controller meeting it at every plant case: "
+                  f"tower load by {case_check.tower_excess_db[i]:+.2f} dB at {case_check.tower_omega[i]:.3g} rad/s "
+                  f"({case_check.case_speeds[i]:g} m/s), generator speed by {case_check.speed_excess_db[j]:+.2f} dB at "
+                  f"{case_check.speed_omega[j]:.3g} rad/s ({case_check.case_speeds[j]:g} m/s), closed-loop decay "
+                  f"{case_check.decay_rate:.3g} 1/s; raise order, or qft.design_qft(spec=...) meets it")
+        notes = notes + (missed,)
+        warnings.warn(missed, RuntimeWarning, stacklevel=3)
+    elif case_check is None and label == "given" and (speed_excess > 0 or tower_ratio.max() > 0):
         # a given pair is a promise to the user: say where the reduced design leaves it
         i, j = int(np.argmax(tower_ratio)), int(np.argmax(speed_ratio))
         missed = (f"the given specifications are not met at {v:g} m/s (nominal plant): tower load by "
@@ -592,5 +629,5 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, *, 
         specs=label, speed_relax_db=float("nan") if relax is None else float(relax),
         notch_spec=notch_spec if notch_spec is not None else w_tower,
         notch_promised_del_reduction=float(notch_promise.exact_del),
-        tower_notch_excess_db=notch_excess, speed_excess_baseline_db=speed_excess0,
+        tower_notch_excess_db=notch_excess, speed_excess_baseline_db=speed_excess0, case_check=case_check,
     )
