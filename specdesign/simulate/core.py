@@ -457,6 +457,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         for q, (A, B, C, D, r, ns) in enumerate(mats):
             n = A.shape[0]
             Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :], Rq[q], Ns[q] = A, B, C, D, r, ns
+        same = _same_locals(Ad, Bd, Cd, Dd, Rq, Ns)
         sfilt = schedule_filter_coefficients(fw, getattr(controller, "filter_damping", None), dt)
         cmd_lim = np.array((-np.inf, np.inf) if plant.pitch_limits is None else plant.pitch_limits, dtype=float)
         if pi is None:
@@ -470,7 +471,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
                   beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on,
                   *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim, cmd_lim)),
-                  lim_idx, lim_val, Rq, Ns, status, TQ, *_torque_outputs(plant, TQ))
+                  lim_idx, lim_val, Rq, Ns, status, TQ, *_torque_outputs(plant, TQ), same)
     _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
 
     skip = int(round(transient / record_dt))
@@ -485,6 +486,15 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         time=idx_t - idx_t[0], wind_speeds=vs, seeds=seeds, outputs=outs, dt=record_dt, sim_dt=dt,
         linear=linear, controller=str(label),
     )
+
+
+def _same_locals(Ad, Bd, Cd, Dd, Rq, Ns):
+    """(K,) int64: for each local of the bank, the first local with the same discrete matrices,
+    integrator gain and slow-state count (the compiled loop runs only those, see ``_run_one``)."""
+    # compared bit for bit (a −0.0 gain is not merged with a +0.0 one)
+    keys = [b"".join(np.ascontiguousarray(a[q]).tobytes() for a in (Ad, Bd, Cd, Dd, Rq, Ns)) for q in range(Rq.size)]
+    first = {}
+    return np.array([first.setdefault(k, q) for q, k in enumerate(keys)], dtype=np.int64)
 
 
 def _torque_params(plant, torque_control, vs, S, linear):

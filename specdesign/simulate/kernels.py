@@ -28,12 +28,16 @@ if TYPE_CHECKING:  # pragma: no cover
     import control
 
 from ..rosco.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
+from ..turbine import aero_loads as _turbine_aero
+from ..turbine import mechanics as _turbine_mechanics
 from ..turbine import outputs as _turbine_outputs
+from ..turbine import outputs_from as _turbine_outputs_from
 from ..turbine import rhs as _turbine_rhs
 
 __all__ = [
     "KIND_TURBINE",
     "KIND_LINEAR",
+    "KIND_USER",
     "NONFINITE",
     "linear_rhs",
     "linear_outputs",
@@ -143,7 +147,9 @@ def linear_plant_params(sys: control.StateSpace, u0: ArrayLike, y0: ArrayLike) -
 
 
 # ----------------------------------------------------------------------------- compiled loop
-@njit(cache=True)
+# The loop's helpers are inlined into it (numba IR), as the turbine kernel's pieces are: a call
+# passing arrays costs reference-count operations on every step.
+@njit(cache=True, inline="always")
 def _wind_at(w, wdt, t):
     s = t / wdt
     i = int(s)
@@ -153,11 +159,12 @@ def _wind_at(w, wdt, t):
     return w[i] * (1.0 - f) + w[i + 1] * f
 
 
-#: Kernel kinds of the compiled loop: the turbine's kernel pair, or the linear one.
-KIND_TURBINE, KIND_LINEAR = 0, 1
+#: Kernel kinds of the compiled loop: the turbine's kernel pair, the linear one, or a user pair
+#: (:func:`compiled_for`).
+KIND_TURBINE, KIND_LINEAR, KIND_USER = 0, 1, 2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
     # The built-in kernels are called directly (a function passed as an argument would
     # defeat numba's on-disk cache); other kernels get rebound copies, see compiled_for.
@@ -167,7 +174,7 @@ def _krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
         linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
     if kind == KIND_TURBINE:
         _turbine_outputs(x, wind, pitch_cmd, gen_torque, p, y)
@@ -175,10 +182,10 @@ def _kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
         linear_outputs(x, wind, pitch_cmd, gen_torque, p, y)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
+    """One RK4 step of ``x``, its first stage ``k1`` (the derivative at t) already computed."""
     n = x.size
-    _krhs(kind, x, _wind_at(w, wdt, t), beta_cmd, torque, p, k1)
     for i in range(n):
         xt[i] = x[i] + 0.5 * dt * k1[i]
     wm = _wind_at(w, wdt, t + 0.5 * dt)
@@ -200,10 +207,14 @@ NONFINITE = 63
 @njit(cache=True)
 def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
              beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
-             cmd_lim, lim_idx, lim_val, Rq, Ns, tq, i_power, i_pitch):
+             cmd_lim, lim_idx, lim_val, Rq, Ns, tq, i_power, i_pitch, same):
     """One run; returns −1, or 64·step + code at the first step where it diverged (code: the
     index of the output limit exceeded, or NONFINITE). ``tq``: the torque law's parameters
-    (mode 0: the torque held at ``torque``)."""
+    (mode 0: the torque held at ``torque``). ``same[q]``: the first local identical to local q
+    (its matrices, integrator gain and slow-state count): identical locals see the same inputs
+    from the same zero state, so their states and outputs stay equal, bit for bit, and only
+    the first is run (ROSCO's gains form pads its bank with K empty locals, a design often
+    puts the same ATD on every local)."""
     nx = x.size
     nc = Ad.shape[1]
     nf = Af.shape[0]
@@ -241,10 +252,19 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
     tq_on = tq[T_MODE] != 0.0
     tst = np.zeros(TORQUE_STATES)
     tst[S_TQ] = torque  # the torque law's last command: the trim torque, as ROSCO measures it at start
+    qs = 0  # the last step's scheduling segment, where the search starts
     j = 0
     for k in range(nsteps):
         t = k * dt
-        _kout(kind, x, _wind_at(w, wdt, t), bcmd, torque, p, y)
+        wt = _wind_at(w, wdt, t)
+        if kind == KIND_TURBINE:
+            # the aerodynamic loads at (x, t) serve the outputs and RK4's first stage: of the
+            # inputs only the pitch command and the torque change between the two (mechanics)
+            aq, athrust = _turbine_aero(p, x[0], wt - x[2], x[3])
+            _turbine_mechanics(x, aq, athrust, bcmd, torque, p, k1)
+            _turbine_outputs_from(x, k1, torque, p, y)
+        else:
+            _kout(kind, x, wt, bcmd, torque, p, y)
         for i in range(ny):
             if not math.isfinite(y[i]):
                 return 64 * k + NONFINITE
@@ -265,6 +285,8 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
         v = -y[i_vel]
         slow = False
         for q in range(K):
+            if same[q] != q:
+                continue
             s = Dd[q, 0] * e + Dd[q, 1] * v
             for i in range(nc):
                 s += Cd[q, i] * xc[q, i]
@@ -295,32 +317,39 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
         elif bf >= sched_pitch[K - 1]:
             q = K - 1
         else:
+            # the segment with sched_pitch[q] < bf <= sched_pitch[q + 1], searched from the last
+            # step's (the filtered pitch moves little per step)
+            q = qs
+            while q > 0 and sched_pitch[q] >= bf:
+                q -= 1
             while sched_pitch[q + 1] < bf:
                 q += 1
+            qs = q
             f = (bf - sched_pitch[q]) / (sched_pitch[q + 1] - sched_pitch[q])
         # Output blending (of the ATD locals only, in the scheduled-PI form).
         if f == 0.0:
-            u = uk[q]
+            u = uk[same[q]]
         else:
-            u = (1.0 - f) * uk[q] + f * uk[q + 1]
+            u = (1.0 - f) * uk[same[q]] + f * uk[same[q + 1]]
         if slow:
             over = beta0 + u - cmd_lim[1]
             if over <= 0.0:
                 over = min(beta0 + u - cmd_lim[0], 0.0)
             if over != 0.0:  # saturated: freeze the slow parts that push further past the limit
                 for r in range(K):
-                    if Ns[r] > 0 and Rq[r] != 0.0 and dslow[r] * over > 0.0:
+                    if same[r] == r and Ns[r] > 0 and Rq[r] != 0.0 and dslow[r] * over > 0.0:
                         iq[r] -= inc[r]
                         uk[r] -= inc[r]
                         for i in range(Ns[r]):
                             xn[r, i] = xc[r, i]
                 if f == 0.0:
-                    u = uk[q]
+                    u = uk[same[q]]
                 else:
-                    u = (1.0 - f) * uk[q] + f * uk[q + 1]
+                    u = (1.0 - f) * uk[same[q]] + f * uk[same[q + 1]]
         for r in range(K):
-            for i in range(nc):
-                xc[r, i] = xn[r, i]
+            if same[r] == r:
+                for i in range(nc):
+                    xc[r, i] = xn[r, i]
         if pi_on:
             # ROSCO's form: one filtered error, gains interpolated in β_f, one integrator of
             # K_i(β_f)·e_f (trapezoid = Tustin of 1/s, so frozen gains give the LTI exactly).
@@ -357,6 +386,10 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
             fu1 = bcmd
             fy2 = fy1
             fy1 = bf
+        if kind == KIND_TURBINE:
+            _turbine_mechanics(x, aq, athrust, bcmd, torque, p, k1)
+        else:
+            _krhs(kind, x, wt, bcmd, torque, p, k1)
         _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
     return -1
 
@@ -364,7 +397,7 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
 @njit(cache=True, parallel=True)
 def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
                beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
-               cmd_lim, lim_idx, lim_val, Rq, Ns, status, TQ, i_power, i_pitch):
+               cmd_lim, lim_idx, lim_val, Rq, Ns, status, TQ, i_power, i_pitch, same):
     """All runs, one per prange iteration; the controller bank is shared by the batch.
     ``status[r]``: −1, or where run r diverged (see :func:`_run_one`)."""
     K = sched_pitch.size
@@ -372,7 +405,7 @@ def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched
         x = X0[r].copy()
         status[r] = _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
                              beta0[r], omega_ref[r], torque[r], sfilt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf,
-                             Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq, Ns, TQ[r], i_power, i_pitch)
+                             Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq, Ns, TQ[r], i_power, i_pitch, same)
 
 
 @njit(cache=True)
@@ -389,6 +422,7 @@ def _step_all(kind, P, X, W, wdt, t, dt, bcmd, torque, Y):
         k4 = np.empty(nx)
         xt = np.empty(nx)
         x = X[r]
+        _krhs(kind, x, _wind_at(W[r], wdt, t), bcmd[r], torque[r], P[r], k1)
         _rk4(kind, x, W[r], wdt, t, dt, bcmd[r], torque[r], P[r], k1, k2, k3, k4, xt)
         y = Y[r]
         _kout(kind, x, _wind_at(W[r], wdt, t + dt), bcmd[r], torque[r], P[r], y)
@@ -422,7 +456,7 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
     -------
     tuple
         ``(kind, run_batch, step_all, outputs_all)``: the kernel kind (:data:`KIND_TURBINE`,
-        :data:`KIND_LINEAR`, or 0 for a rebound user pair) and the batch loop, the one-step
+        :data:`KIND_LINEAR`, or :data:`KIND_USER` for a rebound user pair) and the batch loop, the one-step
         function and the outputs function of the callable path (:func:`run_callable`).
     """
     import types
@@ -451,9 +485,9 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
             fn.__qualname__ = f"{f.py_func.__qualname__}_rebound{len(_REBOUND)}"
             return njit(**kw)(fn)
 
-        g["_rk4"] = copy(_rk4)
+        g["_rk4"] = copy(_rk4, inline="always")
         g["_run_one"] = copy(_run_one)
-        _REBOUND[key] = (0, copy(_run_batch, parallel=True), copy(_step_all), copy(_outputs_all))
+        _REBOUND[key] = (KIND_USER, copy(_run_batch, parallel=True), copy(_step_all), copy(_outputs_all))
     return _REBOUND[key]
 
 

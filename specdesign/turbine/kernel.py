@@ -105,7 +105,10 @@ HEADER_SIZE = 20
 
 
 # ----------------------------------------------------------------------------- kernel
-@njit(cache=True)
+# Every piece is inlined into its callers (inline="always", at numba's IR level): a numba call
+# passing the parameter array costs reference-count operations and stops LLVM optimising
+# across it, and the simulator's loop evaluates these pieces millions of times a campaign.
+@njit(cache=True, inline="always")
 def bicubic(p: np.ndarray, offset: int, tsr: float, pitch: float) -> float:
     """Evaluate one C2 bicubic table (coefficients at ``p[offset:]``) at (tsr, pitch).
 
@@ -127,6 +130,13 @@ def bicubic(p: np.ndarray, offset: int, tsr: float, pitch: float) -> float:
     float
         The coefficient (Cp or Ct, -).
     """
+    base, u, v = _cell(p, tsr, pitch)
+    return _patch(p, offset + base, u, v)
+
+
+@njit(cache=True, inline="always")
+def _cell(p, tsr, pitch):
+    """(index of the cell's first coefficient within a table, u, v in [0, 1]) at (tsr, pitch)."""
     n_tsr = int(p[P_N_TSR])
     n_pitch = int(p[P_N_PITCH])
     u = (tsr - p[P_TSR0]) / p[P_DTSR]
@@ -137,9 +147,12 @@ def bicubic(p: np.ndarray, offset: int, tsr: float, pitch: float) -> float:
     v = min(max(v, 0.0), n_pitch - 1.0)
     i = min(int(u), n_tsr - 2)
     j = min(int(v), n_pitch - 2)
-    u -= i
-    v -= j
-    base = offset + (i * (n_pitch - 1) + j) * 16
+    return (i * (n_pitch - 1) + j) * 16, u - i, v - j
+
+
+@njit(cache=True, inline="always")
+def _patch(p, base, u, v):
+    """The bicubic patch whose 16 coefficients start at ``p[base]``, at (u, v)."""
     out = 0.0
     uk = 1.0
     for k in range(4):
@@ -149,7 +162,7 @@ def bicubic(p: np.ndarray, offset: int, tsr: float, pitch: float) -> float:
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def aero_loads(p: np.ndarray, omega: float, v_rel: float, beta: float) -> tuple[float, float]:
     """Aerodynamic torque and thrust from the compiled Cp/Ct interpolant.
 
@@ -177,14 +190,16 @@ def aero_loads(p: np.ndarray, omega: float, v_rel: float, beta: float) -> tuple[
     v = max(v_rel, 0.1)
     tsr = max(omega, 1e-6) * radius / v
     n_cells = (int(p[P_N_TSR]) - 1) * (int(p[P_N_PITCH]) - 1) * 16
-    cp = bicubic(p, HEADER_SIZE, tsr, beta)
-    ct = bicubic(p, HEADER_SIZE + n_cells, tsr, beta)
+    # Cp and Ct share the grid: one cell lookup for both (the same numbers as two bicubic calls)
+    base, u, w = _cell(p, tsr, beta)
+    cp = _patch(p, HEADER_SIZE + base, u, w)
+    ct = _patch(p, HEADER_SIZE + n_cells + base, u, w)
     q_dyn = 0.5 * p[P_RHO] * area * v * v
     # Aerodynamic torque = P/Ω = q_dyn·R·Cp/λ, written without 1/Ω.
     return q_dyn * radius * cp / tsr, q_dyn * ct
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mechanics(x: np.ndarray, aero_torque: float, thrust: float, pitch_cmd: float, gen_torque: float, p: np.ndarray,
               dx: np.ndarray) -> None:
     """State derivative given the aerodynamic loads, written into ``dx``.
@@ -229,7 +244,7 @@ def mechanics(x: np.ndarray, aero_torque: float, thrust: float, pitch_cmd: float
     dx[4] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rhs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.ndarray, dx: np.ndarray) -> None:
     """State derivative of the reduced IEA 15 MW model, written into ``dx``.
 
@@ -256,7 +271,7 @@ def rhs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.n
     mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def thrust_centre(pitch: float) -> float:
     """Radial centre of thrust as a fraction of the rotor radius, r_T/R = c₀ + c₁β + c₂β².
 
@@ -281,7 +296,7 @@ def thrust_centre(pitch: float) -> float:
     return c0 + pitch * (c1 + pitch * c2)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def outputs_from(x: np.ndarray, dx: np.ndarray, gen_torque: float, p: np.ndarray, y: np.ndarray) -> None:
     """Outputs (:data:`OUTPUT_NAMES`) from the state and its derivative, written into ``y``.
 
@@ -310,7 +325,7 @@ def outputs_from(x: np.ndarray, dx: np.ndarray, gen_torque: float, p: np.ndarray
     y[6] = thrust_centre(x[3]) * p[P_RADIUS] * thrust / BLADE_COUNT
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: np.ndarray, y: np.ndarray) -> None:
     """Outputs of the reduced model in the order of :data:`OUTPUT_NAMES`, written into ``y``.
 
