@@ -5,6 +5,7 @@ unstable, is refused before any run (:func:`specdesign.simulate.simulate` applie
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -13,7 +14,15 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from .core import KernelPlant
 
-__all__ = ["MAX_STEP_EIGENVALUE", "check_step", "sampled_loop_radius", "check_loop_step", "warn_unstable"]
+__all__ = ["MAX_STEP_EIGENVALUE", "check_step", "sampled_loop_radius", "check_loop_step", "checked_loop",
+           "warn_unstable"]
+
+# What the checks found, per plant object (dropped with it): a campaign checks every controller at
+# every speed up front, and each simulation checks its own again; the plant's linearisation and
+# the loop's poles are the same each time. Plants and controllers are not changed in place (the
+# workbench's plant, loop and controller-bank caches assume it too).
+_FASTEST: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # plant → {wind speed: fastest |λ|}
+_LOOPS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # plant → {(id(c), v, dt): (c, poles)}
 
 #: Largest |λ|·dt accepted, λ the fastest eigenvalue of the linearised plant: RK4 is stable up
 #: to about 2.8 and resolves a mode to a fraction of a percent per step at 1 (dt ≤ 0.32 s on
@@ -50,8 +59,11 @@ def check_step(plant: KernelPlant, wind_speeds: Sequence[float], dt: float) -> N
     """
     if plant.linearize is None:
         return
-    fastest = max(float(np.max(np.abs(np.linalg.eigvals(np.asarray(plant.linearize(v).A))), initial=0.0))
-                  for v in wind_speeds)
+    known = _FASTEST.setdefault(plant, {})
+    for v in wind_speeds:
+        if float(v) not in known:
+            known[float(v)] = float(np.max(np.abs(np.linalg.eigvals(np.asarray(plant.linearize(v).A))), initial=0.0))
+    fastest = max(known[float(v)] for v in wind_speeds)
     if fastest * dt > MAX_STEP_EIGENVALUE:
         raise ValueError(f"dt={dt:g} s is too large for this plant: its fastest mode has |λ| = {fastest:.3g} rad/s, so "
                          f"dt must be ≤ {MAX_STEP_EIGENVALUE / fastest:.3g} s (RK4 would be inaccurate or unstable)")
@@ -192,6 +204,68 @@ def check_loop_step(plant: KernelPlant, controller: object, wind_speed: float, d
                      "to the continuous loop: dt = 0.02 s by default)")
 
 
+def checked_loop(plant: KernelPlant, controller: object, wind_speed: float, dt: float) -> np.ndarray:
+    """The linearised loop's unstable poles at ``wind_speed``; where there are none, the step checked.
+
+    :func:`specdesign.closedloop.unstable_poles`, then, for a stable loop,
+    :func:`check_loop_step`; the answer is kept per plant, controller, wind speed and step, so
+    a campaign's up-front checks and its simulations check each loop once.
+
+    Parameters
+    ----------
+    plant : KernelPlant
+        The plant, with a linearisation.
+    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
+        The controller.
+    wind_speed : float
+        Mean wind speed (m/s) of the linearisation.
+    dt : float
+        Simulation step (s).
+
+    Returns
+    -------
+    numpy.ndarray
+        The unstable closed-loop poles (1/s, complex); empty when the loop is stable (and then
+        the step is one at which the sampled loop is stable too).
+
+    Raises
+    ------
+    ValueError
+        If the sampled loop is unstable at ``dt`` where the continuous one is stable.
+
+    Examples
+    --------
+    >>> from specdesign.simulate import turbine_plant
+    >>> from specdesign.turbine import iea15mw, rosco_baseline
+    >>> m = iea15mw()
+    >>> checked_loop(turbine_plant(m), rosco_baseline(m, 19.0), 19.0, 0.02).size
+    0
+    """
+    from ..closedloop import loop_parts, unstable_poles
+
+    key = (id(controller), float(wind_speed), float(dt))
+    known = _LOOPS.setdefault(plant, {})
+    hit = known.get(key)
+    if hit is not None and hit[0] is controller:
+        return hit[1].copy()
+    parts = loop_parts(plant, controller, wind_speed)
+    bad = unstable_poles(plant, controller, wind_speed, parts=parts)
+    if not bad.size:
+        check_loop_step(plant, controller, wind_speed, dt, parts)
+    if len(known) >= _LOOPS_SIZE:
+        try:  # another thread (a threaded dask worker) may have changed it meanwhile: drop any entry
+            known.pop(next(iter(known)), None)
+        except (RuntimeError, StopIteration):
+            pass
+    # the controller is held with its answer, so its id cannot be reused while the entry lives
+    known[key] = (controller, bad)
+    return bad.copy()
+
+
+#: Loop answers kept per plant (:func:`checked_loop`), oldest dropped first.
+_LOOPS_SIZE = 1024
+
+
 def warn_unstable(plant: KernelPlant, controller: object, wind_speeds: Sequence[float], dt: float) -> None:
     """Warn where the linearised loop is unstable; where it is stable, check the step.
 
@@ -219,14 +293,11 @@ def warn_unstable(plant: KernelPlant, controller: object, wind_speeds: Sequence[
         return
     import warnings
 
-    from ..closedloop import ClosedLoopUnstableWarning, loop_parts, unstable_message, unstable_poles
+    from ..closedloop import ClosedLoopUnstableWarning, unstable_message
 
     for v in wind_speeds:
-        parts = loop_parts(plant, controller, v)
-        bad = unstable_poles(plant, controller, v, parts=parts)
+        bad = checked_loop(plant, controller, v, dt)
         if bad.size:
             tail = ("; the simulation runs on the pitch limits (a limit cycle, no result) if it does not diverge"
                     if plant.pitch_limits is not None else "; the simulated response grows without bound")
             warnings.warn(unstable_message(controller, v, bad) + tail, ClosedLoopUnstableWarning, stacklevel=3)
-        else:
-            check_loop_step(plant, controller, v, dt, parts)
