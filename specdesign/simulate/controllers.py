@@ -284,6 +284,14 @@ def _make_bank(controller, dt):
         controller = ScheduledController(np.zeros(1), (as_lti(controller, "controller"),), None, name="controller")
     gains = controller.form == "gains"
     none = (np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1))
+    done = {}  # id → (system, its Tustin matrices): a schedule often holds one ATD at every local
+
+    def tustin(c):
+        hit = done.get(id(c))
+        if hit is None:
+            hit = done[id(c)] = (c, tustin_matrices(c, dt))  # the system held: its id stays its own
+        return hit[1]
+
     mats = []
     for k in range(controller.schedule_pitch.size):
         cb, ca = controller.local(k)
@@ -291,7 +299,7 @@ def _make_bank(controller, dt):
         slow, rest = (None, rest) if gains or r == 0.0 else split_slow(rest)
         As, Bs, Cs, Ds = none if slow is None else tustin_matrices(slow, dt)  # states first: the kernel's ns
         Ab, Bb, Cb, Db = none if gains else tustin_matrices(rest, dt)
-        Aa, Ba, Ca, Da = none if ca is None else tustin_matrices(ca, dt)
+        Aa, Ba, Ca, Da = none if ca is None else tustin(ca)
         ns, nb, na = As.shape[0], Ab.shape[0], Aa.shape[0]
         nt = ns + nb + na
         A = np.zeros((nt, nt))

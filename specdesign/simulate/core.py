@@ -422,7 +422,8 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         X0 = np.repeat(np.stack(x0s), S, axis=0)
     else:
         rhs, outfn = plant.rhs, plant.outputs
-        P = np.ascontiguousarray(np.broadcast_to(plant.params, (R, plant.params.size)))
+        # a writeable copy whatever R (a read-only array of one run would compile another kernel)
+        P = np.repeat(np.asarray(plant.params, dtype=float)[None], R, axis=0)
         X0 = np.repeat(np.stack([np.asarray(t[0], float) for t in trims]), S, axis=0)
     X0 = np.ascontiguousarray(X0)
     kind, run_batch, step_all, outputs_all = compiled_for(rhs, outfn)
