@@ -45,7 +45,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
     """
     from .. import wind as wmod
     from ..closedloop import ClosedLoopUnstableWarning
-    from ..simulate import SimulationDivergedError, SimulationResult, simulate, wind_series
+    from ..simulate import SimulationDivergedError, SimulationResult, simulate, turbine_plant, wind_series
+    from ..simulate.checks import checked_loop
 
     n_keep = len(seeds) if keep_series is True else int(keep_series)
     radius = rotor_radius(model)
@@ -55,8 +56,12 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
            "ppsd": {k: [] for k in SPECTRA}, "series": {}, "unstable": []}
     omega = welch_psd(np.zeros((1, int(round(duration / record_dt)))), record_dt, nperseg)[0]
     sw = None
+    plant = turbine_plant(model)
     for name, c in controllers.items():
-        bad = unstable_poles(model, c, v) if has_linear_form(c) else np.zeros(0)
+        # the answer run_campaign's up-front check (check_campaign_step) already has
+        bad = np.zeros(0)
+        if has_linear_form(c):
+            bad = checked_loop(plant, c, v, dt) if plant.linearize is not None else unstable_poles(model, c, v)
         if bad.size:
             warnings.warn(unstable_message(c, v, bad) + f"; campaign results of {name!r} at {v:g} m/s are NaN",
                           ClosedLoopUnstableWarning, stacklevel=3)
