@@ -15,6 +15,11 @@ Typical use:
 >>> base = baseline_analysis(iea15mw(), 19.0)    # T_{MyT,w}, S_W, ΔD%(ω) at 19 m/s
 >>> res = shape_to_target(base, 15.0)            # notches promising 15 % less damage
 >>> w_myt = res.specification.tf()               # W_MyT(s)
+
+That is the paper's shaper (notches above 0.6 rad/s, no feasibility guarantee). The
+specification to hand to a design is ``shape_to_target(base, 25.0, quantity="del",
+band="whole")``: the whole band, certified over the plant cases, in ``res.certified``
+(:func:`specdesign.feasibility.element_specification`).
 """
 from __future__ import annotations
 
@@ -614,7 +619,11 @@ class Baseline:
     wind_speed : float
         Operating point, m/s (nan when unknown).
     extras : dict
-        Free-form extra data.
+        Free-form extra data; :func:`baseline_analysis` records ``turbulence_class`` and
+        ``controller`` (None for ROSCO's) there.
+    model : TurbineModel or LinearTurbine, optional
+        The turbine the baseline was made on (:func:`baseline_analysis`), so that
+        ``shape_to_target(base, ..., band="whole")`` can certify a specification on its plant.
     """
 
     omega: np.ndarray
@@ -630,6 +639,7 @@ class Baseline:
     output: str = ""
     wind_speed: float = float("nan")
     extras: dict = field(default_factory=dict)
+    model: object = field(default=None, repr=False, compare=False)
 
     @property
     def s_wind(self) -> np.ndarray:
@@ -828,7 +838,8 @@ def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tow
     -------
     Baseline
         The baseline loop's T_{y,w}, S_W, S_y, damage rate and ΔD%(ω), with the closed-loop
-        system in :attr:`Baseline.system`.
+        system in :attr:`Baseline.system`, ``model`` and ``wind_speed`` kept (and
+        ``turbulence_class`` and ``controller`` in :attr:`Baseline.extras`).
 
     Raises
     ------
@@ -853,7 +864,9 @@ def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tow
     t_sys = cl[output, "wind"]
     t = closedloop.frequency_response(cl, omega, output, "wind")
     s_w = wind.rotor_effective_spectrum(omega, wind_speed, model.rotor_radius, turbulence_class=turbulence_class)
-    return baseline_from_response(omega, t, s_w, m, method=method, reduction=reduction, system=t_sys, output=output, wind_speed=wind_speed)
+    base = baseline_from_response(omega, t, s_w, m, method=method, reduction=reduction, system=t_sys, output=output,
+                                  wind_speed=wind_speed)
+    return replace(base, model=model, extras={"turbulence_class": turbulence_class, "controller": controller})
 
 
 @dataclass(frozen=True)
@@ -963,7 +976,12 @@ class ShapingResult:
     message : str
         Human-readable outcome, saying why not when it failed.
     specification : Specification or None
-        Baseline × notches; None when no system is attached to the baseline.
+        Baseline × notches (``band="above"``) or × the whole-band elements (``band="whole"``);
+        None when no system is attached to the baseline.
+    certified : specdesign.feasibility.TargetSpecification or None
+        With ``band="whole"``: the certified pair (tower and generator-speed specifications,
+        the certificate, the plant cases) to hand to ``design_qft(model, v, spec=...)`` or to
+        edit and :func:`specdesign.feasibility.recertify`; None with ``band="above"``.
     """
 
     notches: tuple
@@ -973,6 +991,7 @@ class ShapingResult:
     success: bool
     message: str
     specification: Specification | None = None
+    certified: Any = None
 
     @property
     def reached(self) -> float:
@@ -989,61 +1008,91 @@ def _notch_mag2(omega, params):
     return np.prod(np.abs(n) ** 2, axis=0)
 
 
-def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", keep_below: float = 0.6,
-                    n_notches: int | None = None, max_notches: int = 3, max_depth_db: float = 30.0,
-                    width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5) -> ShapingResult:
-    """Place and size notches where ΔD% is largest above ``keep_below`` to reach a target.
+def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", band: str = "above",
+                    keep_below: float = 0.6, n_notches: int | None = None, max_notches: int | None = None,
+                    max_depth_db: float = 30.0, width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5,
+                    **certify_options) -> ShapingResult:
+    """Shape a tower-load specification that promises a target reduction.
 
-    The seed paper's shaping: notches above a protected band, no feasibility guarantee. A
-    specification over the whole band, with the Bode-integral cost inside it and certified
-    over the plant cases, is :func:`specdesign.feasibility.element_specification` (in these
-    elements) or :func:`specdesign.feasibility.specification_for_target`.
+    Two shapers, one entry point:
 
-    The problem solved (scipy SLSQP, exact Dirlik in the constraint): minimise the mean
-    squared log-magnitude change of the specification, Σ_k w_k (20 log10 |N(jω_k)|)², with
-    w_k = 1 above ``keep_below`` and 100 below, subject to reduction ≥ target. Notch centres
-    are seeded at the largest ΔD% peaks above ``keep_below``.
+    ``band="above"`` (default; the seed paper's shaping, used by the notch designs, notebooks
+    03-06 and their documented numbers): notches where ΔD% is largest above ``keep_below``,
+    no feasibility guarantee. The problem solved (scipy SLSQP, exact Dirlik in the
+    constraint): minimise the mean squared log-magnitude change of the specification,
+    Σ_k w_k (20 log10 |N(jω_k)|)², with w_k = 1 above ``keep_below`` and 100 below, subject
+    to reduction ≥ target. Notch centres are seeded at the largest ΔD% peaks above
+    ``keep_below``.
+
+    ``band="whole"`` (issue 14's specification-driven design: use it when the specification
+    is to be handed to a design): the whole band where ΔD% pays, below the tower mode too,
+    with the generator-speed specification as the constraint that protects power regulation
+    and Bode's cost inside the specification, as ROSCO's map × a gain, a lag, a lead and
+    notches/bumps whose number and places are chosen with exact Dirlik in the constraint,
+    certified at every plant case: :func:`specdesign.feasibility.element_specification` on
+    the baseline's model and wind speed (the baseline must come from
+    :func:`baseline_analysis` of ``tower_base_my`` with ROSCO and the default wind). The
+    promise reported is that of the specification handed to the design; ``certified`` is the
+    pair to give ``design_qft(model, v, spec=res.certified)``, or to edit by hand
+    (``res.certified.tower.add(Notch(...))``) and re-check with
+    :func:`specdesign.feasibility.recertify`.
 
     Parameters
     ----------
     base : Baseline
-        From :func:`baseline_analysis` or :func:`baseline_from_response`.
+        From :func:`baseline_analysis` or :func:`baseline_from_response` (``band="above"``).
     target_reduction : float
         Requested reduction in percent (0 < target < 100) of ``quantity``.
     quantity : {"damage", "del"}
-        Whether the target is a reduction of damage (Eq. 10's quantity) or of DEL at 1 Hz.
+        Whether the target is a reduction of damage (Eq. 10's quantity) or of DEL at 1 Hz
+        (``band="whole"`` certifies the DEL reduction equivalent to a damage target).
+    band : {"above", "whole"}
+        Notches above ``keep_below``, or the certified whole-band specification.
     keep_below : float
-        Protected band upper edge, rad/s: the power-regulation band the notches must leave
-        alone (their effect below it is penalised heavily and the notch centres stay above).
+        ``band="above"``: protected band upper edge, rad/s, the power-regulation band the
+        notches must leave alone (their effect below it is penalised heavily and the notch
+        centres stay above).
     n_notches : int, optional
-        Fixed number of notches; by default 1, 2, ... up to ``max_notches`` until reached.
-    max_notches : int
-        Most notches tried (and most candidate centres seeded).
+        ``band="above"``: fixed number of notches; by default 1, 2, ... up to ``max_notches``.
+    max_notches : int, optional
+        Most notches tried (default 3 with ``band="above"``, and most candidate centres
+        seeded; :data:`specdesign.feasibility.elements.MAX_NOTCHES` with ``band="whole"``).
     max_depth_db : float
-        Deepest notch allowed, dB.
+        ``band="above"``: deepest notch allowed, dB.
     width_range : (float, float)
-        Bounds of the notch width ζ_p (-).
+        ``band="above"``: bounds of the notch width ζ_p (-).
     tolerance : float
-        Accepted shortfall, percentage points.
+        ``band="above"``: accepted shortfall, percentage points.
+    **certify_options
+        ``band="whole"``: passed to :func:`specdesign.feasibility.element_specification`
+        (``headroom_pp``, and the certificate's ``slack_db``, ``case_offsets``,
+        ``max_sensitivity``, ...).
 
     Returns
     -------
     ShapingResult
-        The notches, their promise, whether the target was reached and the specification
-        (baseline × notches, when the baseline has a system).
+        The notches (with ``band="whole"`` the Notch elements among the others), the promise,
+        whether the target was reached, the specification (baseline × elements, when the
+        baseline has a system) and, with ``band="whole"``, the certified pair; its promise is
+        then evaluated on :data:`specdesign.feasibility.elements.FIT_OMEGA` (0.005-20 rad/s),
+        whatever the baseline's grid: the elements are free outside the baseline's band.
 
     Raises
     ------
     TypeError
-        If ``base`` is not a :class:`Baseline`.
+        If ``base`` is not a :class:`Baseline`, or an option of the other band is given.
     ValueError
-        If ``quantity`` is unknown, ``target_reduction`` is not in (0, 100), ``keep_below``
-        lies outside the grid, or no grid frequency lies above ``keep_below``.
+        If ``quantity`` or ``band`` is unknown, ``target_reduction`` is not in (0, 100),
+        ``keep_below`` lies outside the grid, or no grid frequency lies above ``keep_below``;
+        with ``band="whole"``, if the baseline does not carry its model (or was not made on
+        ROSCO's tower-base map with the default wind), or when no certified element
+        specification reaches the target (the message says which constraint binds).
 
     Warns
     -----
     RuntimeWarning
-        When the target cannot be reached (the result then has ``success=False`` and says why).
+        ``band="above"``: when the target cannot be reached (the result then has
+        ``success=False`` and says why).
 
     Examples
     --------
@@ -1054,6 +1103,13 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
     'reached 15.00 % damage reduction (target 15.00 %) with 1 notch(es)'
     >>> print(f"{res.notches[0].omega_n:.2f} rad/s")
     1.02 rad/s
+
+    The certified whole-band specification for 25 % DEL, to hand to ``design_qft``:
+
+    >>> base = baseline_analysis(iea15mw(), 25.0)
+    >>> res = shape_to_target(base, 25.0, quantity="del", band="whole")     # doctest: +SKIP
+    >>> bool(res.promise.exact_del >= 25.0), res.certified.case_speeds      # doctest: +SKIP
+    (True, (24.0, 24.5, 25.0))
     """
     from scipy.optimize import minimize
 
@@ -1061,9 +1117,23 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
         raise TypeError(f"base must be a Baseline (see baseline_analysis), got {type(base).__name__}")
     if quantity not in ("damage", "del"):
         raise ValueError(f"quantity={quantity!r} must be 'damage' or 'del'")
+    if band not in ("above", "whole"):
+        raise ValueError(f"band={band!r} must be 'above' (notches above keep_below) or 'whole' (the certified "
+                         "whole-band specification)")
     t = float(target_reduction)
     if not 0 < t < 100:
         raise ValueError(f"target_reduction={target_reduction!r} must be a percentage strictly between 0 and 100")
+    given = dict(keep_below=keep_below, n_notches=n_notches, max_depth_db=max_depth_db, width_range=width_range,
+                 tolerance=tolerance)
+    if band == "whole":
+        notch_only = sorted(k for k, x in given.items() if x != _ABOVE_DEFAULTS[k])
+        if notch_only:
+            raise TypeError(f"{notch_only} are options of band='above'; band='whole' chooses its elements itself "
+                            "(its options: max_notches and those of feasibility.element_specification)")
+        return _shape_whole(base, t, quantity, max_notches, certify_options)
+    if certify_options:
+        raise TypeError(f"{sorted(certify_options)} are options of band='whole' (feasibility.element_specification)")
+    max_notches = 3 if max_notches is None else max_notches
     omega = base.omega
     keep_below = float(keep_below)
     if not omega[0] <= keep_below < omega[-1]:
@@ -1136,6 +1206,37 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
         warnings.warn(message, RuntimeWarning, stacklevel=2)
     spec = Specification(base.system, notches, name=f"W_{base.output}") if base.system is not None else None
     return ShapingResult(notches, promise, t, quantity, bool(success), message, spec)
+
+
+#: The notch-shaper options of :func:`shape_to_target` at their defaults (refused with band="whole").
+_ABOVE_DEFAULTS = dict(keep_below=0.6, n_notches=None, max_depth_db=30.0, width_range=(0.05, 0.8), tolerance=0.5)
+
+
+def _shape_whole(base, t, quantity, max_notches, options):
+    """shape_to_target's band="whole": the certified element specification on the baseline's model."""
+    from . import feasibility
+
+    why = ["it carries no model (make it with baseline_analysis(model, v))" if base.model is None else "",
+           f"its output is {base.output!r}, not 'tower_base_my'" if base.output != "tower_base_my" else "",
+           "it was made with another controller than ROSCO's" if base.extras.get("controller") is not None else "",
+           f"its wind is turbulence class {base.extras.get('turbulence_class')!r}, not 'B'"
+           if base.extras.get("turbulence_class", "B") != "B" else "",
+           f"its damage method is {base.method!r}, not 'dirlik'" if base.method != "dirlik" else ""]
+    why = [w for w in why if w]
+    if why:
+        raise ValueError("band='whole' certifies a specification against ROSCO's tower-base map on the baseline's "
+                         f"model (baseline_analysis(model, v)); this baseline cannot be used: {'; '.join(why)}")
+    target_del = t if quantity == "del" else float(spectral.del_reduction(t, base.m))
+    if max_notches is not None:
+        options = {**options, "max_notches": max_notches}
+    ts = feasibility.element_specification(base.model, base.wind_speed, target_del, m=base.m, **options)
+    promise = ts.promise  # on the fit's wider grid, which sees the elements outside the baseline's
+    reached = promise.exact_del if quantity == "del" else promise.exact_damage
+    notches = tuple(e for e in ts.tower.elements if isinstance(e, Notch))
+    message = (f"certified {reached:.2f} % {quantity} reduction (target {t:.2f} %) over the whole band with "
+               f"{len(ts.tower.elements)} elements, the speed map relaxed by {ts.speed_relax_db:.2f} dB, at the "
+               f"plant cases {ts.case_speeds} m/s")
+    return ShapingResult(notches, promise, t, quantity, True, message, ts.tower, ts)
 
 
 def speed_specification(model: TurbineModel, wind_speed: float, *, margin_db: float = 0.0,
