@@ -328,7 +328,7 @@ def rosco_baseline(model: TurbineModel, wind_speed: float, *, omega_pc: float = 
     if schedule is None:
         schedule = rosco_gain_schedule(model, omega_pc=omega_pc, zeta_pc=zeta_pc)
     lo = float(np.min(schedule.v))
-    kp, ki = (float(g) for g in schedule.gains(lo if model.rated_wind_speed() <= v < lo else v))
+    kp, ki = (float(g) for g in schedule.gains(lo if v < lo and model.rated_wind_speed() <= v else v))
     pi = control.tf([kp, ki], [1.0, 0.0])
     c = pi * speed_filter()
     return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=name)
