@@ -33,6 +33,7 @@ from ..turbine import mechanics as _turbine_mechanics
 from ..turbine import outputs as _turbine_outputs
 from ..turbine import outputs_from as _turbine_outputs_from
 from ..turbine import rhs as _turbine_rhs
+from ..turbine.kernel import mechanics_scalars as _turbine_mechanics_scalars
 
 __all__ = [
     "KIND_TURBINE",
@@ -198,6 +199,31 @@ def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
     _krhs(kind, xt, _wind_at(w, wdt, t + dt), beta_cmd, torque, p, k4)
     for i in range(n):
         x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+
+
+@njit(cache=True, inline="always")
+def _turbine_rk4(x, w, wdt, t, dt, beta_cmd, torque, p, k1):
+    """:func:`_rk4` of the turbine's kernel with the state in scalars between the stages (the
+    same operations in the same order: the same numbers)."""
+    x0, x1, x2, x3, x4 = x[0], x[1], x[2], x[3], x[4]
+    a0, a1, a2, a3, a4 = k1[0], k1[1], k1[2], k1[3], k1[4]
+    wm = _wind_at(w, wdt, t + 0.5 * dt)
+    y0, y1, y2 = x0 + 0.5 * dt * a0, x1 + 0.5 * dt * a1, x2 + 0.5 * dt * a2
+    y3, y4 = x3 + 0.5 * dt * a3, x4 + 0.5 * dt * a4
+    q, th = _turbine_aero(p, y0, wm - y2, y3)
+    b0, b1, b2, b3, b4 = _turbine_mechanics_scalars(y0, y1, y2, y3, y4, q, th, beta_cmd, torque, p)
+    y0, y1, y2 = x0 + 0.5 * dt * b0, x1 + 0.5 * dt * b1, x2 + 0.5 * dt * b2
+    y3, y4 = x3 + 0.5 * dt * b3, x4 + 0.5 * dt * b4
+    q, th = _turbine_aero(p, y0, wm - y2, y3)
+    c0, c1, c2, c3, c4 = _turbine_mechanics_scalars(y0, y1, y2, y3, y4, q, th, beta_cmd, torque, p)
+    y0, y1, y2, y3, y4 = x0 + dt * c0, x1 + dt * c1, x2 + dt * c2, x3 + dt * c3, x4 + dt * c4
+    q, th = _turbine_aero(p, y0, _wind_at(w, wdt, t + dt) - y2, y3)
+    e0, e1, e2, e3, e4 = _turbine_mechanics_scalars(y0, y1, y2, y3, y4, q, th, beta_cmd, torque, p)
+    x[0] = x0 + dt / 6.0 * (a0 + 2.0 * b0 + 2.0 * c0 + e0)
+    x[1] = x1 + dt / 6.0 * (a1 + 2.0 * b1 + 2.0 * c1 + e1)
+    x[2] = x2 + dt / 6.0 * (a2 + 2.0 * b2 + 2.0 * c2 + e2)
+    x[3] = x3 + dt / 6.0 * (a3 + 2.0 * b3 + 2.0 * c3 + e3)
+    x[4] = x4 + dt / 6.0 * (a4 + 2.0 * b4 + 2.0 * c4 + e4)
 
 
 #: Divergence code of a non-finite output (else the index into the output limits).
@@ -388,9 +414,10 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
             fy1 = bf
         if kind == KIND_TURBINE:
             _turbine_mechanics(x, aq, athrust, bcmd, torque, p, k1)
+            _turbine_rk4(x, w, wdt, t, dt, bcmd, torque, p, k1)
         else:
             _krhs(kind, x, wt, bcmd, torque, p, k1)
-        _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
+            _rk4(kind, x, w, wdt, t, dt, bcmd, torque, p, k1, k2, k3, k4, xt)
     return -1
 
 

@@ -77,6 +77,7 @@ __all__ = [
     "bicubic",
     "aero_loads",
     "mechanics",
+    "mechanics_scalars",
     "rhs",
     "outputs_from",
     "outputs",
@@ -224,12 +225,45 @@ def mechanics(x: np.ndarray, aero_torque: float, thrust: float, pitch_cmd: float
     dx : numpy.ndarray
         Output: float64[5], the state derivative (written).
     """
-    beta = x[3]
-    beta_rate = x[4]
-    qd = x[2]
-    dx[0] = (aero_torque - gen_torque) / p[P_INERTIA]
-    dx[1] = qd
-    dx[2] = (thrust - p[P_TWR_STIFF] * x[1] - p[P_TWR_DAMP] * qd) / p[P_TWR_MASS]
+    dx[0], dx[1], dx[2], dx[3], dx[4] = mechanics_scalars(x[0], x[1], x[2], x[3], x[4], aero_torque, thrust,
+                                                          pitch_cmd, gen_torque, p)
+
+
+@njit(cache=True, inline="always")
+def mechanics_scalars(rotor_speed: float, tower_top_disp: float, tower_top_vel: float, pitch: float, pitch_rate: float,
+                      aero_torque: float, thrust: float, pitch_cmd: float, gen_torque: float,
+                      p: np.ndarray) -> tuple[float, float, float, float, float]:
+    """:func:`mechanics` on the five states as scalars, the derivative returned.
+
+    The compiled simulator's RK4 keeps the state in registers this way (an array between
+    the stages costs a store and a load on every stage's critical path).
+
+    Parameters
+    ----------
+    rotor_speed, tower_top_disp, tower_top_vel, pitch, pitch_rate : float
+        The state (:data:`STATE_NAMES`: rad/s, m, m/s, rad, rad/s).
+    aero_torque : float
+        Aerodynamic torque (N·m).
+    thrust : float
+        Thrust (N).
+    pitch_cmd : float
+        Collective pitch demand (rad).
+    gen_torque : float
+        Generator torque on the rotor shaft (N·m).
+    p : numpy.ndarray
+        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+
+    Returns
+    -------
+    tuple of float
+        The derivatives of the five states, in their order (rad/s², m/s, m/s², rad/s, rad/s²).
+    """
+    beta = pitch
+    beta_rate = pitch_rate
+    qd = tower_top_vel
+    d_speed = (aero_torque - gen_torque) / p[P_INERTIA]
+    d_disp = qd
+    d_vel = (thrust - p[P_TWR_STIFF] * tower_top_disp - p[P_TWR_DAMP] * qd) / p[P_TWR_MASS]
 
     rate_lim = p[P_RATE_LIM]
     rate = min(max(beta_rate, -rate_lim), rate_lim)
@@ -240,8 +274,7 @@ def mechanics(x: np.ndarray, aero_torque: float, thrust: float, pitch_cmd: float
     # No wind-up of the internal rate beyond the rate limit.
     if (beta_rate >= rate_lim and acc > 0.0) or (beta_rate <= -rate_lim and acc < 0.0):
         acc = 0.0
-    dx[3] = rate
-    dx[4] = acc
+    return d_speed, d_disp, d_vel, rate, acc
 
 
 @njit(cache=True, inline="always")
