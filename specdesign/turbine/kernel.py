@@ -6,9 +6,9 @@ linear model is by construction the Jacobian of what the simulator integrates.
 ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` and ``outputs(x, wind, pitch_cmd, gen_torque, p, y)``
 are module-level ``@numba.njit(cache=True)`` functions, callable from other ``@njit`` code.
 They are composed of ``aero_loads(p, omega, v_rel, beta)`` → (torque, thrust),
-``mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)`` and
-``outputs_from(x, dx, gen_torque, p, y)``, so a kernel that changes only the aerodynamics
-reuses the rest:
+``mechanics(x, aero_torque, thrust, pitch_cmd, gen_torque, p, dx)`` (on scalars:
+``mechanics_scalars``) and ``outputs_from(x, dx, gen_torque, p, y)``, so a kernel that changes
+only the aerodynamics reuses the rest:
 
 - ``x`` (float64[5], read) and ``dx`` (float64[5], written) follow :data:`STATE_NAMES`:
 
