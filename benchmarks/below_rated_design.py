@@ -1,12 +1,14 @@
 """The design loop below rated and through the transition (issue 16, part 1): the numbers of docs/below_rated.md.
 
-Run: python benchmarks/below_rated_design.py [--part analysis|designs|transition|torque|bins|all]
+Run: python benchmarks/below_rated_design.py [--part analysis|designs|held|transition|torque|bins|all]
 Prints
 (0) ``analysis``: ``spec.baseline_analysis`` from cut-in to cut-out (the torque law closed in the
     plant; ROSCO's pitch loop linearised at the trim: open below rated): tower DEL and ΔD% (~5 s);
 (1) ``designs``: the specification-driven QFT design (``qft.design_qft(model, v, target)``) at
     11-14 m/s for the targets 25, 20, 15 % (the first that is certified), and 13 m/s at 20 % with
     |S| <= 2.2, with the error message where none is certified (~2-4 min);
+(1b) ``held``: why a design held below rated may not stay at fine pitch: the pitch response to a
+    sustained speed deficit and the first seconds of a 3 m/s run (~1 min);
 (2) ``transition``: ROSCO vs the lifetime demo's schedule (15-25 m/s, held down to rated) vs the
     schedule from 13 m/s (LIFETIME_DESIGNS) vs that with the 11 m/s design too, ROSCO's torque law
     in every run (``torque_control="rosco"``), 9-15 m/s x 4 paired seeds x 600 s: tower-base DEL
@@ -272,15 +274,41 @@ def _share(life, climate, i):
     below = np.asarray(climate.centres) < 10.0
     return 100 * float(np.asarray(life.damage_share)[i, 0, below].sum())
 
+def held_below_rated(model):
+    print("\n## A design held below rated: its pitch for a sustained speed deficit (linear, unsaturated) and at 3 m/s")
+    print("β = −C·δΩ_g for a step δΩ_g = −0.27 rad/s (3 m/s: the rotor at its minimum speed 0.52 rad/s, the pitch "
+          "controller's reference 0.79 rad/s); then the 3 m/s run from the trim (seed 1, ROSCO's torque law):")
+    print("| controller | β max (deg) at (s) | β at 1 s / 5 s / 20 s (deg) | 3 m/s run: Ω at 0, 5, 10, 15 s (rad/s) | pitch max in 0-20 s (deg) |")
+    print("|---|---|---|---|---|")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ctrls = {"QFT 13 m/s (20 %, |S| ≤ 2.2)": qft.design_qft(model, 13.0, 20.0, max_sensitivity=2.2).pitch_controller,
+                 "QFT 15 m/s (25 %)": qft.design_qft(model, 15.0, 25.0).pitch_controller,
+                 "ROSCO's PI at 13 m/s": rosco_baseline(model, 13.0)}
+    t = np.linspace(0.0, 20.0, 2001)
+    for name, c in ctrls.items():
+        _, y = ct.step_response(ct.ss(c), t)
+        beta = np.degrees(0.27 * np.squeeze(y))
+        v = 13.0 if "13" in name else 15.0
+        r = simulate(model, scheduled(model, {v: ct.tf(c)}, name="held"), [3.0], seeds=[1], duration=20.0, transient=0.0,
+                     torque_control="rosco")
+        om, pitch = r["gen_speed"][0, 0], np.degrees(r["pitch"][0, 0])
+        at = [int(round(s / 20.0 * (om.size - 1))) for s in (0.0, 5.0, 10.0, 15.0)]
+        print(f"| {name} | {beta.max():+.1f} at {t[beta.argmax()]:.1f} | {beta[100]:+.1f} / {beta[500]:+.1f} / {beta[-1]:+.1f} "
+              f"| {', '.join(f'{om[i]:.3f}' for i in at)} | {pitch.max():.2f} |")
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("--part", default="all", choices=["analysis", "designs", "transition", "torque", "bins", "all"])
+    ap.add_argument("--part", default="all", choices=["analysis", "designs", "held", "transition", "torque", "bins", "all"])
     part = ap.parse_args().part
     m = iea15mw()
     if part in ("analysis", "all"):
         analysis(m)
     if part in ("designs", "all"):
         designs_near_rated(m)
+    if part in ("held", "all"):
+        held_below_rated(m)
     if part in ("transition", "all"):
         transition(m)
     if part in ("torque", "all"):
