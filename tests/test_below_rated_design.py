@@ -110,3 +110,28 @@ def test_unstable_certificate_near_rated_is_not_a_success(model):
     growth = np.roots(c.den[0][0]).real.max()
     assert growth > qft.UNSTABLE_CONTROLLER_RATE
     assert not d.success and "controller itself is unstable" in d.message
+
+
+# ----------------------------------------------------------------------------- a design held below rated
+def test_fine_pitch_lift_against_an_independent_step_response(model):
+    """Oracle: scipy.signal.step of the same transfer function (another integrator than
+    python-control's), β = −C·δΩ_g for δΩ_g = −deficit. ROSCO's PI pushes the pitch into fine
+    pitch (lift ≤ 0); a controller with the same integral action plus a lightly damped mode of
+    the opposite sign (0.1 rad/s², ζ = 0.1 at 1 rad/s) swings the pitch up first."""
+    from scipy import signal
+
+    from specdesign.qft import fine_pitch_lift
+
+    deficit = model.torque_control.pitch_reference_speed - model.torque_control.min_speed
+    rosco = rosco_baseline(model, 13.0)
+    assert fine_pitch_lift(rosco, deficit) <= 1e-12
+    swing = control.tf([-0.6, -0.08], [1.0, 0.0]) + control.tf([30.0, 0.0], [1.0, 0.2, 1.0])
+    t = np.linspace(0.0, 60.0, 6001)
+    _, y = signal.step(signal.TransferFunction(swing.num[0][0], swing.den[0][0]), T=t)
+    expected = float(np.max(deficit * y))
+    assert expected > model.torque_control.pitch_switch  # lifted beyond ROSCO's region-3 switch
+    assert fine_pitch_lift(swing, deficit) == pytest.approx(expected, rel=1e-6)
+    with pytest.raises(ValueError, match="deficit"):
+        fine_pitch_lift(rosco, -0.1)
+    with pytest.raises(ValueError, match="SISO"):
+        fine_pitch_lift(control.ss(np.zeros((1, 1)), np.zeros((1, 2)), np.zeros((1, 1)), np.zeros((1, 2))), 0.2)

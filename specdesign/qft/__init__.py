@@ -78,6 +78,7 @@ fails are added to the design set and the tuning repeated (up to ``refine`` time
 from __future__ import annotations
 
 from ..closedloop import general_form, partial_loop
+from .checks import fine_pitch_lift
 from .design import (DEFAULT_DESIGN_OMEGA, UNSTABLE_CONTROLLER_RATE, QFTDesign, check_design_speed, design_qft, design_schedule, design_table,
                      format_table)
 
@@ -92,6 +93,7 @@ __all__ = [
     "format_table",
     "DEFAULT_DESIGN_OMEGA",
     "UNSTABLE_CONTROLLER_RATE",
+    "fine_pitch_lift",
 ]
 
 

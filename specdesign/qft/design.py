@@ -782,7 +782,10 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     Warns
     -----
     RuntimeWarning
-        As :func:`design_qft`, for each wind speed whose design does not meet every spec.
+        As :func:`design_qft`, for each wind speed whose design does not meet every spec; and
+        for a model with a torque law when the lowest design, which a schedule holds below
+        rated, lifts the pitch off fine pitch for the speed deficit there
+        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``).
 
     Examples
     --------
@@ -805,7 +808,24 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
                       disable=not progress):
         out.append(design_qft(model, float(v), float(tr), spec=specification, **kwargs))
+    _warn_held_design(model, out[int(np.argmin(vs))])
     return tuple(out)
+
+
+def _warn_held_design(model, design):
+    """Warn when a schedule's lowest design, held below rated, would lift the pitch off fine pitch."""
+    from .checks import fine_pitch_lift
+
+    law = getattr(model, "torque_control", None)
+    if law is None:
+        return
+    deficit = law.pitch_reference_speed - law.min_speed  # the model's gen_speed output is the rotor-shaft speed
+    lift = fine_pitch_lift(design.pitch_controller, deficit)
+    if lift > law.pitch_switch:
+        warnings.warn(f"design_schedule: the lowest design ({design.wind_speed:g} m/s), which a schedule holds down to "
+                      f"rated and below, answers the speed deficit below rated ({deficit:.3f} rad/s) by lifting the pitch "
+                      f"{np.degrees(lift):.1f}° off fine pitch (qft.fine_pitch_lift): below rated it leaves fine pitch and "
+                      "ROSCO's torque state machine goes to rated torque (docs/below_rated.md)", RuntimeWarning, stacklevel=3)
 
 
 def design_table(designs: Iterable[QFTDesign]) -> list[dict[str, Any]]:
