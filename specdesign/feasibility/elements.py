@@ -13,7 +13,8 @@ notch with a negative depth is a bump), chosen over the whole band:
 with e(ω) = 20·log10 |Π elements(jω)| and r the upper envelope (a running maximum over
 ±:data:`ENVELOPES` in ω, the widest first) of 20·log10(|W^cert|/|T^ROSCO_{MyT,w}|), W^cert a
 certificate made for a larger target (:data:`HEADROOM_PP` above it: a specification above the
-certificate promises less than the certificate's). Where the certificate pays Bode's cost
+certificate promises less than the certificate's; a certificate whose controller is itself
+unstable is skipped, as :func:`specdesign.qft.design_qft` refuses such a design). Where the certificate pays Bode's cost
 (r > 0: the relaxations) the elements must rise too, so the cost sits explicitly inside the
 specification; where r < 0 the certificate leaves room and the elements reduce only where ΔD%
 makes that pay. The notches are seeded where ΔD%·room is largest and added one at a time
@@ -243,6 +244,7 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
 
     from .. import spec
     from .._checks import del_target
+    from ..qft import UNSTABLE_CONTROLLER_RATE
     from .target import recertify, specification_for_target
 
     t = del_target(target_reduction)
@@ -264,6 +266,13 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
         except ValueError as e:
             why = str(e)
             break
+        poles = np.asarray(ct.poles(cert.design.controller(model)))
+        if poles.size and poles.real.max() > UNSTABLE_CONTROLLER_RATE:
+            # design_qft refuses a controller that is itself unstable (a saturated pitch opens
+            # the loop) and reduces its design from this certificate: the next headroom
+            p = poles[np.argmax(poles.real)]
+            tried.append(f"{h:g} pp: the certificate's controller is unstable (pole {p.real:.4f}{p.imag:+.4f}j 1/s)")
+            continue
         ratio = 20 * np.log10(np.abs(cert.tower.response(grid)) / t0)
         for env in ENVELOPES:  # the widest envelope first: the fewest, widest elements
             r = maximum_filter1d(ratio, size=max(1, int(round(2 * env / np.log(grid[1] / grid[0])))), mode="nearest")
