@@ -276,10 +276,13 @@ def _share(life, climate, i):
 
 def held_below_rated(model):
     print("\n## A design held below rated: its pitch for a sustained speed deficit (linear, unsaturated) and at 3 m/s")
-    print("β = −C·δΩ_g for a step δΩ_g = −0.27 rad/s (3 m/s: the rotor at its minimum speed 0.52 rad/s, the pitch "
-          "controller's reference 0.79 rad/s); then the 3 m/s run from the trim (seed 1, ROSCO's torque law):")
-    print("| controller | β max (deg) at (s) | β at 1 s / 5 s / 20 s (deg) | 3 m/s run: Ω at 0, 5, 10, 15 s (rad/s) | pitch max in 0-20 s (deg) |")
-    print("|---|---|---|---|---|")
+    law = model.torque_control
+    deficit = law.pitch_reference_speed - law.min_speed
+    print(f"β = −C·δΩ_g for a step δΩ_g = −{deficit:.3f} rad/s (the pitch controller's reference "
+          f"{law.pitch_reference_speed:.3f} rad/s minus the torque law's minimum speed {law.min_speed:.4f}; "
+          "qft.fine_pitch_lift is its largest β); then the 3 m/s run from the trim (seed 1, ROSCO's torque law):")
+    print("| controller | fine_pitch_lift (deg) | β max at (s) | β at 1 s / 5 s / 20 s (deg) | 3 m/s run: Ω at 0, 5, 10, 15 s (rad/s) | pitch max in 0-20 s (deg) |")
+    print("|---|---|---|---|---|---|")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ctrls = {"QFT 13 m/s (20 %, |S| ≤ 2.2)": qft.design_qft(model, 13.0, 20.0, max_sensitivity=2.2).pitch_controller,
@@ -288,13 +291,14 @@ def held_below_rated(model):
     t = np.linspace(0.0, 20.0, 2001)
     for name, c in ctrls.items():
         _, y = ct.step_response(ct.ss(c), t)
-        beta = np.degrees(0.27 * np.squeeze(y))
+        beta = np.degrees(deficit * np.squeeze(y))
         v = 13.0 if "13" in name else 15.0
         r = simulate(model, scheduled(model, {v: ct.tf(c)}, name="held"), [3.0], seeds=[1], duration=20.0, transient=0.0,
                      torque_control="rosco")
         om, pitch = r["gen_speed"][0, 0], np.degrees(r["pitch"][0, 0])
         at = [int(round(s / 20.0 * (om.size - 1))) for s in (0.0, 5.0, 10.0, 15.0)]
-        print(f"| {name} | {beta.max():+.1f} at {t[beta.argmax()]:.1f} | {beta[100]:+.1f} / {beta[500]:+.1f} / {beta[-1]:+.1f} "
+        print(f"| {name} | {np.degrees(qft.fine_pitch_lift(c, deficit)):+.1f} | {t[beta.argmax()]:.1f} "
+              f"| {beta[100]:+.1f} / {beta[500]:+.1f} / {beta[-1]:+.1f} "
               f"| {', '.join(f'{om[i]:.3f}' for i in at)} | {pitch.max():.2f} |")
 
 
