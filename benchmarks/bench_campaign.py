@@ -7,6 +7,8 @@ Run:
                                                      #   and the Markdown table of docs/campaigns.md
     python benchmarks/bench_campaign.py --scale --budget 300   # let a curve point take up to 300 s
     python benchmarks/bench_campaign.py --only-scale           # the scale curves alone
+    python benchmarks/bench_campaign.py --profile    # where the CPU time of the 48-run campaign
+                                                     #   (no predictions) goes: cProfile, CPU time
 
 The lifetime campaign runs the three controllers at the 12 bin centres 3-25 m/s of
 ``validate.weibull_bins()`` with ROSCO's torque law in every run (``torque_control="rosco"``,
@@ -213,11 +215,30 @@ def figure(xr, tr, fr, xs, ts, fs):
     print(f"\nfigure: {FIGURE.relative_to(ROOT)}")
 
 
+def profile():
+    """cProfile of one cold 48-run campaign without predictions, on CPU time (time.process_time:
+    the compiled loop's line is the CPU of numba's threads, twice its wall time on 2 idle cores)."""
+    import cProfile
+    import pstats
+
+    model = turbine.iea15mw()
+    ctrls = controllers(model)
+    prof = cProfile.Profile(time.process_time)
+    prof.enable()
+    va.run_campaign(two_of(ctrls), SPEEDS, [1, 2, 3, 4], model=model, predict=False, progress=False)
+    prof.disable()
+    print(f"\nCPU profile of the 48-run campaign, no predictions (load average {os.getloadavg()[0]:.1f})")
+    pstats.Stats(prof).sort_stats("cumulative").print_stats(30)
+
+
 def main(argv):
     model = turbine.iea15mw()
     ctrls = controllers(model)
     # warm-up (compile or load from cache), excluded from timings
     va.run_campaign(ctrls, [19.0], [1], model=model, duration=20.0, transient=5.0, progress=False)
+    if "--profile" in argv:
+        profile()
+        return
     if "--only-scale" not in argv:
         timings(model, ctrls, quick="--quick" in argv)
     if "--scale" in argv or "--only-scale" in argv:
