@@ -205,8 +205,9 @@ def _require(target, controller):
 
 def _modal(k):
     """C_β as (kinds, x): an integrator ('i': residue), real poles ('r': log(−λ), residue) and
-    complex pairs ('c': log(−Re λ), log(Im λ), residue re/im), then D; None when a pole other
-    than the integrator is not in the open left half-plane or A is defective."""
+    complex pairs ('c': log(−Re λ), log(Im λ), residue re/im), then D; a pole with Re λ ≥ 0
+    (H∞ controllers may have one) is 'ru'/'cu', its real part a parameter as it is (a log would
+    keep it unstable). None when A is defective."""
     lam, vec = np.linalg.eig(np.asarray(k.A, float))
     if np.linalg.cond(vec) > 1e8:
         return None
@@ -221,19 +222,21 @@ def _modal(k):
         if abs(lam_i) < _INTEGRATOR_TOL:
             kinds.append("i")
             x.append(r.real)
-        elif lam_i.real >= 0:
-            return None
         elif abs(lam_i.imag) <= 1e-9 * abs(lam_i):
-            kinds.append("r")
-            x += [np.log(-lam_i.real), r.real]
+            kinds.append("r" if lam_i.real < 0 else "ru")
+            x += [np.log(-lam_i.real) if lam_i.real < 0 else lam_i.real, r.real]
         else:
             j = min((j for j in idx if j not in used), key=lambda j: abs(lam[j] - np.conj(lam_i)))
             used.add(j)
             if lam_i.imag < 0:
                 lam_i, r = np.conj(lam_i), np.conj(r)
-            kinds.append("c")
-            x += [np.log(-lam_i.real), np.log(lam_i.imag), r.real, r.imag]
+            kinds.append("c" if lam_i.real < 0 else "cu")
+            x += [np.log(-lam_i.real) if lam_i.real < 0 else lam_i.real, np.log(lam_i.imag), r.real, r.imag]
     return tuple(kinds), np.array(x + [float(np.asarray(k.D).ravel()[0])])
+
+
+def _real_part(kind, value):
+    return value if kind.endswith("u") else -np.exp(value)
 
 
 def _response(kinds, x, s):
@@ -241,10 +244,10 @@ def _response(kinds, x, s):
     for kind in kinds:
         if kind == "i":
             out, p = out + x[p] / s, p + 1
-        elif kind == "r":
-            out, p = out + x[p + 1] / (s + np.exp(x[p])), p + 2
+        elif kind in ("r", "ru"):
+            out, p = out + x[p + 1] / (s - _real_part(kind, x[p])), p + 2
         else:
-            lam, r = -np.exp(x[p]) + 1j * np.exp(x[p + 1]), x[p + 2] + 1j * x[p + 3]
+            lam, r = _real_part(kind, x[p]) + 1j * np.exp(x[p + 1]), x[p + 2] + 1j * x[p + 3]
             out, p = out + r / (s - lam) + np.conj(r) / (s - np.conj(lam)), p + 4
     return out + x[p]
 
@@ -256,11 +259,11 @@ def _matrices(kinds, x):
         if kind == "i":
             blocks.append([[0.0]]), bs.append([1.0]), cs.append([x[p]])
             p += 1
-        elif kind == "r":
-            blocks.append([[-np.exp(x[p])]]), bs.append([1.0]), cs.append([x[p + 1]])
+        elif kind in ("r", "ru"):
+            blocks.append([[_real_part(kind, x[p])]]), bs.append([1.0]), cs.append([x[p + 1]])
             p += 2
         else:
-            sg, om, rr, ri = -np.exp(x[p]), np.exp(x[p + 1]), x[p + 2], x[p + 3]
+            sg, om, rr, ri = _real_part(kind, x[p]), np.exp(x[p + 1]), x[p + 2], x[p + 3]
             # r/(s − λ) + c.c. = (2·rr·s − 2(rr·σ + ri·ω))/((s − σ)² + ω²): the block [[σ, ω], [−ω, σ]]
             blocks.append([[sg, om], [-om, sg]]), bs.append([0.0, 1.0]), cs.append([-2 * ri, 2 * rr])
             p += 4
@@ -278,7 +281,7 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     """The multi-model H∞ step: adjust a pitch controller until it meets a certified pair at every case.
 
     The poles, residues and feedthrough of ``pitch_controller`` (same order; an integrator, a
-    pole with |λ| < 1e-6 rad/s, stays at s = 0) minimise the exterior penalty
+    pole with |λ| < 1e-6 rad/s, stays at s = 0; stable poles stay stable) minimise the exterior penalty
     Σ max(0, 20·log10(|T_i|/|W_i|) + margin)² over both channels, every plant case and the
     check grid, plus Σ max(0, 20·log10(|S_i|/``max_sensitivity``))² and
     10⁴·Σ max(0, Re p + ``decay_rate``)² over the closed-loop poles of every case (L-BFGS-B,
@@ -313,9 +316,8 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     Returns
     -------
     controller : control.StateSpace
-        The adjusted C_β (or ``pitch_controller`` unchanged when its poles cannot be
-        parametrised: a pole in the closed right half-plane other than the integrator, or a
-        defective A).
+        The adjusted C_β (or ``pitch_controller`` unchanged when its A is defective and its
+        poles cannot be parametrised).
     check : CaseCheck
         :func:`check_pair` of the returned controller.
 
