@@ -81,6 +81,7 @@ from ..closedloop import general_form, partial_loop
 from .checks import fine_pitch_lift
 from .design import (DEFAULT_DESIGN_OMEGA, UNSTABLE_CONTROLLER_RATE, QFTDesign, check_design_speed, design_qft, design_schedule, design_table,
                      format_table)
+from .torque_design import TorqueDesign, design_torque, torque_general_form
 
 __all__ = [
     "QFTDesign",
@@ -94,6 +95,9 @@ __all__ = [
     "DEFAULT_DESIGN_OMEGA",
     "UNSTABLE_CONTROLLER_RATE",
     "fine_pitch_lift",
+    "TorqueDesign",
+    "design_torque",
+    "torque_general_form",
 ]
 
 

@@ -1,0 +1,116 @@
+"""qft.design_torque: the torque-loop design below rated (issue 16 part 1)."""
+from __future__ import annotations
+
+import dataclasses
+
+import control as ct
+import numpy as np
+import pytest
+
+from specdesign import qft
+from specdesign.fatigue import del_rainflow
+from specdesign.rosco import rosco_scheduled
+from specdesign.simulate import simulate
+from specdesign.spectral import del_spectral
+from specdesign.turbine import iea15mw
+from specdesign.wind import rotor_effective_spectrum
+
+
+@pytest.fixture(scope="module")
+def model():
+    return iea15mw()
+
+
+@pytest.fixture(scope="module")
+def design(model):
+    return qft.design_torque(model, 8.0, target_reduction=25.0, max_power_loss_pct=1.0)
+
+
+def _closed_by_interconnect(model, v, k):
+    """T_MyT,w with τ_add = k·Ω_g closed by python-control (signals joined by name)."""
+    P = model.linearize(v)
+    K = ct.ss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[k]], inputs=["gen_speed"], outputs=["gen_torque"],
+              name="K")
+    return ct.interconnect([P, K], inplist=["wind"], outlist=["tower_base_my"], check_unused=False)
+
+
+def test_closed_loop_map_matches_interconnect(model, design):
+    T = _closed_by_interconnect(model, 8.0, design.gain)
+    ref = ct.frequency_response(T, design.omega).complex.ravel()
+    assert np.max(np.abs(design.t_response - ref)) <= 1e-8 * np.max(np.abs(ref))
+    # and the general form (A + B·G)/(C + D·G) with G = −k is the same map
+    A, B, C, D = qft.torque_general_form(model, 8.0, design.omega)
+    form = (A - B * design.gain) / (C - D * design.gain)
+    assert np.max(np.abs(form - ref)) <= 1e-8 * np.max(np.abs(ref))
+    assert np.all(np.real(T.poles()) < 0)
+
+
+def test_promise_recomputed_independently(model, design):
+    # Dirlik on |T|²S_W (interconnect map, wind spectrum from specdesign.wind) vs the open-torque-controller baseline
+    w = design.omega
+    s_w = rotor_effective_spectrum(w, 8.0, model.rotor_radius, turbulence_class="B")
+    base = ct.frequency_response(model.linearize(8.0)["tower_base_my", "wind"], w).complex.ravel()
+    closed = ct.frequency_response(_closed_by_interconnect(model, 8.0, design.gain), w).complex.ravel()
+    promise = 100 * (1 - del_spectral(w, np.abs(closed) ** 2 * s_w, 4.0) / del_spectral(w, np.abs(base) ** 2 * s_w, 4.0))
+    assert promise == pytest.approx(design.promise, abs=1e-6)
+    assert promise >= 25.0 - 1e-6
+    # "smallest gain": 1 % less gain misses the target
+    less = ct.frequency_response(_closed_by_interconnect(model, 8.0, 0.99 * design.gain), w).complex.ravel()
+    assert 100 * (1 - del_spectral(w, np.abs(less) ** 2 * s_w, 4.0) / del_spectral(w, np.abs(base) ** 2 * s_w, 4.0)) < 25.0
+    # the costs are those of the stiffer loop: the rotor speed moves less, the torque more, the power is lost
+    assert design.speed_sd < design.baseline_speed_sd
+    assert design.torque_sd > design.baseline_torque_sd
+    assert -1.0 <= design.power_change_pct < 0
+
+
+def test_design_is_continuous_in_the_inputs(model, design):
+    d = qft.design_torque(model, 8.0 + 1e-9, target_reduction=25.0 + 1e-9, max_power_loss_pct=1.0)
+    assert d.gain == pytest.approx(design.gain, rel=1e-6)
+
+
+def test_torque_law(model, design):
+    law = design.torque_law(model.torque_control)
+    # region 2: the law's stiffness is 2KΩ at the trim; the PI's proportional gain is that plus k (ROSCO's sign)
+    stiff = 2 * model.torque_control.k_opt * model.trim(8.0).rotor_speed
+    assert design.law_stiffness == pytest.approx(stiff)
+    assert law.mode == 3 and law.kp == pytest.approx(-(stiff + design.gain))
+    assert law.ki / law.kp == pytest.approx(model.torque_control.ki / model.torque_control.kp)
+    with pytest.raises(ValueError, match="reference_corner"):
+        design.torque_law(model.torque_control, reference_corner=0.0)
+
+
+def test_refusals(model):
+    with pytest.raises(ValueError, match="pitch loop acts"):
+        qft.design_torque(model, 13.0, target_reduction=10.0)
+    # the limit G → ∞ at 8 m/s is ≈ 41.5 % (docs/below_rated.md section 3: DEL Ω held −42 %)
+    with pytest.raises(ValueError, match=r"G -> inf \(rotor speed held\) gives 41"):
+        qft.design_torque(model, 8.0, target_reduction=45.0)
+    # 25 % costs ≈ 0.84 % power (test above): a 0.5 % budget is refused, naming the loss and the gain
+    with pytest.raises(ValueError, match=r"power loss 0\.8\d % exceeds max_power_loss_pct=0\.5 at k = "):
+        qft.design_torque(model, 8.0, target_reduction=25.0, max_power_loss_pct=0.5)
+    for kw, name in (({"target_reduction": 0.0}, "target_reduction"), ({"target_reduction": float("nan")}, "target_reduction"),
+                     ({"max_power_loss_pct": -1.0}, "max_power_loss_pct"), ({"m": 0.0}, "m="),
+                     ({"omega": [1.0, 0.5]}, "omega")):
+        with pytest.raises(ValueError, match=name):
+            qft.design_torque(model, 8.0, **({"target_reduction": 10.0} | kw))
+    with pytest.raises(ValueError, match="wind_speed"):
+        qft.design_torque(model, float("nan"), target_reduction=10.0)
+    with pytest.raises(TypeError, match="torque law"):
+        qft.design_torque(dataclasses.replace(model, torque_control=None), 8.0, target_reduction=10.0)
+
+
+def test_nonlinear_direction(model, design):
+    """8 m/s, 2 paired seeds x 600 s, ROSCO's pitch PI: the designed law lowers the rainflow tower DEL.
+
+    The linear promise is 25 %; the nonlinear PI (filtered speed, slow reference) is an
+    approximation of the linear gain, so the acceptance is the direction on every seed and at
+    least 40 % of the promise on the pair (measured −20.3 / −13.0 %, docs/below_rated.md).
+    """
+    ros = rosco_scheduled(model)
+    dels = {}
+    for name, law in (("rosco", model.torque_control), ("design", design.torque_law(model.torque_control))):
+        r = simulate(model, ros, [8.0], seeds=range(1, 3), duration=600.0, torque_control=law)
+        dels[name] = np.array([del_rainflow(x, 4.0, 600.0) for x in r["tower_base_my"][0]])
+    change = 100 * (dels["design"] / dels["rosco"] - 1)
+    assert np.all(change < 0)
+    assert change.mean() <= -0.4 * design.promise
