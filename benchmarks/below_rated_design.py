@@ -1,6 +1,6 @@
 """The design loop below rated and through the transition (issue 16, part 1): the numbers of docs/below_rated.md.
 
-Run: python benchmarks/below_rated_design.py [--part analysis|designs|held|transition|torque|bins|all]
+Run: python benchmarks/below_rated_design.py [--part analysis|designs|held|transition|torque|torque_design|bins|all]
 Prints
 (0) ``analysis``: ``spec.baseline_analysis`` from cut-in to cut-out (the torque law closed in the
     plant; ROSCO's pitch loop linearised at the trim: open below rated): tower DEL and ΔD% (~5 s);
@@ -19,6 +19,10 @@ Prints
     (rotor speed held), the pointwise bound for |S| <= r, a proportional family G = -k with
     its costs (rotor-speed, torque and power SD, mean aerodynamic power change, linear), and
     the nonlinear check with ROSCO's own TSR-tracking torque PI made stiffer (~30 s);
+(3b) ``torque_design``: the design loop's step below rated, ``qft.design_torque(model, v, target,
+    max_power_loss_pct=1.0)`` at 5-10 m/s for 10-30 % (gain, promise, costs, or the refusal), and
+    the designs for 10 % at 7, 20 % at 8-9 m/s and 25 % at 8 m/s run nonlinear (``TorqueDesign.torque_law``: ROSCO's
+    mode-3 PI), ROSCO's pitch PI, 4 paired seeds x 600 s (~30 s);
 (4) ``bins``: every 2 m/s wind bin 3-25 m/s x 6 paired seeds x 600 s, ROSCO vs the demo's
     schedule (the same campaign as ``python -m specdesign demo --lifetime``) vs the schedule from
     13 m/s, and both again with the stiffer torque loop: tower DEL change per bin with its SE,
@@ -225,6 +229,45 @@ def torque_law_nonlinear(model, speeds=(5.0, 7.0, 8.0, 9.0)):
                   f"| {tq.std(axis=1).mean() / 1e6:.3f} | {p.mean() / 1e6:.3f} | {100 * (p.mean() / ref[1].mean() - 1):+.2f} |")
 
 
+def torque_design(model):
+    print("\n## The torque-loop design: qft.design_torque(model, v, target, max_power_loss_pct=1.0) (linear, class B, m = 4)")
+    print("| v (m/s) | target (%) | k (MN·m per rad/s) | k / law stiffness | promise (%) | G → ∞ (%) | Ω SD (rad/s) | "
+          "torque SD (MN·m) | power SD (MW) | mean power (%) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for v in (5.0, 7.0, 8.0, 9.0, 10.0):
+        for target in (10.0, 20.0, 30.0):
+            try:
+                d = qft.design_torque(model, v, target, max_power_loss_pct=1.0)
+            except ValueError as e:
+                print(f"| {v:g} | {target:g} | refused: {e} |||||||")
+                continue
+            print(f"| {v:g} | {target:g} | {d.gain / 1e6:.1f} | {d.gain / d.law_stiffness:.2f} | {d.promise:.1f} | "
+                  f"{d.limit_promise:.1f} | {d.baseline_speed_sd:.4f} → {d.speed_sd:.4f} | {d.baseline_torque_sd / 1e6:.3f} → "
+                  f"{d.torque_sd / 1e6:.3f} | {d.baseline_power_sd / 1e6:.3f} → {d.power_sd / 1e6:.3f} | {d.power_change_pct:+.2f} |")
+    print("\nNonlinear: the designs as ROSCO's mode-3 PI (TorqueDesign.torque_law, reference corner 0.02 rad/s) vs ROSCO's "
+          "law (mode 1), ROSCO's pitch PI, 4 paired seeds x 600 s; linear promise and power estimate beside")
+    print("| v (m/s) | target (%) | kp (MN·m per rad/s) | tower DEL change (%) | SE (pp) | linear (%) | Ω SD (rad/s) | "
+          "mean power (%) | linear (%) |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    ros = rosco_scheduled(model)
+    for v, target in ((7.0, 10.0), (8.0, 20.0), (8.0, 25.0), (9.0, 20.0)):
+        try:
+            d = qft.design_torque(model, v, target, max_power_loss_pct=1.0)
+        except ValueError as e:
+            print(f"| {v:g} | {target:g} | refused: {e} ||||||")
+            continue
+        law = d.torque_law(model.torque_control)
+        runs = {}
+        for name, tl in (("rosco", model.torque_control), ("design", law)):
+            r = simulate(model, ros, [v], seeds=range(1, 5), duration=600.0, torque_control=tl)
+            runs[name] = (np.array([del_rainflow(x, 4.0, 600.0) for x in r["tower_base_my"][0]]), r["power"][0].mean(axis=1),
+                          r["gen_speed"][0].std(axis=1).mean())
+        ch, se = _paired_change(runs["design"][0], runs["rosco"][0])
+        dp = 100 * (runs["design"][1].mean() / runs["rosco"][1].mean() - 1)
+        print(f"| {v:g} | {target:g} | {law.kp / 1e6:.1f} | {ch:+.1f} | {se:.1f} | {-d.promise:+.1f} | "
+              f"{runs['rosco'][2]:.4f} → {runs['design'][2]:.4f} | {dp:+.2f} | {d.power_change_pct:+.2f} |")
+
+
 def _merge(a, b, names):
     """Campaign ``a`` with ``b``'s controllers added under ``names`` (same speeds and seeds)."""
     idx = [b.controllers.index(n) for n in names]
@@ -304,7 +347,8 @@ def held_below_rated(model):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("--part", default="all", choices=["analysis", "designs", "held", "transition", "torque", "bins", "all"])
+    ap.add_argument("--part", default="all", choices=["analysis", "designs", "held", "transition", "torque", "torque_design", "bins",
+                                                     "all"])
     part = ap.parse_args().part
     m = iea15mw()
     if part in ("analysis", "all"):
@@ -318,5 +362,7 @@ if __name__ == "__main__":
     if part in ("torque", "all"):
         torque_loop(m)
         torque_law_nonlinear(m)
+    if part in ("torque_design", "all"):
+        torque_design(m)
     if part in ("bins", "all"):
         every_bin(m)

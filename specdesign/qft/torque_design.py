@@ -36,7 +36,7 @@ from scipy.optimize import brentq
 from ..spec import baseline_analysis
 from ..spectral import del_spectral
 
-__all__ = ["TorqueDesign", "design_torque", "torque_general_form", "TORQUE_DESIGN_REGIONS", "DEFAULT_TORQUE_OMEGA"]
+__all__ = ["DEFAULT_TORQUE_OMEGA", "TORQUE_DESIGN_REGIONS", "TorqueDesign", "design_torque", "torque_general_form"]
 
 #: Torque regions (:data:`specdesign.rosco.TORQUE_REGIONS`) where the torque loop is the only
 #: loop; in "2.5s" (setpoint smoothing) and "3" the pitch loop acts.
