@@ -247,9 +247,10 @@ def torque_design(model):
     print("\nNonlinear: the designs as ROSCO's mode-3 PI (TorqueDesign.torque_law, reference corner 0.02 rad/s) vs ROSCO's "
           "law (mode 1), ROSCO's pitch PI, 4 paired seeds x 600 s; linear promise and power estimate beside")
     print("| v (m/s) | target (%) | kp (MN·m per rad/s) | tower DEL change (%) | SE (pp) | linear (%) | Ω SD (rad/s) | "
-          "mean power (%) | linear (%) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "mean power (%) | linear (%) | ROSCO: time Ω > min + 0.005 / > 0.97 rated (%) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     ros = rosco_scheduled(model)
+    tl0 = model.torque_control
     for v, target in ((7.0, 10.0), (8.0, 20.0), (8.0, 25.0), (9.0, 20.0)):
         try:
             d = qft.design_torque(model, v, target, max_power_loss_pct=1.0)
@@ -260,12 +261,15 @@ def torque_design(model):
         runs = {}
         for name, tl in (("rosco", model.torque_control), ("design", law)):
             r = simulate(model, ros, [v], seeds=range(1, 5), duration=600.0, torque_control=tl)
+            om = r["gen_speed"][0]
             runs[name] = (np.array([del_rainflow(x, 4.0, 600.0) for x in r["tower_base_my"][0]]), r["power"][0].mean(axis=1),
-                          r["gen_speed"][0].std(axis=1).mean())
+                          om.std(axis=1).mean(), 100 * np.mean(om > tl0.min_speed + 0.005),
+                          100 * np.mean(om > 0.97 * tl0.reference_speed))
         ch, se = _paired_change(runs["design"][0], runs["rosco"][0])
         dp = 100 * (runs["design"][1].mean() / runs["rosco"][1].mean() - 1)
         print(f"| {v:g} | {target:g} | {law.kp / 1e6:.1f} | {ch:+.1f} | {se:.1f} | {-d.promise:+.1f} | "
-              f"{runs['rosco'][2]:.4f} → {runs['design'][2]:.4f} | {dp:+.2f} | {d.power_change_pct:+.2f} |")
+              f"{runs['rosco'][2]:.4f} → {runs['design'][2]:.4f} | {dp:+.2f} | {d.power_change_pct:+.2f} | "
+              f"{runs['rosco'][3]:.0f} / {runs['rosco'][4]:.1f} |")
 
 
 def _merge(a, b, names):
