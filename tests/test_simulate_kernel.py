@@ -99,3 +99,36 @@ def test_checked_loop_answers_once_per_plant_controller_speed_and_step(model, mo
             checked_loop(plant, c, 19.0, 0.9)
         with pytest.raises(ValueError, match="too large for controller"):
             sm.check_loop_step(plant, c, 19.0, 0.9)
+
+
+class _Inline:
+    """An executor running each task at once, in submission order: the serial campaign."""
+
+    def submit(self, fn, *args):
+        import concurrent.futures as cf
+
+        f = cf.Future()
+        f.set_result(fn(*args))
+        return f
+
+
+def test_local_campaign_two_speeds_at_a_time_is_bitwise_the_serial_one(model, monkeypatch):
+    """Oracle: the same campaign with its tasks run one after the other (an inline executor)."""
+    from test_campaign_store import assert_bitwise_equal
+
+    from specdesign import validate
+    from specdesign.validate import campaign as vc
+
+    rosco = sm.rosco_scheduled(model)
+    ctrls = {"ROSCO": rosco, "PI19": turbine.rosco_baseline(model, 19.0)}
+    kw = dict(model=model, duration=60.0, transient=5.0, keep_series=1, progress=False)
+    serial = validate.run_campaign(ctrls, [15.0, 19.0, 23.0], [1, 2], executor=_Inline(), **kw)
+    used = []
+    real = vc._overlap
+    monkeypatch.setattr(vc, "_overlap", lambda c: used.append(real(c)) or used[-1])
+    local = validate.run_campaign(ctrls, [15.0, 19.0, 23.0], [1, 2], **kw)
+    import numba
+
+    # the threads ran (under OpenMP or TBB; under numba's workqueue the campaign stays serial)
+    assert used == [numba.threading_layer() in ("omp", "tbb")] and used[0]
+    assert_bitwise_equal(local, serial)

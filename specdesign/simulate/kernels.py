@@ -421,7 +421,8 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
     return -1
 
 
-@njit(cache=True, parallel=True)
+# nogil: a local campaign post-processes one wind speed while another is simulated
+@njit(cache=True, parallel=True, nogil=True)
 def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
                beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
                cmd_lim, lim_idx, lim_val, Rq, Ns, status, TQ, i_power, i_pitch, same):

@@ -293,7 +293,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         ``submit(fn, *args)`` returning futures: a ``concurrent.futures`` executor,
         ``client.get_executor()`` or the dask ``Client`` itself (docs/campaigns.md shows a
         multi-machine cluster); the results are bitwise those of a local run, collected as
-        they finish. Default: run locally, the compiled simulator already using every core.
+        they finish. Default: run locally, the compiled simulator using every core, two wind
+        speeds at a time in threads when every controller has a linear form (one speed's
+        Python post-processing runs while the other is simulated; the same results).
         For a local process pool use a "spawn" context,
         ``ProcessPoolExecutor(mp_context=multiprocessing.get_context("spawn"))``: numba's
         OpenMP threads make fork() unsafe.
@@ -401,24 +403,53 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
             st.write(new)
         bar.update(len(new))
 
+    def collect(pool, todo):
+        futs = {pool.submit(campaign_point, *args(t)): t for t in todo}
+        try:
+            for f in _as_completed(list(futs)):
+                finish(futs[f], f.result())
+        finally:  # on an error or an interrupt, do not leave the rest running on the cluster
+            for f in futs:
+                # only the unfinished: cancelling a finished dask future releases its key
+                # on the scheduler, which would cancel an identical task submitted next
+                if not f.done():
+                    f.cancel()
+
     try:
         if executor is None:
-            for t in tasks:
+            todo = list(tasks)
+            if todo:  # the first task here: it starts numba's threading layer, which _overlap checks
+                t = todo.pop(0)
                 finish(t, campaign_point(*args(t)))
+            if len(todo) > 1 and _overlap(controllers):
+                import concurrent.futures as cf
+
+                with cf.ThreadPoolExecutor(2) as pool:
+                    collect(pool, todo)
+            else:
+                for t in todo:
+                    finish(t, campaign_point(*args(t)))
         else:
-            futs = {executor.submit(campaign_point, *args(t)): t for t in tasks}
-            try:
-                for f in _as_completed(list(futs)):
-                    finish(futs[f], f.result())
-            finally:  # on an error or an interrupt, do not leave the rest running on the cluster
-                for f in futs:
-                    # only the unfinished: cancelling a finished dask future releases its key
-                    # on the scheduler, which would cancel an identical task submitted next
-                    if not f.done():
-                        f.cancel()
+            collect(executor, todo=tasks)
     finally:
         bar.close()
     return _assemble(records, names, vs, seeds, settings)
+
+
+def _overlap(controllers) -> bool:
+    """Whether a local campaign runs two wind speeds at a time, in threads: the compiled
+    simulator releases the GIL and uses every core, so one speed's Python work (checks, wind,
+    rainflow, Welch) runs while the other's simulation does, and the results do not depend on
+    the order. Only for controllers with a linear form (a callable may keep state between the
+    steps of a run: two runs at once would share it) and under a numba threading layer that
+    takes calls from two threads at once (OpenMP, TBB; not the workqueue)."""
+    import numba
+
+    try:
+        layer = numba.threading_layer()
+    except ValueError:  # no parallel kernel has run in this process
+        return False
+    return layer in ("omp", "tbb") and all(has_linear_form(c) for c in controllers.values())
 
 
 def _torque_setting(torque_control):
