@@ -129,6 +129,7 @@ def test_local_campaign_two_speeds_at_a_time_is_bitwise_the_serial_one(model, mo
     local = validate.run_campaign(ctrls, [15.0, 19.0, 23.0], [1, 2], **kw)
     import numba
 
-    # the threads ran (under OpenMP or TBB; under numba's workqueue the campaign stays serial)
-    assert used == [numba.threading_layer() in ("omp", "tbb")] and used[0]
+    assert used == [numba.threading_layer() in ("omp", "tbb")]
     assert_bitwise_equal(local, serial)
+    if not used[0]:
+        pytest.skip("numba's threading layer is the workqueue: the campaign stayed serial")
