@@ -290,7 +290,7 @@ def every_bin(model, n_seeds=6, duration=600.0):
     ctrls = {"ROSCO": rosco_scheduled(model),
              "QFT 15-25": schedule(model, DEMO_DESIGNS, "QFT 15-25"),
              "QFT 13-25": schedule(model, LIFETIME_DESIGNS, "QFT 13-25")}
-    kw = dict(model=model, duration=duration, progress=False)
+    kw = {"model": model, "duration": duration, "progress": False}
     camp = validate.run_campaign(ctrls, climate.centres, n_seeds, torque_control="rosco", **kw)
     stiff = validate.run_campaign(ctrls, climate.centres, n_seeds, torque_control=stiff_torque_law(model), **kw)
     both = _merge(camp, stiff, ["ROSCO", "QFT 13-25"])
@@ -343,7 +343,7 @@ def held_below_rated(model):
         r = simulate(model, scheduled(model, {v: ct.tf(c)}, name="held"), [3.0], seeds=[1], duration=20.0, transient=0.0,
                      torque_control="rosco")
         om, pitch = r["gen_speed"][0, 0], np.degrees(r["pitch"][0, 0])
-        at = [int(round(s / 20.0 * (om.size - 1))) for s in (0.0, 5.0, 10.0, 15.0)]
+        at = [round(s / 20.0 * (om.size - 1)) for s in (0.0, 5.0, 10.0, 15.0)]
         print(f"| {name} | {np.degrees(qft.fine_pitch_lift(c, deficit)):+.1f} | {t[beta.argmax()]:.1f} "
               f"| {beta[100]:+.1f} / {beta[500]:+.1f} / {beta[-1]:+.1f} "
               f"| {', '.join(f'{om[i]:.3f}' for i in at)} | {pitch.max():.2f} |")
