@@ -68,7 +68,8 @@ class HinfDesign:
     w_speed : specdesign.spec.Specification or control.LTI
         The generator-speed specification W_Ω used as the weight, rad/s per m/s.
     promised_del_reduction : float
-        The tower specification's exact (Dirlik) promise, %.
+        The tower specification's exact (Dirlik) promise, % (a TargetSpecification's own
+        ``promise``).
     predicted_del_reduction : float
         Dirlik on the reduced controller's closed loop vs ROSCO's, tower-base DEL, %.
     speed_excess_db : float
@@ -613,7 +614,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
     return HinfDesign(
         pitch_controller=parts[0], atd_controller=parts[1] if len(parts) > 1 else None, controller=K, full_controller=K_full,
         gamma=res.gamma, reduction=red, w_tower=w_tower, w_speed=w_speed,
-        promised_del_reduction=float(promise.exact_del),
+        promised_del_reduction=float((promise if target is None else target.promise).exact_del),
         predicted_del_reduction=100.0 * (1.0 - del1 / del0),
         speed_excess_db=speed_excess, tower_excess_db=tower_excess, tower_mode=wt_mode,
         pitch_std=std(t_pitch), pitch_std_baseline=std(t_pitch0), omega=omega,
