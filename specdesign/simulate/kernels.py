@@ -148,8 +148,10 @@ def linear_plant_params(sys: control.StateSpace, u0: ArrayLike, y0: ArrayLike) -
 
 
 # ----------------------------------------------------------------------------- compiled loop
-# The loop's helpers are inlined into it (numba IR), as the turbine kernel's pieces are: a call
-# passing arrays costs reference-count operations on every step.
+# The turbine's path through the loop is inlined into it (numba IR), as the turbine kernel's
+# pieces are: a call passing arrays costs reference-count operations on every step. The other
+# kernels' path (_krhs, _kout, _rk4) stays in calls: inlining it too (it holds the turbine's
+# kernel as well) made the first compile four times longer.
 @njit(cache=True, inline="always")
 def _wind_at(w, wdt, t):
     s = t / wdt
@@ -165,7 +167,7 @@ def _wind_at(w, wdt, t):
 KIND_TURBINE, KIND_LINEAR, KIND_USER = 0, 1, 2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
     # The built-in kernels are called directly (a function passed as an argument would
     # defeat numba's on-disk cache); other kernels get rebound copies, see compiled_for.
@@ -175,7 +177,7 @@ def _krhs(kind, x, wind, pitch_cmd, gen_torque, p, dx):
         linear_rhs(x, wind, pitch_cmd, gen_torque, p, dx)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
     if kind == KIND_TURBINE:
         _turbine_outputs(x, wind, pitch_cmd, gen_torque, p, y)
@@ -183,7 +185,7 @@ def _kout(kind, x, wind, pitch_cmd, gen_torque, p, y):
         linear_outputs(x, wind, pitch_cmd, gen_torque, p, y)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _rk4(kind, x, w, wdt, t, dt, beta_cmd, torque, p, k1, k2, k3, k4, xt):
     """One RK4 step of ``x``, its first stage ``k1`` (the derivative at t) already computed."""
     n = x.size
@@ -513,7 +515,7 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
             fn.__qualname__ = f"{f.py_func.__qualname__}_rebound{len(_REBOUND)}"
             return njit(**kw)(fn)
 
-        g["_rk4"] = copy(_rk4, inline="always")
+        g["_rk4"] = copy(_rk4)
         g["_run_one"] = copy(_run_one)
         _REBOUND[key] = (KIND_USER, copy(_run_batch, parallel=True), copy(_step_all), copy(_outputs_all))
     return _REBOUND[key]
