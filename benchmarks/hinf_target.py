@@ -77,7 +77,11 @@ def main():
             make = feasibility.specification_for_target if args.pair == "target" else feasibility.element_specification
             ts = make(model, v, args.target)
             t = time.perf_counter()
-            d = design_hinf(model, v, specs=ts)
+            try:
+                d = design_hinf(model, v, specs=ts)
+            except ValueError as err:  # e.g. a weight pole slower than the α-shift
+                print(f"| {v:g} | | {ts.promise.exact_del:.2f} | synthesis refused: {err} |||||||", flush=True)
+                continue
             t = time.perf_counter() - t
         if not d.case_check.met:
             print(f"<!-- {v:g} m/s: {d.notes[-1]} -->")

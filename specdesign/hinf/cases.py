@@ -13,7 +13,8 @@ outputs of the nominal plant, with the weights' narrow zeros capped, while the p
 (each ratio ≤ 1) at every case. The step takes the reduced H∞ controller and adjusts its
 poles, residues and feedthrough (its order, and its integrator, kept) until
 max over cases and channels of ‖W_i⁻¹T_i‖∞ ≤ 10^(−margin/20) on the check grid, the loop's
-poles have Re ≤ −``decay_rate`` at every case and |1/(1 + C·P_{Ω,β})| ≤ ``max_sensitivity``:
+poles have Re ≤ −``decay_rate`` at every case and |1/(1 + C·P_{Ω,β})| ≤ ``max_sensitivity``,
+then lowers the worst ratio further (a smooth minimax):
 the per-channel, multi-model H∞ constraint of structured H∞ synthesis (Apkarian & Noll 2006,
 MATLAB's ``hinfstruct``/``systune``), here an exterior penalty minimised by L-BFGS-B.
 
@@ -289,8 +290,12 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     10⁴·Σ max(0, Re p + ``decay_rate``)² over the closed-loop poles of every case (L-BFGS-B,
     finite-difference gradient; deterministic). The penalty is zero exactly when
     max_i ‖W_i⁻¹T_i‖∞ ≤ 10^(−margin/20) per channel with the loop's decay and margin.
-    ``margins_db`` are tightened in turn before ``margin_db`` (a continuation from a far start);
-    the result is then checked by :func:`check_pair` on its own refined grid.
+    ``margins_db`` are tightened in turn before ``margin_db`` (a continuation from a far start).
+    A last stage minimises the smooth maximum (log-sum-exp, 0.1 dB) of every ratio over the
+    cases, channels and grid plus that penalty: min γ of the multi-model problem, so the result
+    is not merely the first feasible point the penalty stage reached (which moved the predicted
+    reduction by 4 pp between 19 and 19 + 1e-9 m/s). The result is then checked by
+    :func:`check_pair` on its own refined grid.
 
     Parameters
     ----------
