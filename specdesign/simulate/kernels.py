@@ -151,7 +151,7 @@ def linear_plant_params(sys: control.StateSpace, u0: ArrayLike, y0: ArrayLike) -
 # The turbine's path through the loop is inlined into it (numba IR), as the turbine kernel's
 # pieces are: a call passing arrays costs reference-count operations on every step. The other
 # kernels' path (_krhs, _kout, _rk4) stays in calls: inlining it too (it holds the turbine's
-# kernel as well) made the first compile four times longer.
+# kernel as well) made the first, cold-cache compile several times longer.
 @njit(cache=True, inline="always")
 def _wind_at(w, wdt, t):
     s = t / wdt
