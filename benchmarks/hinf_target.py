@@ -62,7 +62,7 @@ def explicit_check(model, ts, c_beta):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--speeds", type=float, nargs="+", default=[float(v) for v in range(15, 26)])
+    ap.add_argument("--speeds", type=float, nargs="*", default=[float(v) for v in range(15, 26)])
     ap.add_argument("--target", type=float, default=25.0)
     ap.add_argument("--repro", type=float, nargs="*", default=[19.0])
     ap.add_argument("--pair", choices=("target", "element"), default="target")
