@@ -38,3 +38,10 @@ def test_other_arguments_are_other_entries():
     assert np.array_equal(b, _plain(omega, 19.0 + 1e-9, 120.0))
     assert np.array_equal(c, _plain(omega[:-1], 19.0, 120.0))  # a shorter grid is its own entry
     assert not np.array_equal(a, b)
+
+
+def test_cache_clear_recomputes_the_same_bits():
+    omega = np.linspace(0.0, 3.0, 40)
+    a = wind.disc_coherence(omega, 11.0, 120.0)
+    wind.disc_coherence.cache_clear()
+    assert np.array_equal(wind.disc_coherence(omega, 11.0, 120.0), a)
