@@ -316,19 +316,18 @@ def rosco_baseline(model: TurbineModel, wind_speed: float, *, omega_pc: float = 
     """
     import control
 
-    below = False
-    if getattr(model, "torque_control", None) is not None:
-        v = model.check_operating_speed(wind_speed)
-        below = model.trim(v).region != "3"
-    else:
-        v = model.check_wind_speed(wind_speed)
+    with_torque_law = getattr(model, "torque_control", None) is not None
+    v = model.check_operating_speed(wind_speed) if with_torque_law else model.check_wind_speed(wind_speed)
     name = f"ROSCO_PI@{v:g}mps".replace(".", "p")
-    if below:
+    if with_torque_law and model.trim(v).region != "3":
         return control.tf([0.0], [1.0], inputs="gen_speed", outputs="pitch_cmd", name=f"{name}_fine_pitch")
     if schedule is None:
         schedule = rosco_gain_schedule(model, omega_pc=omega_pc, zeta_pc=zeta_pc)
-    lo = float(np.min(schedule.v))
-    kp, ki = (float(g) for g in schedule.gains(lo if v < lo and model.rated_wind_speed() <= v else v))
+    v_gains = v
+    if with_torque_law and hasattr(schedule, "v"):
+        # above rated but below the grid's first speed: ROSCO's interp1d holds the first gains
+        v_gains = max(v, float(np.min(schedule.v)))
+    kp, ki = (float(g) for g in schedule.gains(v_gains))
     pi = control.tf([kp, ki], [1.0, 0.0])
     c = pi * speed_filter()
     return control.tf(c.num[0][0], c.den[0][0], inputs="gen_speed", outputs="pitch_cmd", name=name)
