@@ -97,7 +97,6 @@ class _Cases:
 
         v = target.design.wind_speed
         self.speeds = tuple(target.case_speeds) or (v,)
-        nom = self.speeds.index(v)
         plants = [model.linearize(s) for s in self.speeds]
         self.loops = []
         for P in plants:
@@ -108,16 +107,18 @@ class _Cases:
         self.roots = roots
         self.omega = refine_grid(base, roots)
         self.plants = plants
-        rosco = sp.baseline_controllers(model, self.speeds)
-        self._set(self.omega, rosco, nom, spec_ratio(target.tower, sp.baseline_analysis(model, v).system),
-                  spec_ratio(target.speed, sp.speed_specification(model, v).baseline))
+        self._rosco = sp.baseline_controllers(model, self.speeds)
+        self._tower_ratio = spec_ratio(target.tower, sp.baseline_analysis(model, v).system)
+        self._speed_ratio = spec_ratio(target.speed, sp.speed_specification(model, v).baseline)
+        self.regrid(self.omega)
 
-    def _set(self, omega, rosco, nom, tower_ratio, speed_ratio):
+    def regrid(self, omega):
+        """Evaluate the plants and the pair's weights at every case on ``omega`` (rad/s)."""
         self.R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my"), method="batched")
-        c0 = np.stack([siso_response(r, omega) for r in rosco], axis=1)
+        c0 = np.stack([siso_response(r, omega) for r in self._rosco], axis=1)
         # W_i = T^ROSCO_i·(W/T^ROSCO_nom): the pair's convention at the non-nominal cases
-        self.w_tower = np.abs(closed_map(self.R, c0, None, "tower_base_my")) * np.abs(tower_ratio(omega))[:, None]
-        self.w_speed = np.abs(closed_map(self.R, c0, None, "gen_speed")) * np.abs(speed_ratio(omega))[:, None]
+        self.w_tower = np.abs(closed_map(self.R, c0, None, "tower_base_my")) * np.abs(self._tower_ratio(omega))[:, None]
+        self.w_speed = np.abs(closed_map(self.R, c0, None, "gen_speed")) * np.abs(self._speed_ratio(omega))[:, None]
         self.ob = self.R[("gen_speed", "pitch_cmd")]
 
     def ratios(self, c):
@@ -182,13 +183,7 @@ def check_pair(model, target, pitch_controller: ct.LTI, *, omega: ArrayLike | No
     poles = cases.poles(a, b, c, d)
     grid = refine_grid(cases.omega, poles)
     if grid.size != cases.omega.size:
-        from .. import spec as sp
-        from ..qft.checks import spec_ratio
-
-        v = target.design.wind_speed
-        cases._set(grid, sp.baseline_controllers(model, cases.speeds), cases.speeds.index(v),
-                   spec_ratio(target.tower, sp.baseline_analysis(model, v).system),
-                   spec_ratio(target.speed, sp.speed_specification(model, v).baseline))
+        cases.regrid(grid)
     rt, rs, sens = cases.ratios(siso_response(k, grid))
     return CaseCheck(case_speeds=cases.speeds, tower_excess_db=tuple(float(x) for x in rt.max(0)),
                      speed_excess_db=tuple(float(x) for x in rs.max(0)),
