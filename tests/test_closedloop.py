@@ -172,3 +172,17 @@ def test_loop_maps_and_figures(setup):
     with pytest.raises(ValueError, match="psd"):
         plot_fatigue_origin(OMEGA, maps.tower_closed, psd[:-1], np.ones_like(OMEGA))
     plt.close("all")
+
+
+def test_case_speeds_clip_and_list_each_operating_point_once():
+    # offsets clipped to the range; a case within CASE_TOLERANCE of another is the same point
+    speeds, nom = cl.case_speeds(19.0, (-1.0, -0.5, 0.5, 1.0), (10.6, 25.0))
+    assert speeds == (18.0, 18.5, 19.0, 19.5, 20.0) and nom == 2
+    speeds, nom = cl.case_speeds(25.0, (-1.0, -0.5, 0.5, 1.0), (10.6, 25.0))
+    assert speeds == (24.0, 24.5, 25.0) and nom == 2
+    edge = 25.0 - 1e-9
+    speeds, nom = cl.case_speeds(edge, (-1.0, -0.5, 0.5, 1.0), (10.6, 25.0))
+    assert speeds == (edge - 1.0, edge - 0.5, edge) and speeds[nom] == edge
+    assert cl.case_speeds(19.0, (), (10.6, 25.0)) == ((19.0,), 0)
+    with pytest.raises(ValueError, match="offsets"):
+        cl.case_speeds(19.0, (np.nan,), (10.6, 25.0))

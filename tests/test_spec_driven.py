@@ -271,3 +271,28 @@ def test_element_specification_bad_input(model):
         fz.element_specification(model, 19.0, 25.0, max_notches=-1)
     with pytest.raises(ValueError, match="no element specification.*promises 70 %"):
         fz.element_specification(model, 19.0, 70.0, headroom_pp=(3.0,))
+
+
+def test_recertify_keeps_the_woehler_exponent_of_the_target(model):
+    # an m = 3 target edited by hand: its promise stays an m = 3 promise, the one
+    # spec.promise_of gives against an m = 3 baseline (recertify once used m = 4 whatever m was)
+    from specdesign import spec
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        ts = fz.specification_for_target(model, 19.0, 20.0, m=3.0)
+    assert ts.m == 3.0
+    edited = fz.recertify(model, ts, tower=ts.tower.add(spec.Gain(0.2)))
+    base3 = spec.baseline_analysis(model, 19.0, m=3.0, omega=ts.design.omega)
+    assert edited.m == 3.0
+    assert edited.promise.exact_del == pytest.approx(spec.promise_of(edited.tower, base3).exact_del, abs=1e-9)
+
+
+def test_a_target_at_the_edge_of_the_range_checks_each_case_once(model):
+    # 25 − 1e-9 m/s: the +0.5 and +1 m/s cases clip to 25.0 m/s, the nominal point to within
+    # 1e-9 m/s; the cases are those of a target at 25 m/s, each once
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        ts = fz.specification_for_target(model, 25.0 - 1e-9, 25.0)
+    assert len(ts.case_speeds) == 3 and ts.case_speeds[-1] == 25.0 - 1e-9
+    assert np.allclose(ts.case_speeds, (24.0, 24.5, 25.0), atol=1e-8)

@@ -29,7 +29,7 @@ Every closed-loop construction of the workbench lives here, one module a concern
 """
 from __future__ import annotations
 
-from .grid import lightly_damped, refine_grid, system_roots
+from .grid import case_speeds, lightly_damped, refine_grid, system_roots
 from .interconnect import (PLANT_INPUTS, check_stability, closed_loop, closed_loop_mimo, named_siso, partial_loop,
                            require_signals)
 from .maps import (LOOP_OUTPUTS, LoopMaps, close_responses, closed_loop_del, closed_map, frequency_response,
@@ -72,6 +72,7 @@ __all__ = [
     "system_roots",
     "lightly_damped",
     "refine_grid",
+    "case_speeds",
     "ORIGIN_TOL",
     "PLANT_INPUTS",
     "LOOP_OUTPUTS",

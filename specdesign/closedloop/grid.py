@@ -10,7 +10,10 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:
     import control
 
-__all__ = ["system_roots", "lightly_damped", "refine_grid"]
+__all__ = ["case_speeds", "lightly_damped", "refine_grid", "system_roots"]
+
+#: Plant cases closer than this (m/s) to another one are the same operating point.
+CASE_TOLERANCE = 1e-6
 
 
 def system_roots(sys: control.LTI) -> np.ndarray:
@@ -154,3 +157,51 @@ def refine_grid(omega: ArrayLike, roots: ArrayLike | control.LTI | Iterable = ()
     extra.append(np.abs(light))
     grid = np.unique(np.concatenate([omega] + [np.asarray(e, float) for e in extra]))
     return grid[(grid >= lo) & (grid <= hi)]
+
+
+def case_speeds(wind_speed: float, offsets: ArrayLike, wind_range: tuple[float, float]) -> tuple[tuple[float, ...], int]:
+    """The plant cases around an operating point: ``wind_speed`` + ``offsets`` clipped to ``wind_range``.
+
+    A case that clips onto another, or onto the nominal speed, to within :data:`CASE_TOLERANCE`
+    m/s is the same operating point and is listed once, so a design at 25 − 1e-9 m/s on a
+    model valid up to 25 m/s checks the cases a design at 25 m/s checks (no 25.0 m/s case
+    beside the nominal 24.999999999 m/s one).
+
+    Parameters
+    ----------
+    wind_speed : float
+        Nominal operating point, m/s (inside ``wind_range``).
+    offsets : array_like
+        Wind-speed offsets of the neighbouring cases, m/s (finite, 1-D; 0 and repeats allowed).
+    wind_range : (float, float)
+        The model's valid wind speeds, m/s.
+
+    Returns
+    -------
+    speeds : tuple of float
+        The case wind speeds, increasing, m/s; the nominal one is ``wind_speed`` exactly.
+    nominal : int
+        Index of ``wind_speed`` in ``speeds``.
+
+    Raises
+    ------
+    ValueError
+        If ``offsets`` is not a 1-D array of finite numbers.
+
+    Examples
+    --------
+    >>> from specdesign.closedloop import case_speeds
+    >>> case_speeds(24.999999999, (-1.0, -0.5, 0.5, 1.0), (10.6, 25.0))
+    ((23.999999999, 24.499999999, 24.999999999), 2)
+    """
+    v = float(wind_speed)
+    o = np.atleast_1d(np.asarray(offsets, float))
+    if o.ndim != 1 or not np.all(np.isfinite(o)):
+        raise ValueError(f"offsets={offsets!r} must be a 1-D array of finite wind-speed offsets in m/s")
+    lo, hi = wind_range
+    speeds = [v]
+    for s in sorted(float(np.clip(v + x, lo, hi)) for x in o):
+        if all(abs(s - t) > CASE_TOLERANCE for t in speeds):
+            speeds.append(s)
+    speeds.sort()
+    return tuple(speeds), speeds.index(v)

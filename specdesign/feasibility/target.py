@@ -51,6 +51,9 @@ class TargetSpecification:
         the designer's.
     speed_slack_db : float
         Room left above the certificate's speed map, dB.
+    m : float
+        Wöhler exponent of the promise (-); :func:`recertify` computes the edited pair's promise
+        with it.
     """
 
     tower: object
@@ -63,6 +66,7 @@ class TargetSpecification:
     case_speeds: tuple = ()
     robustness_db: float = 0.0
     speed_slack_db: float = 0.0
+    m: float = 4.0
 
     @property
     def template_offsets(self) -> tuple:
@@ -153,6 +157,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     """
     from .. import spec
     from .._checks import as_omega, del_target
+    from ..closedloop import case_speeds
 
     t = del_target(target_reduction)
     slack = float(slack_db)
@@ -165,8 +170,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     if offsets.ndim != 1 or not np.all(np.isfinite(offsets)):
         raise ValueError(f"case_offsets={case_offsets!r} must be finite wind-speed offsets in m/s")
     v = model.check_wind_speed(wind_speed)
-    lo, hi = model.wind_range
-    speeds = tuple(sorted({float(np.clip(v + o, lo, hi)) for o in offsets} | {v}))
+    speeds, _ = case_speeds(v, offsets, model.wind_range)
     dense = (np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None
              else as_omega(dense_omega, "dense_omega", allow_zero=False))
     base = spec.baseline_analysis(model, v, m=m, omega=omega)
@@ -197,7 +201,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         while hi_s - lo_s > tolerance_db:
             mid = 0.5 * (lo_s + hi_s)
             lo_s, hi_s = (mid, hi_s) if _slack_promise(design, base, mid + rob[0]) >= t else (lo_s, mid)
-        return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t)
+        return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t, m)
     # a ladder first, then bisection inside the first rung that reaches the target: the promise
     # over the plant cases is not monotone in g (bolder designs are less robust), so a bisection
     # over the whole range could step past the smallest relaxation that works
@@ -223,7 +227,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
             hi_g, best, best_rob = mid, d, rob
         else:
             lo_g = mid
-    return _target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t)
+    return _target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t, m)
 
 
 class _Cases:
@@ -309,7 +313,7 @@ def _slack_promise(design, base, slack_db):
     return spec.promise_of(10 ** (slack_db / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
 
 
-def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target):
+def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target, m):
     import control
 
     from .. import spec
@@ -325,7 +329,7 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     relax = max(g, speed_needed) + speed_slack
     speed = spec.speed_specification(model, float(wind_speed), margin_db=relax)
     return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, total, design, target,
-                               tuple(speeds), robust, speed_slack)
+                               tuple(speeds), robust, speed_slack, float(m))
 
 
 def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> TargetSpecification:
@@ -352,7 +356,8 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     Returns
     -------
     TargetSpecification
-        The edited pair, its promise (exact Dirlik against ROSCO) and the same certificate;
+        The edited pair, its promise (exact Dirlik against ROSCO, Wöhler exponent ``target.m``)
+        and the same certificate;
         ``slack_db`` is then the smallest margin (dB) between the certificate's nominal tower map
         and the edited W_MyT, ``robustness_db`` the plant cases' part of the original.
 
@@ -414,7 +419,7 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
                              "design gives there (relax it there, or make a new target specification)")
     t0 = np.abs(closed_map(R, c, 0.0, "tower_base_my")[:, nom])
     margin = float(20 * np.log10(np.min(np.abs(np.asarray(tower.response(w))) / t0)))
-    base = spec.baseline_analysis(model, v, omega=target.design.omega)
+    base = spec.baseline_analysis(model, v, m=target.m, omega=target.design.omega)
     relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs[:, nom])))
     return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, target.design,
-                               target.target_reduction, speeds, target.robustness_db, target.speed_slack_db)
+                               target.target_reduction, speeds, target.robustness_db, target.speed_slack_db, target.m)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..closedloop import closed_map, general_coefficients, plant_responses, siso_response
+from ..closedloop import case_speeds, closed_map, general_coefficients, plant_responses, siso_response
 
 __all__ = ["BoundsVerdict", "BoundsChecker", "bounds_checker"]
 
@@ -166,9 +166,7 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     if not max_sensitivity > 1:
         raise ValueError(f"max_sensitivity={max_sensitivity!r} must be > 1 (|1/(1+L)| bound)")
     v = model.check_wind_speed(wind_speed)
-    lo, hi = model.wind_range
-    speeds = sorted({float(np.clip(v + o, lo, hi)) for o in np.atleast_1d(np.asarray(template_offsets, float))} | {v})
-    nom = speeds.index(v)
+    speeds, nom = case_speeds(v, template_offsets, model.wind_range)
     w = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
     plants = [model.linearize(s) for s in speeds]
     R = plant_responses(plants, w, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")

@@ -15,7 +15,8 @@ import control as ct
 import numpy as np
 
 from .._checks import del_target, positive_scalar
-from ..closedloop import check_stability, closed_loop, lightly_damped, plant_responses, refine_grid, siso_response
+from ..closedloop import (case_speeds, check_stability, closed_loop, lightly_damped, plant_responses, refine_grid,
+                          siso_response)
 from .checks import bounds_met, loop_checks, spec_ratio, spec_roots
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
@@ -300,12 +301,6 @@ def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01
     return np.unique(w[(w >= 0.005) & (w <= 20.0)])
 
 
-def _template_speeds(model, v, offsets):
-    lo, hi = model.wind_range
-    speeds = sorted({float(np.clip(v + o, lo, hi)) for o in offsets} | {v})
-    return tuple(speeds), speeds.index(v)
-
-
 def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
                speed_relax_db: float | Sequence[float] | None = None, spec: Any = "target",
                structure: str | None = None, **kwargs: Any) -> QFTDesign:
@@ -577,7 +572,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
     wd = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
     wdense = np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None else lqft.check_grid(dense_omega, "dense_omega")
 
-    speeds, nom = _template_speeds(model, v, offsets)
+    speeds, nom = case_speeds(v, offsets, model.wind_range)
     specs = sp.design_specifications(model, v, speed_relax_db=speed_relax_db, spec_reduction=spec_reduction,
                                      tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
                                      keep_below=keep_below)
