@@ -296,3 +296,16 @@ def test_a_target_at_the_edge_of_the_range_checks_each_case_once(model):
         ts = fz.specification_for_target(model, 25.0 - 1e-9, 25.0)
     assert len(ts.case_speeds) == 3 and ts.case_speeds[-1] == 25.0 - 1e-9
     assert np.allclose(ts.case_speeds, (24.0, 24.5, 25.0), atol=1e-8)
+
+
+def test_the_default_design_certifies_and_meets_on_the_plant_cases_asked_for(model, chain19):
+    # template_offsets names the plant cases of a specification-driven design: the pair is
+    # certified on them and the design checked on them (it once raised TypeError)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        d = design_qft(model, 19.0, template_offsets=(-0.5, 0.5))
+    assert d.template_speeds == (18.5, 19.0, 19.5)
+    assert d.success and d.del_reduction >= 25.0 - 0.1
+    ts, _ = chain19
+    with pytest.raises(TypeError, match="case_offsets"):
+        design_qft(model, 19.0, spec=ts, template_offsets=(-0.5, 0.5))

@@ -346,7 +346,8 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         TargetSpecification; their default): the specification's certificate reduced to the
         lowest order that meets it over the plant cases
         (:func:`specdesign.qft.certificate.design_from_certificate`; options
-        ``max_sensitivity``, ``min_decay``, ``design_omega``, ``dense_omega``).
+        ``max_sensitivity``, ``min_decay``, ``design_omega``, ``dense_omega``, and with
+        ``spec="target"`` ``template_offsets``, the plant cases the pair is certified on).
     **kwargs
         Options of each design attempt (keyword only; the certificate takes only the four
         named above, the fixed structures all of these):
@@ -356,7 +357,8 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             (:func:`specdesign.spec.shape_to_target`, notches above ``keep_below`` rad/s).
         template_offsets : sequence of float, default (-1, -0.5, 0.5, 1)
             Wind-speed offsets (m/s) of the neighbouring operating points (clipped to
-            ``model.wind_range``).
+            ``model.wind_range``). With ``spec="target"`` the plant cases the specification is
+            certified on and met on (``specification_for_target(case_offsets=...)``).
         design_omega : array_like, optional
             QFT design frequencies, rad/s (default :data:`DEFAULT_DESIGN_OMEGA` plus the
             tower-mode features of ROSCO's loops).
@@ -437,12 +439,12 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     if isinstance(spec, str) and spec not in ("target", "notch"):
         raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
                          "(tower, speed)")
-    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega"}
+    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets"}
     if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
         named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
         raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
                         "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
-                        "takes max_sensitivity, min_decay, design_omega, dense_omega")
+                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
     if speed_relax_db is None:
         speed_relax_db = (3.0, 4.5, 6.0, 8.0)
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
@@ -457,7 +459,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     if isinstance(spec, str) and spec == "target":
         from ..feasibility import specification_for_target
 
-        spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction)
+        # the plant cases the pair is certified on are the ones the design must meet it on
+        offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
+        spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction,
+                                        **({} if offsets is None else {"case_offsets": offsets}))
     elif isinstance(spec, str):  # "notch"
         spec = None
     if structure == "certificate" and not isinstance(spec, TargetSpecification):
@@ -467,6 +472,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         from .certificate import design_from_certificate
 
         allowed = {"max_sensitivity", "min_decay", "design_omega", "dense_omega"}
+        if "template_offsets" in kwargs:
+            raise TypeError("design_qft(spec=TargetSpecification) meets the pair on the plant cases it was certified on "
+                            "(spec.case_speeds): make the specification with specification_for_target(..., "
+                            "case_offsets=...) instead of passing template_offsets=")
         if set(kwargs) - allowed:
             raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
                             f"got {sorted(set(kwargs) - allowed)}")
