@@ -167,3 +167,19 @@ def test_store_reruns_runs_whose_records_are_now_kept(setup, tmp_path, monkeypat
     monkeypatch.undo()
     assert_bitwise_equal(reordered, run_campaign({"PI19": ctrls["PI19"]}, [19.0], [5, 4], **kw))
     assert np.all(np.isfinite(reordered.series["PI19"].outputs["tower_base_my"]))
+
+
+def test_a_models_fingerprint_does_not_depend_on_its_history():
+    # the store recognises a model by its pickle: trims, compiled tables and linearisations
+    # computed on one instance must not make it another model; a changed field must
+    from dataclasses import replace
+
+    from specdesign.turbine import iea15mw
+    from specdesign.validate.store import fingerprint
+
+    used = iea15mw()
+    fresh = fingerprint(iea15mw())
+    used.trim(19.0)
+    used.linearize(21.0)
+    assert fingerprint(used) == fresh
+    assert fingerprint(replace(used, air_density=1.2)) != fresh

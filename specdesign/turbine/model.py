@@ -16,7 +16,7 @@ The state, input and output vectors and the compiled kernel are those of
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from functools import cached_property
 from typing import TYPE_CHECKING
 
@@ -390,11 +390,27 @@ class TurbineModel:
         >>> iea15mw().trim(8.0).region
         '2'
         """
+        v = self.check_operating_speed(wind_speed)
+        # a trim is an immutable record of the model at v; the design loop asks for the same
+        # speeds over and over (ROSCO's 30-speed schedule, the plant cases: 175 trims, 30
+        # distinct, in one specification_for_target)
+        cache = self._trims
+        if v not in cache:
+            cache[v] = self._trim_below(v) if self.torque_control is not None and v < self._rated_v else self._trim_above(v)
+        return cache[v]
+
+    @cached_property
+    def _trims(self) -> dict:
+        return {}
+
+    def __getstate__(self) -> dict:
+        # the fields only: what is derived from them (compiled tables, trims) is rebuilt on
+        # demand, so a model's pickle, and its store fingerprint, does not depend on its history
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def _trim_above(self, v):
         from scipy.optimize import brentq
 
-        v = self.check_operating_speed(wind_speed)
-        if self.torque_control is not None and v < self._rated_v:
-            return self._trim_below(v)
         omega = self.rated_rotor_speed
         torque = self.rated_generator_torque
 
