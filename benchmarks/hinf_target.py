@@ -2,7 +2,7 @@
 
 For each wind speed: ``specification_for_target(model, v, target)`` (the pair certified over the
 plant cases v + (−1, −0.5, 0.5, 1) m/s within the model's range, by a pitch-only controller,
-docs/spec_driven.md), then ``design_hinf(model, v, specs=pair)`` (pitch only: Riccati synthesis,
+docs/spec_driven.md), then ``design_hinf(model, v, spec=pair)`` (pitch only: Riccati synthesis,
 balanced truncation to 8 states, the multi-model H∞ step of specdesign.hinf.cases). The check
 is recomputed here by the explicit closed-loop formula (closedloop.t_tower_wind /
 t_gen_speed_wind) at every plant case, each case's weight from ROSCO's loop at that speed
@@ -10,8 +10,11 @@ t_gen_speed_wind) at every plant case, each case's weight from ROSCO's loop at t
 around the specifications' roots and every case's closed-loop poles. Printed per speed: the
 promise, the predicted DEL reduction (Dirlik vs ROSCO), the nominal and the worst tower/speed
 excess over the cases (dB, > 0 = missed), the slowest closed-loop decay over the cases (1/s),
-the design time, and the worst tower excess of the reduced Riccati controller before the
-multi-model step (HinfDesign.reduction.controller). ``--repro v`` also designs at v + 1e-9 m/s and prints both predictions.
+the seconds per speed (making the pair, and the H∞ design on it: ``design_hinf(model, v)``, the
+default, is their sum), and the worst tower excess of the reduced Riccati controller before the
+multi-model step (HinfDesign.reduction.controller). ``--repro v`` designs with the default
+``design_hinf(model, x)`` at x = v and v + 1e-9 m/s and prints both predictions. The machine's
+load (/proc/loadavg, 1 min) is printed with the timings: they are wall-clock seconds.
 ``--pair element`` takes ``feasibility.element_specification(model, v, target)`` (the pair in
 element form) instead. Feeds the tables of docs/hinf.md ("H∞ on a certified pair").
 
@@ -20,6 +23,7 @@ Run: python benchmarks/hinf_target.py [--speeds 15 16 ... 25] [--target 25] [--r
 from __future__ import annotations
 
 import argparse
+import os
 import time
 import warnings
 
@@ -69,20 +73,24 @@ def main():
     args = ap.parse_args()
     model = iea15mw()
     print("| v (m/s) | cases (m/s) | promise (%) | predicted (%) | nominal tower excess (dB) "
-          "| worst tower excess (dB @ rad/s, case) | worst speed excess (dB @ rad/s, case) | slowest decay (1/s) | time (s) | before the step: worst tower / speed excess (dB) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "| worst tower excess (dB @ rad/s, case) | worst speed excess (dB @ rad/s, case) | slowest decay (1/s) "
+          "| pair + design (s) | load | before the step: worst tower / speed excess (dB) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    times = []
     for v in args.speeds:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # cvxpy accuracy notes of the certificate
             make = feasibility.specification_for_target if args.pair == "target" else feasibility.element_specification
+            t0 = time.perf_counter()
             ts = make(model, v, args.target)
             t = time.perf_counter()
             try:
-                d = design_hinf(model, v, specs=ts)
+                d = design_hinf(model, v, spec=ts)
             except ValueError as err:  # e.g. a weight pole slower than the α-shift
                 print(f"| {v:g} | | {ts.promise.exact_del:.2f} | synthesis refused: {err} |||||||", flush=True)
                 continue
-            t = time.perf_counter() - t
+            t, t0 = time.perf_counter() - t, t - t0
+            times.append(t0 + t)
         if not d.case_check.met:
             print(f"<!-- {v:g} m/s: {d.notes[-1]} -->")
         rows, re_max = explicit_check(model, ts, d.pitch_controller)
@@ -92,13 +100,19 @@ def main():
         cases = f"{min(ts.case_speeds):g}-{max(ts.case_speeds):g} ({len(ts.case_speeds)})"
         print(f"| {v:g} | {cases} | {ts.promise.exact_del:.2f} | {d.predicted_del_reduction:.2f} | {nom[1]:+.2f} "
               f"| {wt[1]:+.2f} @ {wt[2]:.3g}, {wt[0]:g} | {ws[3]:+.2f} @ {ws[4]:.3g}, {ws[0]:g} | {-re_max:.3f} "
-              f"| {t:.0f} | {max(r[1] for r in before):+.2f} / {max(r[3] for r in before):+.2f} |", flush=True)
+              f"| {t0:.1f} + {t:.1f} | {os.getloadavg()[0]:.1f} | {max(r[1] for r in before):+.2f} / {max(r[3] for r in before):+.2f} |", flush=True)
+    if times:
+        print(f"\nseconds per speed (pair + design): mean {np.mean(times):.1f}, max {np.max(times):.1f} "
+              f"over {len(times)} speeds")
     for v in args.repro:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)
-            p = [design_hinf(model, x, target_reduction=args.target).predicted_del_reduction for x in (v, v + 1e-9)]
+            t = time.perf_counter()
+            p = [design_hinf(model, x, args.target).predicted_del_reduction for x in (v, v + 1e-9)]
+            t = (time.perf_counter() - t) / 2
         print(f"\nreproducibility at {v:g} m/s: predicted {p[0]:.4f} % at v, {p[1]:.4f} % at v + 1e-9 m/s "
-              f"(difference {abs(p[0] - p[1]):.2g} pp)")
+              f"(difference {abs(p[0] - p[1]):.2g} pp); design_hinf(model, v) {t:.1f} s each, load "
+              f"{os.getloadavg()[0]:.1f}")
 
 
 if __name__ == "__main__":

@@ -3,15 +3,19 @@
 Modules: :mod:`~specdesign.hinf.weights` (W⁻¹ of a specification), :mod:`~specdesign.hinf.plant`
 (the generalized plant), :mod:`~specdesign.hinf.design` (:func:`design_hinf` and its result),
 :mod:`~specdesign.hinf.cases` (a certified pair at every plant case: :func:`check_pair` and the
-multi-model H∞ step :func:`refine_on_cases`); the
+multi-model H∞ step :func:`refine_on_cases`), :mod:`~specdesign.hinf.modal` (a controller's
+modal parameters and their analytic derivatives); the
 synthesis, well-posedness checks and reduction are :mod:`loopshaping.hinf`'s.
 
 The specifications of :mod:`specdesign.spec` are upper bounds on closed-loop maps from the
 rotor-effective wind: |T_{MyT,w}(jω)| ≤ |W_MyT(jω)| (tower-base load, the baseline reshaped by
-notches) and |T_{Ω,w}(jω)| ≤ |W_Ω(jω)| (generator speed, the baseline's T_{Ω,w}); by default
-:func:`design_hinf` takes them as ``specdesign.qft.design_qft(spec="notch")`` does (:func:`qft_specifications`:
-the tower spec relaxed above ≈ 1.3 rad/s, the speed spec relaxed by QFT's dB ladder), so H∞ and
-QFT are compared on the same specifications. Dividing each
+notches) and |T_{Ω,w}(jω)| ≤ |W_Ω(jω)| (generator speed, the baseline's T_{Ω,w}). By default
+:func:`design_hinf` takes the feasible pair of a DEL target, as ``specdesign.qft.design_qft`` does
+(:func:`specdesign.feasibility.specification_for_target`, 25 %, certified over plant cases), and
+meets it at every case (pitch only); ``spec="qft"`` takes the specifications of
+``design_qft(spec="notch")`` (:func:`qft_specifications`: the tower spec relaxed above ≈ 1.3
+rad/s, the speed spec relaxed by QFT's dB ladder). Either way H∞ and QFT are compared on the same
+specifications. Dividing each
 output by its specification gives performance outputs whose H∞ norm is ≤ 1 exactly when
 the specification is met, so the generalized plant at one operating point is
 
@@ -30,7 +34,7 @@ from __future__ import annotations
 import warnings
 
 from ..closedloop import closed_loop_mimo, refine_grid
-from .cases import CHECK_OMEGA, CONTINUATION_DB, CaseCheck, check_pair, refine_on_cases
+from .cases import CHECK_OMEGA, CONTINUATION_DB, CaseCheck, check_pair, one_blas_thread, refine_on_cases
 from .design import DEFAULT_DECAY_RATE, QFT_SPEED_RELAX_DB, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
 from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, inverse_weight, siso_weight
@@ -40,6 +44,7 @@ __all__ = [
     "CHECK_OMEGA",
     "CONTINUATION_DB",
     "check_pair",
+    "one_blas_thread",
     "refine_on_cases",
     "GeneralizedPlant",
     "HinfDesign",
