@@ -60,7 +60,7 @@ def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101
     t0 = time.perf_counter()
     hd = {v: hinf.design_hinf(model, v) for v in speeds}
     out["H∞"] = scheduled(model, {v: ct.ss(d.pitch_controller) for v, d in hd.items()},
-                          atd={v: None if d.atd_controller is None else ct.ss(d.atd_controller) for v, d in hd.items()},
+                          atd={v: ct.ss(d.atd_controller) for v, d in hd.items() if d.atd_controller is not None} or None,
                           name="H∞")
     say(f"H∞ designs: {time.perf_counter() - t0:.0f} s")
     out["quadratic MPC"] = mpc.QuadraticMPC(model)
