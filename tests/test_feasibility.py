@@ -246,3 +246,22 @@ def test_the_notch_explorer_shows_the_qft_bounds_verdict(model):
         assert np.array_equal(explorer.bounds_verdict.empty, direct.empty)
         assert direct.summary() in explorer.ax_mag.get_title()
     assert not direct.feasible  # 25 dB at 0.05 rad/s asks for what integral action cannot give
+
+
+def test_the_checkers_responses_equal_python_controls(model):
+    # the check evaluates the plant and ROSCO's loop by batched state-space solves; the oracle
+    # is python-control's own evaluation (one frequency at a time) of the plant and of the
+    # interconnected ROSCO loop
+    v = 19.0
+    w = spec.default_omega()
+    speed = spec.speed_specification(model, v, margin_db=2.0)
+    chk = fz.pitch_checkers(model, v, speed, omega=w)[0]
+    plant = model.linearize(v)
+    a, yb, ow, ob = (closedloop.frequency_response(plant, w, o, i) for o, i in
+                     (("tower_base_my", "wind"), ("tower_base_my", "pitch_cmd"), ("gen_speed", "wind"),
+                      ("gen_speed", "pitch_cmd")))
+    g = yb * ow / ob  # P_{MyT,β}·P_{Ω,w}/P_{Ω,β}
+    np.testing.assert_allclose(chk.inv_g, 1 / np.abs(g), rtol=1e-9)
+    np.testing.assert_allclose(chk.c, -(a - g) / g, rtol=1e-9)
+    t_rosco = np.abs(closedloop.t_tower_wind(plant, spec.baseline_controller(model, v), w))
+    np.testing.assert_allclose(chk.t_rosco, t_rosco, rtol=1e-9)

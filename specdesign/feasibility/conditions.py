@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._blas import on_one_blas_thread
 from .._checks import as_omega, positive_scalar
 from .achievable import YoulaProblem
 
@@ -35,14 +36,13 @@ def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
         ``open_loop`` = P_{MyT,w} − K∞ (the factor of S in T_{MyT,w}) and ``k_inf`` = K∞,
         all arrays on ``omega``.
     """
-    from ..closedloop import frequency_response
+    from ..closedloop import plant_responses
 
     w = as_omega(omega, "omega")
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
-    a = frequency_response(plant, w, "tower_base_my", "wind")
-    yb = frequency_response(plant, w, "tower_base_my", "pitch_cmd")
-    ow = frequency_response(plant, w, "gen_speed", "wind")
-    ob = frequency_response(plant, w, "gen_speed", "pitch_cmd")
+    R = plant_responses([plant], w, ("tower_base_my", "gen_speed"), method="batched")
+    a, yb = R[("tower_base_my", "wind")][:, 0], R[("tower_base_my", "pitch_cmd")][:, 0]
+    ow, ob = R[("gen_speed", "wind")][:, 0], R[("gen_speed", "pitch_cmd")][:, 0]
     k_inf = a - yb * ow / ob
     g = a - k_inf  # = P_{MyT,β}·P_{Ω,w}/P_{Ω,β}
     return dict(c=-k_inf / g, rho=np.asarray(w_tower, float) / np.abs(g), r_speed=np.asarray(w_speed, float) / np.abs(ow),
@@ -154,6 +154,7 @@ def _bands(omega, mask):
     return [f"{omega[a]:.3g}-{omega[b]:.3g} rad/s" if a != b else f"{omega[a]:.3g} rad/s" for a, b in zip(starts, ends)]
 
 
+@on_one_blas_thread
 def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitivity=2.0, omega=None,
                       cases=None) -> PitchFeasibility:
     """Whether a tower-load and a generator-speed specification can be met by pitch control.
@@ -288,7 +289,7 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=
         Nominal case first when ``cases`` is None, else in the order given.
     """
     from .. import spec
-    from ..closedloop import refine_grid, t_tower_wind
+    from ..closedloop import closed_map, plant_responses, refine_grid, siso_response
 
     v = float(wind_speed)
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
@@ -299,7 +300,9 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=
     if omega is None and zeros0.size:
         w = refine_grid(w, zeros0, rel_width=0.2, rel_step=2e-4)
     ws = _magnitude(speed_spec, w, "speed_spec")
-    t_rosco = np.abs(t_tower_wind(model.linearize(v), spec.baseline_controller(model, v), w))
+    R0 = plant_responses([model.linearize(v)], w, ("tower_base_my", "gen_speed", "tower_top_vel"), method="batched")
+    t_rosco = np.abs(closed_map(R0, siso_response(spec.baseline_controller(model, v), w)[:, None], 0.0,
+                                "tower_base_my"))[:, 0]
     out = []
     for plant in plants:
         d = sensitivity_disks(plant, w, np.ones(w.shape), ws, max_sensitivity)
@@ -382,6 +385,7 @@ def _magnitude(spec_like, omega, name):
     return out
 
 
+@on_one_blas_thread
 def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8.0), *, max_sensitivity=2.0,
                    max_pitch_rate_ratio=1.0, m=4.0, omega=None) -> dict:
     """The largest tower-base DEL reduction a pitch controller can promise, per speed relaxation.

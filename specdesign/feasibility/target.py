@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._blas import on_one_blas_thread
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["TargetSpecification", "specification_for_target", "recertify", "DEFAULT_CASE_OFFSETS", "RELAX_LADDER_DB"]
@@ -81,6 +82,7 @@ class TargetSpecification:
         return tuple(float(c - v) for c in self.case_speeds if c != v)
 
 
+@on_one_blas_thread
 def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
                              max_sensitivity=1.8, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
                              m=4.0, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
