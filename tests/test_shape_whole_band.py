@@ -4,8 +4,10 @@ the certified whole-band specification (feasibility.element_specification on the
 The acceptance numbers are the issue's: promise ≥ 24.5 % recomputed independently (Dirlik DEL on
 |W|²S_W against ROSCO's |T|²S_W) within 0.5 pp; the certificate meets the pair at every plant case
 (the explicit SISO formula T = P_yw + P_yβ·T_βw on a dense 0.005-20 rad/s grid); the design handed
-the pair meets |T_MyT,w| ≤ |W_MyT| + 0.1 dB and predicts ≥ promise − 0.1 pp. The speed is 25 m/s,
-where the ±3 % envelope of the certificate alone left no element specification (issue 14).
+the pair meets |T_MyT,w| ≤ |W_MyT| + 0.1 dB and predicts ≥ promise − 0.1 pp; the shaping and the
+design at v − 1e-9 m/s give the same promise and prediction within 0.2 pp. The speed is 25 m/s, where
+the ±3 % envelope of the certificate alone left no element specification and where v − 1e-9 m/s
+failed outright while the fit stopped at an iteration cap (issue 14).
 """
 from __future__ import annotations
 
@@ -14,7 +16,8 @@ import warnings
 import numpy as np
 import pytest
 
-from specdesign import closedloop, feasibility as fz, spec, spectral, wind
+from specdesign import closedloop, spec, spectral, wind
+from specdesign import feasibility as fz
 from specdesign.qft import design_qft
 from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw
@@ -79,7 +82,7 @@ def _explicit_maps(model, v, controller, w):
 
 
 @pytest.mark.slow
-def test_the_whole_band_specification_at_25_mps_promises_the_target_and_is_met(model, whole25):
+def test_the_whole_band_specification_at_25_mps_promises_the_target_and_is_met(model, whole25, design25):
     res = whole25
     ts = res.certified
     assert res.success and res.specification is ts.tower
@@ -103,11 +106,47 @@ def test_the_whole_band_specification_at_25_mps_promises_the_target_and_is_met(m
         for k, wy in enumerate((ts.tower, ts.speed)):
             bound = rosco[k] * np.abs(wy.response(w)) / rosco_nom[k]
             assert np.max(20 * np.log10(got[k] / bound)) <= 1e-6, (v, k)
-    d = design_qft(model, 25.0, spec=ts)
+    d = design25
     assert d.success, d.message
     t_my = _explicit_maps(model, 25.0, d.pitch_controller, w)[0]
     assert np.max(20 * np.log10(t_my / np.abs(ts.tower.response(w)))) <= 0.1
     assert d.del_reduction >= res.promise.exact_del - 0.1
+
+
+@pytest.fixture(scope="module")
+def design25(model, whole25):
+    return design_qft(model, 25.0, spec=whole25.certified)
+
+
+@pytest.mark.slow
+def test_the_promise_is_the_target_plus_the_margin_by_an_independent_dirlik(model, whole25):
+    # the settle step raises the gain until the promise is target + PROMISE_MARGIN_PP; recomputed
+    # here with spectral.del_spectral on the fit's grid (not the fit's own moment code)
+    w = fz.elements.FIT_OMEGA
+    base = spec.baseline_analysis(model, 25.0, omega=w)
+    tower = whole25.certified.tower
+    del_w = spectral.del_spectral(w, np.abs(tower.response(w)) ** 2 * base.wind_psd, 4.0)
+    del_r = spectral.del_spectral(w, base.psd, 4.0)
+    assert 100 * (1 - del_w / del_r) == pytest.approx(25.0 + fz.elements.PROMISE_MARGIN_PP, abs=1e-6)
+    assert whole25.promise.exact_del == pytest.approx(100 * (1 - del_w / del_r), abs=1e-9)
+
+
+@pytest.mark.slow
+def test_a_rounding_error_in_the_wind_speed_moves_neither_promise_nor_prediction(model, base25, whole25, design25):
+    # issue 14's acceptance: the design at v and at v ± 1e-9 m/s predicts the same reduction within
+    # 0.2 pp (25 m/s is the top of the model's range, so − 1e-9). The certificate is the same to its
+    # solver's tolerance and the settle step pins the promise at target + margin; the fitted
+    # notches may differ (a multi-modal fit: see docs/spec_elements.md), so they are not compared
+    v = 25.0 - 1e-9
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        near = spec.shape_to_target(spec.baseline_analysis(model, v), 25.0, quantity="del", band="whole").certified
+    ts = whole25.certified
+    assert abs(near.speed_relax_db - ts.speed_relax_db) <= 1e-3
+    assert abs(near.promise.exact_del - ts.promise.exact_del) <= 1e-6
+    d = design_qft(model, v, spec=near)
+    assert d.success, d.message
+    assert abs(d.del_reduction - design25.del_reduction) <= 0.2
 
 
 @pytest.mark.slow
