@@ -33,8 +33,20 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import linalg, optimize
 
-from ..closedloop import closed_map, lightly_damped, plant_responses, refine_grid, siso_response
-from .modal import modal_matrices, modal_matrices_jacobian, modal_parameters, modal_response
+from ..closedloop import (
+    closed_map,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+)
+from .modal import (
+    modal_bounds,
+    modal_matrices,
+    modal_matrices_jacobian,
+    modal_parameters,
+    modal_response,
+)
 
 __all__ = ["CHECK_OMEGA", "CONTINUATION_DB", "CaseCheck", "check_pair", "one_blas_thread", "refine_on_cases"]
 
@@ -51,6 +63,16 @@ _SMOOTH_DB = 0.1
 #: (:func:`specdesign.closedloop.refine_grid`'s ``rel_step``): 10× the dense check's, ≥ 20
 #: points across a ζ = 0.01 peak; the margin covers the rest and the dense check judges.
 _COARSE_STEP = 1e-3
+#: Weight of the closed-loop poles' exterior penalty Σ max(0, Re p + decay)², (dB·s)². 10⁴
+#: let the ratios' sum over the cases and the grid outweigh an unstable pole at 24 m/s (a pole
+#: crossing between the optimisation grid's points is not seen in the ratios): the step ended
+#: with Re p = +0.05 1/s; 10⁶ keeps every case stable at 15-25 m/s.
+_POLE_WEIGHT = 1e6
+#: Largest |Re λ| and Im λ of the adjusted controller's poles, rad/s (or the start's, if larger):
+#: 50× the check grid's top, so the grid cannot tell a faster pole from a constant.
+_MAX_RATE = 1e3
+#: Objective value of a controller whose poles overflowed (a step far outside the model).
+_WALL = 1e30
 #: dB per neper: 20·log10|z| = _DB·Re log z.
 _DB = 20 / np.log(10)
 
@@ -241,22 +263,24 @@ class _Objective:
         return rt, rs, sens, self.g_tower / (num * den), -self.ob / den, jac
 
     def _poles(self, x):
-        """Penalty 10⁴·Σ max(0, Re p + decay)² over every case's closed-loop poles, and its gradient."""
+        """Penalty :data:`_POLE_WEIGHT`·Σ max(0, Re p + decay)² over every case's closed-loop poles, and its gradient."""
         a, b, c, d = modal_matrices(self.kinds, x)
         f, grad, dmats = 0.0, np.zeros(x.size), None
+        if not np.all(np.isfinite(a)):  # a pole pushed to overflow: a wall the line search backs off from
+            return _WALL, grad
         for A, B, C, D in self.cases.loops:
             M = np.block([[A - B @ d @ C, -B @ c], [b @ C, a]])
             lam = np.linalg.eigvals(M)
             h = np.maximum(lam.real + self.decay_rate, 0.0)
             if not np.any(h > 0):
                 continue
-            f += 1e4 * float(np.sum(h ** 2))
+            f += _POLE_WEIGHT * float(np.sum(h ** 2))
             if dmats is None:
                 dmats = modal_matrices_jacobian(self.kinds, x)
             lam, wl, vr = linalg.eig(M, left=True, right=True)
             act = np.flatnonzero(lam.real + self.decay_rate > 0)
             wl, vr = wl[:, act], vr[:, act]
-            scale = 2e4 * (lam.real[act] + self.decay_rate) / np.einsum("ij,ij->j", wl.conj(), vr)
+            scale = 2 * _POLE_WEIGHT * (lam.real[act] + self.decay_rate) / np.einsum("ij,ij->j", wl.conj(), vr)
             for k, (da, db, dc, dd) in enumerate(dmats):
                 dM = np.block([[-B @ dd @ C, -B @ dc], [db @ C, da]])
                 grad[k] += float(np.sum((scale * np.einsum("ij,ik,kj->j", wl.conj(), dM, vr)).real))
@@ -264,21 +288,25 @@ class _Objective:
 
     def penalty(self, x, margin):
         """Exterior penalty at ``margin`` (dB) and its gradient."""
+        fp, gp = self._poles(x)
+        if fp >= _WALL:
+            return fp, gp
         rt, rs, sens, gt, gs, jac = self._maps(x)
         ht, hs, hS = (np.maximum(r, 0.0) for r in (rt + margin, rs + margin, sens - self.log_ms))
         w = np.sum(2 * (ht * gt + (hs + hS) * gs), axis=1)
-        fp, gp = self._poles(x)
         return float(np.sum(ht ** 2) + np.sum(hs ** 2) + np.sum(hS ** 2)) + fp, _DB * (w @ jac).real + gp
 
     def worst(self, x, margin):
         """Smooth maximum (log-sum-exp, :data:`_SMOOTH_DB`) of every ratio plus the penalty at
         ``margin``, and its gradient: the multi-model H∞ objective itself."""
+        f, g = self.penalty(x, margin)
+        if f >= _WALL:
+            return f, g
         rt, rs, _, gt, gs, jac = self._maps(x)
         top = max(rt.max(), rs.max())
         et, es = np.exp((rt - top) / _SMOOTH_DB), np.exp((rs - top) / _SMOOTH_DB)
         total = et.sum() + es.sum()
         w = np.sum(et * gt + es * gs, axis=1) / total
-        f, g = self.penalty(x, margin)
         return float(top + _SMOOTH_DB * np.log(total)) + f, _DB * (w @ jac).real + g
 
 
@@ -312,11 +340,11 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     """The multi-model H∞ step: adjust a pitch controller until it meets a certified pair at every case.
 
     The poles, residues and feedthrough of ``pitch_controller`` (same order; an integrator, a
-    pole with |λ| < 1e-6 rad/s, stays at s = 0; stable poles stay stable;
+    pole with |λ| < 1e-6 rad/s, stays at s = 0; stable poles stay stable, no pole faster than 10³ rad/s;
     :mod:`specdesign.hinf.modal`) minimise the exterior penalty
     Σ max(0, 20·log10(|T_i|/|W_i|) + margin)² over both channels, every plant case and the
     optimisation grid, plus Σ max(0, 20·log10(|S_i|/``max_sensitivity``))² and
-    10⁴·Σ max(0, Re p + ``decay_rate``)² over the closed-loop poles of every case (L-BFGS-B
+    10⁶·Σ max(0, Re p + ``decay_rate``)² over the closed-loop poles of every case (L-BFGS-B
     with the analytic gradient: every ratio is rational in C(jω), which is linear in the
     residues and feedthrough; BLAS on one thread; deterministic). The penalty is zero exactly when
     max_i ‖W_i⁻¹T_i‖∞ ≤ 10^(−margin/20) per channel with the loop's decay and margin.
@@ -394,11 +422,11 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
         return k, check_pair(model, target, k, omega=omega)
     kinds, x = modal
     cases = _Cases(model, target, omega, rel_step=_COARSE_STEP)
-    capped = []
+    capped, bounds = [], modal_bounds(kinds, x, _MAX_RATE)
 
     def run(fun, x, margin):
-        res = optimize.minimize(fun, x, args=(margin,), jac=True, method="L-BFGS-B",
-                                options=dict(maxiter=int(max_iterations)))
+        res = optimize.minimize(fun, x, args=(margin,), jac=True, method="L-BFGS-B", bounds=bounds,
+                                options={"maxiter": int(max_iterations)})
         if res.nit >= max_iterations:
             capped.append(f"{fun.__name__} at {margin:g} dB")
         return res.x

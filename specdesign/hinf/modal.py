@@ -14,7 +14,8 @@ import control as ct
 import numpy as np
 from scipy.linalg import block_diag
 
-__all__ = ["INTEGRATOR_TOL", "modal_matrices", "modal_matrices_jacobian", "modal_parameters", "modal_response"]
+__all__ = ["INTEGRATOR_TOL", "modal_bounds", "modal_matrices", "modal_matrices_jacobian", "modal_parameters",
+           "modal_response"]
 
 #: Below this |λ| (rad/s) a controller pole is its integrator, kept at s = 0 exactly.
 INTEGRATOR_TOL = 1e-6
@@ -221,3 +222,56 @@ def modal_matrices_jacobian(kinds: tuple[str, ...], x: np.ndarray) -> list[tuple
         xc[k] += 1j * _COMPLEX_STEP
         out.append(tuple(m.imag / _COMPLEX_STEP for m in modal_matrices(kinds, xc)))
     return out
+
+
+def modal_bounds(kinds: tuple[str, ...], x: np.ndarray, max_rate: float) -> list[tuple[float | None, float | None]]:
+    """Bounds for an optimiser: every pole's |Re λ| and Im λ at most ``max_rate`` (rad/s, raised
+    to what ``x`` already has), residues and feedthrough free.
+
+    Without them a real pole can run off to −∞ with its residue (r/(s − λ) → a constant, the
+    same response on any finite grid): the optimiser once left one at −7·10¹⁴ rad/s, a controller
+    no sampled implementation can run.
+
+    Parameters
+    ----------
+    kinds : tuple of str
+        From :func:`modal_parameters`.
+    x : numpy.ndarray
+        The parameters (real).
+    max_rate : float
+        Largest |Re λ| and Im λ allowed, rad/s (> 0).
+
+    Returns
+    -------
+    list of tuple
+        (lower, upper) per parameter, None for unbounded (scipy.optimize.minimize's form).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from specdesign.hinf.modal import modal_bounds
+    >>> b = modal_bounds(("r",), np.array([0.0, 2.0, 0.5]), 100.0)
+    >>> round(b[0][1], 4), b[1], b[2]  # log(100) on log(−λ); residue and D free
+    (4.6052, (None, None), (None, None))
+    """
+    if not (np.isfinite(max_rate) and max_rate > 0):
+        raise ValueError(f"max_rate={max_rate!r} must be a positive rate in rad/s")
+    log_max = float(np.log(max_rate))
+    out, p = [], 0
+    for kind in kinds:
+        if kind == "i":
+            out.append((None, None))
+            p += 1
+            continue
+        if kind.endswith("u"):  # real part as is: bounded below
+            re = (min(-max_rate, float(x[p])), None)
+        else:  # log(−Re λ)
+            re = (None, max(log_max, float(x[p])))
+        out.append(re)
+        if kind.startswith("c"):
+            out += [(None, max(log_max, float(x[p + 1]))), (None, None), (None, None)]
+            p += 4
+        else:
+            out.append((None, None))
+            p += 2
+    return out + [(None, None)]
