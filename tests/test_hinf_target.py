@@ -168,3 +168,11 @@ def test_modal_parameters_and_their_analytic_derivatives():
         np.testing.assert_allclose(jac[:, i], fd, rtol=1e-5, atol=1e-8 * np.abs(fd).max())
         for got, hi, lo in zip(dmats[i], modal.modal_matrices(kinds, x + e), modal.modal_matrices(kinds, x - e)):
             np.testing.assert_allclose(got, (hi - lo) / (2 * h), atol=1e-6)
+    # the optimiser's bounds: pole rates capped (log(−Re λ), log(Im λ) ≤ log(max_rate), or the
+    # start's if faster), residues, the integrator's residue and D free
+    bounds = modal.modal_bounds(kinds, x, 10.0)
+    assert len(bounds) == x.size and bounds[-1] == (None, None)
+    capped = [hi for lo, hi in bounds if hi is not None]
+    assert capped and all(hi >= np.log(10.0) for hi in capped)
+    with pytest.raises(ValueError, match="max_rate"):
+        modal.modal_bounds(kinds, x, 0.0)
