@@ -463,11 +463,15 @@ def design_hinf(
     v = float(wind_speed)
     if isinstance(specs, str) and specs == "target":
         made = w_tower is None or w_speed is None
-        if not (np.ndim(target_reduction) == 0 and 0 < float(target_reduction) < 100):
+        try:
+            reduction = float(target_reduction)
+        except (TypeError, ValueError):
+            reduction = float("nan")
+        if not 0 < reduction < 100:
             raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % (0-100)")
         # design_qft's default: the feasible (certified) pair for the DEL target, then meet it
         specs = "custom" if w_tower is not None and w_speed is not None else specification_for_target(
-            model, v, float(target_reduction), m=m)
+            model, v, reduction, m=m)
     target = specs if isinstance(specs, TargetSpecification) and w_tower is None and w_speed is None else None
     if measurements is None:
         measurements = ("gen_speed",) if target is not None else ("gen_speed", "tower_top_vel")
