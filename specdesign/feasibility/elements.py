@@ -79,7 +79,7 @@ SMOOTHING_DB = (0.1, 0.02)
 #: log-frequency mean of e²): it only settles what the promise leaves free (where ΔD% is nil).
 REGULARISATION = 1e-3
 #: Most L-BFGS-B iterations per smoothing stage, a guard: a stage stops on its projected gradient
-#: (1e-5 % of promise per unit of parameter) or on a relative change of its cost below 1e-12.
+#: (1e-4 % of promise per unit of parameter) or on a relative change of its cost below 1e-10.
 MAX_ITERATIONS = 2000
 _DB = 10 / np.log(10)  # 10·log10(x) = _DB·ln(x)
 _ORDERS = (0.0, 0.75, 1.0, 1.5, 2.0, 4.0)  # the moments spectral.SpectralStats holds, in its order
@@ -207,7 +207,7 @@ def _fit(promise, grid, r, n_notch, x, bounds):
 
         with _one_blas_thread():
             x = minimize(cost, x, jac=True, method="L-BFGS-B", bounds=bounds,
-                         options={"maxiter": MAX_ITERATIONS, "gtol": 1e-5, "ftol": 1e-12, "maxcor": 30}).x
+                         options={"maxiter": MAX_ITERATIONS, "gtol": 1e-4, "ftol": 1e-10, "maxcor": 30}).x
     x[0] = 0.0
     s = _element_db(grid, x, n_notch)[0]
     x[0] = float(np.max(r - s))
