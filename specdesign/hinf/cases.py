@@ -71,6 +71,10 @@ _POLE_WEIGHT = 1e6
 #: Largest |Re λ| and Im λ of the adjusted controller's poles, rad/s (or the start's, if larger):
 #: 50× the check grid's top, so the grid cannot tell a faster pole from a constant.
 _MAX_RATE = 1e3
+#: Frequencies above the check grid (rad/s) where the adjusted controller's gain is bounded, and
+#: by how much it may exceed the start's there (dB).
+_HF_OMEGA = np.geomspace(20.0, 400.0, 60)
+_HF_ROOM_DB = 6.0
 #: Objective value of a controller whose poles overflowed (a step far outside the model).
 _WALL = 1e30
 #: dB per neper: 20·log10|z| = _DB·Re log z.
@@ -241,10 +245,15 @@ class _Objective:
     d(dB)/dx = (20/ln 10)·Re((dT/dC)/T · dC/dx), dC/dx closed-form (:func:`modal_response`);
     a closed-loop pole moves by dλ = wᴴ·dA_cl·v/(wᴴv) (left/right eigenvectors)."""
 
-    def __init__(self, cases, kinds, decay_rate, max_sensitivity):
+    def __init__(self, cases, kinds, decay_rate, max_sensitivity, x0):
         self.cases, self.kinds, self.decay_rate = cases, kinds, decay_rate
         self.log_ms = 20 * np.log10(max_sensitivity)
         self.s = 1j * cases.omega
+        # above the check grid nothing judges the loop: C may not rise there by more than
+        # _HF_ROOM_DB over the start (unbounded, a pair at 21 rad/s lifted |C| 20 dB and the loop
+        # sampled at 0.02 s was unstable)
+        self.s_hf = 1j * _HF_OMEGA
+        self.log_cap = _DB * np.log(np.abs(modal_response(kinds, x0, self.s_hf))) + _HF_ROOM_DB
         R = cases.R
         self.yw, self.ow, self.ob = R[("tower_base_my", "wind")], R[("gen_speed", "wind")], cases.ob
         # T_MyT = (P_yw + C·X)/(1 + C·P_Ωβ), X = P_yw·P_Ωβ − P_yβ·P_Ωw: dT/dC = −P_yβ·P_Ωw/(1 + C·P_Ωβ)²
@@ -294,7 +303,10 @@ class _Objective:
         rt, rs, sens, gt, gs, jac = self._maps(x)
         ht, hs, hS = (np.maximum(r, 0.0) for r in (rt + margin, rs + margin, sens - self.log_ms))
         w = np.sum(2 * (ht * gt + (hs + hS) * gs), axis=1)
-        return float(np.sum(ht ** 2) + np.sum(hs ** 2) + np.sum(hS ** 2)) + fp, _DB * (w @ jac).real + gp
+        c, jc = modal_response(self.kinds, x, self.s_hf, jacobian=True)
+        hc = np.maximum(_DB * np.log(np.abs(c)) - self.log_cap, 0.0)
+        f = float(np.sum(ht ** 2) + np.sum(hs ** 2) + np.sum(hS ** 2) + np.sum(hc ** 2)) + fp
+        return f, _DB * (w @ jac).real + _DB * ((2 * hc / c) @ jc).real + gp
 
     def worst(self, x, margin):
         """Smooth maximum (log-sum-exp, :data:`_SMOOTH_DB`) of every ratio plus the penalty at
@@ -420,6 +432,7 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     if modal is None:
         return k, check_pair(model, target, k, omega=omega)
     kinds, x = modal
+    x0 = x
     cases = _Cases(model, target, omega, rel_step=_COARSE_STEP)
     capped, bounds = [], modal_bounds(kinds, x, _MAX_RATE)
 
@@ -434,11 +447,11 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
         # the smooth maximum of every ratio: every zero-penalty point is feasible, and minimising
         # the worst ratio picks one point of that set, so the design does not depend on where
         # the penalty stage stopped
-        return run(_Objective(cases, kinds, decay_rate, max_sensitivity).worst, x, margin_db)
+        return run(_Objective(cases, kinds, decay_rate, max_sensitivity, x0).worst, x, margin_db)
 
     with warnings.catch_warnings(), one_blas_thread():
         warnings.simplefilter("ignore", RuntimeWarning)
-        obj = _Objective(cases, kinds, decay_rate, max_sensitivity)
+        obj = _Objective(cases, kinds, decay_rate, max_sensitivity, x0)
         for margin in (*margins_db, margin_db):
             if obj.penalty(x, margin)[0] > 0:
                 x = run(obj.penalty, x, margin)
