@@ -356,7 +356,9 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     :mod:`specdesign.hinf.modal`) minimise the exterior penalty
     Σ max(0, 20·log10(|T_i|/|W_i|) + margin)² over both channels, every plant case and the
     optimisation grid, plus Σ max(0, 20·log10(|S_i|/``max_sensitivity``))² and
-    10⁶·Σ max(0, Re p + ``decay_rate``)² over the closed-loop poles of every case (L-BFGS-B
+    10⁶·Σ max(0, Re p + ``decay_rate``)² over the closed-loop poles of every case, plus
+    Σ max(0, 20·log10(|C(jω)|/|C_start(jω)|) − 6)² at 20-400 rad/s, above the grid, where
+    nothing else holds the controller's gain (a sampled implementation needs it) (L-BFGS-B
     with the analytic gradient: every ratio is rational in C(jω), which is linear in the
     residues and feedthrough; BLAS on one thread; deterministic). The penalty is zero exactly when
     max_i ‖W_i⁻¹T_i‖∞ ≤ 10^(−margin/20) per channel with the loop's decay and margin.
