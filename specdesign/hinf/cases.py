@@ -393,7 +393,7 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
         Base grid, rad/s (default :data:`CHECK_OMEGA`).
     max_iterations : int
         Cap on the L-BFGS-B iterations of each stage: a guard, not the stopping rule (each
-        stage converges in at most ≈ 2100 iterations at 15-25 m/s on the IEA 15 MW model); a
+        stage converges in at most ≈ 1500 iterations at 15-25 m/s on the IEA 15 MW model); a
         stage stopped by it is warned about, since where it stops would depend on round-off.
 
     Returns
