@@ -66,9 +66,10 @@ range): the result carries a `TargetSpecification` like any other (`res.certifie
 (`res.certified.tower.add(spec.Notch(...))`, then `feasibility.recertify`), and
 `qft.design_qft(spec=res.certified)` meets it.
 
-Which shaper when: `shape_to_target(base, t)` (default `band="above"`) is the seed paper's
-notches above 0.6 rad/s, with no feasibility guarantee (the notch designs of notebooks 04-06);
-`band="whole"` is the specification to hand to a design.
+Which shaper when: `band="whole"` (the default for a DEL target, `quantity="del"`) is the
+specification to hand to a design; `band="above"` (the default for a damage target,
+`shape_to_target(base, t)`) is the seed paper's notches above 0.6 rad/s, with no feasibility
+guarantee (the notch designs of notebooks 04-06).
 
 | column | meaning |
 |---|---|

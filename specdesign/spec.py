@@ -17,9 +17,9 @@ Typical use:
 >>> w_myt = res.specification.tf()               # W_MyT(s)
 
 That is the paper's shaper (notches above 0.6 rad/s, no feasibility guarantee). The
-specification to hand to a design is ``shape_to_target(base, 25.0, quantity="del",
-band="whole")``: the whole band, certified over the plant cases, in ``res.certified``
-(:func:`specdesign.feasibility.element_specification`).
+specification to hand to a design is ``shape_to_target(base, 25.0, quantity="del")``
+(``band="whole"``, the default for a DEL target): the whole band, certified over the plant
+cases, in ``res.certified`` (:func:`specdesign.feasibility.element_specification`).
 """
 from __future__ import annotations
 
@@ -1008,15 +1008,16 @@ def _notch_mag2(omega, params):
     return np.prod(np.abs(n) ** 2, axis=0)
 
 
-def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", band: str = "above",
+def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", band: str | None = None,
                     keep_below: float = 0.6, n_notches: int | None = None, max_notches: int | None = None,
                     max_depth_db: float = 30.0, width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5,
                     **certify_options) -> ShapingResult:
     """Shape a tower-load specification that promises a target reduction.
 
-    Two shapers, one entry point:
+    Two shapers, one entry point; a DEL target (``quantity="del"``) gets the second by
+    default, a damage target the first:
 
-    ``band="above"`` (default; the seed paper's shaping, used by the notch designs, notebooks
+    ``band="above"`` (the seed paper's shaping, used by the notch designs, notebooks
     03-06 and their documented numbers): notches where ΔD% is largest above ``keep_below``,
     no feasibility guarantee. The problem solved (scipy SLSQP, exact Dirlik in the
     constraint): minimise the mean squared log-magnitude change of the specification,
@@ -1046,8 +1047,9 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
     quantity : {"damage", "del"}
         Whether the target is a reduction of damage (Eq. 10's quantity) or of DEL at 1 Hz
         (``band="whole"`` certifies the DEL reduction equivalent to a damage target).
-    band : {"above", "whole"}
-        Notches above ``keep_below``, or the certified whole-band specification.
+    band : {"above", "whole"}, optional
+        Notches above ``keep_below``, or the certified whole-band specification. Default:
+        ``"whole"`` for ``quantity="del"``, ``"above"`` for ``quantity="damage"``.
     keep_below : float
         ``band="above"``: protected band upper edge, rad/s, the power-regulation band the
         notches must leave alone (their effect below it is penalised heavily and the notch
@@ -1107,7 +1109,7 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
     The certified whole-band specification for 25 % DEL, to hand to ``design_qft``:
 
     >>> base = baseline_analysis(iea15mw(), 25.0)
-    >>> res = shape_to_target(base, 25.0, quantity="del", band="whole")     # doctest: +SKIP
+    >>> res = shape_to_target(base, 25.0, quantity="del")     # band="whole"  # doctest: +SKIP
     >>> bool(res.promise.exact_del >= 25.0), res.certified.case_speeds      # doctest: +SKIP
     (True, (24.0, 24.5, 25.0))
     """
@@ -1117,6 +1119,8 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
         raise TypeError(f"base must be a Baseline (see baseline_analysis), got {type(base).__name__}")
     if quantity not in ("damage", "del"):
         raise ValueError(f"quantity={quantity!r} must be 'damage' or 'del'")
+    if band is None:
+        band = "whole" if quantity == "del" else "above"
     if band not in ("above", "whole"):
         raise ValueError(f"band={band!r} must be 'above' (notches above keep_below) or 'whole' (the certified "
                          "whole-band specification)")
@@ -1128,8 +1132,9 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
     if band == "whole":
         notch_only = sorted(k for k, x in given.items() if x != _ABOVE_DEFAULTS[k])
         if notch_only:
-            raise TypeError(f"{notch_only} are options of band='above'; band='whole' chooses its elements itself "
-                            "(its options: max_notches and those of feasibility.element_specification)")
+            raise TypeError(f"{notch_only} are options of band='above' (pass it for the paper's notches); band='whole', "
+                            "the default for a DEL target, chooses its elements itself (its options: max_notches and "
+                            "those of feasibility.element_specification)")
         return _shape_whole(base, t, quantity, max_notches, certify_options)
     if certify_options:
         raise TypeError(f"{sorted(certify_options)} are options of band='whole' (feasibility.element_specification)")

@@ -70,7 +70,7 @@ def test_an_unreachable_whole_band_target_says_which_constraint_binds(base25):
 def whole25(base25):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy accuracy notes on some rungs
-        return spec.shape_to_target(base25, 25.0, quantity="del", band="whole")
+        return spec.shape_to_target(base25, 25.0, quantity="del")  # band="whole" is the default for a DEL target
 
 
 def _explicit_maps(model, v, controller, w):
