@@ -37,10 +37,11 @@ Units: ω in rad/s, magnitudes in dB here, promises in % DEL.
 """
 from __future__ import annotations
 
-import contextlib
 from dataclasses import replace
 
 import numpy as np
+
+from .._blas import on_one_blas_thread
 
 __all__ = ["ENVELOPES", "ENVELOPE_LOSS_PP", "FIT_OMEGA", "HEADROOM_PP", "MAX_ITERATIONS", "MAX_NOTCHES", "PROMISE_MARGIN_PP",
            "REGULARISATION", "SMOOTHING_DB", "element_specification"]
@@ -161,19 +162,6 @@ def _unpack(x, n_notch):
     return tuple(out)
 
 
-def _one_blas_thread():
-    """A context limiting BLAS to one thread, when threadpoolctl is installed (a scikit-learn
-    dependency; without it the fit is only slower). scipy's L-BFGS-B makes small BLAS calls
-    every iteration: on this shared 2-core machine a multi-threaded OpenBLAS spends 4 ms per
-    iteration synchronising its threads (13 ms per evaluation of a 20-variable Rosenbrock at
-    load 7, 0.1 ms with one thread)."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        return contextlib.nullcontext()
-    return threadpool_limits(1, user_api="blas")
-
-
 def _fit(promise, grid, r, n_notch, x, bounds):
     """The shape of most promise above ``r`` for ``n_notch`` notches, from ``x``: (x, promise).
 
@@ -205,9 +193,8 @@ def _fit(promise, grid, r, n_notch, x, bounds):
             grad[0] = 0.0
             return REGULARISATION * float(wk @ e**2) - p, grad
 
-        with _one_blas_thread():
-            x = minimize(cost, x, jac=True, method="L-BFGS-B", bounds=bounds,
-                         options={"maxiter": MAX_ITERATIONS, "gtol": 1e-4, "ftol": 1e-10, "maxcor": 30}).x
+        x = minimize(cost, x, jac=True, method="L-BFGS-B", bounds=bounds,
+                     options={"maxiter": MAX_ITERATIONS, "gtol": 1e-4, "ftol": 1e-10, "maxcor": 30}).x
     x[0] = 0.0
     s = _element_db(grid, x, n_notch)[0]
     x[0] = float(np.max(r - s))
@@ -287,6 +274,7 @@ def _seeds(base, grid, r):
     return out
 
 
+@on_one_blas_thread  # L-BFGS-B's small BLAS calls: 10× faster on one thread (specdesign._blas)
 def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_pp=HEADROOM_PP,
                           max_notches=MAX_NOTCHES, m=4.0, omega=None, **target_options):
     """A certified tower specification for ``target_reduction``, as ROSCO's map times shaping elements.
