@@ -34,7 +34,7 @@ from __future__ import annotations
 import warnings
 
 from ..closedloop import closed_loop_mimo, refine_grid
-from .cases import CHECK_OMEGA, CONTINUATION_DB, CaseCheck, check_pair, one_blas_thread, refine_on_cases
+from .cases import CHECK_OMEGA, CONTINUATION_DB, CaseCheck, check_pair, refine_on_cases
 from .design import DEFAULT_DECAY_RATE, QFT_SPEED_RELAX_DB, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
 from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, inverse_weight, siso_weight
@@ -44,7 +44,6 @@ __all__ = [
     "CHECK_OMEGA",
     "CONTINUATION_DB",
     "check_pair",
-    "one_blas_thread",
     "refine_on_cases",
     "GeneralizedPlant",
     "HinfDesign",

@@ -24,7 +24,6 @@ pitch controller C_β in the workbench sign β = −C_β·Ω_g (rad per rad/s).
 """
 from __future__ import annotations
 
-import contextlib
 import warnings
 from dataclasses import dataclass
 
@@ -33,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy import linalg, optimize
 
+from .._blas import one_blas_thread
 from ..closedloop import (
     closed_map,
     lightly_damped,
@@ -48,7 +48,7 @@ from .modal import (
     modal_response,
 )
 
-__all__ = ["CHECK_OMEGA", "CONTINUATION_DB", "CaseCheck", "check_pair", "one_blas_thread", "refine_on_cases"]
+__all__ = ["CHECK_OMEGA", "CONTINUATION_DB", "CaseCheck", "check_pair", "refine_on_cases"]
 
 #: Base grid of the dense check, rad/s (refined around the specification's and the loop's
 #: lightly damped roots): the certificate's (:mod:`specdesign.qft.certificate`).
@@ -320,30 +320,6 @@ class _Objective:
         total = et.sum() + es.sum()
         w = np.sum(et * gt + es * gs, axis=1) / total
         return float(top + _SMOOTH_DB * np.log(total)) + f, _DB * (w @ jac).real + g
-
-
-def one_blas_thread():
-    """A context limiting BLAS to one thread while L-BFGS-B runs, when threadpoolctl is installed.
-
-    L-BFGS-B makes small BLAS calls every iteration; on a shared 2-core machine a multi-threaded
-    OpenBLAS spends more time synchronising its threads than computing (≈ 10× on the
-    feasibility element fit). Without threadpoolctl the optimisation is only slower.
-
-    Returns
-    -------
-    contextlib.AbstractContextManager
-
-    Examples
-    --------
-    >>> from specdesign.hinf.cases import one_blas_thread
-    >>> with one_blas_thread():
-    ...     pass
-    """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - an optional speed-up
-        return contextlib.nullcontext()
-    return threadpool_limits(1, user_api="blas")
 
 
 def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float = 0.15, decay_rate: float = 0.02,

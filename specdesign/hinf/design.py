@@ -19,9 +19,10 @@ from numpy.typing import ArrayLike
 
 from loopshaping import hinf as lhinf
 
+from .._blas import one_blas_thread
 from ..closedloop import closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
-from .cases import CaseCheck, one_blas_thread, refine_on_cases
+from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
 
