@@ -265,3 +265,17 @@ def test_the_checkers_responses_equal_python_controls(model):
     np.testing.assert_allclose(chk.c, -(a - g) / g, rtol=1e-9)
     t_rosco = np.abs(closedloop.t_tower_wind(plant, spec.baseline_controller(model, v), w))
     np.testing.assert_allclose(chk.t_rosco, t_rosco, rtol=1e-9)
+
+
+def test_a_certificate_search_answers_several_targets_as_specification_for_target(model, target19):
+    # one search reused across targets (the element shaper's headroom loop) gives, target by
+    # target, exactly what a fresh specification_for_target gives
+    search = fz.CertificateSearch(model, 19.0)
+    for t, fresh in ((28.0, fz.specification_for_target(model, 19.0, 28.0)), (25.0, target19)):
+        got = search.for_target(t)
+        assert (got.promise.exact_del, got.speed_relax_db, got.slack_db, got.case_speeds) == \
+            (fresh.promise.exact_del, fresh.speed_relax_db, fresh.slack_db, fresh.case_speeds)
+    with pytest.raises(ValueError, match="slack_db"):
+        search.for_target(25.0, slack_db=-1.0)
+    with pytest.raises(ValueError, match="case_offsets"):
+        fz.CertificateSearch(model, 19.0, case_offsets=[np.nan])

@@ -55,8 +55,8 @@ from .achievable import YOULA_PAIRS, YOULA_REAL_POLES, AchievablePitch, YoulaPro
 from .conditions import (PitchChecker, PitchFeasibility, combine, pitch_checkers, pitch_feasibility, pitch_frontier,
                          sensitivity_disks)
 from .elements import element_specification
-from .target import TargetSpecification, recertify, specification_for_target
+from .target import CertificateSearch, TargetSpecification, recertify, specification_for_target
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
            "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks",
-           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification"]
+           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification", "CertificateSearch"]

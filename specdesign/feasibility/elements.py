@@ -299,8 +299,9 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
         Grid of the promise and the fit, rad/s, and of the certificate's design (default: the
         fit and the promise on :data:`FIT_OMEGA`, the certificate on its own default grid).
     **target_options
-        Passed to :func:`specification_for_target` for the certificate (e.g. ``slack_db``,
-        ``case_offsets``, ``max_sensitivity``).
+        Options of the certificate, as for :func:`specification_for_target` (e.g. ``slack_db``,
+        ``case_offsets``, ``max_sensitivity``); one :class:`CertificateSearch` serves every
+        headroom, each speed relaxation solved once.
 
     Returns
     -------
@@ -334,7 +335,7 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     from .._checks import del_target
     from ..closedloop import siso_response
     from ..qft import UNSTABLE_CONTROLLER_RATE
-    from .target import recertify, specification_for_target
+    from .target import CertificateSearch, recertify
 
     t = del_target(target_reduction)
     heads = np.atleast_1d(np.asarray(headroom_pp, float))
@@ -348,12 +349,21 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     grid = _fit_grid(base.omega)
     t0 = np.abs(siso_response(base.system, grid))
     aim = t + PROMISE_MARGIN_PP
+    search_keys = {"max_sensitivity", "max_pitch_rate_ratio", "case_offsets", "dense_omega"}
+    target_keys = {"slack_db", "speed_relax_db", "max_relax_db", "tolerance_db", "speed_slack_db"}
+    unknown = sorted(set(target_options) - search_keys - target_keys)
+    if unknown:
+        raise TypeError(f"element_specification got unknown option(s) {unknown}; the certificate's are "
+                        f"{sorted(search_keys | target_keys)}")
+    search = CertificateSearch(model, v, m=m, omega=omega,
+                               **{k: x for k, x in target_options.items() if k in search_keys})
+    for_target = {k: x for k, x in target_options.items() if k in target_keys}
     tried, why = [], ""
     for h in heads:
         if t + h >= 100:
             break
         try:
-            cert = specification_for_target(model, v, t + float(h), m=m, omega=omega, **target_options)
+            cert = search.for_target(t + float(h), **for_target)
         except ValueError as e:
             why = str(e)
             break
