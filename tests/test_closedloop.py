@@ -186,3 +186,5 @@ def test_case_speeds_clip_and_list_each_operating_point_once():
     assert cl.case_speeds(19.0, (), (10.6, 25.0)) == ((19.0,), 0)
     with pytest.raises(ValueError, match="offsets"):
         cl.case_speeds(19.0, (np.nan,), (10.6, 25.0))
+    with pytest.raises(ValueError, match=r"^template_offsets=\[\[0.5\]\] must be a 1-D array"):
+        cl.case_speeds(19.0, [[0.5]], (10.6, 25.0), name="template_offsets")

@@ -159,7 +159,8 @@ def refine_grid(omega: ArrayLike, roots: ArrayLike | control.LTI | Iterable = ()
     return grid[(grid >= lo) & (grid <= hi)]
 
 
-def case_speeds(wind_speed: float, offsets: ArrayLike, wind_range: tuple[float, float]) -> tuple[tuple[float, ...], int]:
+def case_speeds(wind_speed: float, offsets: ArrayLike, wind_range: tuple[float, float], *,
+                name: str = "offsets") -> tuple[tuple[float, ...], int]:
     """The plant cases around an operating point: ``wind_speed`` + ``offsets`` clipped to ``wind_range``.
 
     A case that clips onto another, or onto the nominal speed, to within :data:`CASE_TOLERANCE`
@@ -175,6 +176,8 @@ def case_speeds(wind_speed: float, offsets: ArrayLike, wind_range: tuple[float, 
         Wind-speed offsets of the neighbouring cases, m/s (finite, 1-D; 0 and repeats allowed).
     wind_range : (float, float)
         The model's valid wind speeds, m/s.
+    name : str
+        The caller's name for ``offsets``, in the error message.
 
     Returns
     -------
@@ -186,7 +189,7 @@ def case_speeds(wind_speed: float, offsets: ArrayLike, wind_range: tuple[float, 
     Raises
     ------
     ValueError
-        If ``offsets`` is not a 1-D array of finite numbers.
+        If ``offsets`` is not a 1-D array of finite numbers (the message names it ``name``).
 
     Examples
     --------
@@ -197,7 +200,7 @@ def case_speeds(wind_speed: float, offsets: ArrayLike, wind_range: tuple[float, 
     v = float(wind_speed)
     o = np.atleast_1d(np.asarray(offsets, float))
     if o.ndim != 1 or not np.all(np.isfinite(o)):
-        raise ValueError(f"offsets={offsets!r} must be a 1-D array of finite wind-speed offsets in m/s")
+        raise ValueError(f"{name}={offsets!r} must be a 1-D array of finite wind-speed offsets in m/s")
     lo, hi = wind_range
     speeds = [v]
     for s in sorted(float(np.clip(v + x, lo, hi)) for x in o):

@@ -218,12 +218,9 @@ class CertificateSearch:
         from .._checks import as_omega
         from ..closedloop import case_speeds
 
-        offsets = np.atleast_1d(np.asarray(case_offsets, float))
-        if offsets.ndim != 1 or not np.all(np.isfinite(offsets)):
-            raise ValueError(f"case_offsets={case_offsets!r} must be finite wind-speed offsets in m/s")
         self.model, self.m = model, float(m)
         self.wind_speed = v = model.check_wind_speed(wind_speed)
-        self.case_speeds, _ = case_speeds(v, offsets, model.wind_range)
+        self.case_speeds, _ = case_speeds(v, case_offsets, model.wind_range, name="case_offsets")
         self.dense = (np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None
                       else as_omega(dense_omega, "dense_omega", allow_zero=False))
         self.base = spec.baseline_analysis(model, v, m=m, omega=omega)

@@ -166,7 +166,7 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     if not max_sensitivity > 1:
         raise ValueError(f"max_sensitivity={max_sensitivity!r} must be > 1 (|1/(1+L)| bound)")
     v = model.check_wind_speed(wind_speed)
-    speeds, nom = case_speeds(v, template_offsets, model.wind_range)
+    speeds, nom = case_speeds(v, template_offsets, model.wind_range, name="template_offsets")
     w = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
     plants = [model.linearize(s) for s in speeds]
     R = plant_responses(plants, w, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")

@@ -576,12 +576,10 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
         raise ValueError(f"max_sensitivity={max_sensitivity!r} must be > 1 (|1/(1+L)| bound)")
     positive_scalar(min_decay, "min_decay")
     offsets = np.atleast_1d(np.asarray(template_offsets, float))
-    if offsets.ndim != 1 or not np.all(np.isfinite(offsets)):
-        raise ValueError("template_offsets must be a 1-D array of finite wind-speed offsets in m/s")
     wd = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
     wdense = np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None else lqft.check_grid(dense_omega, "dense_omega")
 
-    speeds, nom = case_speeds(v, offsets, model.wind_range)
+    speeds, nom = case_speeds(v, offsets, model.wind_range, name="template_offsets")
     specs = sp.design_specifications(model, v, speed_relax_db=speed_relax_db, spec_reduction=spec_reduction,
                                      tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
                                      keep_below=keep_below)
