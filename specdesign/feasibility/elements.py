@@ -328,6 +328,8 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     >>> [type(e).__name__ for e in ts.tower.elements]        # doctest: +SKIP
     ['Gain', 'LeadLag', 'LeadLag', 'Notch', 'Notch']
     """
+    import inspect
+
     import control as ct
     from scipy.ndimage import maximum_filter1d
 
@@ -349,8 +351,9 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     grid = _fit_grid(base.omega)
     t0 = np.abs(siso_response(base.system, grid))
     aim = t + PROMISE_MARGIN_PP
-    search_keys = {"max_sensitivity", "max_pitch_rate_ratio", "case_offsets", "dense_omega"}
-    target_keys = {"slack_db", "speed_relax_db", "max_relax_db", "tolerance_db", "speed_slack_db"}
+    # the certificate's options, split between the search and its targets as their signatures do
+    search_keys = set(inspect.signature(CertificateSearch).parameters) - {"model", "wind_speed", "m", "omega"}
+    target_keys = set(inspect.signature(CertificateSearch.for_target).parameters) - {"self", "target_reduction"}
     unknown = sorted(set(target_options) - search_keys - target_keys)
     if unknown:
         raise TypeError(f"element_specification got unknown option(s) {unknown}; the certificate's are "
