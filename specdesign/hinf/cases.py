@@ -421,23 +421,21 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
             capped.append(f"{fun.__name__} at {margin:g} dB")
         return res.x
 
-    def minimax(x):
-        # the smooth maximum of every ratio: every zero-penalty point is feasible, and minimising
-        # the worst ratio picks one point of that set, so the design does not depend on where
-        # the penalty stage stopped
-        return run(_Objective(cases, kinds, decay_rate, max_sensitivity, x0).worst, x, margin_db)
-
     with warnings.catch_warnings(), one_blas_thread():
         warnings.simplefilter("ignore", RuntimeWarning)
         obj = _Objective(cases, kinds, decay_rate, max_sensitivity, x0)
         for margin in (*margins_db, margin_db):
             if obj.penalty(x, margin)[0] > 0:
                 x = run(obj.penalty, x, margin)
-        x = minimax(x)
+        # the smooth maximum of every ratio: every zero-penalty point is feasible, and minimising
+        # the worst ratio picks one point of that set, so the design does not depend on where
+        # the penalty stage stopped
+        x = run(obj.worst, x, margin_db)
         out = ct.ss(*modal_matrices(kinds, x))
         check = _check(cases, out)
-        if not check.met:  # a feature the coarse grid did not resolve: again on the dense check grid
-            x = minimax(x)
+        if not check.met:  # a feature the coarse grid did not resolve: again on the dense check grid,
+            # where _check has just regridded the cases
+            x = run(_Objective(cases, kinds, decay_rate, max_sensitivity, x0).worst, x, margin_db)
             out = ct.ss(*modal_matrices(kinds, x))
             check = _check(cases, out)
     if capped:
