@@ -279,3 +279,28 @@ def test_a_certificate_search_answers_several_targets_as_specification_for_targe
         search.for_target(25.0, slack_db=-1.0)
     with pytest.raises(ValueError, match="case_offsets"):
         fz.CertificateSearch(model, 19.0, case_offsets=[np.nan])
+
+
+def test_a_solver_failure_is_a_relaxation_with_no_design_not_a_crash(model, monkeypatch):
+    # Clarabel can stop with "insufficient progress" on a design it had nearly solved; cvxpy
+    # raises SolverError for it. The Youla problem says so as its documented RuntimeError, and
+    # a certificate search counts that relaxation as one with no design (the ladder goes on).
+    import cvxpy as cp
+
+    search = fz.CertificateSearch(model, 19.0)
+    solve = search._youla.problem.solve
+    calls = []
+
+    def failing_first(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 1:
+            raise cp.error.SolverError("Solver 'CLARABEL' failed.")
+        return solve(*args, **kwargs)
+
+    monkeypatch.setattr(search._youla.problem, "solve", failing_first)
+    with pytest.raises(RuntimeError, match=r"19 m/s: the solver failed"):
+        search._youla.solve(1.0)
+    calls.clear()
+    got = search.for_target(25.0)  # its first rung (0.5 dB) fails: the search goes on from there
+    assert search._designs[0.5] == (None, None)
+    assert got.promise.exact_del >= 25.0 and got.speed_relax_db > 0.5

@@ -218,3 +218,19 @@ def test_validity_range_errors(model):
 def test_rated_wind_speed_near_rosco(model):
     # ROSCO's schedule starts one step above its rated speed, (25 − v_rated)/30 apart
     assert abs(model.rated_wind_speed() - 10.59) < 0.05
+
+
+def test_models_compare_and_hash_by_their_fields():
+    # The dataclass's generated __eq__ compared the fields as tuples, and a tuple holding the
+    # rotor tables has no truth value: ``model == model`` raised, and a model could not key a
+    # dict. Two builds of the same turbine are equal whatever either has computed (trims are
+    # derived state), and a change of one table entry or one scalar makes them differ.
+    a, b = iea15mw(), iea15mw()
+    a.trim(19.0)
+    assert a == b and hash(a) == hash(b) and {a: "x"}[b] == "x"
+    table = b.cp_table.copy()
+    table[3, 4] *= 1 + 1e-12
+    assert a != dataclasses.replace(b, cp_table=table)
+    assert a != dataclasses.replace(b, tower_damping_ratio=b.tower_damping_ratio * 1.01)
+    assert a != dataclasses.replace(b, cp_table=b.cp_table[:, :-1])  # another shape, not an error
+    assert (a == "iea15mw") is False

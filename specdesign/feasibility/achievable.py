@@ -249,7 +249,8 @@ class YoulaProblem:
         ValueError
             For a negative or non-finite relaxation.
         RuntimeError
-            If the solver finds no solution.
+            If the solver finds no solution or fails (a cvxpy ``SolverError``): a search over
+            the relaxation then counts that relaxation as one with no design.
         """
         from .. import spectral
 
@@ -259,7 +260,12 @@ class YoulaProblem:
         base, w = self.base, self.base.omega
         w_speed = self.w_speed0 * 10 ** (g / 20)
         self.s_bound.value = np.minimum(self.ms, w_speed / np.abs(self.ow))
-        self.problem.solve()
+        import cvxpy as cp
+
+        try:
+            self.problem.solve()
+        except cp.error.SolverError as e:  # e.g. Clarabel's "insufficient progress": no design, said as such
+            raise RuntimeError(f"achievable_pitch at {self.wind_speed:g} m/s: the solver failed ({e})") from e
         y, status = self.y.value, self.problem.status
         if y is None or status not in ("optimal", "optimal_inaccurate"):
             raise RuntimeError(f"achievable_pitch at {self.wind_speed:g} m/s: the solver returned {status!r}")

@@ -64,7 +64,7 @@ from .tables import bicubic_coefficients, read_rotor_table, read_text, uniform_s
 __all__ = ["TurbineModel", "iea15mw"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # eq/hash below: the generated ones compare arrays with ==
 class TurbineModel:
     """Reduced-order turbine: rotor + rigid drivetrain + tower fore-aft mode + pitch actuator.
 
@@ -403,6 +403,16 @@ class TurbineModel:
     def _trims(self) -> dict:
         return {}
 
+    def __eq__(self, other) -> bool:
+        # field by field, arrays by shape and value (the dataclass's own __eq__ compared the
+        # fields as a tuple, and a tuple of arrays has no truth value: model == model raised)
+        if not isinstance(other, TurbineModel):
+            return NotImplemented
+        return all(_same(getattr(self, f.name), getattr(other, f.name)) for f in fields(self))
+
+    def __hash__(self) -> int:
+        return hash(tuple(_hashable(getattr(self, f.name)) for f in fields(self)))
+
     def __getstate__(self) -> dict:
         # the fields only: what is derived from them (compiled tables, trims) is rebuilt on
         # demand, so a model's pickle, and its store fingerprint, does not depend on its history
@@ -712,3 +722,17 @@ def iea15mw() -> TurbineModel:
                      max_rate=par["max_generator_torque_rate_Nm_s"], omega_vs=par["rosco_tuning"]["omega_vs_rad_s"],
                      zeta_vs=par["rosco_tuning"]["zeta_vs"])
     return dataclasses.replace(model, torque_control=law)
+
+
+def _same(a, b) -> bool:
+    """Whether two field values are equal; arrays by shape and value."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.shape == b.shape and bool(np.array_equal(a, b))
+    return bool(a == b)
+
+
+def _hashable(x):
+    """A field value as something hashable (an array by its dtype, shape and bytes)."""
+    if isinstance(x, np.ndarray):
+        return (x.dtype.str, x.shape, x.tobytes())
+    return x
