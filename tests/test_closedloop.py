@@ -188,3 +188,42 @@ def test_case_speeds_clip_and_list_each_operating_point_once():
         cl.case_speeds(19.0, (np.nan,), (10.6, 25.0))
     with pytest.raises(ValueError, match=r"^template_offsets=\[\[0.5\]\] must be a 1-D array"):
         cl.case_speeds(19.0, [[0.5]], (10.6, 25.0), name="template_offsets")
+
+
+def test_batched_siso_response_equals_python_controls():
+    # siso_response(method="batched") evaluates a state space at every frequency at once
+    # (state_space_response); python-control's per-frequency evaluation is the oracle
+    rng = np.random.default_rng(3)
+    sys = control.rss(25, 1, 1)
+    sys = control.ss(sys.A - 0.05 * np.eye(25), sys.B, sys.C, rng.normal(size=(1, 1)))
+    w = np.geomspace(0.005, 20.0, 700)
+    np.testing.assert_allclose(cl.siso_response(sys, w, method="batched"), cl.siso_response(sys, w),
+                               rtol=1e-9)
+    tf = control.tf([1.0, 2.0], [1.0, 0.3, 1.0])  # a transfer function: its polynomials either way
+    assert np.array_equal(cl.siso_response(tf, w, method="batched"), cl.siso_response(tf, w))
+    with pytest.raises(ValueError, match="method"):
+        cl.siso_response(sys, w, method="modal")
+
+
+def test_refine_grid_points_per_width_samples_every_peak_finely_and_no_more():
+    # points_per_width: the spacing at a root of damping ζ is max(rel_step, 2ζ/points_per_width)
+    # over ±rel_width of |Im p|, so a well-damped root gets a dozen points, a lightly damped one
+    # keeps rel_step's, and every peak is still found to 0.01 dB
+    w = np.geomspace(0.1, 10.0, 50)
+    cases = ((1.0, 0.2), (3.0, 1e-3))  # (ω_n rad/s, ζ)
+    systems = [control.tf([wn * wn], [1.0, 2 * z * wn, wn * wn]) for wn, z in cases]
+    g = cl.refine_grid(w, systems, points_per_width=50)
+    g0 = cl.refine_grid(w, systems)
+    for sys, (wn, z) in zip(systems, cases):
+        im = wn * np.sqrt(1 - z * z)
+        band, band0 = g[np.abs(g / im - 1) <= 0.05], g0[np.abs(g0 / im - 1) <= 0.05]
+        assert np.max(np.diff(np.log(band))) <= max(1e-4, 2 * z / 50) * (1 + 1e-9)
+        peak = np.max(np.abs(cl.siso_response(sys, g)))
+        true = np.max(np.abs(cl.siso_response(sys, np.geomspace(0.9 * wn, 1.1 * wn, 200001))))
+        assert 20 * np.log10(true / peak) < 0.01
+        if z > 0.01:
+            assert band0.size > 900 and band.size < 30   # 1000 points at rel_step, a dozen here
+        else:
+            assert band.size == band0.size               # 2ζ/50 = 4e-5 < rel_step: rel_step's spacing
+    with pytest.raises(ValueError, match="points_per_width"):
+        cl.refine_grid(w, systems[0], points_per_width=0.0)

@@ -304,3 +304,38 @@ def test_a_solver_failure_is_a_relaxation_with_no_design_not_a_crash(model, monk
     got = search.for_target(25.0)  # its first rung (0.5 dB) fails: the search goes on from there
     assert search._designs[0.5] == (None, None)
     assert got.promise.exact_del >= 25.0 and got.speed_relax_db > 0.5
+
+
+def test_the_compact_youla_problem_has_the_optimum_of_the_problem_written_out(model):
+    # YoulaProblem hands the solver ‖R y + Qᵀb‖², one 3-cone per |S| bound and ‖R_rate y‖ ≤ κ
+    # (n_basis unknowns). The same problem written out term by term, as achievable_pitch's
+    # docstring states it (sums of squares and norms over the grid), must reach the same optimum.
+    import cvxpy as cp
+
+    from specdesign.feasibility.achievable import _youla_basis
+    from specdesign.spectral import trapezoid_weights
+
+    yp = fz.YoulaProblem(model, 19.0, max_sensitivity=1.8)
+    d = yp.solve(1.5)
+    base, w, phi = yp.base, yp.base.omega, yp.phi_o
+    weight = np.maximum(base.sensitivity, 0.0) + 1e-3 * base.sensitivity.max()
+    scale = np.sqrt(weight) / np.abs(base.t_response)
+    y = cp.Variable(phi.shape[1])
+    t_re, t_im = yp.a.real - (yp.gy[:, None] * phi).real @ y, yp.a.imag - (yp.gy[:, None] * phi).imag @ y
+    s_re, s_im = 1.0 - (yp.ob[:, None] * phi).real @ y, -(yp.ob[:, None] * phi).imag @ y
+    w_speed = np.abs(spec.speed_specification(model, 19.0).response(w)) * 10 ** (1.5 / 20)
+    c_ref = closedloop.siso_response(spec.baseline_controller(model, 19.0), w)
+    tw = trapezoid_weights(w)
+    rate_ref = np.sum(tw * np.abs(w * c_ref * yp.ow / (1 + c_ref * yp.ob)) ** 2 * base.wind_psd)
+    rate = (w * yp.ow)[:, None] * phi * np.sqrt(tw * base.wind_psd / rate_ref)[:, None]
+    p0 = float(np.real(model.linearize(19.0)["gen_speed", "pitch_cmd"].dcgain()))
+    phi0 = np.linalg.solve(yp.rr.T, np.real(_youla_basis(np.zeros(1, complex))[0]))
+    written = cp.Problem(
+        cp.Minimize(cp.sum_squares(cp.multiply(scale, t_re)) + cp.sum_squares(cp.multiply(scale, t_im))),
+        [cp.norm(cp.vstack([s_re, s_im]), 2, axis=0) <= np.minimum(1.8, w_speed / np.abs(yp.ow)),
+         cp.sum_squares(rate.real @ y) + cp.sum_squares(rate.imag @ y) <= 1.0, p0 * (phi0 @ y) == 1.0])
+    written.solve()
+    assert written.value == pytest.approx(yp.problem.value, rel=1e-6)
+    # and the design's own maps give that optimum: Σ weight·|T_MyT|²/|T^ROSCO|² on the grid
+    assert float(np.sum(scale ** 2 * np.abs(d.t_tower) ** 2)) == pytest.approx(yp.problem.value, rel=1e-6)
+    assert np.max(np.abs(d.sensitivity)) <= 1.8 * (1 + 1e-4)

