@@ -339,3 +339,44 @@ def test_the_compact_youla_problem_has_the_optimum_of_the_problem_written_out(mo
     # and the design's own maps give that optimum: Σ weight·|T_MyT|²/|T^ROSCO|² on the grid
     assert float(np.sum(scale ** 2 * np.abs(d.t_tower) ** 2)) == pytest.approx(yp.problem.value, rel=1e-6)
     assert np.max(np.abs(d.sensitivity)) <= 1.8 * (1 + 1e-4)
+
+
+def test_a_tower_bound_in_the_youla_design_is_met_on_its_grid(model):
+    # YoulaProblem(tower_bound=True): |T_MyT|/|T^ROSCO| ≤ 10^(b/20) at every grid point, here a
+    # bound 3 dB below ROSCO's map around the tower mode (0.6-1.5 rad/s) and free elsewhere
+    yp = fz.YoulaProblem(model, 19.0, max_sensitivity=1.8, tower_bound=True)
+    w = yp.base.omega
+    b = np.where((w > 0.6) & (w < 1.5), -3.0, 40.0)
+    d = yp.solve(3.0, b)
+    ratio_db = 20 * np.log10(np.abs(d.t_tower) / np.abs(yp.base.t_response))
+    assert np.max(ratio_db - b) <= 1e-3
+    with pytest.raises(ValueError, match="tower_bound_db is required"):
+        yp.solve(3.0)
+    with pytest.raises(ValueError, match="tower_bound_db must be"):
+        yp.solve(3.0, b[:-1])
+    with pytest.raises(ValueError, match="refused by one made without"):
+        fz.YoulaProblem(model, 19.0).solve(3.0, b)
+
+
+def test_a_certificate_for_a_given_tower_specification_meets_it_at_every_case(model, target19):
+    # CertificateSearch.for_tower: the Youla design made to meet a given W_MyT (here the certified
+    # one with a 2 dB dip at the tower mode), checked independently at every plant case with the
+    # explicit SISO formula against W_i = T^ROSCO_i·W/T^ROSCO_nominal on a dense grid
+    search = fz.CertificateSearch(model, 19.0)
+    tower = target19.tower.add(spec.Notch(1.0, 2.0, 0.3))
+    ts = search.for_tower(tower, 25.0)
+    assert ts.tower is tower and ts.promise.exact_del > target19.promise.exact_del
+    c = ts.design.controller(model)
+    w = np.geomspace(0.005, 20.0, 3000)
+    ratio = np.abs(tower.response(w)) / np.abs(closedloop.t_tower_wind(model.linearize(19.0), rosco_baseline(model, 19.0), w))
+    for v in ts.case_speeds:
+        plant = model.linearize(v)
+        t = np.abs(closedloop.t_tower_wind(plant, c, w))
+        bound = np.abs(closedloop.t_tower_wind(plant, rosco_baseline(model, v), w)) * ratio
+        assert np.max(20 * np.log10(t / bound)) <= 1e-6
+        s = np.abs(closedloop.t_gen_speed_wind(plant, c, w))
+        s_bound = np.abs(closedloop.t_gen_speed_wind(plant, rosco_baseline(model, v), w)) * 10 ** (ts.speed_relax_db / 20)
+        assert np.max(20 * np.log10(s / s_bound)) <= 1e-6
+    # a tower map 20 dB below ROSCO's everywhere: no design, said per rung
+    with pytest.raises(ValueError, match=r"no pitch design meets the tower specification.*0 dB: no design"):
+        search.for_tower(spec.Specification(target19.tower.baseline, (spec.Gain(-40.0),)), 25.0)

@@ -159,3 +159,22 @@ def test_a_hand_edit_of_the_whole_band_specification_is_recertified(model, whole
     # a 6 dB notch at the tower mode asks for more than the certificate gives: said, with where
     with pytest.raises(ValueError, match="exceeds the edited W_MyT by .* dB at .* rad/s for the plant case"):
         fz.recertify(model, ts, tower=ts.tower.add(spec.Notch(1.08, 6.0, 0.3)))
+
+
+def test_the_fallback_fits_elements_above_a_larger_certificate(model, monkeypatch):
+    # when no followed certificate can be certified (FOLLOW exhausted; forced here), the elements
+    # are fitted above the envelope of a certificate for a larger target: still a certified pair
+    # that promises the target (+ PROMISE_MARGIN_PP, exact Dirlik on FIT_OMEGA), met by that
+    # certificate at every plant case (recertify, which element_specification ends with, raises
+    # otherwise; here re-run on the result), its speed map that certificate's
+    from specdesign.feasibility import elements
+
+    monkeypatch.setattr(elements, "FOLLOW", ())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        ts = fz.element_specification(model, 25.0, 25.0)
+    assert ts.promise.exact_del == pytest.approx(25.0 + elements.PROMISE_MARGIN_PP, abs=1e-6)
+    again = fz.recertify(model, ts)
+    assert again.speed_relax_db == pytest.approx(ts.speed_relax_db, abs=1e-9)
+    # the fallback's certificate was made for a larger target (3 pp or more of headroom)
+    assert ts.design.del_reduction > 25.0 + 3.0

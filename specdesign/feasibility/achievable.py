@@ -17,7 +17,7 @@ YOULA_PAIRS = (0.9, 1.02, 1.1, 1.25)
 #: Clarabel's stopping tolerances: a relative gap of 1e-7 on an objective of order 1 is far below
 #: what the promise can see, and Clarabel's default 1e-8 sometimes stalls once reached (its
 #: "insufficient progress", which cvxpy reports as a failure, on a design it had solved).
-SOLVER_OPTIONS = dict(tol_gap_abs=1e-7, tol_gap_rel=1e-7)
+SOLVER_OPTIONS = {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7}
 
 
 def _youla_basis(s):
@@ -182,10 +182,15 @@ class YoulaProblem:
         ROSCO's baseline at ``wind_speed`` if already computed (its grid is used).
     integral_action : bool
         Require S(0) = 0 (see :func:`achievable_pitch`).
+    tower_bound : bool
+        Also bound the tower map, |T_{MyT,w}| ≤ 10^(b/20)·|T^ROSCO_{MyT,w}| at each grid point,
+        with b given to :meth:`solve` (``tower_bound_db``): the design then meets a given tower
+        specification, as when shaping elements are certified
+        (:func:`specdesign.feasibility.element_specification`).
     """
 
     def __init__(self, model, wind_speed, *, max_sensitivity=2.0, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
-                 base=None, integral_action=True):
+                 base=None, integral_action=True, tower_bound=False):
         import cvxpy as cp
 
         from .. import spec
@@ -238,15 +243,25 @@ class YoulaProblem:
             p0 = float(np.real(plant["gen_speed", "pitch_cmd"].dcgain()))
             phi0 = np.linalg.solve(self.rr.T, np.real(_youla_basis(np.zeros(1, complex))[0]))
             constraints.append(p0 * (phi0 @ y) == 1.0)
+        self.t_bound = None
+        if tower_bound:  # |T_MyT|/|T^ROSCO| ≤ 10^(b/20): one 3-cone per frequency, in units of ROSCO's map
+            ref = np.abs(base.t_response)
+            tt = -(self.gy / ref)[:, None] * phi_o
+            self.t_bound = cp.Parameter(w.size, nonneg=True)
+            constraints.append(cp.SOC(self.t_bound, cp.vstack([self.a.real / ref + tt.real @ y,
+                                                               self.a.imag / ref + tt.imag @ y]), axis=0))
         self.problem = cp.Problem(cp.Minimize(objective), constraints)
 
-    def solve(self, speed_relax_db):
+    def solve(self, speed_relax_db, tower_bound_db=None):
         """The design under the speed map relaxed by ``speed_relax_db``.
 
         Parameters
         ----------
         speed_relax_db : float
             Relaxation g of the generator-speed specification, dB (≥ 0).
+        tower_bound_db : array_like, optional
+            The tower bound b(ω) on the grid, dB over ROSCO's |T_{MyT,w}| (a problem made with
+            ``tower_bound=True`` only; required there).
 
         Returns
         -------
@@ -256,7 +271,8 @@ class YoulaProblem:
         Raises
         ------
         ValueError
-            For a negative or non-finite relaxation.
+            For a negative or non-finite relaxation, or a tower bound that is missing, not
+            finite, of another length than the grid, or given to a problem without one.
         RuntimeError
             If the solver finds no solution or fails (a cvxpy ``SolverError``): a search over
             the relaxation then counts that relaxation as one with no design.
@@ -269,6 +285,14 @@ class YoulaProblem:
         if not (np.isfinite(g) and g >= 0):
             raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB")
         base, w = self.base, self.base.omega
+        if (tower_bound_db is None) != (self.t_bound is None):
+            raise ValueError("tower_bound_db is required by a YoulaProblem made with tower_bound=True, and refused by "
+                             "one made without")
+        if tower_bound_db is not None:
+            b = np.asarray(tower_bound_db, float)
+            if b.shape != w.shape or not np.all(np.isfinite(b)):
+                raise ValueError(f"tower_bound_db must be {w.size} finite values (dB) on the problem's grid")
+            self.t_bound.value = 10 ** (b / 20)
         w_speed = self.w_speed0 * 10 ** (g / 20)
         self.s_bound.value = np.minimum(self.ms, w_speed / np.abs(self.ow))
         try:

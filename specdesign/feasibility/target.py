@@ -20,6 +20,15 @@ DEFAULT_CASE_OFFSETS = (-1.0, -0.5, 0.5, 1.0)
 #: finely is missed by < 0.002 dB, and a certificate's dozen roots at ζ ≈ 0.2 get ~10 points
 #: each instead of 1000 (the check of one certificate on ~17 000 points took half its search).
 DENSE_POINTS_PER_WIDTH = 50
+#: Half-width (in ln ω) over which :meth:`CertificateSearch.for_tower` spreads the margin it
+#: adds where a plant case exceeds the tower specification: the cases' tower modes lie within a
+#: few per cent of the nominal one.
+MARGIN_WIDTH = 0.05
+#: An excess (dB) of a plant case over the tower specification beyond which no margin is tried
+#: (a case's resonance a few per cent from the nominal one, 20-30 dB over at 23 m/s on the
+#: IEA 15 MW): :meth:`CertificateSearch.for_tower` goes to the next relaxation, and gives up
+#: after three such relaxations in a row.
+HOPELESS_DB = 6.0
 #: Relaxations of the speed map (dB) tried in turn by :func:`specification_for_target` before
 #: its bisection.
 RELAX_LADDER_DB = (0.5, 1.0, 1.5, 2.0, 3.0, 4.5, 6.0, 8.0)
@@ -230,8 +239,9 @@ class CertificateSearch:
                       else as_omega(dense_omega, "dense_omega", allow_zero=False))
         self.base = spec.baseline_analysis(model, v, m=m, omega=omega)
         self._cases = _Cases(model, self.case_speeds, v)
-        self._youla = YoulaProblem(model, v, max_sensitivity=max_sensitivity, max_pitch_rate_ratio=max_pitch_rate_ratio,
-                                   base=self.base)
+        self._youla_options = {"max_sensitivity": max_sensitivity, "max_pitch_rate_ratio": max_pitch_rate_ratio}
+        self._youla = YoulaProblem(model, v, base=self.base, **self._youla_options)
+        self._youla_tower = None  # the same problem with a tower bound, made on first use (for_tower)
         self._designs = {}
 
     def _design(self, g):
@@ -319,12 +329,104 @@ class CertificateSearch:
         return _target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t, self.m)
 
 
+    def for_tower(self, tower, target_reduction, *, relax_ladder_db=(0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0),
+                  max_relax_db=12.0, speed_slack_db=0.2, margin_steps=4) -> TargetSpecification:
+        """The certified pair with a given tower specification: the least speed relaxation on a ladder.
+
+        At each relaxation g the Youla design is made to meet ``tower`` at the nominal plant on
+        the design grid (|T_MyT| ≤ |W_MyT|, lowered by a margin), closed around every plant case
+        and checked on the dense grid as :func:`recertify` checks a pair; where a case exceeds
+        W_MyT the margin grows by that excess there (spread over ±:data:`MARGIN_WIDTH` in ln ω)
+        and the design is made again (``margin_steps`` times), and
+        where no design meets it the next rung is tried. The speed specification
+        is ROSCO's relaxed by what the design needs over the cases plus ``speed_slack_db``.
+
+        Parameters
+        ----------
+        tower : specdesign.spec.Specification
+            W_MyT at the nominal speed (e.g. ROSCO's map times shaping elements).
+        target_reduction : float
+            The DEL reduction it is meant for, %: recorded (the promise is ``tower``'s own).
+        relax_ladder_db : sequence of float
+            Relaxations g tried in turn, dB (those above ``max_relax_db`` are skipped).
+        max_relax_db : float
+            Largest relaxation tried, dB.
+        speed_slack_db : float
+            Room left above the certificate's speed maps in W_Ω, dB (≥ 0).
+        margin_steps : int
+            Most re-designs with a larger margin at one relaxation.
+
+        Returns
+        -------
+        TargetSpecification
+            ``tower``, the certified speed specification, ``tower``'s promise and the certificate.
+
+        Raises
+        ------
+        ValueError
+            If no rung gives a design that meets ``tower`` at every plant case (the message
+            says, per rung, whether no design existed or by how much a case exceeded W_MyT).
+        """
+        from .. import spec
+
+        t, _, sslack = _check_target(target_reduction, 0.0, speed_slack_db)
+        if self._youla_tower is None:
+            self._youla_tower = YoulaProblem(self.model, self.wind_speed, base=self.base, tower_bound=True,
+                                             **self._youla_options)
+        w = self.base.omega
+        bound = 20 * np.log10(np.abs(np.asarray(tower.response(w))) / np.abs(self.base.t_response))
+        tried, hopeless = [], 0
+        for g in [float(x) for x in relax_ladder_db if x <= max_relax_db]:
+            if hopeless >= 3:  # three rungs in a row left a case far over W_MyT: more g will not help
+                tried.append("stopped: a case stays far over W_MyT at every relaxation")
+                break
+            margin, rung_hopeless = np.zeros(w.size), False
+            for step in range(int(margin_steps)):
+                try:
+                    d = self._youla_tower.solve(g, bound - margin)
+                except RuntimeError:
+                    tried.append(f"{g:g} dB: no design")
+                    break
+                controller = d.controller(self.model)
+                speed_g = spec.speed_specification(self.model, self.wind_speed, margin_db=g)
+                checked = _spec_excess(self._cases, controller, tower, speed_g, self.dense)
+                if checked is None:
+                    tried.append(f"{g:g} dB: a plant case unstable")
+                    break
+                x, wk, case, profile = checked[0]["W_MyT"]
+                if x <= 0.0:
+                    # W_Ω: ROSCO's map relaxed by what the cases need (g plus their excess over it)
+                    relax = g + max(checked[0]["W_Ω"][0], 0.0) + sslack
+                    speed = spec.speed_specification(self.model, self.wind_speed, margin_db=relax)
+                    record = TargetSpecification(tower, speed, None, relax, 0.0, d, t, self.case_speeds,
+                                                 float(margin.max()), sslack, self.m)
+                    return _recertified(self.model, record, self._cases, controller, tower, speed, self.dense)
+                tried.append(f"{g:g} dB, margin {margin.max():.2f} dB: {x:.2f} dB over W_MyT at {wk:.3g} rad/s "
+                             f"({case:g} m/s)")
+                if x > HOPELESS_DB:
+                    # far over: the case's own resonance, not the nominal design's level, is
+                    # what exceeds W_MyT there (a margin that large leaves no design)
+                    rung_hopeless = True
+                    break
+                # where a case exceeds W_MyT (its resonance moved with its speed, its gain with
+                # its operating point) the nominal design keeps that much farther below W_MyT,
+                # over ±MARGIN_WIDTH in ln ω around each excess, plus 0.05 dB
+                over = profile > 0
+                near = np.abs(np.log(w)[:, None] - np.log(checked[1][over])[None, :]) <= MARGIN_WIDTH
+                margin += np.max(np.where(near, profile[over][None, :] + 0.05, 0.0), axis=1)
+            hopeless = hopeless + 1 if rung_hopeless else 0
+        raise ValueError(f"no pitch design meets the tower specification at every plant case {self.case_speeds} m/s at "
+                         f"{self.wind_speed:g} m/s with the speed map relaxed up to {max_relax_db:g} dB ("
+                         + "; ".join(tried) + ")")
+
+
 class _Cases:
     """The plant cases and ROSCO's loops on them, for the certificate's robustness check."""
 
     def __init__(self, model, speeds, v):
         from ..spec import baseline_controllers
 
+        self.speeds = tuple(speeds)
         self.plants = [model.linearize(s) for s in speeds]
         self.rosco = baseline_controllers(model, speeds)  # ROSCO's schedule fitted once for every case
         self.nom = speeds.index(v)
@@ -394,6 +496,36 @@ class _Cases:
         speed_db = float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / rs)))
         tower_db = float(20 * np.log10(np.max(ratio / ratio[:, self.nom:self.nom + 1])))
         return max(tower_db, 0.0), speed_db
+
+
+def _spec_excess(cases, controller, tower, speed, dense):
+    """Where the certificate ``controller`` exceeds the pair (``tower``, ``speed``) over the plant
+    cases: {label: (excess dB, ω rad/s, case speed m/s)} for "W_MyT" and "W_Ω" (each case's bound is
+    ROSCO's map at its speed times the nominal ratio W/T^ROSCO), with the grid, the responses and
+    the nominal case's tower map, on ``dense`` refined around the lightly damped roots of the
+    loop and of both specifications. None if a case is unstable."""
+    import warnings
+
+    from .. import spec
+    from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response, system_roots
+
+    if cases._unstable(controller):
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cl0 = closed_loop(cases.plants[cases.nom], controller, warn=False)
+    roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
+    roots += [system_roots(x.baseline) for x in (tower, speed) if isinstance(x, spec.Specification)]
+    w, (R, rt, rs) = cases._on_refined(dense, refine_grid(dense, lightly_damped(np.concatenate(roots)),
+                                                          points_per_width=DENSE_POINTS_PER_WIDTH))
+    c = siso_response(controller, w)[:, None]
+    nom, out = cases.nom, {}
+    for label, spec_like, ref, name in (("W_MyT", tower, rt, "tower_base_my"), ("W_Ω", speed, rs, "gen_speed")):
+        bound = ref * (np.abs(np.asarray(spec_like.response(w))) / ref[:, nom])[:, None]
+        excess = 20 * np.log10(np.abs(closed_map(R, c, 0.0, name)) / bound)
+        k, i = np.unravel_index(np.argmax(excess), excess.shape)
+        out[label] = (float(excess[k, i]), float(w[k]), cases.speeds[i], excess.max(axis=1))
+    return out, w, np.abs(closed_map(R, c, 0.0, "tower_base_my")[:, nom]), rs[:, nom]
 
 
 def _slack_promise(design, base, slack_db):
@@ -469,11 +601,7 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     >>> bool(looser.promise.exact_del < t.promise.exact_del)
     True
     """
-    import warnings
-
-    from .. import spec
     from .._checks import as_omega
-    from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response, system_roots
 
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a TargetSpecification, got {type(target).__name__}")
@@ -485,32 +613,29 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     v = target.design.wind_speed
     speeds = tuple(target.case_speeds) or (v,)
     cases = _Cases(model, speeds, v)
-    controller = target.design.controller(model)
-    if cases._unstable(controller):
-        raise ValueError("the certificate destabilises a plant case of this model: was the target made on another model?")
     dense = (np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None
              else as_omega(dense_omega, "dense_omega", allow_zero=False))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        cl0 = closed_loop(cases.plants[cases.nom], controller, warn=False)
-    roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
-    roots += [system_roots(x.baseline) for x in (tower, speed) if isinstance(x, spec.Specification)]
-    w, (R, rt, rs) = cases._on_refined(dense, refine_grid(dense, lightly_damped(np.concatenate(roots)),
-                                                          points_per_width=DENSE_POINTS_PER_WIDTH))
-    c = siso_response(controller, w)[:, None]
-    nom = cases.nom
-    for label, spec_like, ref, out in (("W_MyT", tower, rt, "tower_base_my"), ("W_Ω", speed, rs, "gen_speed")):
-        # each case's bound: ROSCO's map at its speed times the nominal ratio W/T^ROSCO
-        bound = ref * (np.abs(np.asarray(spec_like.response(w))) / ref[:, nom])[:, None]
-        excess = 20 * np.log10(np.abs(closed_map(R, c, 0.0, out)) / bound)
-        k, i = np.unravel_index(np.argmax(excess), excess.shape)
-        if excess[k, i] > 1e-9:
-            raise ValueError(f"the certificate exceeds the edited {label} by {excess[k, i]:.2f} dB at {w[k]:.4g} rad/s "
-                             f"for the plant case at {speeds[i]:g} m/s: the edit asks for more than the certified "
+    return _recertified(model, target, cases, target.design.controller(model), tower, speed, dense)
+
+
+def _recertified(model, target, cases, controller, tower, speed, dense, design=None):
+    """:func:`recertify`'s check and record, on plant cases already built, for the certificate
+    ``controller`` (of ``design``, default ``target.design``)."""
+    from .. import spec
+
+    checked = _spec_excess(cases, controller, tower, speed, dense)
+    if checked is None:
+        raise ValueError("the certificate destabilises a plant case of this model: was the target made on another model?")
+    excess, w, t0, rs0 = checked
+    for label in ("W_MyT", "W_Ω"):
+        x, wk, case, _ = excess[label]
+        if x > 1e-9:
+            raise ValueError(f"the certificate exceeds the edited {label} by {x:.2f} dB at {wk:.4g} rad/s "
+                             f"for the plant case at {case:g} m/s: the edit asks for more than the certified "
                              "design gives there (relax it there, or make a new target specification)")
-    t0 = np.abs(closed_map(R, c, 0.0, "tower_base_my")[:, nom])
+    design = target.design if design is None else design
     margin = float(20 * np.log10(np.min(np.abs(np.asarray(tower.response(w))) / t0)))
-    base = spec.baseline_analysis(model, v, m=target.m, omega=target.design.omega)
-    relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs[:, nom])))
-    return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, target.design,
-                               target.target_reduction, speeds, target.robustness_db, target.speed_slack_db, target.m)
+    base = spec.baseline_analysis(model, design.wind_speed, m=target.m, omega=design.omega)
+    relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs0)))
+    return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, design,
+                               target.target_reduction, cases.speeds, target.robustness_db, target.speed_slack_db, target.m)
