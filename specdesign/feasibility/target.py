@@ -8,8 +8,8 @@ import numpy as np
 from .._blas import on_one_blas_thread
 from .achievable import AchievablePitch, YoulaProblem
 
-__all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "RELAX_LADDER_DB", "CertificateSearch", "TargetSpecification", "recertify",
-           "specification_for_target"]
+__all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
+           "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
 
 
 #: Wind-speed offsets (m/s) of the plant cases a target specification is certified on: the
@@ -338,7 +338,9 @@ class CertificateSearch:
         and checked on the dense grid as :func:`recertify` checks a pair; where a case exceeds
         W_MyT the margin grows by that excess there (spread over ±:data:`MARGIN_WIDTH` in ln ω)
         and the design is made again (``margin_steps`` times), and
-        where no design meets it the next rung is tried. The speed specification
+        where no design meets it the next rung is tried. A case more than :data:`HOPELESS_DB`
+        over W_MyT (its own resonance, which no margin moves) ends the rung at once, and three
+        such rungs in a row end the search. The speed specification
         is ROSCO's relaxed by what the design needs over the cases plus ``speed_slack_db``.
 
         Parameters
@@ -366,6 +368,16 @@ class CertificateSearch:
         ValueError
             If no rung gives a design that meets ``tower`` at every plant case (the message
             says, per rung, whether no design existed or by how much a case exceeded W_MyT).
+
+        Examples
+        --------
+        >>> from specdesign import spec
+        >>> from specdesign.turbine import iea15mw
+        >>> search = CertificateSearch(iea15mw(), 19.0)
+        >>> t = search.for_target(25.0)
+        >>> deeper = search.for_tower(t.tower.add(spec.Notch(1.0, 2.0, 0.3)), 25.0)  # 2 dB more at the tower mode
+        >>> bool(deeper.promise.exact_del > t.promise.exact_del and deeper.speed_relax_db >= t.speed_relax_db - 0.5)
+        True
         """
         from .. import spec
 
