@@ -6,8 +6,8 @@ At one operating point (default 19 m/s), best of ``--repeat`` runs, beside the i
 2. the specification for a 25 % target (``feasibility.specification_for_target``: the convex
    Youla design on the ladder and the bisection, each certified over 5 plant cases);
 3. the same target as a whole-band element specification, the user's entry point
-   ``spec.shape_to_target(base, 25, quantity="del", band="whole")`` (certificates with headroom,
-   the elements fitted above their envelope, recertified over the plant cases);
+   ``spec.shape_to_target(base, 25, quantity="del", band="whole")`` (the elements follow a
+   certificate's envelope and are certified by a Youla design that meets them at every plant case);
 4. the design that meets it (``qft.design_qft(spec=...)``: reduction + QFT checks);
 5. the fixed-structure QFT design at the same point (``qft.design_qft``), for comparison.
 """

@@ -380,3 +380,15 @@ def test_a_certificate_for_a_given_tower_specification_meets_it_at_every_case(mo
     # a tower map 20 dB below ROSCO's everywhere: no design, said per rung
     with pytest.raises(ValueError, match=r"no pitch design meets the tower specification.*0 dB: no design"):
         search.for_tower(spec.Specification(target19.tower.baseline, (spec.Gain(-40.0),)), 25.0)
+
+
+def test_bad_requests_to_for_tower_are_named(model, target19):
+    search = fz.CertificateSearch(model, 19.0)
+    with pytest.raises(TypeError, match="tower must be a specification"):
+        search.for_tower(np.ones(3), 25.0)
+    with pytest.raises(ValueError, match="relax_ladder_db"):
+        search.for_tower(target19.tower, 25.0, relax_ladder_db=[-1.0])
+    with pytest.raises(ValueError, match="margin_steps"):
+        search.for_tower(target19.tower, 25.0, margin_steps=0)
+    with pytest.raises(ValueError, match="target_reduction"):
+        search.for_tower(target19.tower, 120.0)

@@ -328,7 +328,6 @@ class CertificateSearch:
                 lo_g = mid
         return _target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t, self.m)
 
-
     def for_tower(self, tower, target_reduction, *, relax_ladder_db=(0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0),
                   max_relax_db=12.0, speed_slack_db=0.2, margin_steps=4) -> TargetSpecification:
         """The certified pair with a given tower specification: the least speed relaxation on a ladder.
@@ -365,9 +364,12 @@ class CertificateSearch:
 
         Raises
         ------
+        TypeError
+            If ``tower`` has no ``response(omega)``.
         ValueError
-            If no rung gives a design that meets ``tower`` at every plant case (the message
-            says, per rung, whether no design existed or by how much a case exceeded W_MyT).
+            For a bad target, slack, ladder or ``margin_steps``; or if no rung gives a design
+            that meets ``tower`` at every plant case (the message says, per rung, whether no
+            design existed or by how much a case exceeded W_MyT).
 
         Examples
         --------
@@ -382,13 +384,20 @@ class CertificateSearch:
         from .. import spec
 
         t, _, sslack = _check_target(target_reduction, 0.0, speed_slack_db)
+        if not hasattr(tower, "response"):
+            raise TypeError(f"tower must be a specification with response(omega), got {type(tower).__name__}")
+        ladder = np.atleast_1d(np.asarray(relax_ladder_db, float))
+        if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
+            raise ValueError(f"relax_ladder_db={relax_ladder_db!r} must be relaxations ≥ 0 dB")
+        if int(margin_steps) != margin_steps or margin_steps < 1:
+            raise ValueError(f"margin_steps={margin_steps!r} must be a whole number ≥ 1")
         if self._youla_tower is None:
             self._youla_tower = YoulaProblem(self.model, self.wind_speed, base=self.base, tower_bound=True,
                                              **self._youla_options)
         w = self.base.omega
         bound = 20 * np.log10(np.abs(np.asarray(tower.response(w))) / np.abs(self.base.t_response))
         tried, hopeless = [], 0
-        for g in [float(x) for x in relax_ladder_db if x <= max_relax_db]:
+        for g in [float(x) for x in ladder if x <= max_relax_db]:
             if hopeless >= 3:  # three rungs in a row left a case far over W_MyT: more g will not help
                 tried.append("stopped: a case stays far over W_MyT at every relaxation")
                 break
