@@ -42,7 +42,9 @@ disks at every frequency): the true frontier lies between the two.
 :func:`specification_for_target` inverts the frontier: the smallest speed relaxation whose
 design promises a requested DEL reduction, and the specification pair it certifies.
 :func:`element_specification` writes such a certified tower specification as ROSCO's map times
-a few shaping elements (gain, lag, lead, notches and bumps) over the whole band, editable by hand.
+a few shaping elements (gain, lag, lead, notches and bumps) over the whole band, editable by hand:
+the elements follow a certificate's envelope, and :meth:`CertificateSearch.for_tower` certifies
+them with a Youla design made to meet them (the tower bound, |T_{MyT,w}| ≤ |W_MyT|, is convex too).
 
 Modules: :mod:`~specdesign.feasibility.conditions` (the necessary conditions, the frontier),
 :mod:`~specdesign.feasibility.achievable` (the convex Youla design),
