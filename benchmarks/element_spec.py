@@ -136,13 +136,13 @@ class _Clock:
         self.last_follow = None
 
     def note_follow(self, owner, name):
-        """Record the (headroom, envelope) of the last call of ``owner.name`` that returned a result."""
+        """Record the (headroom, envelope), its last two arguments, of the last call of
+        ``owner.name`` that returned a result."""
         inner = getattr(owner, name)
 
-        def noted(search, base, promise, t, aim, max_notches, for_target, headroom_pp, envelope):
-            out = inner(search, base, promise, t, aim, max_notches, for_target, headroom_pp, envelope)
-            if out is not None:
-                self.last_follow = (headroom_pp, envelope)
+        def noted(*args):
+            out = inner(*args)
+            self.last_follow = args[-2:]
             return out
 
         setattr(owner, name, noted)

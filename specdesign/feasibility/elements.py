@@ -326,17 +326,29 @@ def _seeds(base, grid, r):
     return out
 
 
+def _unstable_pole(design, model):
+    """The rightmost pole (1/s) of a certificate's controller when it is itself unstable (real
+    part above :data:`specdesign.qft.UNSTABLE_CONTROLLER_RATE`), else None: design_qft refuses
+    such a controller (a saturated pitch opens the loop) and reduces its design from it."""
+    import control as ct
+
+    from ..qft import UNSTABLE_CONTROLLER_RATE
+
+    poles = np.asarray(ct.poles(design.controller(model)))
+    if poles.size and poles.real.max() > UNSTABLE_CONTROLLER_RATE:
+        return complex(poles[np.argmax(poles.real)])
+    return None
+
+
 def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_pp, envelope):
     """The elements that follow the upper envelope (±``envelope`` in ln ω) of the certificate for
     ``t`` + ``headroom_pp``, shifted to promise ``aim`` and certified themselves
-    (:meth:`CertificateSearch.for_tower`); None when the certifying controller is itself
-    unstable. Raises ValueError as ``for_tower`` does."""
-    import control as ct
+    (:meth:`CertificateSearch.for_tower`). Raises ValueError as ``for_tower`` does, and when
+    the certifying controller is itself unstable."""
     from scipy.ndimage import maximum_filter1d
 
     from .. import spec
     from ..closedloop import siso_response
-    from ..qft import UNSTABLE_CONTROLLER_RATE
 
     cert = search.for_target(t + headroom_pp, **for_target)
     w = base.omega
@@ -366,11 +378,10 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
     delta, x, n = best
     x[0] += delta
     tower = spec.Specification(base.system, _unpack(x, n), name="W_tower_base_my")
-    speed_slack = for_target.get("speed_slack_db", 0.2)
-    ts = search.for_tower(tower, t, speed_slack_db=speed_slack)
-    poles = np.asarray(ct.poles(ts.design.controller(search.model)))
-    if poles.size and poles.real.max() > UNSTABLE_CONTROLLER_RATE:
-        return None
+    ts = search.for_tower(tower, t, **{k: x for k, x in for_target.items() if k == "speed_slack_db"})
+    p = _unstable_pole(ts.design, search.model)
+    if p is not None:
+        raise ValueError(f"its certificate's controller is unstable (pole {p.real:.4f}{p.imag:+.4f}j 1/s)")
     return replace(ts, promise=spec.promise_of(tower, base), target_reduction=t)
 
 
@@ -435,13 +446,11 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     """
     import inspect
 
-    import control as ct
     from scipy.ndimage import maximum_filter1d
 
     from .. import spec
     from .._checks import del_target
     from ..closedloop import siso_response
-    from ..qft import UNSTABLE_CONTROLLER_RATE
     from .target import CertificateSearch, recertify
 
     t = del_target(target_reduction)
@@ -471,10 +480,7 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
         if t + h >= 100:
             break
         try:
-            ts = _followed(search, base, promise, t, aim, max_notches, for_target, h, env)
-            if ts is not None:
-                return ts
-            tried.append(f"following the {h:g} pp certificate (±{100 * env:g} %): its controller is unstable")
+            return _followed(search, base, promise, t, aim, max_notches, for_target, h, env)
         except ValueError as e:
             tried.append(f"following the {h:g} pp certificate (±{100 * env:g} %): {e}")
     for h in heads:
@@ -485,11 +491,8 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
         except ValueError as e:
             why = str(e)
             break
-        poles = np.asarray(ct.poles(cert.design.controller(model)))
-        if poles.size and poles.real.max() > UNSTABLE_CONTROLLER_RATE:
-            # design_qft refuses a controller that is itself unstable (a saturated pitch opens
-            # the loop) and reduces its design from this certificate: the next headroom
-            p = poles[np.argmax(poles.real)]
+        p = _unstable_pole(cert.design, model)
+        if p is not None:  # design_qft would refuse the design reduced from it: the next headroom
             tried.append(f"{h:g} pp: the certificate's controller is unstable (pole {p.real:.4f}{p.imag:+.4f}j 1/s)")
             continue
         ratio = 20 * np.log10(np.abs(cert.tower.response(grid)) / t0)

@@ -410,7 +410,7 @@ class CertificateSearch:
                     break
                 controller = d.controller(self.model)
                 speed_g = spec.speed_specification(self.model, self.wind_speed, margin_db=g)
-                checked = _spec_excess(self._cases, controller, tower, speed_g, self.dense)
+                checked = self._cases.spec_excess(controller, tower, speed_g, self.dense)
                 if checked is None:
                     tried.append(f"{g:g} dB: a plant case unstable")
                     break
@@ -419,9 +419,11 @@ class CertificateSearch:
                     # W_Ω: ROSCO's map relaxed by what the cases need (g plus their excess over it)
                     relax = g + max(checked[0]["W_Ω"][0], 0.0) + sslack
                     speed = spec.speed_specification(self.model, self.wind_speed, margin_db=relax)
+                    # the check just made is that pair's: W_Ω relaxed further only lifts its bound,
+                    # and the grid is refined around the same roots (ROSCO's speed map either way)
                     record = TargetSpecification(tower, speed, None, relax, 0.0, d, t, self.case_speeds,
                                                  float(margin.max()), sslack, self.m)
-                    return _recertified(self.model, record, self._cases, controller, tower, speed, self.dense)
+                    return _checked_record(self.model, record, self._cases, tower, speed, *checked[1:])
                 tried.append(f"{g:g} dB, margin {margin.max():.2f} dB: {x:.2f} dB over W_MyT at {wk:.3g} rad/s "
                              f"({case:g} m/s)")
                 if x > HOPELESS_DB:
@@ -494,59 +496,69 @@ class _Cases:
                 return True
         return False
 
-    def excess(self, controller, omega):
-        """(tower robustness, speed relaxation needed), dB, or None if a case is unstable.
-
-        The grid is refined around the lightly damped roots of the certificate's nominal maps:
-        a narrow dip of W between grid points would hide a violation.
-        """
+    def _closed(self, controller, omega, specs=()):
+        """The certificate ``controller`` closed around every case on ``omega`` refined around the
+        lightly damped roots of its nominal maps and of ``specs``' baselines (a narrow dip of W
+        between grid points would hide a violation): (grid, responses, ROSCO's |T_MyT| and
+        |T_Ω|, C(jω) as a column), or None if some case is unstable."""
         import warnings
 
-        from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response, system_roots
+        from .. import spec
+        from ..closedloop import closed_loop, lightly_damped, refine_grid, siso_response, system_roots
 
         if self._unstable(controller):
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             cl0 = closed_loop(self.plants[self.nom], controller, warn=False)
-        roots = np.concatenate([system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])])
-        w, (R, rt, rs) = self._on_refined(omega, refine_grid(omega, lightly_damped(roots),
+        roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
+        roots += [system_roots(x.baseline) for x in specs if isinstance(x, spec.Specification)]
+        w, (R, rt, rs) = self._on_refined(omega, refine_grid(omega, lightly_damped(np.concatenate(roots)),
                                                              points_per_width=DENSE_POINTS_PER_WIDTH))
-        c = siso_response(controller, w)[:, None]
+        return w, R, rt, rs, siso_response(controller, w)[:, None]
+
+    def excess(self, controller, omega):
+        """(tower robustness, speed relaxation needed), dB, or None if a case is unstable.
+
+        The tower robustness is the largest excess of a case's |T_MyT|/|T^ROSCO_MyT| over the
+        nominal case's; the speed relaxation the largest |T_Ω|/|T^ROSCO_Ω| (:meth:`_closed`'s grid).
+        """
+        from ..closedloop import closed_map
+
+        closed = self._closed(controller, omega)
+        if closed is None:
+            return None
+        _, R, rt, rs, c = closed
         ratio = np.abs(closed_map(R, c, 0.0, "tower_base_my")) / rt
         speed_db = float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / rs)))
         tower_db = float(20 * np.log10(np.max(ratio / ratio[:, self.nom:self.nom + 1])))
         return max(tower_db, 0.0), speed_db
 
+    def spec_excess(self, controller, tower, speed, omega):
+        """Where the certificate ``controller`` exceeds the pair (``tower``, ``speed``) over the
+        cases, each case's bound being ROSCO's map at its speed times the nominal ratio
+        W/T^ROSCO, on :meth:`_closed`'s grid (refined around the specifications' roots too).
 
-def _spec_excess(cases, controller, tower, speed, dense):
-    """Where the certificate ``controller`` exceeds the pair (``tower``, ``speed``) over the plant
-    cases: {label: (excess dB, ω rad/s, case speed m/s)} for "W_MyT" and "W_Ω" (each case's bound is
-    ROSCO's map at its speed times the nominal ratio W/T^ROSCO), with the grid, the responses and
-    the nominal case's tower map, on ``dense`` refined around the lightly damped roots of the
-    loop and of both specifications. None if a case is unstable."""
-    import warnings
+        Returns
+        -------
+        tuple or None
+            ({label: (largest excess dB, its ω rad/s, its case speed m/s, largest excess over
+            the cases at each ω dB)} for "W_MyT" and "W_Ω", the grid, the nominal case's
+            |T_MyT| and ROSCO's nominal |T_Ω| on it), or None if a case is unstable.
+        """
+        from ..closedloop import closed_map
 
-    from .. import spec
-    from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response, system_roots
-
-    if cases._unstable(controller):
-        return None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        cl0 = closed_loop(cases.plants[cases.nom], controller, warn=False)
-    roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
-    roots += [system_roots(x.baseline) for x in (tower, speed) if isinstance(x, spec.Specification)]
-    w, (R, rt, rs) = cases._on_refined(dense, refine_grid(dense, lightly_damped(np.concatenate(roots)),
-                                                          points_per_width=DENSE_POINTS_PER_WIDTH))
-    c = siso_response(controller, w)[:, None]
-    nom, out = cases.nom, {}
-    for label, spec_like, ref, name in (("W_MyT", tower, rt, "tower_base_my"), ("W_Ω", speed, rs, "gen_speed")):
-        bound = ref * (np.abs(np.asarray(spec_like.response(w))) / ref[:, nom])[:, None]
-        excess = 20 * np.log10(np.abs(closed_map(R, c, 0.0, name)) / bound)
-        k, i = np.unravel_index(np.argmax(excess), excess.shape)
-        out[label] = (float(excess[k, i]), float(w[k]), cases.speeds[i], excess.max(axis=1))
-    return out, w, np.abs(closed_map(R, c, 0.0, "tower_base_my")[:, nom]), rs[:, nom]
+        closed = self._closed(controller, omega, (tower, speed))
+        if closed is None:
+            return None
+        w, R, rt, rs, c = closed
+        out = {}
+        for label, spec_like, ref, name in (("W_MyT", tower, rt, "tower_base_my"), ("W_Ω", speed, rs, "gen_speed")):
+            bound = ref * (np.abs(np.asarray(spec_like.response(w))) / ref[:, self.nom])[:, None]
+            excess = 20 * np.log10(np.abs(closed_map(R, c, 0.0, name)) / bound)
+            k, i = np.unravel_index(np.argmax(excess), excess.shape)
+            out[label] = (float(excess[k, i]), float(w[k]), self.speeds[i], excess.max(axis=1))
+        return out, w, np.abs(closed_map(R, c, 0.0, "tower_base_my")[:, self.nom]), rs[:, self.nom]
 
 
 def _slack_promise(design, base, slack_db):
@@ -639,22 +651,28 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     return _recertified(model, target, cases, target.design.controller(model), tower, speed, dense)
 
 
-def _recertified(model, target, cases, controller, tower, speed, dense, design=None):
+def _recertified(model, target, cases, controller, tower, speed, dense):
     """:func:`recertify`'s check and record, on plant cases already built, for the certificate
-    ``controller`` (of ``design``, default ``target.design``)."""
-    from .. import spec
-
-    checked = _spec_excess(cases, controller, tower, speed, dense)
+    ``controller`` of ``target.design``."""
+    checked = cases.spec_excess(controller, tower, speed, dense)
     if checked is None:
         raise ValueError("the certificate destabilises a plant case of this model: was the target made on another model?")
-    excess, w, t0, rs0 = checked
+    excess = checked[0]
     for label in ("W_MyT", "W_Ω"):
         x, wk, case, _ = excess[label]
         if x > 1e-9:
             raise ValueError(f"the certificate exceeds the edited {label} by {x:.2f} dB at {wk:.4g} rad/s "
                              f"for the plant case at {case:g} m/s: the edit asks for more than the certified "
                              "design gives there (relax it there, or make a new target specification)")
-    design = target.design if design is None else design
+    return _checked_record(model, target, cases, tower, speed, *checked[1:])
+
+
+def _checked_record(model, target, cases, tower, speed, w, t0, rs0):
+    """The record of a pair checked on grid ``w`` (the certificate's nominal |T_MyT| ``t0`` and
+    ROSCO's nominal |T_Ω| ``rs0`` there): its promise, speed relaxation and tower margin."""
+    from .. import spec
+
+    design = target.design
     margin = float(20 * np.log10(np.min(np.abs(np.asarray(tower.response(w))) / t0)))
     base = spec.baseline_analysis(model, design.wind_speed, m=target.m, omega=design.omega)
     relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs0)))
