@@ -7,7 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["as_omega", "as_psd", "as_signal", "as_real", "positive_scalar", "del_target", "distinct_keys"]
+__all__ = ["as_omega", "as_psd", "as_signal", "as_real", "real_scalar", "positive_scalar", "del_target",
+           "distinct_keys", "bisection_tolerance", "MAX_BISECTIONS"]
+
+#: Most halvings of a bisection: 100 halve any interval a search starts from (≤ 1e3 dB or m/s)
+#: below 1e-27, far under any tolerance a user asks for, so a tolerance float64 cannot resolve
+#: (1e-300 dB next to 3 dB) still ends.
+MAX_BISECTIONS = 100
 
 
 def as_real(x, name: str) -> np.ndarray:
@@ -71,6 +77,36 @@ def as_signal(x, name: str = "x", *, min_samples: int = 2) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
+def real_scalar(value, name: str) -> float:
+    """A finite real scalar (in the unit of argument ``name``) as a float.
+
+    A bool, a string or bytes is a TypeError (``float`` would read True as 1 and "0.01" as
+    0.01); NaN or inf a ValueError.
+    """
+    if np.iscomplexobj(value):
+        raise TypeError(f"{name} is complex; pass a real number")
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__} {value!r}")
+    if np.ndim(value) != 0:
+        raise TypeError(f"{name} must be a single real number, got an array of shape {np.shape(value)}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}") from None
+    if not np.isfinite(v):
+        raise ValueError(f"{name}={value!r} must be finite")
+    return v
+
+
+def bisection_tolerance(value, name: str = "tolerance_db") -> float:
+    """A bisection's tolerance (in the unit of argument ``name``): finite and > 0, else the
+    bisection would never end (0 or a negative width is never reached)."""
+    v = real_scalar(value, name)
+    if v <= 0:
+        raise ValueError(f"{name}={value!r} must be > 0: a bisection to a width ≤ 0 never ends (e.g. 0.05)")
+    return v
+
+
 def positive_scalar(value, name: str) -> float:
     """Validate a finite, strictly positive real scalar (in the unit of argument ``name``) and return it as a float."""
     if np.iscomplexobj(value):
@@ -87,8 +123,11 @@ def positive_scalar(value, name: str) -> float:
 
 
 def del_target(value, name: str = "target_reduction") -> float:
-    """Validate a DEL-reduction target in % (0 < value < 100) and return it as a float."""
-    t = float(value)
+    """Validate a DEL-reduction target in % (0 < value < 100) and return it as a float.
+
+    A bool or a string is a TypeError (True would read as a 1 % target).
+    """
+    t = real_scalar(value, name)
     if not 0 < t < 100:
         raise ValueError(f"{name}={value!r} must be a DEL reduction in % strictly between 0 and 100")
     return t
