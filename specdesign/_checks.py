@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["as_omega", "as_psd", "as_signal", "as_real", "real_scalar", "positive_scalar", "del_target",
-           "distinct_keys", "bisection_tolerance", "MAX_BISECTIONS"]
+           "distinct_keys", "bisection_tolerance", "MAX_BISECTIONS", "finite_system", "spec_made_at"]
 
 #: Most halvings of a bisection: 100 halve any interval a search starts from (≤ 1e3 dB or m/s)
 #: below 1e-27, far under any tolerance a user asks for, so a tolerance float64 cannot resolve
@@ -176,3 +176,61 @@ def distinct_keys(make_error=None):
         return out
 
     return pairs
+
+
+def finite_system(sys, name: str) -> None:
+    """Raise ValueError if the state-space matrices of ``sys`` (argument ``name``) hold NaN or inf.
+
+    A NaN plant otherwise reaches LAPACK or SLICOT, whose "SVD did not converge" names nothing.
+    Transfer functions are checked on their coefficients.
+    """
+    parts = [(k, getattr(sys, k, None)) for k in ("A", "B", "C", "D")]
+    if all(m is None for _, m in parts):
+        parts = [("num", np.concatenate([np.ravel(c) for row in sys.num for c in row])),
+                 ("den", np.concatenate([np.ravel(c) for row in sys.den for c in row]))]
+    for key, m in parts:
+        a = np.asarray(m, dtype=complex)
+        if a.size and not np.all(np.isfinite(a)):
+            i = [int(j) for j in np.unravel_index(int(np.argmin(np.isfinite(a))), a.shape)]
+            raise ValueError(f"{name} has a NaN or inf entry ({key}{i} = {float(a[tuple(i)].real)!r}); check the model or "
+                             "the operating point it was linearised at")
+
+
+def spec_made_at(spec, wind_speed: float, name: str = "spec") -> None:
+    """Refuse a specification record made at another operating point than the design's.
+
+    A specification (a :class:`specdesign.feasibility.TargetSpecification`, a
+    :class:`specdesign.spec.DesignSpecifications`, a design record) carries the wind speed it
+    was made and certified at (``wind_speed``, or ``base.wind_speed``) and its plant cases
+    (``case_speeds``); its promise and its certificate hold there only. Records that carry no
+    wind speed (a bare pair of transfer functions) pass.
+
+    Parameters
+    ----------
+    spec : object
+        The record.
+    wind_speed : float
+        The design's operating point, m/s.
+    name : str
+        The argument's name, for the message.
+
+    Raises
+    ------
+    ValueError
+        Naming both wind speeds, the plant cases and the fix.
+    """
+    made = getattr(spec, "wind_speed", None)
+    if made is None and hasattr(spec, "base"):
+        made = getattr(spec.base, "wind_speed", None)
+    try:
+        made = float(made)
+    except (TypeError, ValueError):
+        return
+    if not np.isfinite(made) or made == float(wind_speed):
+        return
+    cases = tuple(float(c) for c in getattr(spec, "case_speeds", ()) or ())
+    certified = f" and certified on the plant cases {cases} m/s" if cases else ""
+    raise ValueError(f"{name} was made at {made:g} m/s{certified}, not at wind_speed={float(wind_speed):g} m/s: its "
+                     f"promise holds there only; make one at {float(wind_speed):g} m/s (e.g. "
+                     f"feasibility.specification_for_target(model, {float(wind_speed):g}, target)) or design at "
+                     f"{made:g} m/s")

@@ -86,6 +86,11 @@ class TargetSpecification:
     m: float = 4.0
 
     @property
+    def wind_speed(self) -> float:
+        """The operating point the pair was made and certified at, m/s (its certificate's)."""
+        return float(self.design.wind_speed)
+
+    @property
     def template_offsets(self) -> tuple:
         """Offsets (m/s) of the non-nominal plant cases from the nominal speed.
 
