@@ -29,6 +29,7 @@ command (HSS N·m, N times that on the rotor shaft, which the plant takes).
 from __future__ import annotations
 
 import ctypes
+import os
 import re
 import shutil
 import tempfile
@@ -154,6 +155,35 @@ def _run_copy(discon_in: Path, folder: Path) -> Path:
     return out
 
 
+#: The files ROSCO opens, by the DISCON.IN key naming each and the mode key that makes it read
+#: it (ReadSetParameters.f90, ROSCO 2.9): ReadCpFile opens PerfFileName with STATUS='old' and
+#: no IOSTAT when WE_Mode > 0, so a missing table ends the whole process (gfortran's runtime
+#: error), taking the caller's interpreter with it.
+_OPENED_FILES = (("PerfFileName", "WE_Mode"), ("OL_Filename", "OL_Mode"), ("DLL_FileName", "Ext_Mode"))
+
+
+def _check_opened_files(discon_in: Path, entries: dict) -> None:
+    """Raise FileNotFoundError, naming the DISCON.IN, the line and the key, for a file ROSCO
+    will open that is missing or unreadable (checked before the library is loaded: ROSCO's
+    Fortran runtime would stop the process instead)."""
+    for key, mode in _OPENED_FILES:
+        e, m = entries.get(key), entries.get(mode)
+        try:
+            used = m is not None and int(float(m.values[0])) > 0
+        except (ValueError, IndexError):
+            raise ValueError(f"{discon_in}: line {m.line}: {mode} = {' '.join(m.values)!r} is not a whole number") from None
+        if not used:
+            continue
+        if e is None or not e.values or not e.values[0].strip('"'):
+            raise ValueError(f"{discon_in}: {mode} > 0 makes ROSCO read {key}, which is missing or empty")
+        name = e.values[0].strip('"')
+        path = Path(name) if Path(name).is_absolute() else discon_in.parent / name  # ROSCO: from the file's folder
+        if not path.is_file() or not os.access(path, os.R_OK):
+            why = "does not exist" if not path.exists() else "is not a readable file"
+            raise FileNotFoundError(f"{discon_in}: line {e.line}: {key} = {e.values[0]}: {path} {why}; ROSCO "
+                                    f"({mode} = {m.values[0]}) would stop the Python process opening it")
+
+
 class Discon:
     """ROSCO's compiled controller (its DISCON library) as a controller of :func:`specdesign.simulate.simulate`.
 
@@ -175,7 +205,12 @@ class Discon:
     Raises
     ------
     FileNotFoundError
-        If ``discon_in`` or ``library`` does not exist.
+        If ``discon_in`` or ``library`` does not exist, or a file ROSCO will open does not
+        (``PerfFileName`` with ``WE_Mode`` > 0, ``OL_Filename`` with ``OL_Mode`` > 0,
+        ``DLL_FileName`` with ``Ext_Mode`` > 0; relative names from the DISCON.IN's folder):
+        ROSCO's Fortran runtime would end the Python process on a missing performance table,
+        so every such file is checked before the library is loaded, and the message names the
+        DISCON.IN, the line and the key.
     ModuleNotFoundError
         Without ``library``, if the ``rosco`` package is not installed.
     ValueError
@@ -206,6 +241,7 @@ class Discon:
     def __init__(self, discon_in: str | Path, library: str | Path | None = None, *, name: str = "ROSCO DISCON"):
         self.discon_in = Path(discon_in)
         entries, self.file_version = read_discon(self.discon_in)
+        _check_opened_files(self.discon_in, entries)  # before the library is loaded (it can end the process)
         self.library = Path(library) if library is not None else rosco_library()
         if not self.library.is_file():
             raise FileNotFoundError(f"library={str(self.library)!r} does not exist")
