@@ -5,10 +5,13 @@ TypeError whose message names the argument and says how to fix it.
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 __all__ = ["as_omega", "as_psd", "as_signal", "as_real", "real_scalar", "positive_scalar", "del_target",
-           "distinct_keys", "bisection_tolerance", "MAX_BISECTIONS", "finite_system", "spec_made_at"]
+           "distinct_keys", "bisection_tolerance", "MAX_BISECTIONS", "finite_system", "spec_made_at",
+           "bad_measurements"]
 
 #: Most halvings of a bisection: 100 halve any interval a search starts from (≤ 1e3 dB or m/s)
 #: below 1e-27, far under any tolerance a user asks for, so a tolerance float64 cannot resolve
@@ -234,3 +237,45 @@ def spec_made_at(spec, wind_speed: float, name: str = "spec") -> None:
                      f"promise holds there only; make one at {float(wind_speed):g} m/s (e.g. "
                      f"feasibility.specification_for_target(model, {float(wind_speed):g}, target)) or design at "
                      f"{made:g} m/s")
+
+
+def bad_measurements(y, names, t: float, warned: set, who: str) -> np.ndarray:
+    """The runs whose measurements ``names`` hold NaN or inf at time ``t``: the controllers'
+    common convention for a bad sample.
+
+    Every controller of the simulator's callable contract (:class:`specdesign.mpc.SampledController`
+    and its subclasses, :class:`specdesign.mpc.HealthMPC`, :class:`specdesign.rosco.Discon`)
+    treats such a run alike: it holds its last command, leaves its state (estimator,
+    filters, counters) as it was, and resumes at the next finite sample; a RuntimeWarning
+    names the signal, the time and the run, once per signal and run start (``warned``).
+
+    Parameters
+    ----------
+    y : dict
+        Output name → (R,) measurements (SI).
+    names : sequence of str
+        The measurements the controller reads.
+    t : float
+        Time (s), for the message.
+    warned : set
+        Signals already warned about since the controller's start (updated).
+    who : str
+        The controller's name, for the message.
+
+    Returns
+    -------
+    numpy.ndarray
+        (R,) bool, True where a run's sample is not finite.
+    """
+    bad = None
+    for n in names:
+        v = np.asarray(y[n], dtype=float)
+        b = ~np.isfinite(v)
+        bad = b if bad is None else bad | b
+        if b.any() and n not in warned:
+            warned.add(n)
+            r = int(np.flatnonzero(b)[0])
+            warnings.warn(f"{who}: measurement {n!r} = {float(np.ravel(v)[r])!r} at t = {t:g} s (run {r}): the run "
+                          f"holds its last command until {n} is finite again (said once per signal)", RuntimeWarning,
+                          stacklevel=3)
+    return bad

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from .._checks import bad_measurements
 from .discon_file import read_discon
 
 __all__ = ["SWAP_SIZE", "DisconError", "rosco_library", "rosco_test_cases", "Discon"]
@@ -329,12 +330,13 @@ class Discon:
     def _message(self, r: int) -> str:
         return bytes(self._msg[r]).split(b"\0", 1)[0].decode(errors="replace").strip()
 
-    def _call_all(self, status: int) -> None:
+    def _call_all(self, status: int, skip=None) -> None:
         sw = self._swap
         sw[:, 0] = status
         fns, infile = self._fns, self._infile
         for r, (a, f, o, m) in enumerate(self._args):
-            fns[r](a, f, infile, o, m)
+            if skip is None or not skip[r]:  # a skipped run (a bad sample) keeps ROSCO's state and command
+                fns[r](a, f, infile, o, m)
         self._flush()
         if self._fail.min() < 0:
             r = int(np.flatnonzero(self._fail < 0)[0])
@@ -371,17 +373,37 @@ class Discon:
         RuntimeError
             If :meth:`start` was not called.
         ValueError
-            If ROSCO refuses the DISCON.IN at its initialisation (the parameter is named).
+            If ROSCO refuses the DISCON.IN at its initialisation (the parameter is named), or
+            a measurement is NaN or inf at the first call (ROSCO initialises on it).
         DisconError
             If ROSCO stops a run later.
+
+        Warns
+        -----
+        RuntimeWarning
+            Once per signal, for a NaN or inf measurement after the first call: ROSCO is not
+            called for that run at that step, which holds its last commands (and ROSCO its
+            state) until the signal is finite again (:func:`specdesign._checks.bad_measurements`,
+            the convention of every controller).
         """
         if not self._runs:
             raise RuntimeError("Discon.start(dt, wind, pitch, torque) must run first (simulate calls it)")
-        omega = np.ascontiguousarray(y["gen_speed"], dtype=float)
+        signals = ("gen_speed", "pitch", "power", "tower_top_acc")
+        if self._step == 0:
+            self._warned = set()
+            bad = [n for n in signals if not np.all(np.isfinite(np.asarray(y[n], float)))]
+            if bad:  # ROSCO initialises on this sample: no command to hold yet
+                raise ValueError(f"{self.__name__}: measurement {bad[0]!r} is not finite at the first call (t = "
+                                 f"{float(t):g} s): ROSCO initialises on it, and there is no command to hold yet")
+        bad = bad_measurements(y, signals, float(t), self._warned, self.__name__)
+        keep = self._swap[bad].copy() if bad.any() else None
+        omega = np.ascontiguousarray(np.where(bad, 0.0, y["gen_speed"]), dtype=float)  # the azimuth holds too
         _fill_swap(self._swap, float(t), omega, np.ascontiguousarray(y["pitch"], dtype=float),
                    np.ascontiguousarray(y["power"], dtype=float), np.ascontiguousarray(y["tower_top_acc"], dtype=float),
                    self.gearbox_ratio)
-        self._call_all(0 if self._step == 0 else 1)
+        if keep is not None:
+            self._swap[bad] = keep
+        self._call_all(0 if self._step == 0 else 1, skip=bad if keep is not None else None)
         self._step += 1
         pitch, torque = np.empty(self._runs), np.empty(self._runs)
         _read_swap(self._swap, omega, self._dt, self.gearbox_ratio, pitch, torque)
