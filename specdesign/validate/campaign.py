@@ -311,7 +311,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         runs already there and simulates only the missing ones: an interrupted campaign
         resumes, and one given more seeds, speeds or controllers runs only those. The
         result is bitwise that of an uninterrupted run. A store holding other settings,
-        another model or another controller under the same name is refused.
+        another model or another controller under the same name is refused; a stored cell
+        that fails verification (unreadable, another cell's coordinates, its checksum) is
+        recomputed with a RuntimeWarning naming its file.
     torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, default "auto"
         Generator torque of the simulations (:func:`specdesign.simulate.simulate`): "auto"
         runs the model's torque law below rated and holds the trim torque above; "rosco"
