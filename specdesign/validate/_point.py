@@ -72,8 +72,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
                 r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
                              record_dt=record_dt, transient=transient, torque_control=tc)
             except SimulationDivergedError as err:
-                warnings.warn(f"{err}; campaign results of {name!r} at {v:g} m/s are NaN", ClosedLoopUnstableWarning,
-                              stacklevel=3)
+                warnings.warn(f"controller {name!r}: {err}; campaign results of {name!r} at {v:g} m/s are NaN",
+                              ClosedLoopUnstableWarning, stacklevel=3)
                 bad = np.array([np.nan])
         out["unstable"].append(bool(bad.size))
         if r is None:
@@ -90,8 +90,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
                                   record_dt=record_dt, transient=transient, linear=True)
                     lin = indicators(rl.outputs, rl.dt, m).as_dict()
                 except SimulationDivergedError as err:  # keep the nonlinear results: only the twin is NaN
-                    warnings.warn(f"{err}; the linear twin of {name!r} at {v:g} m/s is NaN", ClosedLoopUnstableWarning,
-                                  stacklevel=3)
+                    warnings.warn(f"controller {name!r}: {err}; the linear twin of {name!r} at {v:g} m/s is NaN",
+                                  ClosedLoopUnstableWarning, stacklevel=3)
             for k, val in lin.items():
                 out["linear"].setdefault(k, []).append(val[0])
         if volterra:
