@@ -113,12 +113,11 @@ def test_discon_holds_too(model):
     d = deck / "IEA-15-240-RWT-Monopile_DISCON.IN"
     clean, _ = _run(model, Discon(d))
     r, msgs = _run(model, Inject(Discon(d), t0=5.0, t1=5.05))
-    t = np.arange(r["pitch_cmd"].shape[-1]) * 0.02
     run0 = r["pitch_cmd"][0, 0]
     assert np.all(np.isfinite(r["pitch_cmd"])) and np.all(np.isfinite(r["power"]))
     # ROSCO is called every step (0.02 s): the steps at 5.00, 5.02 and 5.04 s are skipped, so
     # the command of the 4.98 s step is held in the records at 5.02, 5.04 and 5.06 s
-    i = int(round(5.0 / 0.02))
+    i = round(5.0 / 0.02)
     assert run0[i + 1] == run0[i + 2] == run0[i + 3]
     np.testing.assert_array_equal(run0[:i + 1], clean["pitch_cmd"][0, 0][:i + 1])
     np.testing.assert_array_equal(r["pitch_cmd"][1, 0], clean["pitch_cmd"][1, 0])

@@ -7,6 +7,7 @@ import warnings
 
 import numpy as np
 
+from .._blas import on_one_blas_thread
 from ..closedloop import unstable_message, unstable_poles
 from ._loop import has_linear_form, rotor_radius
 from .metrics import INDICATORS, indicators
@@ -33,6 +34,10 @@ def _nan_point(out, omega, n_seeds, linear_twin, volterra):
         out["ppsd"][k].append(np.full(omega.size, np.nan))
 
 
+# BLAS on one thread in every task, wherever it runs: a campaign's results must not depend on
+# the thread count of the process running it (a dask worker's differs from the client's, and a
+# threaded reduction sums in another order: 12 of 384 values differed in the last bit)
+@on_one_blas_thread
 def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
                     turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0, torque_control="auto"):
     """One wind speed, every controller, the same seeds: indicators, per-seed spectra, predictions.

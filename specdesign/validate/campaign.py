@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._blas import on_one_blas_thread
 from .._checks import positive_scalar
 from ._loop import has_linear_form
 from ._point import SPECTRA, campaign_point
@@ -240,6 +241,7 @@ def check_campaign_step(model, controllers: Mapping, wind_speeds, dt: float) -> 
                 raise ValueError(f"campaign controller {name!r}: {err}") from None
 
 
+@on_one_blas_thread  # the tasks' own limit (campaign_point) nests in it: two local threads never undo it
 def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, duration: float = 600.0, dt: float = 0.02,
                  record_dt: float = 0.1, transient: float = 60.0, m: float = 4.0, predict: bool = True,
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
