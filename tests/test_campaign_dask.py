@@ -77,7 +77,7 @@ def test_bitwise_whatever_blas_threads_the_workers_start_with(setup):
     # dask starts workers with OPENBLAS/OMP/MKL_NUM_THREADS=1 (distributed.nanny.pre-spawn-environ);
     # without that they run BLAS on every core, as a local run does by default. Every task runs
     # BLAS on one thread itself (campaign_point), so neither the workers' environment nor the
-    # client's thread count changes a bit (before: 12 of 384 values differed in the last bit).
+    # client's thread count changes a bit.
     import dask
     from threadpoolctl import threadpool_limits
 

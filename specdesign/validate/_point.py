@@ -36,7 +36,7 @@ def _nan_point(out, omega, n_seeds, linear_twin, volterra):
 
 # BLAS on one thread in every task, wherever it runs: a campaign's results must not depend on
 # the thread count of the process running it (a dask worker's differs from the client's, and a
-# threaded reduction sums in another order: 12 of 384 values differed in the last bit)
+# threaded BLAS reduction may sum in another order)
 @on_one_blas_thread
 def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
                     turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0, torque_control="auto"):
