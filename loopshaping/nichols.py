@@ -304,6 +304,12 @@ def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes |
         for i, w in enumerate(design):
             j = int(np.argmin(np.abs(grid - w)))
             ax.plot(lo + np.mod(ph[j] - lo, 360.0), mag[j], "o", color=colours[i], mec="k", ms=7)
+    # the critical point (−180° + k·360°, 0 dB) in every period the window shows: the loop's
+    # distance to it is the stability margin a reader looks for first
+    crit = [p for p in -180.0 + 360.0 * np.arange(np.floor((lo + 180.0) / 360.0), np.ceil((hi + 180.0) / 360.0) + 1)
+            if lo <= p <= hi]
+    if crit:
+        ax.plot(crit, np.zeros(len(crit)), "+", color="r", ms=12, mew=2, zorder=5, label="critical point (−180°, 0 dB)")
     ax.set_xlim(lo, hi)
     if ylim is not None:
         ax.set_ylim(*ylim)

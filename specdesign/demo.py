@@ -143,8 +143,9 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     _say(f"      C_β(s) = {_tf_text(pitch)}")
     if atd is not None:
         _say(f"      C_ATD(s) = {_tf_text(atd)}")
-    fig = Figure(figsize=(14, 5.5))
-    plot_design_nichols(design, axes=fig.subplots(1, 2))
+    n_loops = 1 if atd is None else 2  # a pitch-only design has no ATD chart to draw
+    fig = Figure(figsize=(7 * n_loops, 5.5))
+    plot_design_nichols(design, axes=fig.subplots(1, n_loops, squeeze=False)[0])
     fig.savefig(out / "3_nichols.png", dpi=120)
     fig = Figure(figsize=(9, 7.5))
     plot_design_bode(design, model, axes=fig.subplots(2, 1, sharex=True))
