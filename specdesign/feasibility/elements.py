@@ -328,11 +328,9 @@ def _seeds(base, grid, r):
 
 def _unstable_pole(design, model):
     """The rightmost pole (1/s) of a certificate's controller when it is itself unstable (real
-    part above :data:`specdesign.qft.UNSTABLE_CONTROLLER_RATE`), else None: design_qft refuses
+    part above :data:`specdesign.closedloop.UNSTABLE_CONTROLLER_RATE`), else None: design_qft refuses
     such a controller (a saturated pitch opens the loop) and reduces its design from it."""
     import control as ct
-
-    from ..qft import UNSTABLE_CONTROLLER_RATE
 
     poles = np.asarray(ct.poles(design.controller(model)))
     if poles.size and poles.real.max() > UNSTABLE_CONTROLLER_RATE:

@@ -15,8 +15,8 @@ import control as ct
 import numpy as np
 
 from .._checks import del_target, positive_scalar
-from ..closedloop import (case_speeds, check_stability, closed_loop, lightly_damped, plant_responses, refine_grid,
-                          siso_response)
+from ..closedloop import (UNSTABLE_CONTROLLER_RATE, case_speeds, check_stability, closed_loop, lightly_damped,
+                          plant_responses, refine_grid, siso_response)
 from .checks import bounds_met, loop_checks, spec_ratio, spec_roots
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
@@ -30,17 +30,12 @@ if TYPE_CHECKING:
     from ..turbine import TurbineModel
 
 __all__ = ["QFTDesign", "design_qft", "assemble_design", "design_schedule", "design_table", "format_table",
-           "DEFAULT_DESIGN_OMEGA", "check_design_speed", "UNSTABLE_CONTROLLER_RATE"]
+           "DEFAULT_DESIGN_OMEGA", "check_design_speed"]
 
 
 #: Default QFT design frequencies, rad/s: the wind band, the tower mode (~1.06 rad/s) and
 #: the actuator band.
 DEFAULT_DESIGN_OMEGA = np.unique(np.r_[0.005, 0.007, np.logspace(-2, 1, 37), 0.9, 0.95, 1.0, 1.03, 1.05, 1.07, 1.1, 1.15, 1.2])
-
-
-#: Growth rate (1/s) above which a controller pole counts as unstable in :func:`design_qft`'s
-#: checks: slower modes grow less than e-fold over a 10-minute record.
-UNSTABLE_CONTROLLER_RATE = 1e-3
 
 
 # ----------------------------------------------------------------------------- result
@@ -124,7 +119,7 @@ class QFTDesign:
     success : bool
         Every specification met: target (within 0.5 pp), bounds, dense checks, stability of
         every closed loop and of the controller itself (no pole growing faster than
-        :data:`UNSTABLE_CONTROLLER_RATE`: a saturated pitch opens the loop).
+        :data:`specdesign.closedloop.UNSTABLE_CONTROLLER_RATE`: a saturated pitch opens the loop).
     message : str
         ``"all specifications met"`` or what failed.
     parameters : dict of str to float

@@ -3,7 +3,7 @@
 One ``@njit`` loop integrates a batch of runs in parallel (``prange`` over runs): per run, fixed-step
 RK4 of the plant kernel pair with the wind linearly interpolated between its samples, the pitch
 command and generator torque held over a step, and the discrete controller bank of
-:mod:`specdesign.simulate.controllers` (output-blended locals, each with its integrator run
+:mod:`specdesign.controller.scheduled` (output-blended locals, each with its integrator run
 apart and clamped or conditionally integrated, and ROSCO's gain-scheduled PI) scheduled on the
 filtered pitch command. See :mod:`specdesign.simulate` for the conventions.
 
@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:  # pragma: no cover
     import control
 
-from ..rosco.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
+from ..controller.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
 from ..turbine import aero_loads as _turbine_aero
 from ..turbine import mechanics as _turbine_mechanics
 from ..turbine import outputs as _turbine_outputs

@@ -74,18 +74,3 @@ __all__ = [
     # lifetime
     "DEL_CHANNELS", "WindClimate", "weibull_bins", "wind_climate", "LifetimeDEL", "lifetime",
 ]
-
-#: names that moved to :mod:`specdesign.cli` (campaign files are the command line's business)
-_MOVED_TO_CLI = ("ConfigError", "read_config", "load_controller", "run_config")
-
-
-def __getattr__(name):
-    if name in _MOVED_TO_CLI:
-        import warnings
-
-        warnings.warn(f"specdesign.validate.{name} moved to specdesign.cli.{name}; import it from there",
-                      DeprecationWarning, stacklevel=2)
-        from .. import cli
-
-        return getattr(cli, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

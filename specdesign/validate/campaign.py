@@ -454,7 +454,7 @@ def _overlap(controllers) -> bool:
 
 def _torque_setting(torque_control):
     """``torque_control`` as a JSON-serialisable store setting (a law by its fingerprint), checked up front."""
-    from ..rosco.torque import TorqueLaw
+    from ..controller.torque import TorqueLaw
 
     if isinstance(torque_control, TorqueLaw):
         from .store import fingerprint

@@ -69,7 +69,7 @@ TORQUE_STATES = 16
 
 @dataclass(frozen=True)
 class TorqueLaw:
-    """ROSCO's generator-torque controller, on the rotor shaft (see :mod:`specdesign.rosco.torque`).
+    """ROSCO's generator-torque controller, on the rotor shaft (see :mod:`specdesign.controller.torque`).
 
     Parameters
     ----------
@@ -508,7 +508,7 @@ def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):
 @njit(cache=True)
 def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitch: float, dt: float,
                 first: bool) -> tuple[float, float]:
-    """One step of ROSCO's torque controller (compiled; :mod:`specdesign.rosco.torque`).
+    """One step of ROSCO's torque controller (compiled; :mod:`specdesign.controller.torque`).
 
     Parameters
     ----------
