@@ -23,8 +23,21 @@ objects).
 """
 from __future__ import annotations
 
-from .discon_file import DisconEntry, DisconSchedule, from_discon, read_discon, write_discon
-from .lti import SLOW_OMEGA, as_lti, is_lti_like, split_integrator, split_slow, tustin_matrices
+from .discon_file import (
+    DisconEntry,
+    DisconSchedule,
+    from_discon,
+    read_discon,
+    write_discon,
+)
+from .lti import (
+    SLOW_OMEGA,
+    as_lti,
+    is_lti_like,
+    split_integrator,
+    split_slow,
+    tustin_matrices,
+)
 from .scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from .torque import (
     TORQUE_MODES,

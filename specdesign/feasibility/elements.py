@@ -47,6 +47,7 @@ from dataclasses import replace
 import numpy as np
 
 from .._blas import on_one_blas_thread
+from ..closedloop import UNSTABLE_CONTROLLER_RATE
 
 __all__ = ["BELOW_WEIGHT", "ENVELOPES", "ENVELOPE_LOSS_PP", "FIT_OMEGA", "FOLLOW", "FOLLOW_GAIN_DB", "HEADROOM_PP",
            "MAX_ITERATIONS", "MAX_NOTCHES", "PROMISE_MARGIN_PP", "REGULARISATION", "SMOOTHING_DB",

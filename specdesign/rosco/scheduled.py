@@ -18,7 +18,12 @@ from numpy.typing import ArrayLike
 from ..controller.discon_file import DisconSchedule
 from ..controller.scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from ..turbine import TurbineModel, iea15mw
-from ..turbine.baseline import RoscoSchedule, rosco_baseline, rosco_gain_schedule, speed_filter
+from ..turbine.baseline import (
+    RoscoSchedule,
+    rosco_baseline,
+    rosco_gain_schedule,
+    speed_filter,
+)
 from ..turbine.plant import scheduled, turbine_plant
 from ..turbine.tables import DATA_DIR
 

@@ -32,6 +32,7 @@ stand on it.
 """
 from __future__ import annotations
 
+from .baseline import RoscoSchedule, rosco_baseline, rosco_gain_schedule, speed_filter
 from .kernel import (
     INPUT_NAMES,
     OUTPUT_NAMES,
@@ -61,7 +62,6 @@ from .kernel import (
     outputs_from,
     rhs,
 )
-from .baseline import RoscoSchedule, rosco_baseline, rosco_gain_schedule, speed_filter
 from .model import TurbineModel, iea15mw
 from .openfast_deck import from_openfast
 from .operating import AERO_VARIABLES, LOAD_INPUT_NAMES, AeroExpansion, OperatingPoint

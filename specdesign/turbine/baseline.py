@@ -14,7 +14,6 @@ and lives in :mod:`specdesign.rosco`, which re-exports these names (ROSCO in one
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
