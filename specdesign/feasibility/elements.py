@@ -36,7 +36,7 @@ promise(s + g) − :data:`REGULARISATION`·mean(e²) with g the log-sum-exp of r
 :data:`SMOOTHING_DB` (the least gain above r for a shape s), then settle the gain as above.
 This fallback is slower (a chain of non-convex fits per headroom) and its elements follow a
 certificate for a larger target, so it needs a more relaxed speed map.
-:func:`specdesign.spec.shape_to_target` with ``band="whole"`` is the user's entry point.
+:func:`specdesign.feasibility.shape_whole_band` is the user's entry point.
 
 Units: ω in rad/s, magnitudes in dB here, promises in % DEL.
 """
