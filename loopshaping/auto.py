@@ -25,10 +25,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_keywords
-from .bounds import Bounds, BoundsWarning, bounds, intersect
+from .bounds import Bounds, BoundsWarning, as_specs, bounds, intersect
+from .check import check
 from .controller import Controller
 from .freqresp import check_grid, evaluate
-from .specs import as_specs
 from .templates import Template
 
 __all__ = ["InfeasibleError", "RefineResult", "refine", "shape"]
@@ -317,8 +317,6 @@ def refine(template: Template, specs: "Bounds | Spec | Sequence[Spec]", omega: A
     ValueError
         If the template has no systems, a disk radius that varies, or ``max_rounds`` < 1.
     """
-    from .check import check
-
     if not isinstance(template, Template):
         raise TypeError(f"template must be a loopshaping.qft.Template; got {type(template).__name__}")
     if template.systems is None:

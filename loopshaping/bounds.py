@@ -20,6 +20,7 @@ Frequencies in rad/s; magnitudes in dB only in the bound tables (``forbidden_db`
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,7 +31,7 @@ from .freqresp import DEFAULT_PHASES_DEG, check_phases, grid_indices
 from .specs import Spec
 from .templates import Template, tracking_pairs
 
-__all__ = ["DEFAULT_PHASES_DEG", "Bounds", "BoundsWarning", "bounds", "intersect"]
+__all__ = ["DEFAULT_PHASES_DEG", "Bounds", "BoundsWarning", "bounds", "intersect", "as_specs"]
 
 # Phases × cases evaluated at once: small enough to stay in cache (measured optimum).
 _BLOCK = 50_000
@@ -539,3 +540,37 @@ def intersect(*bounds_list: Bounds) -> Bounds:
 
 
 Bounds.__init__ = renamed_keywords(omegas="omega")(Bounds.__init__)
+
+
+def as_specs(specs: Bounds | Spec | Iterable[Spec]) -> list:
+    """A Bounds (its specs), one Spec, or an iterable of Spec → a non-empty list of Spec.
+
+    Parameters
+    ----------
+    specs : Bounds or Spec or iterable of Spec
+        The specifications.
+
+    Returns
+    -------
+    list of Spec
+        Non-empty.
+
+    Raises
+    ------
+    TypeError
+        If ``specs`` is empty or holds something else than :class:`Spec`.
+
+    Examples
+    --------
+    >>> [sp.name for sp in as_specs(Spec("stability", 1.2))]
+    ['stability']
+    """
+    if isinstance(specs, Bounds):
+        specs = list(specs.specs)
+    elif isinstance(specs, Spec):
+        specs = [specs]
+    else:
+        specs = list(specs)
+    if not specs or not all(isinstance(sp, Spec) for sp in specs):
+        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
+    return specs

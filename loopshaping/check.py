@@ -16,9 +16,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._deprecation import renamed_attribute, renamed_keywords
+from .bounds import as_specs
 from .controller import Controller
 from .freqresp import check_grid, evaluate, is_lti
-from .specs import as_specs
 from .templates import Template
 
 __all__ = ["CheckResult", "check", "closed_loop_poles", "feedback_poles"]

@@ -3,7 +3,7 @@
 Every specification is written in the general form |(A + B·G)/(C + D·G)| ≤ W per case; the
 classic kinds (:data:`KINDS`) only choose A, B, C, D from the plant P. :class:`Spec` holds
 one specification (kind, weight, band, name, kind arguments) and evaluates its weight and
-coefficients at any frequencies; :func:`as_specs` normalises "a Bounds, a Spec or a list of
+coefficients at any frequencies; :func:`loopshaping.bounds.as_specs` normalises "a Bounds, a Spec or a list of
 Spec" arguments.
 
 Frequencies in rad/s; weights are linear magnitudes (not dB).
@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from ._deprecation import renamed_keywords
 from .freqresp import evaluate, is_lti
 
-__all__ = ["KINDS", "Spec", "as_specs"]
+__all__ = ["KINDS", "Spec"]
 
 KINDS = ("stability", "sensitivity", "input_disturbance", "control_effort", "noise", "tracking", "general")
 _KIND_ARGS = {
@@ -282,39 +282,3 @@ def _static_gain(sys):
     if isinstance(sys, ct.StateSpace) and sys.nstates == 0:
         return float(np.real(sys.D[0, 0]))
     return None
-
-
-def as_specs(specs: "Bounds | Spec | Iterable[Spec]") -> list:
-    """A Bounds (its specs), one Spec, or an iterable of Spec → a non-empty list of Spec.
-
-    Parameters
-    ----------
-    specs : Bounds or Spec or iterable of Spec
-        The specifications.
-
-    Returns
-    -------
-    list of Spec
-        Non-empty.
-
-    Raises
-    ------
-    TypeError
-        If ``specs`` is empty or holds something else than :class:`Spec`.
-
-    Examples
-    --------
-    >>> [sp.name for sp in as_specs(Spec("stability", 1.2))]
-    ['stability']
-    """
-    from .bounds import Bounds  # bounds imports this module
-
-    if isinstance(specs, Bounds):
-        specs = list(specs.specs)
-    elif isinstance(specs, Spec):
-        specs = [specs]
-    else:
-        specs = list(specs)
-    if not specs or not all(isinstance(sp, Spec) for sp in specs):
-        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
-    return specs

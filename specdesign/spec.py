@@ -33,9 +33,13 @@ import control as ct
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import spectral
+from loopshaping import controller as lc
+from loopshaping.controller import Controller, Element
+
+from . import closedloop, spectral, turbine, wind
 from ._checks import as_omega, as_psd, positive_scalar
 from .closedloop import siso_response
+from .rosco import rosco_baseline, rosco_gain_schedule
 
 if TYPE_CHECKING:
     from loopshaping.controller import Controller, Element
@@ -149,8 +153,6 @@ class Notch:
         tuple of loopshaping.controller.Element
             One ``notch(omega_n, zeta_zero, width)``.
         """
-        from loopshaping import controller as lc
-
         return (lc.notch(self.omega_n, self.zeta_zero, self.width),)
 
 
@@ -205,8 +207,6 @@ class Gain:
         tuple of loopshaping.controller.Element
             One ``gain(10^(gain_db/20))``.
         """
-        from loopshaping import controller as lc
-
         return (lc.gain(10 ** (self.gain_db / 20)),)
 
 
@@ -277,8 +277,6 @@ class LeadLag:
         tuple of loopshaping.controller.Element
             One ``lead_lag(omega_zero, omega_pole)``.
         """
-        from loopshaping import controller as lc
-
         return (lc.lead_lag(self.omega_zero, self.omega_pole),)
 
 
@@ -349,8 +347,6 @@ class LowPass:
         tuple of loopshaping.controller.Element
             A ``complex_pole`` (ζ < 1) or two ``real_pole`` at ω_c(ζ ± √(ζ² − 1)) (ζ ≥ 1).
         """
-        from loopshaping import controller as lc
-
         if self.zeta < 1:
             return (lc.complex_pole(self.omega_c, self.zeta),)
         r = math.sqrt(self.zeta ** 2 - 1)
@@ -390,8 +386,6 @@ def from_element(element: Element) -> Gain | LeadLag | Notch | LowPass:
     >>> from_element(lc.notch(1.0, 0.05, 0.2))       # ζ_z/ζ_p = 1/4: 12 dB deep
     Notch(omega_n=1.0, depth_db=12.041199826559248, width=0.2)
     """
-    from loopshaping.controller import Element
-
     if not isinstance(element, Element):
         raise TypeError(f"element must be a loopshaping.controller.Element, got {type(element).__name__}")
     k, p = element.kind, element.params
@@ -547,8 +541,6 @@ class Specification:
         loopshaping.controller.Controller
             The elements' product (-), without the baseline.
         """
-        from loopshaping.controller import Controller
-
         return Controller(tuple(x for e in self.elements for x in e.to_elements()))
 
     def with_elements(self, elements: Iterable) -> "Specification":
@@ -768,8 +760,6 @@ def baseline_controller(model, wind_speed: float) -> ct.LTI:
     own = getattr(model, "baseline_controller", None)
     if callable(own):
         return own(wind_speed)
-    from . import turbine
-
     return turbine.rosco_baseline(model, wind_speed)
 
 
@@ -798,8 +788,6 @@ def baseline_controllers(model, wind_speeds: Sequence[float]) -> list:
     """
     if callable(getattr(model, "baseline_controller", None)):
         return [model.baseline_controller(float(v)) for v in wind_speeds]
-    from .rosco import rosco_baseline, rosco_gain_schedule
-
     schedule = rosco_gain_schedule(model)  # once for every speed (the same fit each call would redo)
     return [rosco_baseline(model, float(v), schedule=schedule) for v in wind_speeds]
 
@@ -856,8 +844,6 @@ def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tow
     >>> print(f"{base.output}: DEL {base.del_1hz / 1e6:.1f} MN·m, ΣΔD% = {base.sensitivity.sum():.2f}")
     tower_base_my: DEL 32.2 MN·m, ΣΔD% = 2.00
     """
-    from . import closedloop, wind
-
     omega = default_omega() if omega is None else as_omega(omega, allow_zero=False)
     plant = model.linearize(wind_speed)
     c = baseline_controller(model, wind_speed) if controller is None else controller
@@ -1188,8 +1174,6 @@ def speed_specification(model: TurbineModel, wind_speed: float, *, margin_db: fl
     >>> speed_specification(iea15mw(), 19.0, margin_db=3.0).elements
     (Gain(gain_db=3.0),)
     """
-    from . import closedloop
-
     plant = model.linearize(wind_speed)
     c = baseline_controller(model, wind_speed) if controller is None else controller
     cl = closedloop.closed_loop(plant, c)

@@ -65,14 +65,9 @@ def test_every_old_name_is_still_importable(module, names):
     assert set(mod.__all__) <= set(star)
 
 
-def test_discretize_is_renamed_tustin_matrices():
-    # simulate.discretize (the kernel's matrices) and loopshaping.hinf.discretize (a discrete
-    # LTI) shared a name; the simulator's is now tustin_matrices, the old name warns
+def test_tustin_matrices_are_python_controls_tustin_map():
     import control
 
-    with pytest.warns(DeprecationWarning, match="tustin_matrices"):
-        old = simulate.discretize
-    assert old is simulate.tustin_matrices
     c = control.tf([1.0, 0.2], [1.0, 1.0, 0.5])
     A, B, C, D = simulate.tustin_matrices(c, 0.05)
     d = control.c2d(control.ss(c), 0.05, method="tustin")  # python-control's own Tustin map

@@ -10,6 +10,7 @@ linearisation, with the torque loop closed in it.
 """
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -215,8 +216,6 @@ def local_response(model: TurbineModel | KernelPlant | None, controller: Any, wi
     >>> np.round(np.abs(cb), 3), ca
     (array([0.448, 0.086]), array([0.+0.j, 0.+0.j]))
     """
-    import warnings
-
     s = np.asarray(s)
     plant = turbine_plant(model)
     if plant.rated_wind_speed is not None and wind_speed < plant.rated_wind_speed:

@@ -7,11 +7,13 @@ same :class:`~specdesign.spec.ShapingResult` out, but shaped over the whole band
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .. import spectral
-from ..spec import Baseline, Notch, ShapingResult
 from .elements import MAX_NOTCHES, element_specification
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..spec import Baseline, ShapingResult
 
 __all__ = ["shape_whole_band"]
 
@@ -76,6 +78,12 @@ def shape_whole_band(base: Baseline, target_reduction: float, *, quantity: str =
     >>> bool(res.promise.exact_del >= 25.0), res.certified.case_speeds      # doctest: +SKIP
     (True, (24.0, 24.5, 25.0))
     """
+    from ..spec import (  # heavy: python-control (feasibility loads without it)
+        Baseline,
+        Notch,
+        ShapingResult,
+    )
+
     if not isinstance(base, Baseline):
         raise TypeError(f"base must be a Baseline (see baseline_analysis), got {type(base).__name__}")
     if quantity not in ("damage", "del"):

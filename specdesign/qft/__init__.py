@@ -98,12 +98,3 @@ __all__ = [
     "design_torque",
     "torque_general_form",
 ]
-
-
-def __getattr__(name):
-    if name == "DEFAULT_DESIGN_OMEGAS":  # renamed: one name for frequency grids, omega
-        import warnings
-
-        warnings.warn("DEFAULT_DESIGN_OMEGAS is deprecated, use DEFAULT_DESIGN_OMEGA", DeprecationWarning, stacklevel=2)
-        return DEFAULT_DESIGN_OMEGA
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -29,6 +29,7 @@ command (HSS N·m, N times that on the rotor shaft, which the plant takes).
 from __future__ import annotations
 
 import ctypes
+import importlib.metadata
 import re
 import shutil
 import tempfile
@@ -77,8 +78,6 @@ class DisconError(RuntimeError):
 
 
 def _rosco_file(rel: str) -> Path:
-    import importlib.metadata
-
     try:
         dist = importlib.metadata.distribution("rosco")
     except importlib.metadata.PackageNotFoundError:

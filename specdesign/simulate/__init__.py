@@ -127,12 +127,3 @@ __all__ = [
     "FORMS",
     "warn_unstable",
 ]
-
-def __getattr__(name):
-    if name == "discretize":  # renamed: loopshaping.hinf.discretize returns a discrete LTI, this the kernel's matrices
-        import warnings
-
-        warnings.warn("specdesign.simulate.discretize is deprecated, use specdesign.simulate.tustin_matrices",
-                      DeprecationWarning, stacklevel=2)
-        return tustin_matrices
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

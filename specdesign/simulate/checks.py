@@ -5,6 +5,7 @@ unstable, is refused before any run (:func:`specdesign.simulate.simulate` applie
 from __future__ import annotations
 
 import math
+import warnings
 import weakref
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
@@ -294,8 +295,6 @@ def warn_unstable(plant: KernelPlant, controller: object, wind_speeds: Sequence[
     """
     if plant.linearize is None:
         return
-    import warnings
-
     for v in wind_speeds:
         bad = checked_loop(plant, controller, v, dt)
         if bad.size:

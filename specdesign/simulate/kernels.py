@@ -17,6 +17,7 @@ by :func:`specdesign.simulate.simulate`; nothing is meant to be called directly 
 from __future__ import annotations
 
 import math
+import types
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
@@ -489,8 +490,6 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
         :data:`KIND_LINEAR`, or :data:`KIND_USER` for a rebound user pair) and the batch loop, the one-step
         function and the outputs function of the callable path (:func:`run_callable`).
     """
-    import types
-
     if rhs is linear_rhs:
         return KIND_LINEAR, _run_batch, _step_all, _outputs_all
     if rhs is _turbine_rhs and outfn is _turbine_outputs:

@@ -15,6 +15,7 @@ The state, input and output vectors and the compiled kernel are those of
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass, field, fields
 from functools import cached_property
@@ -686,8 +687,6 @@ def iea15mw() -> TurbineModel:
     >>> iea15mw().name
     'IEA-15-240-RWT'
     """
-    import dataclasses
-
     par = json.loads(read_text("parameters.json"))
     tsr, pitch_deg, cp, ct = read_rotor_table()
     model = TurbineModel(
