@@ -26,7 +26,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_attribute, renamed_keywords
 from .freqresp import DEFAULT_PHASES_DEG, check_phases, grid_indices
 from .specs import Spec
 from .templates import Template, tracking_pairs
@@ -190,8 +189,6 @@ class _Part:
     W: np.ndarray
     forbidden_db: np.ndarray  # (n_f, n_phase, k, 2)
 
-    omegas = renamed_attribute("omegas", "omega")
-
     def ok(self, fi, L0, rtol=1e-9):
         """Spec met at frequency index fi for nominal loop values L0 (any shape) → bool."""
         G = L0[..., None] / self.p0[fi]
@@ -308,7 +305,7 @@ class Bounds:
     Parameters
     ----------
     omega : numpy.ndarray
-        (n_omega,) design frequencies, rad/s. (Former name ``omegas``: deprecated.)
+        (n_omega,) design frequencies, rad/s.
     phases_deg : numpy.ndarray
         (n_phase,) phase grid of L0, degrees.
     forbidden_db : numpy.ndarray
@@ -323,8 +320,6 @@ class Bounds:
     phases_deg: np.ndarray
     forbidden_db: np.ndarray
     parts: tuple
-
-    omegas = renamed_attribute("omegas", "omega")
 
     @property
     def names(self) -> tuple:
@@ -537,9 +532,6 @@ def intersect(*bounds_list: Bounds) -> Bounds:
         hi_all.append(hi)
     lo, hi = _merge(np.concatenate(lo_all, -1), np.concatenate(hi_all, -1))
     return Bounds(omega, phases, np.stack([lo, hi], -1), parts)
-
-
-Bounds.__init__ = renamed_keywords(omegas="omega")(Bounds.__init__)
 
 
 def as_specs(specs: Bounds | Spec | Iterable[Spec]) -> list:

@@ -24,7 +24,6 @@ from .bounds import (
     intersect,
 )
 from .freqresp import check_grid, evaluate
-from .freqresp import check_grid as _check_grid  # noqa: F401  (the former private name, for old callers)
 from .specs import KINDS, Spec
 from .templates import Template, tracking_pairs
 

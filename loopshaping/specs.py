@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
 from .freqresp import evaluate, is_lti
 
 __all__ = ["KINDS", "Spec"]
@@ -111,7 +110,6 @@ class Spec:
         if self.name is None:
             object.__setattr__(self, "name", self.kind)
 
-    @renamed_keywords(omegas="omega")
     def in_band(self, omega: ArrayLike) -> np.ndarray:
         """Where the spec applies.
 
@@ -130,7 +128,6 @@ class Spec:
             return np.ones(omega.shape, bool)
         return (omega >= self.band[0]) & (omega <= self.band[1])
 
-    @renamed_keywords(omegas="omega")
     def weights(self, omega: ArrayLike, n_cases: int, design: ArrayLike | None = None) -> np.ndarray:
         """|W| at ``omega``; for tracking, the allowed ratio.
 
@@ -197,7 +194,6 @@ class Spec:
                              "(|T| ≤ 0 cannot be met; a zero of the weighting function on the jω axis?)")
         return w
 
-    @renamed_keywords(omegas="omega")
     def coefficients(self, omega: ArrayLike, plants: np.ndarray, design: ArrayLike | None = None) -> tuple:
         """General-form coefficients A, B, C, D at ``omega`` for the plant responses ``plants``.
 
