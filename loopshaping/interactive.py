@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._designer_widget import build_widget
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
 from .freqresp import check_grid, evaluate
@@ -596,8 +597,6 @@ class Designer:
         ImportError
             Without ipywidgets.
         """
-        from ._designer_widget import build_widget
-
         if self.figure is None:
             self.draw()
         return build_widget(self)

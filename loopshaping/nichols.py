@@ -13,7 +13,6 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
 from .bounds import Bounds
 from .controller import Controller
 from .freqresp import check_grid, evaluate
@@ -22,7 +21,6 @@ from .templates import Template
 __all__ = ["draw", "loop_nichols", "m_contour", "plot_templates", "template_nichols", "wrap_phase"]
 
 
-@renamed_keywords(omegas="omega")
 def loop_nichols(loop: object, omega: ArrayLike, phase_window: tuple = (-360.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """Phase (degrees, unwrapped) and magnitude (dB) of a loop on the grid ``omega``.
 

@@ -24,6 +24,15 @@ from pathlib import Path
 import control as ct
 import numpy as np
 
+from loopshaping.freqresp import is_zero
+
+from .plots.fatigue import plot_sensitivity
+from .plots.qft import plot_design_bode, plot_design_nichols
+from .plots.validation import plot_lifetime_damage, plot_spectra, plot_time_series
+from .rosco import rosco_baseline, rosco_scheduled
+from .simulate import scheduled
+from .turbine import iea15mw
+
 __all__ = ["run_demo", "run_lifetime_demo", "LIFETIME_DESIGN_SPEEDS"]
 
 #: Wind speeds (m/s) of the QFT designs the lifetime demo schedules (the seed paper's range).
@@ -71,19 +80,12 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     dict
         The headline numbers (DELs in MN·m, reductions in %, deviations in pp, run time in s).
     """
-    from matplotlib.figure import Figure  # figures only written to files: no pyplot, no backend
-
-    from loopshaping.freqresp import is_zero
+    from matplotlib.figure import (
+        Figure,  # figures only written to files: no pyplot, no backend
+    )
 
     from . import feasibility, qft, spec, validate
-    from .plots.fatigue import plot_sensitivity
-    from .plots.qft import plot_design_bode, plot_design_nichols
     from .plots.spec import plot_specification
-    from .plots.validation import plot_spectra, plot_time_series
-    from .rosco import rosco_baseline
-    from .simulate import scheduled
-    from .turbine import iea15mw
-
     if method not in ("target", "notch"):
         raise ValueError(f"method={method!r} must be 'target' (specification-driven) or 'notch'")
     out = Path(out)
@@ -294,14 +296,7 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     """
     from matplotlib.figure import Figure
 
-    from loopshaping.freqresp import is_zero
-
     from . import qft, validate
-    from .plots.validation import plot_lifetime_damage
-    from .rosco import rosco_scheduled
-    from .simulate import scheduled
-    from .turbine import iea15mw
-
     out = Path(out)
     n_seeds = n_seeds or (3 if fast else 6)
     duration = duration or (300.0 if fast else 600.0)

@@ -1,11 +1,23 @@
 """A feasible specification pair for a DEL-reduction target (see :mod:`specdesign.feasibility`)."""
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._blas import on_one_blas_thread
+from .._checks import as_omega, del_target
+from ..closedloop import (
+    case_speeds,
+    closed_loop,
+    closed_map,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+    system_roots,
+)
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
@@ -182,8 +194,6 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
 def _check_target(target_reduction, slack_db, speed_slack_db):
     """(target %, slack dB, speed slack dB), checked."""
-    from .._checks import del_target
-
     t = del_target(target_reduction)
     slack, sslack = float(slack_db), float(speed_slack_db)
     if not (np.isfinite(slack) and slack >= 0):
@@ -229,9 +239,6 @@ class CertificateSearch:
     def __init__(self, model, wind_speed, *, max_sensitivity=1.8, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
                  case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None):
         from .. import spec
-        from .._checks import as_omega
-        from ..closedloop import case_speeds
-
         self.model, self.m = model, float(m)
         self.wind_speed = v = model.check_wind_speed(wind_speed)
         self.case_speeds, _ = case_speeds(v, case_offsets, model.wind_range, name="case_offsets")
@@ -457,8 +464,6 @@ class _Cases:
 
     def _on(self, omega):
         """Plant responses and ROSCO's maps (|T_MyT|, |T_Ω|), each (n_omega, n_cases), on ``omega``."""
-        from ..closedloop import closed_map, plant_responses, siso_response
-
         R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
         c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
         return R, np.abs(closed_map(R, c, 0.0, "tower_base_my")), np.abs(closed_map(R, c, 0.0, "gen_speed"))
@@ -501,11 +506,7 @@ class _Cases:
         lightly damped roots of its nominal maps and of ``specs``' baselines (a narrow dip of W
         between grid points would hide a violation): (grid, responses, ROSCO's |T_MyT| and
         |T_Ω|, C(jω) as a column), or None if some case is unstable."""
-        import warnings
-
         from .. import spec
-        from ..closedloop import closed_loop, lightly_damped, refine_grid, siso_response, system_roots
-
         if self._unstable(controller):
             return None
         with warnings.catch_warnings():
@@ -523,8 +524,6 @@ class _Cases:
         The tower robustness is the largest excess of a case's |T_MyT|/|T^ROSCO_MyT| over the
         nominal case's; the speed relaxation the largest |T_Ω|/|T^ROSCO_Ω| (:meth:`_closed`'s grid).
         """
-        from ..closedloop import closed_map
-
         closed = self._closed(controller, omega)
         if closed is None:
             return None
@@ -546,8 +545,6 @@ class _Cases:
             the cases at each ω dB)} for "W_MyT" and "W_Ω", the grid, the nominal case's
             |T_MyT| and ROSCO's nominal |T_Ω| on it), or None if a case is unstable.
         """
-        from ..closedloop import closed_map
-
         closed = self._closed(controller, omega, (tower, speed))
         if closed is None:
             return None
@@ -572,8 +569,6 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     import control
 
     from .. import spec
-    from ..closedloop import closed_loop
-
     plant = model.linearize(float(wind_speed))
     # kept as a state space: the polynomial coefficients of a ~25th-order map carry no digits
     t_sys = control.minreal(closed_loop(plant, design.controller(model), warn=False)["tower_base_my", "wind"],
@@ -634,8 +629,6 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     >>> bool(looser.promise.exact_del < t.promise.exact_del)
     True
     """
-    from .._checks import as_omega
-
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a TargetSpecification, got {type(target).__name__}")
     tower = target.tower if tower is None else tower

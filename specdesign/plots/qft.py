@@ -5,11 +5,19 @@ Magnitudes in dB, phases in degrees, ω in rad/s.
 """
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+from loopshaping import nichols
+from loopshaping import qft as lqft
+from loopshaping.freqresp import is_zero
+
+from .. import closedloop
+from ..turbine import iea15mw
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -58,8 +66,6 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
         The figure (two stacked axes, shared ω axis in rad/s): |T| in dB re 1 (rad/s)/(m/s)
         and re 1 N·m/(m/s).
     """
-    from .. import closedloop
-
     w = np.logspace(-2, 1, 800) if omega is None else np.asarray(omega, dtype=float)
     if axes is None:
         import matplotlib.pyplot as plt
@@ -68,8 +74,6 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
     else:
         fig = axes[0].figure
     if model is None:
-        from ..turbine import iea15mw
-
         model = iea15mw()
     cl_base = closedloop.closed_loop(model.linearize(design.wind_speed), design.baseline_controller, warn=False)
     opts = design.options
@@ -128,10 +132,6 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
 def _bounds_at(bounds, template, picks):
     """The same specs' bounds at the template frequencies nearest to ``picks`` (rad/s):
     a readable chart shows a handful of frequencies, not every design frequency."""
-    import warnings
-
-    from loopshaping import qft as lqft
-
     w = template.omega
     sub = np.unique([w[np.argmin(np.abs(w - p))] for p in picks])
     with warnings.catch_warnings():
@@ -169,9 +169,6 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
         If ``axes`` holds another number of axes than the design has loops.
     """
     import matplotlib.pyplot as plt
-
-    from loopshaping import nichols
-    from loopshaping.freqresp import is_zero
 
     with_atd = not is_zero(design.atd_controller)
     loops = [(design.pitch_bounds, design.pitch_template, design.pitch_controller, (-60, 60),

@@ -29,6 +29,7 @@ command (HSS N·m, N times that on the rotor shaft, which the plant takes).
 from __future__ import annotations
 
 import ctypes
+import importlib.metadata
 import re
 import shutil
 import tempfile
@@ -37,7 +38,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from .discon_file import read_discon
+from ..controller.discon_file import read_discon
 
 __all__ = ["SWAP_SIZE", "DisconError", "rosco_library", "rosco_test_cases", "Discon"]
 
@@ -77,8 +78,6 @@ class DisconError(RuntimeError):
 
 
 def _rosco_file(rel: str) -> Path:
-    import importlib.metadata
-
     try:
         dist = importlib.metadata.distribution("rosco")
     except importlib.metadata.PackageNotFoundError:

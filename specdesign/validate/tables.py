@@ -12,7 +12,16 @@ from pathlib import Path
 import numpy as np
 
 from .campaign import Campaign
-from .stats import WEIBULL_A, WEIBULL_K, paired_change, pool, resampled_se, weibull_weights
+from .lifetime_del import lifetime
+from .prediction import linear_prediction
+from .stats import (
+    WEIBULL_A,
+    WEIBULL_K,
+    paired_change,
+    pool,
+    resampled_se,
+    weibull_weights,
+)
 
 __all__ = ["Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance"]
 
@@ -172,8 +181,6 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
     w = weibull_weights(campaign.wind_speeds, k, scale)
     life = None
     if climate is not None:
-        from .lifetime_del import lifetime
-
         life = lifetime(campaign, climate, controllers=(baseline, designed), m=campaign.m)
     rows = []
     for ind in ("gen_speed_sd", "mean_power", "tower_del", "pitch_sd", "pitch_rate_sd"):
@@ -507,8 +514,6 @@ def linear_table3(model, designed, wind_speeds, *, baseline=None, promised: Mapp
     0.0
     """
     from ..spec import baseline_controller
-    from .prediction import linear_prediction
-
     vs = [float(v) for v in np.atleast_1d(np.asarray(wind_speeds, float))]
     pred = []
     for v in vs:
