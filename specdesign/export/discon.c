@@ -513,11 +513,12 @@ static double control_step(Controller *c, double omega, double power, double pit
     }
     e = -(omega - wref);
     /* tower-top velocity from the acceleration: high-passed, s/(s + w), then a leaky integral,
-     * 1/(s + w), both by Tustin, from rest at the initial acceleration (w = atd_highpass; with
-     * w = 0 the trapezoid integral of the acceleration's change since the initialisation) */
+     * 1/(s + w), both by Tustin (w = atd_highpass; with w = 0 the trapezoid integral of the
+     * acceleration). The velocity starts at 0 (the trim's) and the high-pass passes the first
+     * acceleration (a transient at the start, not a bias: a bias decays from it over 1/w) */
     if (first) {
         c->a_prev = acc;
-        c->a_hp = 0.0;
+        c->a_hp = acc;
         c->vel = 0.0;
     } else {
         double w = c->atd_hp, g = (2.0 - w * dt) / (2.0 + w * dt);
