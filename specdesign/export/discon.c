@@ -684,7 +684,7 @@ EXPORT void DISCON(float *avrSWAP, int *aviFAIL, const char *accINFILE, char *av
         if (fabs(avrSWAP[2] - ctl.dt) > 1e-6 * ctl.dt) {
             snprintf(msg, sizeof msg,
                      "specdesign DISCON: %s: the design is discrete at dt = %.9g s but the controller is called every "
-                     "%.9g s (avrSWAP(3), ServoDyn's DLL_DT): export it again with dt = DLL_DT",
+                     "%.6g s (avrSWAP(3), ServoDyn's DLL_DT): export it again with dt = DLL_DT",
                      path, ctl.dt, (double)avrSWAP[2]);
             release(&ctl);
             *aviFAIL = -1;
