@@ -182,10 +182,15 @@ class Discon:
     and ``Echo`` set to 0 (no debug files) and its relative file names made absolute; ROSCO
     prints its banner and a status line every 10 s of simulated time on the process's stdout.
 
+    An exported controller runs the same way: ``Discon(rec.parameters, library=rec.library)``
+    for a record of :func:`specdesign.export.export_discon`; its parameter file (first word
+    ``specdesign-discon``) is read as it is, its ``gearbox_ratio`` converting the speeds.
+
     Parameters
     ----------
     discon_in : str or pathlib.Path
-        The DISCON.IN file, written for the library's ROSCO version.
+        The DISCON.IN file, written for the library's ROSCO version, or the parameter file of
+        an exported controller.
     library : str or pathlib.Path, optional
         The compiled controller (default :func:`rosco_library`, the ``rosco`` package's).
     name : str, optional
@@ -198,7 +203,8 @@ class Discon:
     ModuleNotFoundError
         Without ``library``, if the ``rosco`` package is not installed.
     ValueError
-        If ``discon_in`` lacks ``WE_GearboxRatio`` or has a non-positive one, or uses
+        If an exported controller's file has no numeric ``gearbox_ratio``; if ``discon_in``
+        lacks ``WE_GearboxRatio`` or has a non-positive one, or uses
         ``WE_Mode = 0`` (ROSCO would read a hub-height wind the simulator does not give).
 
     Notes
