@@ -30,7 +30,7 @@ TORQUE_MODES = {"constant": 0, "power": 1, "rosco": 2}
 class DisconParameters:
     """Everything the exported library reads: the controller discrete at ``dt`` (SI, rotor shaft).
 
-    The pitch part is :func:`specdesign.simulate.controller_bank` of the controller at ``dt``:
+    The pitch part is :func:`specdesign.simulate.controllers.controller_bank` of the controller at ``dt``:
     K local controllers x⁺ = A x + B [e, −v], u = C x + D [e, −v] + i, with e = Ω_ref − Ω
     (rad/s) and v the tower-top fore-aft velocity (m/s), each integrator i (gain
     ``integrator_gain``, rad per rad) run apart by the trapezoid rule; output-blended in the
@@ -61,7 +61,7 @@ class DisconParameters:
     torque_law : numpy.ndarray
         (24,) :meth:`specdesign.rosco.TorqueLaw.params` (zeros unless mode 2).
     schedule_filter : numpy.ndarray
-        (1,) or (5,) :func:`specdesign.simulate.schedule_filter_coefficients`.
+        (1,) or (5,) :func:`specdesign.simulate.schedule.schedule_filter_coefficients`.
     atd_highpass : float
         Corner w (rad/s) of the tower-top velocity estimate from acceleration,
         s/(s + w)·1/(s + w); 0: the plain integral.
