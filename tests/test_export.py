@@ -24,8 +24,14 @@ import control as ct
 import numpy as np
 import pytest
 
-from specdesign.export import (DisconParameters, discon_library, discon_parameters, export_discon, read_parameters,
-                               write_parameters)
+from specdesign.export import (
+    DisconParameters,
+    discon_library,
+    discon_parameters,
+    export_discon,
+    read_parameters,
+    write_parameters,
+)
 from specdesign.export.library import SOURCE, CompilerNotFoundError
 from specdesign.fatigue import del_rainflow
 from specdesign.rosco import Discon, rosco_scheduled
@@ -130,7 +136,7 @@ def test_parameter_file_round_trips_the_simulators_matrices(model, qft19, tmp_pa
     assert p.same(discon_parameters(qft19, model=model))
     # the very matrices the simulator runs (controller_bank at the same dt), bit for bit
     python = ScheduledController(np.zeros(1), (ct.tf(qft19.pitch_controller),), None)
-    sched, mats, _, pi = controller_bank(python, 0.02)
+    _, mats, _, pi = controller_bank(python, 0.02)
     A, B, C, D, r, ns = mats[0]
     n = A.shape[0]
     assert pi is None and p.A.shape == (1, n, n)

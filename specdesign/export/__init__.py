@@ -17,7 +17,14 @@ from __future__ import annotations
 
 from .bladed import PARAMETER_FILE, DisconExport, discon_parameters, export_discon
 from .library import SOURCE, CompilerNotFoundError, default_cache, discon_library
-from .parameters import FORMAT_NAME, FORMAT_VERSION, TORQUE_MODES, DisconParameters, read_parameters, write_parameters
+from .parameters import (
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    TORQUE_MODES,
+    DisconParameters,
+    read_parameters,
+    write_parameters,
+)
 
 __all__ = [
     "DisconExport",

@@ -83,7 +83,7 @@ def discon_library(*, cache: str | Path | None = None, compiler: str | None = No
     fd, tmp = tempfile.mkstemp(suffix=_suffix(), dir=lib.parent)
     os.close(fd)
     try:
-        run = subprocess.run([path, *_FLAGS, "-o", tmp, str(SOURCE), "-lm"], capture_output=True, text=True)
+        run = subprocess.run([path, *_FLAGS, "-o", tmp, str(SOURCE), "-lm"], capture_output=True, text=True, check=False)
         if run.returncode != 0:
             raise RuntimeError(f"{cc} failed to build {SOURCE} (exit {run.returncode}): {run.stderr.strip()[-2000:]}")
         os.replace(tmp, lib)
