@@ -35,7 +35,7 @@ from specdesign.export import (
 from specdesign.export.library import SOURCE, CompilerNotFoundError
 from specdesign.fatigue import del_rainflow
 from specdesign.rosco import Discon, rosco_scheduled
-from specdesign.simulate import ScheduledController, simulate
+from specdesign.simulate import ScheduledController, scheduled, simulate
 from specdesign.simulate.controllers import controller_bank
 from specdesign.turbine import iea15mw, rosco_baseline
 
@@ -89,7 +89,20 @@ def test_qft_19_design_exported_equals_python(model, qft19, tmp_path):
     assert qft19.success
     rec = export_discon(qft19, tmp_path, model=model, torque="constant")
     python = ScheduledController(np.zeros(1), (ct.tf(qft19.pitch_controller),), None, name="QFT")
-    a, b = _runs(model, python, rec, [19.0])
+    # at 19 m/s, and at 10.8 m/s where the command reaches the pitch floor: the conditional
+    # integration of the design's integrator and slow mode (slow_states > 0) is exercised
+    assert read_parameters(rec.parameters).slow_states[0] > 0
+    a, b = _runs(model, python, rec, [10.8, 19.0])
+    assert (a["pitch_cmd"][0] == model.pitch_min).any() and (b["pitch_cmd"][0] == model.pitch_min).any()
+    _assert_equal_records(a, b)
+
+
+def test_output_blended_schedule_exported_equals_python(model, tmp_path):
+    # four locals blended in the filtered pitch, each integrator clamped (PI-like locals)
+    sc = scheduled(model, {v: rosco_baseline(model, v) for v in (13.0, 17.0, 21.0, 25.0)})
+    rec = export_discon(sc, tmp_path, model=model, torque="constant")
+    assert read_parameters(rec.parameters).schedule_pitch.size == 4
+    a, b = _runs(model, sc, rec, [12.0, 14.0, 18.0, 23.0])
     _assert_equal_records(a, b)
 
 
