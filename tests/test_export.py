@@ -251,6 +251,25 @@ def test_constant_power_torque(model, tmp_path):
     assert sw[46] == pytest.approx(expected, rel=EPS32 * 4)
 
 
+def test_rosco_law_with_constant_power_in_region_3(model, tmp_path):
+    # ROSCO's VS_ConstPower = 1 (Controllers.f90): in region 3 (pitch above PC_Switch) the torque
+    # is P/(η·Ω_f), the speed filter starting at its input; without it, the rated torque
+    law = model.torque_control
+    speed = np.float32(1.05 * model.rated_rotor_speed)
+    out = {}
+    for torque in ("rosco", "rosco_power"):
+        rec = export_discon(rosco_baseline(model, 19.0), tmp_path / torque, model=model, torque=torque)
+        lib = _fresh(rec.library, tmp_path, torque)
+        infile = str(rec.parameters).encode()
+        sw = _swap(infile=infile, speed=float(speed), pitch=0.3, power=law.rated_power)
+        for status in (0, 1):
+            assert _call(lib, sw, infile, status)[0] == 0
+        out[torque] = float(sw[46])
+    assert out["rosco"] == np.float32(law.rated_torque)
+    expected = law.rated_power / law.generator_efficiency / float(speed)
+    assert expected < law.rated_torque and out["rosco_power"] == pytest.approx(expected, rel=4 * EPS32)
+
+
 def test_pitch_rate_limit_limits_the_command(model, tmp_path):
     rec = export_discon(rosco_baseline(model, 19.0), tmp_path, model=model, pitch_rate_limit=0.01)
     lib = _fresh(rec.library, tmp_path, "rate")

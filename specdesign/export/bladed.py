@@ -40,7 +40,7 @@ class DisconExport:
     dt : float
         The controller's sample time (s): ServoDyn's ``DLL_DT``.
     torque : str
-        The generator-torque law: "constant", "power" or "rosco".
+        The generator-torque law: "constant", "power", "rosco" or "rosco_power".
     name : str
         Label of the controller.
     """
@@ -77,8 +77,8 @@ def _torque(torque, model: TurbineModel):
         return ("rosco", law) if law is not None else ("constant", None)
     if torque not in TORQUE_MODES:
         raise ValueError(f"torque={torque!r} must be one of {tuple(TORQUE_MODES)}, None or a specdesign.rosco.TorqueLaw")
-    if torque == "rosco" and law is None:
-        raise ValueError("torque='rosco' needs a model with a torque law (torque_control); pass a TorqueLaw instead")
+    if torque in ("rosco", "rosco_power") and law is None:
+        raise ValueError(f"torque={torque!r} needs a model with a torque law (torque_control); pass a TorqueLaw instead")
     return torque, law
 
 
@@ -96,7 +96,7 @@ def discon_parameters(controller_or_design: object, *, dt: float = 0.02, model: 
         Sample time (s).
     model : TurbineModel, optional
         The turbine (default :func:`specdesign.turbine.iea15mw`).
-    torque : {"constant", "power", "rosco"}, TorqueLaw or None, optional
+    torque : {"constant", "power", "rosco", "rosco_power"}, TorqueLaw or None, optional
         The generator-torque law (see :func:`export_discon`).
     pitch_rate_limit : float, optional
         Largest rate of the pitch command (rad/s), inf for none.
@@ -150,7 +150,7 @@ def discon_parameters(controller_or_design: object, *, dt: float = 0.02, model: 
         rated_power=float(model.rated_power), generator_efficiency=float(model.generator_efficiency),
         # ROSCO's generator-speed filter (F_LPFCornerFreq, F_LPFDamping): the law's, or ROSCO's defaults
         speed_filter=(law.filter_corner, law.filter_damping) if law is not None else (1.0081, 0.7),
-        torque_law=law.params() if mode == "rosco" else np.zeros(TORQUE_PARAMS),
+        torque_law=law.params() if mode in ("rosco", "rosco_power") else np.zeros(TORQUE_PARAMS),
         schedule_filter=schedule_filter_coefficients(fw, getattr(ctrl, "filter_damping", None), dt),
         atd_highpass=hp, schedule_pitch=np.asarray(sched, float), integrator_gain=np.array([m[4] for m in mats]),
         slow_states=np.array([m[5] for m in mats], dtype=np.int64), A=A, B=B, C=C, D=D, name=label, **kw)
@@ -183,12 +183,14 @@ def export_discon(controller_or_design: object, folder: str | Path, *, dt: float
     model : TurbineModel, optional
         The turbine (default :func:`specdesign.turbine.iea15mw`): its rated speed (the
         reference), pitch limits, rated torque and power, generator efficiency, torque law.
-    torque : {"constant", "power", "rosco"}, TorqueLaw or None, optional
+    torque : {"constant", "power", "rosco", "rosco_power"}, TorqueLaw or None, optional
         Generator torque: "constant" the rated torque (the simulator above rated); "power"
-        P_rated/(η·Ω_f) capped at the law's maximum torque (ROSCO's ``VS_ConstPower = 1``);
+        P_rated/(η·Ω_f) capped at the law's maximum torque, everywhere (for runs above rated);
         "rosco" the model's ROSCO torque law (``simulate(..., torque_control="rosco")``) or a
-        given :class:`~specdesign.rosco.TorqueLaw`. None (default): "rosco" if the model has
-        a torque law, else "constant".
+        given :class:`~specdesign.rosco.TorqueLaw`; "rosco_power" that law with constant power
+        in region 3 and its ceiling, as ROSCO runs ``VS_ConstPower = 1`` (not modelled by the
+        simulator: no equality check there). None (default): "rosco" if the model has a
+        torque law, else "constant".
     pitch_rate_limit : float, optional
         Largest rate of the pitch command (rad/s); default inf (the workbench's controllers
         have none; its actuator model limits the pitch rate). For OpenFAST without a pitch

@@ -57,7 +57,7 @@ enum { T_MODE, T_K, T_KP, T_KI, T_MIN_SPEED, T_VS_REF, T_PC_REF, T_RATED_TQ, T_M
 enum { S_WF, S_WF2, S_U1, S_U2, S_REF, S_REF_U, S_SSF, S_SS_U, S_IAR, S_IBR, S_AR, S_BR, S_STATE, S_TQ, S_PLAST };
 #define TORQUE_STATES 16
 
-enum { TQ_CONSTANT = 0, TQ_POWER = 1, TQ_ROSCO = 2 };
+enum { TQ_CONSTANT = 0, TQ_POWER = 1, TQ_ROSCO = 2, TQ_ROSCO_POWER = 3 };
 
 typedef struct {
     int ready;
@@ -227,7 +227,7 @@ static int parse(Controller *c, Reader *r)
     if (!(c->dt > 0) || !(c->gear > 0) || !(c->omega_ref > 0) || !(c->cmd_lo < c->cmd_hi) || !(c->rate_lim > 0))
         return fail(r, r->tok_line, "dt, gearbox_ratio, rated_speed and pitch_rate_limit must be positive and "
                                     "pitch_limits increasing");
-    if (integer(r, "torque_mode", 0, 2, &c->torque_mode) || numbers(r, "rated_torque", &c->rated_torque, 1) ||
+    if (integer(r, "torque_mode", 0, 3, &c->torque_mode) || numbers(r, "rated_torque", &c->rated_torque, 1) ||
         numbers(r, "max_torque", &c->max_torque, 1) || numbers(r, "rated_power", &c->rated_power, 1) ||
         numbers(r, "generator_efficiency", &c->gen_eff, 1) || numbers(r, "speed_filter", &c->sf_corner, 1) ||
         number(r, "speed_filter", &c->sf_damp) || numbers(r, "torque_law", c->tq, TORQUE_PARAMS))
@@ -235,8 +235,11 @@ static int parse(Controller *c, Reader *r)
     if (c->torque_mode == TQ_POWER && !(c->rated_power > 0 && c->gen_eff > 0 && c->sf_corner > 0 && c->sf_damp > 0))
         return fail(r, r->tok_line, "torque_mode 1 (constant power) needs positive rated_power, generator_efficiency "
                                     "and speed_filter");
-    if (c->torque_mode == TQ_ROSCO && !(c->tq[T_MODE] == 1 || c->tq[T_MODE] == 3 || c->tq[T_MODE] == 4))
-        return fail(r, r->tok_line, "torque_mode 2 needs a torque_law whose first entry (VS_ControlMode) is 1, 3 or 4");
+    if (c->torque_mode >= TQ_ROSCO && !(c->tq[T_MODE] == 1 || c->tq[T_MODE] == 3 || c->tq[T_MODE] == 4))
+        return fail(r, r->tok_line, "torque_mode 2 and 3 need a torque_law whose first entry (VS_ControlMode) is 1, 3 "
+                                    "or 4");
+    if (c->torque_mode == TQ_ROSCO_POWER && !(c->tq[T_RATED_POWER] > 0 && c->tq[T_GEN_EFF] > 0))
+        return fail(r, r->tok_line, "torque_mode 3 (constant power) needs the torque_law's rated power and efficiency");
     if (integer(r, "schedule_filter", 1, 5, &c->nsf))
         return -1;
     if (c->nsf != 1 && c->nsf != 5)
@@ -387,9 +390,11 @@ static double lpf2(double *st, double u, double corner, double damp, double dt, 
     return y;
 }
 
-/* One step of ROSCO's torque controller: a line-by-line port of torque.py, torque_step. */
+/* One step of ROSCO's torque controller: a line-by-line port of torque.py, torque_step. With
+ * const_power, ROSCO's VS_ConstPower = 1 (Controllers.f90, VariableSpeedControl): region 3 holds
+ * P/(eta*wf), and the torque ceiling is min(P/(eta*wf), VS_MaxTq) instead of VS_RtTq. */
 static double torque_step(const double *tq, double *st, double omega, double power, double pitch, double dt, int first,
-                          double *pc_ref_out)
+                          int const_power, double *pc_ref_out)
 {
     int mode = (int)tq[T_MODE];
     double c = tq[T_FILT_CORNER], wf;
@@ -450,6 +455,8 @@ static double torque_step(const double *tq, double *st, double omega, double pow
         st[S_SSF] = lpf1(st, S_SSF, S_SS_U, d, tq[T_SS_CORNER], dt, first);
     }
     double last = st[S_TQ], t;
+    double pwr_tq = tq[T_RATED_POWER] / tq[T_GEN_EFF] / wf;
+    double ceiling = const_power ? fmin(pwr_tq, tq[T_MAX_TQ]) : tq[T_RATED_TQ];
     if (mode == 1) {
         double ar = pi_ctl(err, tq[T_KP], tq[T_KI], max_om, tq[T_AR_SAT], dt, max_om, st, S_IAR, first);
         double br = pi_ctl(err_br, tq[T_KP], tq[T_KI], tq[T_MIN_TQ], min_om, dt, min_om, st, S_IBR, first);
@@ -462,13 +469,13 @@ static double torque_step(const double *tq, double *st, double omega, double pow
         else if (state == 3)
             t = ar;
         else if (state == 4)
-            t = tq[T_RATED_TQ];
+            t = const_power ? pwr_tq : tq[T_RATED_TQ];
         else
             t = last;
     } else {
-        t = pi_ctl(err, tq[T_KP], tq[T_KI], tq[T_MIN_TQ], tq[T_RATED_TQ], dt, last, st, S_IAR, first);
+        t = pi_ctl(err, tq[T_KP], tq[T_KI], tq[T_MIN_TQ], ceiling, dt, last, st, S_IAR, first);
     }
-    t = fmin(fmax(t, tq[T_MIN_TQ]), fmin(tq[T_MAX_TQ], tq[T_RATED_TQ]));
+    t = fmin(fmax(t, tq[T_MIN_TQ]), fmin(tq[T_MAX_TQ], ceiling));
     if (!first) {
         double rr = tq[T_MAX_RATE] * dt;
         t = fmin(fmax(t, last - rr), last + rr);
@@ -503,8 +510,8 @@ static double control_step(Controller *c, double omega, double power, double pit
     const int K = c->K, nc = c->nc, nf = c->nf, first = c->step == 0;
     const double dt = c->dt;
     double wref = c->omega_ref, e, v;
-    if (c->torque_mode == TQ_ROSCO) {
-        *torque = torque_step(c->tq, c->tst, omega, power, pitch, dt, first, &wref);
+    if (c->torque_mode == TQ_ROSCO || c->torque_mode == TQ_ROSCO_POWER) {
+        *torque = torque_step(c->tq, c->tst, omega, power, pitch, dt, first, c->torque_mode == TQ_ROSCO_POWER, &wref);
     } else if (c->torque_mode == TQ_POWER) {
         double wf = lpf2(c->pw, omega, c->sf_corner, c->sf_damp, dt, first);
         *torque = fmin(c->rated_power / (c->gen_eff * wf), c->max_torque);

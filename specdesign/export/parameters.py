@@ -22,8 +22,9 @@ __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "TORQUE_MODES", "DisconParameters", 
 FORMAT_NAME = "specdesign-discon"
 #: Version of the format this package writes and its library reads.
 FORMAT_VERSION = 1
-#: ``torque_mode`` codes of the file: the rated torque held, constant power P/(η·Ω_f), ROSCO's law.
-TORQUE_MODES = {"constant": 0, "power": 1, "rosco": 2}
+#: ``torque_mode`` codes of the file: the rated torque held, constant power P/(η·Ω_f), ROSCO's law,
+#: ROSCO's law with constant power in region 3 (``VS_ConstPower = 1``).
+TORQUE_MODES = {"constant": 0, "power": 1, "rosco": 2, "rosco_power": 3}
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare with :meth:`same`
@@ -49,7 +50,8 @@ class DisconParameters:
     pitch_rate_limit : float
         Largest |rate| of the command (rad/s); ``inf`` for none (the workbench's runs).
     torque_mode : int
-        0 constant (``rated_torque``), 1 constant power, 2 ROSCO's law (``torque_law``).
+        0 constant (``rated_torque``), 1 constant power, 2 ROSCO's law (``torque_law``), 3 the
+        same with constant power in region 3.
     rated_torque, max_torque : float
         Generator torque held above rated, and the ceiling of constant power (rotor N·m).
     rated_power : float
@@ -174,7 +176,8 @@ def write_parameters(p: DisconParameters, path: str | Path, *, comment: str = ""
             "# gearbox_ratio); e = rated_speed - rotor speed (rad/s), v = tower-top fore-aft velocity (m/s).",
             _line("dt", [p.dt]), _line("gearbox_ratio", [p.gearbox_ratio]), _line("rated_speed", [p.rated_speed]),
             _line("pitch_limits", p.pitch_limits), _line("pitch_rate_limit", [p.pitch_rate_limit]),
-            "# torque: 0 constant rated_torque, 1 constant power, 2 ROSCO's law (torque_law, 24 numbers)",
+            "# torque: 0 constant rated_torque, 1 constant power, 2 ROSCO's law (torque_law, 24 numbers),",
+            "# 3 ROSCO's law with constant power in region 3",
             f"torque_mode {int(p.torque_mode)}", _line("rated_torque", [p.rated_torque]),
             _line("max_torque", [p.max_torque]), _line("rated_power", [p.rated_power]),
             _line("generator_efficiency", [p.generator_efficiency]), _line("speed_filter", p.speed_filter),
