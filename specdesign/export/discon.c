@@ -34,6 +34,8 @@
  *   IF ( NINT( dll_data%avrSWAP(55) ) /=  0 ) ... (pitch override), avrSWAP(56) (torque override): 0
  *   p%NumOuts_DLL = NINT( m%dll_data%avrSWAP(65) )             logging channels: 0
  *   if (dll_data%avrSWAP(102)==4) ... elseif (dll_data%avrSWAP(102)==0)   yaw control flag: 0
+ * The array holds R + 2*DLL_NumTrq - 1 + MaxLoggingChannels records, R = R_v43 = 165 and
+ * MaxLoggingChannels = 300 (STATIC_DLL_LOAD aside), so every record written here exists.
  * ServoDyn calls status 0 once at initialisation (GetBladedLoggingChannels, t = 0), then 1 from
  * t = 0 every DLL_DT, and -1 at the end (BladedInterface_End).
  *
