@@ -16,6 +16,10 @@ that tolerance is derived from the integration error measured on the Python run 
 import ctypes
 import fnmatch
 import math
+import pickle
+import shutil
+import subprocess
+import sys
 import tomllib
 import warnings
 from pathlib import Path
@@ -81,6 +85,9 @@ def test_rosco_pi_exported_equals_python(model, tmp_path):
     assert rec.library.is_file() and rec.parameters.is_file() and rec.torque == "constant"
     a, b = _runs(model, c, rec, [19.0])
     _assert_equal_records(a, b)
+    # a campaign's worker gets the harness pickled: it stays an exported controller
+    again = pickle.loads(pickle.dumps(Discon(rec.parameters, library=rec.library)))
+    assert again.exported and again.gearbox_ratio == 1.0
     # the float32 interface is visible: the two are not bit for bit the same
     assert np.abs(a["pitch_cmd"] - b["pitch_cmd"]).max() > 0
 
@@ -292,6 +299,11 @@ def test_library_is_compiled_once_and_shipped(tmp_path, monkeypatch):
     stamp = lib.stat().st_mtime_ns
     assert discon_library(cache=tmp_path) == lib and lib.stat().st_mtime_ns == stamp
     assert lib.parent.name and len(lib.parent.name) == 16
+    # nothing of Python at run time: the C library and libm only (what ldd lists, where it exists)
+    ldd = shutil.which("ldd")
+    if ldd is not None and sys.platform.startswith("linux"):
+        needed = subprocess.run([ldd, str(lib)], capture_output=True, text=True, check=True).stdout
+        assert "libc.so" in needed and "python" not in needed.lower()
     monkeypatch.delenv("CC", raising=False)
     with pytest.raises(CompilerNotFoundError, match="no C compiler 'no-such-cc'"):
         discon_library(cache=tmp_path / "other", compiler="no-such-cc")
