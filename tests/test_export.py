@@ -40,7 +40,7 @@ from specdesign.export.library import SOURCE, CompilerNotFoundError
 from specdesign.fatigue import del_rainflow
 from specdesign.rosco import Discon, rosco_scheduled
 from specdesign.simulate import ScheduledController, scheduled, simulate
-from specdesign.simulate.controllers import controller_bank
+from specdesign.controller.scheduled import controller_bank
 from specdesign.turbine import iea15mw, rosco_baseline
 
 EPS32 = 2.0**-24

@@ -13,10 +13,9 @@ import numpy as np
 from loopshaping.freqresp import is_zero
 
 from .._checks import positive_scalar
-from ..rosco.torque import TORQUE_PARAMS, TorqueLaw
-from ..simulate import ScheduledController, as_lti, is_lti_like
-from ..simulate.controllers import controller_bank
-from ..simulate.schedule import schedule_filter_coefficients
+from ..controller.lti import as_lti, is_lti_like
+from ..controller.scheduled import ScheduledController, controller_bank, schedule_filter_coefficients
+from ..controller.torque import TORQUE_PARAMS, TorqueLaw
 from ..turbine import TurbineModel, iea15mw
 from .library import discon_library
 from .parameters import TORQUE_MODES, DisconParameters, write_parameters

@@ -6,7 +6,7 @@
  * by specdesign.export.export_discon and described in docs/export.md), read at the
  * initialisation call. The controller is the one specdesign.simulate's compiled loop runs
  * (specdesign/simulate/kernels.py, _run_one): the same discrete matrices (Tustin at the
- * controller's sample time, from specdesign.simulate.controllers.controller_bank), the same order of
+ * controller's sample time, from specdesign.controller.scheduled.controller_bank), the same order of
  * operations, the same anti-windup (integrator clamp for PI-like locals, conditional
  * integration of the integrator and slow modes otherwise, ROSCO's clamps in the gains form),
  * the same scheduling filter and interpolation, and the same ROSCO torque law

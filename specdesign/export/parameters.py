@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..rosco.torque import TORQUE_PARAMS
+from ..controller.torque import TORQUE_PARAMS
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "TORQUE_MODES", "DisconParameters", "write_parameters", "read_parameters"]
 
@@ -31,7 +31,7 @@ TORQUE_MODES = {"constant": 0, "power": 1, "rosco": 2, "rosco_power": 3}
 class DisconParameters:
     """Everything the exported library reads: the controller discrete at ``dt`` (SI, rotor shaft).
 
-    The pitch part is :func:`specdesign.simulate.controllers.controller_bank` of the controller at ``dt``:
+    The pitch part is :func:`specdesign.controller.scheduled.controller_bank` of the controller at ``dt``:
     K local controllers x⁺ = A x + B [e, −v], u = C x + D [e, −v] + i, with e = Ω_ref − Ω
     (rad/s) and v the tower-top fore-aft velocity (m/s), each integrator i (gain
     ``integrator_gain``, rad per rad) run apart by the trapezoid rule; output-blended in the
@@ -63,7 +63,7 @@ class DisconParameters:
     torque_law : numpy.ndarray
         (24,) :meth:`specdesign.rosco.TorqueLaw.params` (zeros unless mode 2).
     schedule_filter : numpy.ndarray
-        (1,) or (5,) :func:`specdesign.simulate.schedule.schedule_filter_coefficients`.
+        (1,) or (5,) :func:`specdesign.controller.scheduled.schedule_filter_coefficients`.
     atd_highpass : float
         Corner w (rad/s) of the tower-top velocity estimate from acceleration,
         s/(s + w)·1/(s + w); 0: the plain integral.
