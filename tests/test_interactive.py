@@ -138,6 +138,9 @@ def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
     sliders[1].value = round(12.0 + 0.04, 1)  # the echo of 12.0, from before the update
     sliders[2].value = round(start.width, 2)
     assert ex.notch == spec.Notch(1.05, 9.0, 0.2)
+    # and the sliders show what the figure draws, not the late echo (notebook 03 after Run All
+    # showed a 2.80 dB slider over a 12 dB notch, and the first touch jumped from there)
+    assert [s.value for s in sliders] == [1.05, 9.0, 0.2]
     sliders[1].value = 15.0  # a move again
     assert ex.notch == spec.Notch(1.05, 15.0, 0.2)
     plt.close("all")
