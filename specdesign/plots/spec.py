@@ -147,6 +147,7 @@ class NotchExplorer:
         self._sliders, self._sent, self._quiet = None, {}, False  # the widget's sliders, once built
         if hasattr(self.fig.canvas, "header_visible"):  # ipympl: no "Figure n" label above the plot
             self.fig.canvas.header_visible = False
+            self.fig.canvas.toolbar_position = "right"  # beside the figure, not over its labels
         self.update(self.notch.omega_n, self.notch.depth_db, self.notch.width)
 
     def update(self, omega_n: float, depth_db: float, width: float, *, redraw: bool = True) -> Promise:
