@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
 
 __all__ = [
     "KINDS", "MAX_DEGREE", "MAX_NOTCH_ZETA", "MAX_OMEGA", "MAX_ORDER", "MIN_OMEGA", "Controller", "Element",
@@ -165,7 +164,6 @@ class Element:
         w = p["omega"]
         return np.array([1.0, 2 * p["zeta_zero"] * w, w * w]), np.array([1.0, 2 * p["zeta_pole"] * w, w * w])
 
-    @renamed_keywords(omegas="omega")
     def response(self, omega: ArrayLike) -> np.ndarray:
         """Complex response at s = jω.
 
@@ -534,7 +532,6 @@ class Controller:
         num, den = self.polys()
         return ct.tf(num, den)
 
-    @renamed_keywords(omegas="omega")
     def response(self, omega: ArrayLike) -> np.ndarray:
         """Complex response at s = jω, evaluated factor by factor.
 

@@ -11,7 +11,7 @@ import numpy as np
 
 __all__ = ["as_omega", "as_psd", "as_signal", "as_real", "real_scalar", "positive_scalar", "del_target",
            "distinct_keys", "bisection_tolerance", "MAX_BISECTIONS", "finite_system", "spec_made_at",
-           "bad_measurements"]
+           "bad_measurements", "margin_db", "search_options"]
 
 #: Most halvings of a bisection: 100 halve any interval a search starts from (≤ 1e3 dB or m/s)
 #: below 1e-27, far under any tolerance a user asks for, so a tolerance float64 cannot resolve
@@ -108,6 +108,27 @@ def bisection_tolerance(value, name: str = "tolerance_db") -> float:
     if v <= 0:
         raise ValueError(f"{name}={value!r} must be > 0: a bisection to a width ≤ 0 never ends (e.g. 0.05)")
     return v
+
+
+def margin_db(value, name: str) -> float:
+    """A margin or slack (dB, argument ``name``): a finite real number ≥ 0."""
+    v = real_scalar(value, name)
+    if v < 0:
+        raise ValueError(f"{name}={value!r} must be a finite margin ≥ 0 dB")
+    return v
+
+
+def search_options(tolerance_db, max_relax_db, speed_relax_db=None):
+    """A certificate search's (tolerance dB, largest relaxation dB, fixed relaxation dB or None),
+    checked: a tolerance ≤ 0 would never end its bisection, a relaxation is ≥ 0 dB."""
+    tol = bisection_tolerance(tolerance_db, "tolerance_db")
+    top = real_scalar(max_relax_db, "max_relax_db")
+    if top < 0:
+        raise ValueError(f"max_relax_db={max_relax_db!r} must be a relaxation ≥ 0 dB (e.g. 12)")
+    g = None if speed_relax_db is None else real_scalar(speed_relax_db, "speed_relax_db")
+    if g is not None and g < 0:
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB, or None to search it")
+    return tol, top, g
 
 
 def positive_scalar(value, name: str) -> float:

@@ -17,12 +17,29 @@ import json
 import math
 import os
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from .validate import (INDICATORS, Campaign, acceptance, check_campaign_step, check_plant_step, run_campaign,
-                       seeds_from, table2, table3)
+from loopshaping.controller import Controller
+
+from . import __version__, turbine
+from ._checks import distinct_keys
+from .plots import validation as pv
+from .rosco import rosco_scheduled
+from .simulate import ScheduledController, scheduled
+from .validate import (
+    INDICATORS,
+    Campaign,
+    acceptance,
+    check_campaign_step,
+    check_plant_step,
+    run_campaign,
+    seeds_from,
+    table2,
+    table3,
+)
 
 __all__ = ["main", "ConfigError", "read_config", "load_controller", "run_config", "output_folder"]
 
@@ -51,8 +68,6 @@ def main(argv: list[str] | None = None) -> int:
     >>> main(["--version"])  # doctest: +SKIP
     specdesign 0.1.0
     """
-    from specdesign import __version__
-
     parser = argparse.ArgumentParser(prog="specdesign", description=_DESCRIPTION,
                                      epilog="Campaign file schema: docs/validation.md.")
     parser.add_argument("--version", action="version", version=f"specdesign {__version__}")
@@ -315,9 +330,6 @@ def load_controller(spec: dict, base: str | os.PathLike, model, *, config: str |
     """
     import control
 
-    from .rosco import rosco_scheduled
-    from .simulate import ScheduledController, scheduled
-
     where = f"controllers.{name}"
     base = Path(base)
     src = config if config is not None else base
@@ -354,8 +366,6 @@ def load_controller(spec: dict, base: str | os.PathLike, model, *, config: str |
 
     def tf(d, key):
         if isinstance(d, dict) and "elements" in d:
-            from loopshaping.controller import Controller
-
             try:
                 num, den = Controller.from_dict(d).polys()
             except (TypeError, ValueError) as e:
@@ -429,8 +439,6 @@ def _wind_speeds(vs, model, path, key, operating=False) -> list:
 
 def _load_json(text: bytes, path: Path, what: str):
     """JSON with every object's keys distinct (a repeated key would silently keep the last)."""
-    from ._checks import distinct_keys
-
     def repeated(k):
         return ConfigError(f"{path}: key {k!r} appears twice in one object; keep one")
 
@@ -446,8 +454,6 @@ def _read_config(path: Path) -> dict:
     except OSError as e:
         raise type(e)(f"{path}: cannot read the campaign file ({e.strerror or e})") from None
     if path.suffix.lower() == ".toml":
-        import tomllib
-
         try:
             return tomllib.loads(text.decode())
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
@@ -502,8 +508,6 @@ def read_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -
     OSError
         A file that cannot be read or an output folder that cannot be written, naming it.
     """
-    from . import turbine
-
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"config file {path} does not exist")
@@ -660,8 +664,6 @@ def _write_figures(camp: Campaign, out: Path, designed, baseline) -> list[Path]:
     """Figs. 8-10 as PNG files (the paths written): figures made without pyplot, so no backend
     is involved."""
     from matplotlib.figure import Figure
-
-    from .plots import validation as pv
 
     written = []
     for v in camp.wind_speeds:

@@ -25,7 +25,15 @@ from pathlib import Path
 import control as ct
 import numpy as np
 
+from loopshaping.freqresp import is_zero
+
 from ._checks import del_target, positive_scalar, real_scalar
+from .plots.fatigue import plot_sensitivity
+from .plots.qft import plot_design_bode, plot_design_nichols
+from .plots.validation import plot_lifetime_damage, plot_spectra, plot_time_series
+from .rosco import rosco_baseline, rosco_scheduled
+from .simulate import scheduled
+from .turbine import iea15mw
 
 __all__ = ["run_demo", "run_lifetime_demo", "LIFETIME_DESIGN_SPEEDS", "check_demo_options", "check_lifetime_options",
            "DemoOptions"]
@@ -227,19 +235,12 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     TypeError, ValueError
         For an option out of range (:func:`check_demo_options`), before any work.
     """
-    from matplotlib.figure import Figure  # figures only written to files: no pyplot, no backend
-
-    from loopshaping.freqresp import is_zero
+    from matplotlib.figure import (
+        Figure,  # figures only written to files: no pyplot, no backend
+    )
 
     from . import feasibility, qft, spec, validate
-    from .plots.fatigue import plot_sensitivity
-    from .plots.qft import plot_design_bode, plot_design_nichols
     from .plots.spec import plot_specification
-    from .plots.validation import plot_spectra, plot_time_series
-    from .rosco import rosco_baseline
-    from .simulate import scheduled
-    from .turbine import iea15mw
-
     if method not in ("target", "notch"):
         raise ValueError(f"method={method!r} must be 'target' (specification-driven) or 'notch'")
     model = iea15mw()
@@ -299,8 +300,9 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     _say(f"      C_β(s) = {_tf_text(pitch)}")
     if atd is not None:
         _say(f"      C_ATD(s) = {_tf_text(atd)}")
-    fig = Figure(figsize=(14, 5.5))
-    plot_design_nichols(design, axes=fig.subplots(1, 2))
+    n_loops = 1 if atd is None else 2  # a pitch-only design has no ATD chart to draw
+    fig = Figure(figsize=(7 * n_loops, 5.5))
+    plot_design_nichols(design, axes=fig.subplots(1, n_loops, squeeze=False)[0])
     fig.savefig(out / "3_nichols.png", dpi=120)
     fig = Figure(figsize=(9, 7.5))
     plot_design_bode(design, model, axes=fig.subplots(2, 1, sharex=True))
@@ -454,14 +456,7 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     """
     from matplotlib.figure import Figure
 
-    from loopshaping.freqresp import is_zero
-
     from . import qft, validate
-    from .plots.validation import plot_lifetime_damage
-    from .rosco import rosco_scheduled
-    from .simulate import scheduled
-    from .turbine import iea15mw
-
     out = Path(out)
     model = iea15mw()
     # every option, the design speeds included, before the first design

@@ -29,15 +29,19 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 import control as ct
 import numpy as np
 
+from loopshaping.controller import Controller
+
 from . import spec as _spec_module
-from ._checks import finite_system
+from . import turbine
+from ._checks import distinct_keys, finite_system
+from .openfast import read_linearization
 
 __all__ = ["SCHEMA", "VERSION", "Session", "save_session", "load_session", "session_to_dict", "session_from_dict"]
 
@@ -111,8 +115,6 @@ class Session:
     notes: str = ""
 
     def __post_init__(self):
-        from loopshaping.controller import Controller
-
         _model_ref(self.model)
         speeds = tuple(self.wind_speeds) if np.ndim(self.wind_speeds) else (self.wind_speeds,)
         for v in speeds:
@@ -217,8 +219,6 @@ class Session:
         ValueError
             If the session refers to a set of ``.lin`` files (read those with :meth:`linearization`).
         """
-        from . import turbine
-
         if self.model == "iea15mw":
             return turbine.iea15mw()
         if "fst" in self.model:
@@ -246,8 +246,6 @@ class Session:
         """
         if not isinstance(self.model, dict) or "lin_files" not in self.model:
             raise ValueError("the session's model is not a set of .lin files; use Session.turbine()")
-        from .openfast import read_linearization
-
         return read_linearization(self.model["lin_files"], **kwargs)
 
     def specification_name(self, name: str | None = None) -> str:
@@ -394,10 +392,6 @@ def session_to_dict(session: Session) -> dict:
     TypeError
         If ``session`` is not a :class:`Session`.
     """
-    from dataclasses import asdict
-
-    from loopshaping.controller import Controller
-
     if not isinstance(session, Session):
         raise TypeError(f"session must be a specdesign.session.Session, got {type(session).__name__}")
     specs = {}
@@ -431,8 +425,6 @@ def session_from_dict(data: dict) -> Session:
     ValueError
         For another schema, a newer or unknown version, unknown keys or an invalid entry (named).
     """
-    from loopshaping.controller import Controller
-
     if not isinstance(data, dict) or data.get("schema") != SCHEMA:
         raise ValueError(f"not a design session: the file must be a JSON object with \"schema\": \"{SCHEMA}\"")
     version = data.get("version")
@@ -522,8 +514,6 @@ def load_session(path: str | os.PathLike) -> Session:
         If it is not JSON, repeats a key, or is not a design session of a version this
         specdesign reads (the message names the file).
     """
-    from ._checks import distinct_keys
-
     path = Path(path)
     try:
         data = json.loads(path.read_text(encoding="utf-8"), object_pairs_hook=distinct_keys())

@@ -135,3 +135,137 @@ def test_no_module_chooses_the_matplotlib_backend():
            if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) and n.func.attr == "use"
            and isinstance(n.func.value, ast.Name) and n.func.value.id in ("matplotlib", "mpl")]
     assert not bad, bad
+
+
+# ----------------------------------------------------------------------------- layers (issue 30)
+#: Imports that may stay inside a function, by the module imported (a dotted prefix), with the
+#: reason: an optional dependency, or one heavy at import time that only the calling function
+#: needs (a light module, e.g. the simulator or the fatigue code, then loads without it). Every
+#: other import is at the top of its module. The own modules listed are heavy because they
+#: import python-control at load time (checked by test_own_local_imports_are_heavy).
+LOCAL_IMPORTS = {
+    "control": "python-control loads matplotlib.pyplot and scipy.signal at import (1-3 s)",
+    "scipy": "scipy's subpackages (optimize, interpolate, signal, linalg, stats) take 0.5-2.7 s each",
+    "matplotlib": "figures only: 0.4 s, 1.4 s with pyplot; never loaded by a computation",
+    "cvxpy": "the convex solvers of the feasibility certificate and the MPC: ~3 s",
+    "sklearn": "optional extra `surrogate` (the Gaussian-process surrogate)",
+    "slycot": "optional for loopshaping as a whole, needed by its H-infinity routines only",
+    "IPython": "notebook display only",
+    "ipywidgets": "notebook widgets only",
+    "ipympl": "notebook widgets only",
+    "rosco": "optional extra `rosco` (ROSCO's compiled controller and its test decks)",
+    "distributed": "optional extra `cluster` (dask campaigns)",
+    "dask": "optional extra `cluster` (dask campaigns)",
+    "xarray": "optional: reading a campaign store back as a dataset",
+    "openfast_io": "OpenFAST's input-file library: only the deck adapters use it",
+    "specdesign.spec": "imports python-control at load",
+    "specdesign.qft": "imports python-control at load",
+    "specdesign.hinf": "imports python-control at load",
+    "specdesign.session": "imports python-control at load",
+    "specdesign.demo": "imports python-control at load",
+    "specdesign.plots.spec": "imports python-control at load",
+    "loopshaping._statespace": "imports python-control at load",
+    "loopshaping.hinf": "imports python-control at load",
+    "loopshaping.reduction": "imports python-control at load",
+    "loopshaping.wellposed": "imports python-control at load",
+}
+#: Heavy third-party modules an own module listed in LOCAL_IMPORTS must load at import.
+HEAVY = ("control", "cvxpy", "ipywidgets")
+
+
+def _in_type_checking(node, parents):
+    """Whether ``node`` sits under ``if TYPE_CHECKING:`` (an annotation, never executed)."""
+    while node in parents:
+        node = parents[node]
+        if isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING":
+            return True
+    return False
+
+
+def _imports(package):
+    """(path, module, node, targets, inside a function) of every executed import in ``package``."""
+    for path, modname in _modules():
+        if not modname.startswith(package + "."):
+            continue
+        tree = ast.parse(path.read_text(), filename=str(path))
+        parents = {c: n for n in ast.walk(tree) for c in ast.iter_child_nodes(n)}
+        for node in ast.walk(tree):
+            if not isinstance(node, (ast.Import, ast.ImportFrom)) or _in_type_checking(node, parents):
+                continue
+            if isinstance(node, ast.Import):
+                targets = [a.name for a in node.names]
+            else:
+                src = _resolve(modname, node)
+                targets = [src] + [f"{src}.{a.name}" for a in node.names]  # `from pkg import module`
+            up, local = node, False
+            while up in parents and not local:
+                up = parents[up]
+                local = isinstance(up, (ast.FunctionDef, ast.AsyncFunctionDef))
+            yield path, modname, node, targets, local
+
+
+def _part(module):
+    """The part of specdesign a module belongs to: its subpackage or top-level module."""
+    parts = module.split(".")
+    return parts[1] if parts[0] == "specdesign" and len(parts) > 1 and parts[1] != "__init__" else None
+
+
+def test_the_parts_of_specdesign_form_no_cycle():
+    # every import counts, inside functions too (only `if TYPE_CHECKING:` annotations do not):
+    # each part stands on the parts below it and never on one above
+    edges = {}
+    for path, modname, node, targets, _ in _imports("specdesign"):
+        me = _part(modname)
+        for t in targets:
+            other = _part(t)
+            if me and other and other != me and t.startswith("specdesign."):
+                edges.setdefault(me, {}).setdefault(other, f"{path.relative_to(ROOT)}:{node.lineno}")
+    state, cycles = {}, []
+
+    def visit(part, stack):
+        state[part] = "open"
+        stack.append(part)
+        for nxt in sorted(edges.get(part, {})):
+            if state.get(nxt) == "open":
+                loop = stack[stack.index(nxt):] + [nxt]
+                cycles.append(" -> ".join(f"{a} ({edges[a][b]})" for a, b in zip(loop, loop[1:])))
+            elif nxt not in state:
+                visit(nxt, stack)
+        stack.pop()
+        state[part] = "done"
+
+    for part in sorted(edges):
+        if part not in state:
+            visit(part, [])
+    assert not cycles, "import cycles between the parts of specdesign:\n" + "\n".join(cycles)
+    # the layers named in issue 30: the controller representation under the turbine, the
+    # linear loop and the simulator; the specification side under the designers
+    for low, high in (("controller", "turbine"), ("controller", "closedloop"), ("controller", "simulate"),
+                      ("turbine", "rosco"), ("closedloop", "simulate"), ("spec", "feasibility"),
+                      ("feasibility", "qft"), ("validate", "cli")):
+        assert low in edges.get(high, {}), f"{high} no longer stands on {low}: update this test's layers"
+        assert high not in edges.get(low, {}), f"{low} imports {high} ({edges[low][high]})"
+
+
+def test_no_import_inside_a_function_unless_listed():
+    def listed(targets):
+        return any(t == p or t.startswith(p + ".") for t in targets for p in LOCAL_IMPORTS)
+
+    bad = [f"{path.relative_to(ROOT)}:{node.lineno}: {ast.unparse(node)}"
+           for pkg in PACKAGES for path, _, node, targets, local in _imports(pkg) if local and not listed(targets)]
+    assert not bad, ("imports inside functions (move them to the top, or list the dependency in LOCAL_IMPORTS "
+                     "with the reason):\n" + "\n".join(bad))
+
+
+def test_own_local_imports_are_heavy():
+    # an own module may be imported inside a function only if it is heavy at import time
+    own = [m for m in LOCAL_IMPORTS if m.split(".")[0] in PACKAGES]
+    code = ("import importlib, sys\n"
+            f"importlib.import_module(sys.argv[1])\nprint(sorted(m for m in {HEAVY!r} if m in sys.modules))\n")
+    light = []
+    for m in own:
+        out = subprocess.run([sys.executable, "-c", code, m], capture_output=True, text=True, cwd=ROOT)
+        assert out.returncode == 0, out.stderr
+        if out.stdout.strip() == "[]":
+            light.append(m)
+    assert not light, f"listed in LOCAL_IMPORTS as heavy but load none of {HEAVY}: {light} (import them at the top)"

@@ -35,8 +35,8 @@ from .interconnect import (PLANT_INPUTS, check_stability, closed_loop, closed_lo
 from .maps import (LOOP_OUTPUTS, LoopMaps, close_responses, closed_loop_del, closed_map, frequency_response,
                    general_coefficients, general_form, loop_maps, output_psd, plant_responses, siso_response,
                    t_gen_speed_wind, t_output_wind, t_tower_wind)
-from .stability import (ORIGIN_TOL, ClosedLoopUnstableWarning, closed_loop_matrices, closed_loop_poles,
-                        hidden_origin_poles, local_response, loop_parts, trim_weights, unstable_message,
+from .stability import (ORIGIN_TOL, UNSTABLE_CONTROLLER_RATE, ClosedLoopUnstableWarning, closed_loop_matrices,
+                        closed_loop_poles, hidden_origin_poles, local_response, loop_parts, trim_weights, unstable_message,
                         unstable_poles)
 
 __all__ = [
@@ -74,6 +74,7 @@ __all__ = [
     "refine_grid",
     "case_speeds",
     "ORIGIN_TOL",
+    "UNSTABLE_CONTROLLER_RATE",
     "PLANT_INPUTS",
     "LOOP_OUTPUTS",
 ]

@@ -10,19 +10,31 @@ linearisation, with the torque loop closed in it.
 """
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..controller.lti import as_lti, split_integrator
+from ..controller.scheduled import ScheduledController
+from ..turbine.plant import KernelPlant, turbine_plant
+
 if TYPE_CHECKING:
     import control
 
-    from ..simulate import KernelPlant, ScheduledController
     from ..turbine import TurbineModel
 
 __all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_loop_matrices", "closed_loop_poles",
-           "hidden_origin_poles", "unstable_poles", "unstable_message", "trim_weights", "ORIGIN_TOL"]
+           "hidden_origin_poles", "unstable_poles", "unstable_message", "trim_weights", "ORIGIN_TOL",
+           "UNSTABLE_CONTROLLER_RATE"]
+
+
+#: Growth rate (1/s) above which a controller's own pole counts as unstable (a controller with
+#: one is refused by :func:`specdesign.qft.design_qft` and by the certificate's follow path:
+#: wherever the pitch saturates the loop opens and the mode grows): slower modes grow less
+#: than e-fold over a 10-minute record.
+UNSTABLE_CONTROLLER_RATE = 1e-3
 
 
 class ClosedLoopUnstableWarning(UserWarning):
@@ -72,8 +84,6 @@ def loop_parts(model: TurbineModel | KernelPlant | None, controller: Any,
     TypeError
         If the controller is neither an LTI system, a Controller nor a ScheduledController.
     """
-    from ..simulate import turbine_plant
-
     plant = turbine_plant(model)  # one plant per model: the model and its plant share the cache
     key = (id(plant), id(controller), float(wind_speed))
     hit = _PARTS.get(key)
@@ -101,8 +111,6 @@ _PARTS_SIZE = 256
 def _loop_parts(plant, controller, wind_speed):
     """:func:`loop_parts` computed."""
     import control
-
-    from ..simulate import ScheduledController, as_lti
 
     if plant.linearize is None:
         raise ValueError(f"plant {plant.name!r} has no linearisation: its closed-loop poles are unknown")
@@ -208,10 +216,6 @@ def local_response(model: TurbineModel | KernelPlant | None, controller: Any, wi
     >>> np.round(np.abs(cb), 3), ca
     (array([0.448, 0.086]), array([0.+0.j, 0.+0.j]))
     """
-    import warnings
-
-    from ..simulate import ScheduledController, as_lti, turbine_plant
-
     s = np.asarray(s)
     plant = turbine_plant(model)
     if plant.rated_wind_speed is not None and wind_speed < plant.rated_wind_speed:
@@ -453,8 +457,6 @@ def unstable_message(controller: Any, wind_speed: float, poles: ArrayLike) -> st
 def _blend(weighted):
     """Σ w·C as one state-space system with a single integrator: Σ w·r/s + Σ w·C_r."""
     import control
-
-    from ..simulate import split_integrator
 
     r, rest = 0.0, control.ss([], [], [], [[0.0]])
     for wq, c in weighted:

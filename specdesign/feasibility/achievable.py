@@ -5,7 +5,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import spectral
 from .._checks import positive_scalar
+from ..closedloop import frequency_response, siso_response
+from ..spectral import trapezoid_weights
 
 __all__ = ["SOLVER_OPTIONS", "YOULA_REAL_POLES", "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "YoulaProblem"]
 
@@ -194,9 +197,6 @@ class YoulaProblem:
         import cvxpy as cp
 
         from .. import spec
-        from ..closedloop import frequency_response, siso_response
-        from ..spectral import trapezoid_weights
-
         kappa = positive_scalar(max_pitch_rate_ratio, "max_pitch_rate_ratio")
         self.ms = positive_scalar(max_sensitivity, "max_sensitivity")
         self.wind_speed = float(wind_speed)
@@ -278,8 +278,6 @@ class YoulaProblem:
             the relaxation then counts that relaxation as one with no design.
         """
         import cvxpy as cp
-
-        from .. import spectral
 
         g = float(speed_relax_db)
         if not (np.isfinite(g) and g >= 0):

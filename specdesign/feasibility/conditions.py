@@ -7,6 +7,8 @@ import numpy as np
 
 from .._blas import on_one_blas_thread
 from .._checks import as_omega, positive_scalar, real_scalar
+from ..closedloop import closed_map, plant_responses, refine_grid, siso_response
+from ..spectral import trapezoid_weights
 from .achievable import YoulaProblem
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "pitch_frontier",
@@ -36,8 +38,6 @@ def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
         ``open_loop`` = P_{MyT,w} − K∞ (the factor of S in T_{MyT,w}) and ``k_inf`` = K∞,
         all arrays on ``omega``.
     """
-    from ..closedloop import plant_responses
-
     w = as_omega(omega, "omega", allow_zero=False)  # ω = 0: the disks' 1/|P| at DC is no frequency-domain bound
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
     R = plant_responses([plant], w, ("tower_base_my", "gen_speed"), method="batched")
@@ -74,8 +74,6 @@ def _poisson_kernel(z):
 def _poisson_weights(omega, z):
     """Weights q with q @ f = (1/π)∫ f(|ω|)·Re z/((Re z)² + (ω − Im z)²) dω over the grid
     (ω of both signs), trapezoid rule, for z = x + iy with x > 0."""
-    from ..spectral import trapezoid_weights
-
     kernel, _ = _poisson_kernel(z)
     return trapezoid_weights(omega) * kernel(omega)
 
@@ -289,8 +287,6 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=
         Nominal case first when ``cases`` is None, else in the order given.
     """
     from .. import spec
-    from ..closedloop import closed_map, plant_responses, refine_grid, siso_response
-
     v = real_scalar(wind_speed, "wind_speed")
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
     speeds = [v] if cases is None else [real_scalar(c, f"cases[{i}]") for i, c in enumerate(cases)]
@@ -378,8 +374,6 @@ def _magnitude(spec_like, omega, name):
             raise ValueError(f"{name} returned values ≤ 0 or NaN; give |W(jω)| > 0 (linear, not dB) or W(jω) complex")
         out = np.abs(raw)
     else:
-        from ..closedloop import siso_response
-
         out = np.abs(siso_response(spec_like, omega, name))
     out = np.broadcast_to(np.asarray(out, float), omega.shape)
     if np.any(~(out > 0)):

@@ -1,12 +1,23 @@
 """A feasible specification pair for a DEL-reduction target (see :mod:`specdesign.feasibility`)."""
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._blas import on_one_blas_thread
-from .._checks import MAX_BISECTIONS, bisection_tolerance, real_scalar
+from .._checks import MAX_BISECTIONS, as_omega, del_target, margin_db, search_options
+from ..closedloop import (
+    case_speeds,
+    closed_loop,
+    closed_map,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+    system_roots,
+)
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
@@ -182,7 +193,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     True
     """
     _check_target(target_reduction, slack_db, speed_slack_db)  # at the door, before the plant cases are built
-    _check_search(tolerance_db, max_relax_db, speed_relax_db)
+    search_options(tolerance_db, max_relax_db, speed_relax_db)
     search = CertificateSearch(model, wind_speed, max_sensitivity=max_sensitivity,
                                max_pitch_rate_ratio=max_pitch_rate_ratio, m=m, omega=omega, case_offsets=case_offsets,
                                dense_omega=dense_omega)
@@ -192,28 +203,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
 def _check_target(target_reduction, slack_db, speed_slack_db):
     """(target %, slack dB, speed slack dB), checked."""
-    from .._checks import del_target, real_scalar
-
-    t = del_target(target_reduction)
-    slack, sslack = real_scalar(slack_db, "slack_db"), real_scalar(speed_slack_db, "speed_slack_db")
-    if not (np.isfinite(slack) and slack >= 0):
-        raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")
-    if not (np.isfinite(sslack) and sslack >= 0):
-        raise ValueError(f"speed_slack_db={speed_slack_db!r} must be a finite margin ≥ 0 dB")
-    return t, slack, sslack
-
-
-def _check_search(tolerance_db, max_relax_db, speed_relax_db=None):
-    """(tolerance dB, largest relaxation dB, fixed relaxation dB or None), checked: a tolerance
-    ≤ 0 would never end the bisection."""
-    tol = bisection_tolerance(tolerance_db, "tolerance_db")
-    top = real_scalar(max_relax_db, "max_relax_db")
-    if top < 0:
-        raise ValueError(f"max_relax_db={max_relax_db!r} must be a relaxation ≥ 0 dB (e.g. 12)")
-    g = None if speed_relax_db is None else real_scalar(speed_relax_db, "speed_relax_db")
-    if g is not None and g < 0:
-        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB, or None to search it")
-    return tol, top, g
+    return del_target(target_reduction), margin_db(slack_db, "slack_db"), margin_db(speed_slack_db, "speed_slack_db")
 
 
 class CertificateSearch:
@@ -252,9 +242,6 @@ class CertificateSearch:
     def __init__(self, model, wind_speed, *, max_sensitivity=1.8, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
                  case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None):
         from .. import spec
-        from .._checks import as_omega
-        from ..closedloop import case_speeds
-
         self.model, self.m = model, float(m)
         self.wind_speed = v = model.check_wind_speed(wind_speed)
         self.case_speeds, _ = case_speeds(v, case_offsets, model.wind_range, name="case_offsets")
@@ -309,7 +296,7 @@ class CertificateSearch:
             As :func:`specification_for_target`.
         """
         t, slack, sslack = _check_target(target_reduction, slack_db, speed_slack_db)
-        tolerance_db, max_relax_db, g = _check_search(tolerance_db, max_relax_db, speed_relax_db)
+        tolerance_db, max_relax_db, g = search_options(tolerance_db, max_relax_db, speed_relax_db)
         model, v, speeds, base = self.model, self.wind_speed, self.case_speeds, self.base
         if speed_relax_db is not None:
             design, best, rob = self._reached(g, 0.0)
@@ -484,8 +471,6 @@ class _Cases:
 
     def _on(self, omega):
         """Plant responses and ROSCO's maps (|T_MyT|, |T_Ω|), each (n_omega, n_cases), on ``omega``."""
-        from ..closedloop import closed_map, plant_responses, siso_response
-
         R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
         c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
         return R, np.abs(closed_map(R, c, 0.0, "tower_base_my")), np.abs(closed_map(R, c, 0.0, "gen_speed"))
@@ -528,11 +513,7 @@ class _Cases:
         lightly damped roots of its nominal maps and of ``specs``' baselines (a narrow dip of W
         between grid points would hide a violation): (grid, responses, ROSCO's |T_MyT| and
         |T_Ω|, C(jω) as a column), or None if some case is unstable."""
-        import warnings
-
         from .. import spec
-        from ..closedloop import closed_loop, lightly_damped, refine_grid, siso_response, system_roots
-
         if self._unstable(controller):
             return None
         with warnings.catch_warnings():
@@ -550,8 +531,6 @@ class _Cases:
         The tower robustness is the largest excess of a case's |T_MyT|/|T^ROSCO_MyT| over the
         nominal case's; the speed relaxation the largest |T_Ω|/|T^ROSCO_Ω| (:meth:`_closed`'s grid).
         """
-        from ..closedloop import closed_map
-
         closed = self._closed(controller, omega)
         if closed is None:
             return None
@@ -573,8 +552,6 @@ class _Cases:
             the cases at each ω dB)} for "W_MyT" and "W_Ω", the grid, the nominal case's
             |T_MyT| and ROSCO's nominal |T_Ω| on it), or None if a case is unstable.
         """
-        from ..closedloop import closed_map
-
         closed = self._closed(controller, omega, (tower, speed))
         if closed is None:
             return None
@@ -599,8 +576,6 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     import control
 
     from .. import spec
-    from ..closedloop import closed_loop
-
     plant = model.linearize(float(wind_speed))
     # kept as a state space: the polynomial coefficients of a ~25th-order map carry no digits
     t_sys = control.minreal(closed_loop(plant, design.controller(model), warn=False)["tower_base_my", "wind"],
@@ -661,8 +636,6 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     >>> bool(looser.promise.exact_del < t.promise.exact_del)
     True
     """
-    from .._checks import as_omega
-
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a TargetSpecification, got {type(target).__name__}")
     tower = target.tower if tower is None else tower

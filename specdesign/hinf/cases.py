@@ -40,6 +40,7 @@ from ..closedloop import (
     refine_grid,
     siso_response,
 )
+from ..feasibility import TargetSpecification
 from .modal import (
     modal_bounds,
     modal_matrices,
@@ -231,8 +232,6 @@ def _check(cases, k):
 
 
 def _require(target, controller):
-    from ..feasibility import TargetSpecification
-
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a feasibility.TargetSpecification, got {type(target).__name__}")
     if not isinstance(controller, ct.LTI):

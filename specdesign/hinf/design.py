@@ -17,12 +17,14 @@ import control as ct
 import numpy as np
 from numpy.typing import ArrayLike
 
+from loopshaping import check, qft
 from loopshaping import hinf as lhinf
 
 from .._blas import one_blas_thread
 from .._checks import finite_system, spec_made_at
 from ..closedloop import closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
+from ..feasibility import TargetSpecification, specification_for_target
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
@@ -177,8 +179,6 @@ def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
     """Re-check a SISO pitch controller with :mod:`loopshaping.check`: the tower spec in
     the general form |(A + B·C)/(1 + D·C)| ≤ |W_MyT| with A = P_{MyT,w},
     B = P_{MyT,w}P_{Ω,β} − P_{MyT,β}P_{Ω,w}, D = P_{Ω,β}; the speed spec with A = P_{Ω,w}, B = 0."""
-    from loopshaping import check, qft
-
     def resp(o, i):
         sub = plant[o, i]
         return lambda w: _response(sub, w).reshape(-1, 1)
@@ -455,8 +455,6 @@ def design_hinf(
     True
     """
     from .. import spec as sp
-    from ..feasibility import TargetSpecification, specification_for_target
-
     if specs is not None:
         warnings.warn("design_hinf(specs=...) is deprecated; use spec=... (the name design_qft uses)",
                       DeprecationWarning, stacklevel=2)

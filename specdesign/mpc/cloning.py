@@ -31,10 +31,13 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from .._checks import positive_scalar
+from ..simulate import SimulationDivergedError, simulate
 from .base import MEASURED, SampledController, discretize_turbine
 from .economic import economic_problem, solve_cone
+from .quadratic import QuadraticMPC
 
 __all__ = ["Demonstrations", "demonstrations", "CloningRegressor", "ClonedController", "OpenLoopPlayback", "clone",
            "UPREV"]
@@ -153,9 +156,6 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
         For ``every`` not a whole multiple of ``ts``, or a behaviour controller at another
         sample time.
     """
-    from ..simulate import SimulationDivergedError, simulate
-    from .quadratic import QuadraticMPC
-
     horizon, ts, every = positive_scalar(horizon, "horizon"), positive_scalar(ts, "ts"), positive_scalar(every, "every")
     stride = int(round(every / ts))
     if stride < 1 or abs(stride * ts - every) > 1e-9 * every:
@@ -200,8 +200,6 @@ _POOLS = []
 def _threadpools():
     """threadpoolctl's controller, built once (it scans the loaded libraries: milliseconds)."""
     if not _POOLS:
-        from threadpoolctl import ThreadpoolController  # a scikit-learn dependency
-
         _POOLS.append(ThreadpoolController())
     return _POOLS[0]
 

@@ -33,6 +33,8 @@ import numpy as np
 
 from .._checks import positive_scalar
 from ..fatigue import VarianceDamageFit, economic_cost, fit_variance_damage
+from ..simulate import simulate
+from ..turbine import rosco_baseline
 from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine
 
 __all__ = ["solve_cone", "FatigueTerm", "fit_fatigue_terms", "surrogate_cost", "economic_problem",
@@ -133,9 +135,6 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
         For an output the model does not have, one without a Wöhler exponent, or a window
         longer than ``duration``.
     """
-    from ..simulate import simulate
-    from ..turbine import rosco_baseline
-
     window = positive_scalar(window, "window")
     duration = positive_scalar(duration, "duration")
     if window > duration / 2:

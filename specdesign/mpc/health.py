@@ -56,6 +56,8 @@ import time
 import numpy as np
 
 from .._checks import bad_measurements, positive_scalar
+from ..fatigue import SNCurve
+from ..fatigue_online import StreamingDamage
 from .base import MEASURED, SampledController
 from .lpv import LPVTurbine, lpv_observer, lpv_turbine
 
@@ -366,9 +368,6 @@ class HealthMPC(SampledController):
         torque : numpy.ndarray
             (R,) generator torque (N·m).
         """
-        from ..fatigue import SNCurve
-        from ..fatigue_online import StreamingDamage
-
         super().start(dt, wind, pitch, torque)
         sn = SNCurve(m=self.blade_m, s_ref=self.del_budget if self.del_budget is not None else 1e6)
         self._run["damage"] = [StreamingDamage(sn) for _ in range(np.asarray(pitch).size)]

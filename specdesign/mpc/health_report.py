@@ -14,6 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..fatigue import del_rainflow
+from ..rosco import rosco_scheduled
+from ..simulate import simulate
+from .health import HealthMPC
+
 __all__ = ["TradeoffPoint", "health_tradeoff", "plot_tradeoff", "BLADE_M", "TOWER_M"]
 
 #: Wöhler exponents of the blade root (glass fibre) and the tower base (steel).
@@ -56,8 +61,6 @@ class TradeoffPoint:
 
 
 def _pooled_del(x, m, duration):
-    from ..fatigue import del_rainflow
-
     dels = np.array([del_rainflow(s, m, duration) for s in x.reshape(-1, x.shape[-1])])
     return float(np.mean(dels**m) ** (1.0 / m))
 
@@ -100,10 +103,6 @@ def health_tradeoff(model, wind_speeds, seeds, *, health_weights=(0.0, 3.0, 10.0
     tuple of TradeoffPoint
         ROSCO (if asked), then the ψ sweep, then the ψ_acc sweep.
     """
-    from ..rosco import rosco_scheduled
-    from ..simulate import simulate
-    from .health import HealthMPC
-
     out = []
     run = dict(seeds=list(seeds), duration=duration, transient=transient)
     if baseline:

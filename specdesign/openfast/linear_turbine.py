@@ -33,6 +33,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import positive_scalar
+from ..rosco import rosco_baseline, rosco_gain_schedule
+from ..simulate import KernelPlant
+from ..simulate.kernels import linear_outputs, linear_plant_params, linear_rhs
+from .lin import read_lin_file, read_linearization
+from .signals import plant_from_linearization
 
 __all__ = ["LinearOperatingPoint", "RotorModelSchedule", "LinearTurbine", "rotor_speed_model"]
 
@@ -389,8 +394,6 @@ class LinearTurbine:
             Outside ``wind_range``, or a plant whose rotor model cannot be read
             (:func:`rotor_speed_model`).
         """
-        from ..rosco import rosco_baseline
-
         return rosco_baseline(self, wind_speed, schedule=self.schedule)
 
     def kernel_plant(self):
@@ -408,9 +411,6 @@ class LinearTurbine:
             The plant.
         """
         import control
-
-        from ..simulate import KernelPlant
-        from ..simulate.kernels import linear_outputs, linear_plant_params, linear_rhs
 
         def linearize(v):
             sys = self.linearize(v)
@@ -491,8 +491,6 @@ class LinearTurbine:
         LinearTurbine
             Plants ``model.linearize(v)``, operating points of ``model.trim(v)``.
         """
-        from ..rosco import rosco_gain_schedule
-
         vs = [float(v) for v in wind_speeds]
         sched = rosco_gain_schedule(model) if isinstance(schedule, str) and schedule == "rosco" else schedule
         ops = {v: LinearOperatingPoint(v, *(float(getattr(model.trim(v), k)) for k in ("rotor_speed", "pitch", "gen_torque")))
@@ -540,9 +538,6 @@ class LinearTurbine:
         >>> lt.wind_range, round(lt.rotor_radius, 1)
         ((19.0, 19.0), 119.5)
         """
-        from .lin import read_lin_file, read_linearization
-        from .signals import plant_from_linearization
-
         if isinstance(paths, (str, os.PathLike)):
             p = os.fspath(paths)
             files = sorted(glob.glob(p)) if glob.has_magic(p) else [p]

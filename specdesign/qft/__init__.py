@@ -79,7 +79,7 @@ from __future__ import annotations
 
 from ..closedloop import general_form, partial_loop
 from .checks import fine_pitch_lift
-from .design import (DEFAULT_DESIGN_OMEGA, UNSTABLE_CONTROLLER_RATE, QFTDesign, check_design_speed, design_qft, design_schedule, design_table,
+from .design import (DEFAULT_DESIGN_OMEGA, QFTDesign, check_design_speed, design_qft, design_schedule, design_table,
                      format_table)
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 
@@ -93,18 +93,8 @@ __all__ = [
     "design_table",
     "format_table",
     "DEFAULT_DESIGN_OMEGA",
-    "UNSTABLE_CONTROLLER_RATE",
     "fine_pitch_lift",
     "TorqueDesign",
     "design_torque",
     "torque_general_form",
 ]
-
-
-def __getattr__(name):
-    if name == "DEFAULT_DESIGN_OMEGAS":  # renamed: one name for frequency grids, omega
-        import warnings
-
-        warnings.warn("DEFAULT_DESIGN_OMEGAS is deprecated, use DEFAULT_DESIGN_OMEGA", DeprecationWarning, stacklevel=2)
-        return DEFAULT_DESIGN_OMEGA
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

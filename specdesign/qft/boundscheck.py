@@ -15,11 +15,20 @@ Units: ω in rad/s, magnitudes linear (N·m per m/s for the tower weight).
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..closedloop import case_speeds, closed_map, general_coefficients, plant_responses, siso_response
+from loopshaping import qft as lqft
+
+from ..closedloop import (
+    case_speeds,
+    closed_map,
+    general_coefficients,
+    plant_responses,
+    siso_response,
+)
 
 __all__ = ["BoundsVerdict", "BoundsChecker", "bounds_checker"]
 
@@ -97,10 +106,6 @@ class BoundsChecker:
         ValueError
             If an array of the wrong length is given.
         """
-        import warnings
-
-        from loopshaping import qft as lqft
-
         w = self.template.omega
         vals = (np.asarray(tower_spec.response(w)) if hasattr(tower_spec, "response")
                 else np.asarray(tower_spec, complex))
@@ -155,10 +160,6 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     >>> checker.check(design_specifications(model, 19.0).tower).feasible
     True
     """
-    import warnings
-
-    from loopshaping import qft as lqft
-
     from .. import spec as sp
     from ..spec import baseline_controllers
     from .design import DEFAULT_DESIGN_OMEGA

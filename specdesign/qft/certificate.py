@@ -21,7 +21,17 @@ from typing import Any
 import control as ct
 import numpy as np
 
-from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response
+from loopshaping import qft as lqft
+
+from ..closedloop import (
+    closed_loop,
+    closed_map,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+)
+from ..feasibility import TargetSpecification
 from .checks import spec_ratio, spec_roots
 
 __all__ = ["design_from_certificate"]
@@ -64,10 +74,7 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
     ValueError
         If ``max_sensitivity`` ≤ 1, ``min_decay`` ≤ 0 or ``min_order`` < 1.
     """
-    from loopshaping import qft as lqft
-
     from .. import spec as sp
-    from ..feasibility import TargetSpecification
     from .design import DEFAULT_DESIGN_OMEGA, assemble_design
     from .tuner import TuningProblem
 
@@ -114,8 +121,6 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
 def _lowest_order(prob, full, omega, min_order, ms, min_decay):
     """The lowest-order balanced truncation of ``full`` that meets every specification on ``omega``
     at every plant case, is stable with decay ≥ ``min_decay`` and keeps |S| ≤ ``ms``; else ``full``."""
-    from ..closedloop import plant_responses
-
     R = plant_responses(prob.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
     w_speed, w_tower = prob.weights(omega)
     ob = R[("gen_speed", "pitch_cmd")]

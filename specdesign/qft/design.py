@@ -6,6 +6,7 @@ phase margins in degrees, decay rates in 1/s; β = −C_β·Ω_g − C_atd·ẋ_
 """
 from __future__ import annotations
 
+import inspect
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -13,10 +14,23 @@ from typing import TYPE_CHECKING, Any
 
 import control as ct
 import numpy as np
+from tqdm.auto import tqdm
 
+from loopshaping import qft as lqft
+
+from .. import turbine
 from .._checks import del_target, positive_scalar, spec_made_at
-from ..closedloop import (case_speeds, check_stability, closed_loop, lightly_damped, plant_responses, refine_grid,
-                          siso_response)
+from ..closedloop import (
+    UNSTABLE_CONTROLLER_RATE,
+    case_speeds,
+    check_stability,
+    closed_loop,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+)
+from ..feasibility import TargetSpecification, specification_for_target
 from .checks import bounds_met, loop_checks, spec_ratio, spec_roots
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
@@ -30,17 +44,12 @@ if TYPE_CHECKING:
     from ..turbine import TurbineModel
 
 __all__ = ["QFTDesign", "design_qft", "assemble_design", "design_schedule", "design_table", "format_table",
-           "DEFAULT_DESIGN_OMEGA", "check_design_speed", "UNSTABLE_CONTROLLER_RATE"]
+           "DEFAULT_DESIGN_OMEGA", "check_design_speed"]
 
 
 #: Default QFT design frequencies, rad/s: the wind band, the tower mode (~1.06 rad/s) and
 #: the actuator band.
 DEFAULT_DESIGN_OMEGA = np.unique(np.r_[0.005, 0.007, np.logspace(-2, 1, 37), 0.9, 0.95, 1.0, 1.03, 1.05, 1.07, 1.1, 1.15, 1.2])
-
-
-#: Growth rate (1/s) above which a controller pole counts as unstable in :func:`design_qft`'s
-#: checks: slower modes grow less than e-fold over a 10-minute record.
-UNSTABLE_CONTROLLER_RATE = 1e-3
 
 
 # ----------------------------------------------------------------------------- result
@@ -124,7 +133,7 @@ class QFTDesign:
     success : bool
         Every specification met: target (within 0.5 pp), bounds, dense checks, stability of
         every closed loop and of the controller itself (no pole growing faster than
-        :data:`UNSTABLE_CONTROLLER_RATE`: a saturated pitch opens the loop).
+        :data:`specdesign.closedloop.UNSTABLE_CONTROLLER_RATE`: a saturated pitch opens the loop).
     message : str
         ``"all specifications met"`` or what failed.
     parameters : dict of str to float
@@ -424,14 +433,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             if new_name in kwargs:
                 raise TypeError(f"design_qft got both {old_name}= and {new_name}=")
             kwargs[new_name] = kwargs.pop(old_name)
-    import inspect
-
     options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
     unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
     if unknown:  # named here, not as a TypeError of an internal function
         raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
-    from .. import turbine
-
     if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
         raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
                         f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
@@ -452,13 +457,9 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
     if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
-    from ..feasibility import TargetSpecification
-
     if structure not in (None, "certificate", "fixed"):
         raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
     if isinstance(spec, str) and spec == "target":
-        from ..feasibility import specification_for_target
-
         # the plant cases the pair is certified on are the ones the design must meet it on
         offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
         spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction,
@@ -562,8 +563,6 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
                    design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
                    max_sensitivity=1.9, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
-    from loopshaping import qft as lqft
-
     from .. import spec as sp
 
     v = model.check_wind_speed(wind_speed)  # the model's type is checked by design_qft
@@ -684,8 +683,6 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
     QFTDesign
         The design; ``success`` False with a message (and a RuntimeWarning) when a check fails.
     """
-    from loopshaping import qft as lqft
-
     v, nom, speeds = prob.v, prob.nom, prob.speeds
     if checks is None:
         checks = loop_checks(prob, cb, ca, wdense)
@@ -811,7 +808,6 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
                          "one number or one per wind speed")
     targets = np.array([del_target(x, f"target_reduction[{i}]" if per_speed else "target_reduction") for i, x in
                         enumerate(target_reduction if per_speed else [target_reduction] * vs.size)])
-    from tqdm.auto import tqdm
 
     out = []
     for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
@@ -905,10 +901,3 @@ def format_table(rows: Iterable[dict[str, Any]]) -> str:
             f"| {r['atd_phase_margin_deg']:.1f} | {'yes' if r['bounds_met'] else 'NO'} | {'pass' if r['dense_check_passed'] else 'FAIL'} "
             f"| {'yes' if r['all_stable'] else 'NO'} | {r['n_states']} |")
     return "\n".join(lines)
-
-
-def __getattr__(name):
-    if name == "DEFAULT_DESIGN_OMEGAS":  # renamed: one name for frequency grids, omega
-        warnings.warn("DEFAULT_DESIGN_OMEGAS is deprecated, use DEFAULT_DESIGN_OMEGA", DeprecationWarning, stacklevel=2)
-        return DEFAULT_DESIGN_OMEGA
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

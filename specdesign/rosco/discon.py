@@ -29,6 +29,7 @@ command (HSS N·m, N times that on the rotor shaft, which the plant takes).
 from __future__ import annotations
 
 import ctypes
+import importlib.metadata
 import os
 import re
 import shutil
@@ -39,7 +40,7 @@ import numpy as np
 from numba import njit
 
 from .._checks import bad_measurements
-from .discon_file import read_discon
+from ..controller.discon_file import read_discon
 
 __all__ = ["SWAP_SIZE", "DisconError", "rosco_library", "rosco_test_cases", "Discon"]
 
@@ -79,8 +80,6 @@ class DisconError(RuntimeError):
 
 
 def _rosco_file(rel: str) -> Path:
-    import importlib.metadata
-
     try:
         dist = importlib.metadata.distribution("rosco")
     except importlib.metadata.PackageNotFoundError:
@@ -125,6 +124,25 @@ def rosco_test_cases() -> Path:
         If the ``rosco`` package is not installed (``pip install 'specdesign[rosco]'``).
     """
     return _rosco_file("Examples/Test_Cases")
+
+
+#: First word of a parameter file of :func:`specdesign.export.export_discon` (its own format, not ROSCO's).
+_EXPORTED = "specdesign-discon"
+
+
+def _exported_gearbox_ratio(path: Path) -> float | None:
+    """The ``gearbox_ratio`` of an exported controller's parameter file, None for a ROSCO DISCON.IN."""
+    with open(path, errors="replace") as f:
+        if f.read(len(_EXPORTED)) != _EXPORTED:
+            return None
+        for line in f:
+            words = line.partition("#")[0].split()
+            if words[:1] == ["gearbox_ratio"] and len(words) == 2:
+                try:
+                    return float(words[1])
+                except ValueError:
+                    break
+    raise ValueError(f"{path}: no numeric gearbox_ratio: write the file with specdesign.export.export_discon")
 
 
 def _refused_parameter(msg: str) -> str | None:
@@ -194,10 +212,15 @@ class Discon:
     and ``Echo`` set to 0 (no debug files) and its relative file names made absolute; ROSCO
     prints its banner and a status line every 10 s of simulated time on the process's stdout.
 
+    An exported controller runs the same way: ``Discon(rec.parameters, library=rec.library)``
+    for a record of :func:`specdesign.export.export_discon`; its parameter file (first word
+    ``specdesign-discon``) is read as it is, its ``gearbox_ratio`` converting the speeds.
+
     Parameters
     ----------
     discon_in : str or pathlib.Path
-        The DISCON.IN file, written for the library's ROSCO version.
+        The DISCON.IN file, written for the library's ROSCO version, or the parameter file of
+        an exported controller.
     library : str or pathlib.Path, optional
         The compiled controller (default :func:`rosco_library`, the ``rosco`` package's).
     name : str, optional
@@ -215,7 +238,8 @@ class Discon:
     ModuleNotFoundError
         Without ``library``, if the ``rosco`` package is not installed.
     ValueError
-        If ``discon_in`` lacks ``WE_GearboxRatio`` or has a non-positive one, or uses
+        If an exported controller's file has no numeric ``gearbox_ratio``; if ``discon_in``
+        lacks ``WE_GearboxRatio`` or has a non-positive one, or uses
         ``WE_Mode = 0`` (ROSCO would read a hub-height wind the simulator does not give).
 
     Notes
@@ -241,11 +265,22 @@ class Discon:
 
     def __init__(self, discon_in: str | Path, library: str | Path | None = None, *, name: str = "ROSCO DISCON"):
         self.discon_in = Path(discon_in)
-        entries, self.file_version = read_discon(self.discon_in)
-        _check_opened_files(self.discon_in, entries)  # before the library is loaded (it can end the process)
+        if not self.discon_in.is_file():
+            raise FileNotFoundError(f"discon_in={str(self.discon_in)!r} does not exist")
+        # an exported controller's parameter file (specdesign.export): its library reads it as it is
+        exported = _exported_gearbox_ratio(self.discon_in)
+        self.exported = exported is not None
         self.library = Path(library) if library is not None else rosco_library()
         if not self.library.is_file():
             raise FileNotFoundError(f"library={str(self.library)!r} does not exist")
+        self.__name__ = str(name)
+        self._tmp = None
+        self._runs = 0
+        if self.exported:
+            self.gearbox_ratio, self.file_version = exported, _EXPORTED
+            return
+        entries, self.file_version = read_discon(self.discon_in)
+        _check_opened_files(self.discon_in, entries)  # before the library is loaded (it can end the process)
         e = entries.get("WE_GearboxRatio")
         try:
             ratio = float(e.values[0]) if e is not None else float("nan")
@@ -259,14 +294,11 @@ class Discon:
             raise ValueError(f"{self.discon_in}: line {we.line}: WE_Mode = 0 reads the measured hub-height wind, which "
                              "the simulator does not give the controller; use WE_Mode = 1 or 2 (ROSCO's estimators)")
         self.gearbox_ratio = ratio
-        self.__name__ = str(name)
-        self._tmp = None
-        self._runs = 0
 
     def __getstate__(self):
         # the loaded library copies stay with this process: a pickled Discon (a campaign's
         # task on another worker) carries its files and starts fresh copies there
-        keep = ("discon_in", "file_version", "library", "gearbox_ratio", "__name__")
+        keep = ("discon_in", "exported", "file_version", "library", "gearbox_ratio", "__name__")
         return {**{k: self.__dict__[k] for k in keep}, "_tmp": None, "_runs": 0}
 
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
@@ -287,7 +319,7 @@ class Discon:
         R = int(np.size(wind))
         self._tmp = tempfile.TemporaryDirectory(prefix="specdesign_discon_")
         folder = Path(self._tmp.name)
-        infile = _run_copy(self.discon_in, folder)
+        infile = self.discon_in.resolve() if self.exported else _run_copy(self.discon_in, folder)
         # loading the original first resolves the copies' dependencies (its RPATH points next to it)
         ctypes.CDLL(str(self.library))
         self._fns = []
@@ -341,6 +373,8 @@ class Discon:
         if self._fail.min() < 0:
             r = int(np.flatnonzero(self._fail < 0)[0])
             msg = self._message(r)
+            if status == 0 and self.exported:
+                raise ValueError(f"the exported controller ({self.library.name}) refused its parameter file: {msg}")
             if status == 0:
                 key = _refused_parameter(msg)
                 what = f"parameter {key}" if key else "its input"

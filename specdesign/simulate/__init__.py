@@ -81,26 +81,29 @@ and its torque input is held at the trim.
 
 Layout
 ------
-- :mod:`specdesign.simulate.core`: :func:`simulate`, :class:`KernelPlant`, :func:`turbine_plant`,
-  :class:`SimulationResult`, :class:`SimulationDivergedError`.
+- :mod:`specdesign.simulate.core`: :func:`simulate`, :class:`SimulationResult`,
+  :class:`SimulationDivergedError`.
 - :mod:`specdesign.simulate.checks`: the step checks (:func:`check_step`,
   :func:`check_loop_step`, :func:`sampled_loop_radius`).
-- :mod:`specdesign.simulate.schedule`: :class:`ScheduledController`, :func:`scheduled`.
-- :mod:`specdesign.simulate.controllers`: controller preparation (:func:`as_lti`,
-  :func:`tustin_matrices`, :func:`split_integrator`, :func:`split_slow`, the discrete bank).
 - :mod:`specdesign.simulate.kernels`: the numba kernels (the compiled loop, the linear plant).
-- :func:`rosco_scheduled` lives in :mod:`specdesign.rosco`, :func:`wind_series` and
-  :func:`seed_for` in :mod:`specdesign.wind`; both are re-exported here.
+- Re-exported here, the same objects, from the layers the simulator stands on:
+  :class:`ScheduledController` (:mod:`specdesign.controller.scheduled`), the controller
+  preparation :func:`as_lti`, :func:`tustin_matrices`, :func:`split_integrator`,
+  :func:`split_slow` (:mod:`specdesign.controller.lti`), the plant :class:`KernelPlant`,
+  :func:`turbine_plant` and :func:`scheduled` (:mod:`specdesign.turbine.plant`),
+  :func:`rosco_scheduled` (:mod:`specdesign.rosco`), :func:`wind_series` and :func:`seed_for`
+  (:mod:`specdesign.wind`).
 """
 from __future__ import annotations
 
+from ..controller.lti import SLOW_OMEGA, as_lti, is_lti_like, split_integrator, split_slow, tustin_matrices
+from ..controller.scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from ..rosco import rosco_scheduled
+from ..turbine.plant import KernelPlant, scheduled, turbine_plant
 from ..wind import seed_for, wind_series
 from .checks import MAX_STEP_EIGENVALUE, check_loop_step, check_step, sampled_loop_radius, warn_unstable
-from .controllers import SLOW_OMEGA, as_lti, is_lti_like, split_integrator, split_slow, tustin_matrices
-from .core import WIND_MEAN_TOLERANCE, KernelPlant, SimulationDivergedError, SimulationResult, simulate, turbine_plant
+from .core import WIND_MEAN_TOLERANCE, SimulationDivergedError, SimulationResult, simulate
 from .kernels import linear_plant_params
-from .schedule import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController, scheduled
 
 __all__ = [
     "SimulationDivergedError",
@@ -129,12 +132,3 @@ __all__ = [
     "FORMS",
     "warn_unstable",
 ]
-
-def __getattr__(name):
-    if name == "discretize":  # renamed: loopshaping.hinf.discretize returns a discrete LTI, this the kernel's matrices
-        import warnings
-
-        warnings.warn("specdesign.simulate.discretize is deprecated, use specdesign.simulate.tustin_matrices",
-                      DeprecationWarning, stacklevel=2)
-        return tustin_matrices
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -3,7 +3,7 @@
 One ``@njit`` loop integrates a batch of runs in parallel (``prange`` over runs): per run, fixed-step
 RK4 of the plant kernel pair with the wind linearly interpolated between its samples, the pitch
 command and generator torque held over a step, and the discrete controller bank of
-:mod:`specdesign.simulate.controllers` (output-blended locals, each with its integrator run
+:mod:`specdesign.controller.scheduled` (output-blended locals, each with its integrator run
 apart and clamped or conditionally integrated, and ROSCO's gain-scheduled PI) scheduled on the
 filtered pitch command. See :mod:`specdesign.simulate` for the conventions.
 
@@ -17,6 +17,7 @@ by :func:`specdesign.simulate.simulate`; nothing is meant to be called directly 
 from __future__ import annotations
 
 import math
+import types
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
@@ -27,7 +28,7 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:  # pragma: no cover
     import control
 
-from ..rosco.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
+from ..controller.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
 from ..turbine import aero_loads as _turbine_aero
 from ..turbine import mechanics as _turbine_mechanics
 from ..turbine import outputs as _turbine_outputs
@@ -489,8 +490,6 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
         :data:`KIND_LINEAR`, or :data:`KIND_USER` for a rebound user pair) and the batch loop, the one-step
         function and the outputs function of the callable path (:func:`run_callable`).
     """
-    import types
-
     if rhs is linear_rhs:
         return KIND_LINEAR, _run_batch, _step_all, _outputs_all
     if rhs is _turbine_rhs and outfn is _turbine_outputs:

@@ -4,7 +4,7 @@ The model: rigid-drivetrain rotor (aerodynamic torque from Cp(λ, β), thrust fr
 first tower fore-aft mode driven by thrust with the rotor seeing the relative wind U − ẋ_top,
 a 2nd-order pitch actuator with rate and position limits, and a generator torque that is an
 input (constant, ``rated_generator_torque``, above rated; below rated set by ROSCO's torque law,
-the model's ``torque_control``, :mod:`specdesign.rosco.torque`, closed in :meth:`TurbineModel.trim`
+the model's ``torque_control``, :mod:`specdesign.controller.torque`, closed in :meth:`TurbineModel.trim`
 and :meth:`TurbineModel.linearize` from cut-in to cut-out). Figures come from the shipped
 ``specdesign/data/iea15mw`` (IEA Wind Task 37 and NREL ROSCO, Apache-2.0; see NOTICE.md).
 
@@ -15,6 +15,7 @@ The state, input and output vectors and the compiled kernel are those of
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass, field, fields
 from functools import cached_property
@@ -24,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
+from ..controller.torque import close_torque_loop, steady_state, torque_law
 
 if TYPE_CHECKING:  # pragma: no cover
     import control
@@ -464,8 +466,6 @@ class TurbineModel:
         )
 
     def _trim_below(self, v):
-        from ..rosco.torque import steady_state
-
         omega, torque, beta, region = steady_state(self, self.torque_control, v)
         tsr = omega * self.rotor_radius / v
         cp, ct = (float(c) for c in self.rotor_coefficients(tsr, beta))
@@ -577,8 +577,6 @@ class TurbineModel:
         A, B, C, D = self.jacobians(op)
         inputs, states = list(INPUT_NAMES), list(STATE_NAMES)
         if op.region != "3":
-            from ..rosco.torque import close_torque_loop
-
             A, B, C, D, extra = close_torque_loop(A, B, C, D, self.torque_control, op.rotor_speed, op.region)
             states += extra
         if load_inputs:
@@ -689,10 +687,6 @@ def iea15mw() -> TurbineModel:
     >>> iea15mw().name
     'IEA-15-240-RWT'
     """
-    import dataclasses
-
-    from ..rosco.torque import torque_law
-
     par = json.loads(read_text("parameters.json"))
     tsr, pitch_deg, cp, ct = read_rotor_table()
     model = TurbineModel(

@@ -38,11 +38,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from .._checks import positive_scalar
+from ..controller.discon_file import from_discon, read_discon
+from ..controller.torque import torque_law_from_discon
 from .model import TurbineModel
 
 __all__ = ["GRAVITY", "read_openfast_file", "read_cp_table", "from_openfast"]
@@ -308,8 +311,6 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     >>> from specdesign.rosco import rosco_test_cases
     >>> m = from_openfast(rosco_test_cases() / "NREL-5MW/NREL-5MW.fst")  # doctest: +SKIP
     """
-    from ..rosco.discon_file import from_discon, read_discon
-
     fst = _File(fst_path)
     if fst.has("CompSub") and fst.number("CompSub") != 0:
         raise ValueError(f"{fst.path}: line {fst.entries['CompSub'][1]}: CompSub = {fst.entries['CompSub'][0]}: the "
@@ -391,10 +392,6 @@ def _discon_positive(discon, entries, key, default):
 def _with_torque_law(model, discon, entries):
     """The model with ROSCO's torque law of its DISCON.IN attached (trim and linearize from
     cut-in), or unchanged with a warning when the workbench does not run that DISCON's law."""
-    import warnings
-
-    from ..rosco.torque import torque_law_from_discon
-
     e = entries.get("VS_ControlMode")
     try:
         # mode 2 tracks the TSR from ROSCO's wind-speed estimator (not modelled): its power-based

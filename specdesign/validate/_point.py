@@ -7,8 +7,17 @@ import warnings
 
 import numpy as np
 
+from .. import wind as wmod
 from .._blas import on_one_blas_thread
-from ..closedloop import unstable_message, unstable_poles
+from ..closedloop import ClosedLoopUnstableWarning, unstable_message, unstable_poles
+from ..simulate import (
+    SimulationDivergedError,
+    SimulationResult,
+    simulate,
+    turbine_plant,
+    wind_series,
+)
+from ..simulate.checks import checked_loop
 from ._loop import has_linear_form, rotor_radius
 from .metrics import INDICATORS, indicators
 from .prediction import closed_loop_response, linear_prediction, prediction_grid
@@ -48,11 +57,6 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
     for the compiled controllers; a callable one commands the torque itself (or holds the
     trim torque), so it runs with "auto" unless None is asked.
     """
-    from .. import wind as wmod
-    from ..closedloop import ClosedLoopUnstableWarning
-    from ..simulate import SimulationDivergedError, SimulationResult, simulate, turbine_plant, wind_series
-    from ..simulate.checks import checked_loop
-
     n_keep = len(seeds) if keep_series is True else int(keep_series)
     radius = rotor_radius(model)
     wdt = record_dt

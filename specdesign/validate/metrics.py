@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
+from ..fatigue import del_rainflow
 
 __all__ = ["BLADE_M", "INDICATORS", "Indicators", "indicators"]
 
@@ -104,8 +105,6 @@ def indicators(series: Mapping, dt: float, m: float = 4.0) -> Indicators:
     >>> float(indicators(s, 0.1).mean_power)
     15000000.0
     """
-    from ..fatigue import del_rainflow
-
     dt = positive_scalar(dt, "dt")
     m = positive_scalar(m, "m")
     get = series.__getitem__

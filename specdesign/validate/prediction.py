@@ -6,9 +6,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import spectral, wind
 from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind, unstable_message, unstable_poles
 from ..closedloop.maps import state_space_response
+from ..simulate import turbine_plant
 from ._loop import rotor_radius
 
 __all__ = ["loop_plant", "closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction"]
@@ -30,8 +32,6 @@ def loop_plant(model):
     KernelPlant
         The plant.
     """
-    from ..simulate import turbine_plant
-
     own = getattr(model, "kernel_plant", None)
     return own() if callable(own) else turbine_plant(model)
 
@@ -162,8 +162,6 @@ def linear_prediction(model, controller, wind_speed: float, *, output: str = "to
         The controller destabilises the loop (naming it and the unstable poles): |T|²S_W of
         an unstable loop is finite but describes no response.
     """
-    from .. import spectral, wind
-
     bad = unstable_poles(loop_plant(model), controller, wind_speed)
     if bad.size:
         raise ValueError(unstable_message(controller, wind_speed, bad) + "; a linear prediction of an unstable loop is meaningless")

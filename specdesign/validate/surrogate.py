@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..wind import TURBULENCE_CLASSES
+from .campaign import Campaign
 from .metrics import INDICATORS
 
 __all__ = ["CONDITIONS", "DelData", "del_data", "SurrogatePrediction", "GPSurrogate", "fit_gp", "LookupTable",
@@ -74,8 +76,6 @@ class DelData:
 
 
 def _turbulence_key(key) -> float:
-    from ..wind import TURBULENCE_CLASSES
-
     if isinstance(key, str):
         if key not in TURBULENCE_CLASSES:
             raise ValueError(f"campaigns key {key!r} must be an IEC turbulence class {sorted(TURBULENCE_CLASSES)} "
@@ -118,8 +118,6 @@ def del_data(campaigns, controller, indicator: str = "tower_del") -> DelData:
     TypeError
         ``campaigns`` is neither a Campaign nor a non-empty mapping of them.
     """
-    from .campaign import Campaign
-
     if indicator not in INDICATORS:
         raise ValueError(f"indicator={indicator!r} must be one of {INDICATORS}")
     if isinstance(campaigns, Campaign):

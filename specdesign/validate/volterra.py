@@ -9,8 +9,11 @@ import numpy as np
 
 from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind
+from ..fatigue import del_rainflow
+from ..simulate import wind_series
+from ..turbine import OUTPUT_NAMES
 from ._loop import has_linear_form, rotor_radius
-from .stats import pool
+from .stats import pool, seeds_from
 
 __all__ = ["volterra_response", "VolterraPrediction", "volterra_prediction"]
 
@@ -65,8 +68,6 @@ def volterra_response(model, controller, wind_speed: float, wind, dt: float, *, 
         An order outside 1-3, an unknown output, a non-finite or too short wind record, or a
         non-positive ``dt``.
     """
-    from ..turbine import OUTPUT_NAMES
-
     if not hasattr(model, "aero_expansion"):
         raise TypeError(f"model must be a turbine.TurbineModel (with aero_expansion), got {type(model).__name__}")
     if order not in (1, 2, 3):
@@ -201,10 +202,6 @@ def volterra_prediction(model, controller, wind_speed: float, *, seeds=range(100
     TypeError
         See :func:`volterra_response`.
     """
-    from ..fatigue import del_rainflow
-    from ..simulate import wind_series
-    from .campaign import seeds_from  # the campaign's meaning of seeds (an int n → 0..n−1)
-
     seeds = seeds_from(seeds)
     duration, dt, m = positive_scalar(duration, "duration"), positive_scalar(dt, "dt"), positive_scalar(m, "m")
     dels, sq = [], []

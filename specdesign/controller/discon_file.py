@@ -16,30 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["DisconEntry", "DisconSchedule", "iea15mw_discon", "read_discon", "from_discon", "write_discon"]
-
-
-def iea15mw_discon() -> Path:
-    """Path of the shipped DISCON.IN of the IEA 15 MW monopile (ROSCO 2.9.4 tuning).
-
-    Its ``PerfFileName`` points outside the package: it reads as a schedule
-    (:func:`from_discon`) but the compiled ROSCO cannot run it as it is.
-
-    Returns
-    -------
-    pathlib.Path
-        ``specdesign/data/iea15mw/IEA-15-240-RWT-Monopile_DISCON.IN``.
-
-    Examples
-    --------
-    >>> iea15mw_discon().name
-    'IEA-15-240-RWT-Monopile_DISCON.IN'
-    """
-    from importlib import resources
-
-    from ..turbine.tables import DATA_DIR
-
-    return Path(str(resources.files("specdesign").joinpath(f"{DATA_DIR}/IEA-15-240-RWT-Monopile_DISCON.IN")))
+__all__ = ["DisconEntry", "DisconSchedule", "read_discon", "from_discon", "write_discon"]
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,7 @@ speeds are divided by its gearbox ratio N, torques multiplied by it (K by N³, P
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -69,7 +70,7 @@ TORQUE_STATES = 16
 
 @dataclass(frozen=True)
 class TorqueLaw:
-    """ROSCO's generator-torque controller, on the rotor shaft (see :mod:`specdesign.rosco.torque`).
+    """ROSCO's generator-torque controller, on the rotor shaft (see :mod:`specdesign.controller.torque`).
 
     Parameters
     ----------
@@ -343,8 +344,6 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
             raise ValueError(f"{p}: line {entries[key].line}: {key} = {int(f(key))} is not modelled (the workbench "
                              "runs constant torque above rated, variable pitch, no power-reference tracking); set it to 0")
     if "PS_Mode" in entries and int(f("PS_Mode")) != 0:
-        import warnings
-
         warnings.warn(f"{p}: PS_Mode = {int(f('PS_Mode'))}: peak shaving (a minimum pitch from ROSCO's wind-speed "
                       "estimate) is not modelled; the pitch limit is the model's", UserWarning, stacklevel=2)
     n = f("WE_GearboxRatio")
@@ -508,7 +507,7 @@ def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):
 @njit(cache=True)
 def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitch: float, dt: float,
                 first: bool) -> tuple[float, float]:
-    """One step of ROSCO's torque controller (compiled; :mod:`specdesign.rosco.torque`).
+    """One step of ROSCO's torque controller (compiled; :mod:`specdesign.controller.torque`).
 
     Parameters
     ----------
