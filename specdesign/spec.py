@@ -635,12 +635,6 @@ class Baseline:
     model: object = field(default=None, repr=False, compare=False)
 
     @property
-    def s_wind(self) -> np.ndarray:
-        """Deprecated name of :attr:`wind_psd` (one name for the wind PSD)."""
-        warnings.warn("Baseline.s_wind is deprecated, use Baseline.wind_psd", DeprecationWarning, stacklevel=2)
-        return self.wind_psd
-
-    @property
     def del_1hz(self) -> float:
         """DEL at 1 Hz of the baseline output, a range in the output's units (N·m for MyT)."""
         return float(self.damage_rate ** (1.0 / self.m))
@@ -1337,12 +1331,3 @@ def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax
     tower = Specification(base.system, tuple(shaping.notches) + relax, name="W_tower_base_my")
     speed = speed_specification(model, v, margin_db=float(speed_relax_db))
     return DesignSpecifications(base, shaping, tower, speed)
-
-
-def __getattr__(name):
-    # spec.evaluate was renamed: loopshaping.qft.evaluate is a frequency response, this a promise
-    if name == "evaluate":
-        warnings.warn("specdesign.spec.evaluate is deprecated; use specdesign.spec.promise_of", DeprecationWarning,
-                      stacklevel=2)
-        return promise_of
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

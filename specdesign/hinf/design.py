@@ -294,7 +294,6 @@ def design_hinf(
     target_reduction: float = 25.0,
     *,
     spec: str | Any = "target",
-    specs: str | Any | None = None,
     spec_reduction: float = 15.0,
     measurements: Sequence[str] | None = None,
     order: int = 8,
@@ -353,8 +352,6 @@ def design_hinf(
         exactly the specs that design met. ``"rosco"``: the unrelaxed notch spec and ROSCO's
         T_{Ω,w} (its ζ = 0.01 dip at the tower mode is a spec no well-damped loop can follow,
         docs/hinf.md).
-    specs : optional
-        Deprecated alias of ``spec`` (DeprecationWarning); give one of the two.
     spec_reduction : float
         % of tower-base damage the automatic notch specification
         (:func:`specdesign.spec.shape_to_target`) must promise with ``spec="qft"`` or
@@ -452,12 +449,6 @@ def design_hinf(
     True
     """
     from .. import spec as sp
-    if specs is not None:
-        warnings.warn("design_hinf(specs=...) is deprecated; use spec=... (the name design_qft uses)",
-                      DeprecationWarning, stacklevel=2)
-        if not (isinstance(spec, str) and spec == "target"):
-            raise ValueError(f"give spec={spec!r} or the deprecated specs={specs!r}, not both")
-        spec = specs
     specs, made = spec, False
     v = float(wind_speed)
     if isinstance(specs, str) and specs == "target":

@@ -191,30 +191,6 @@ class QFTDesign:
     options: dict[str, Any] = field(default_factory=dict)
 
     @property
-    def design_omegas(self) -> np.ndarray:
-        """Deprecated name of :attr:`design_omega`.
-
-        Warns
-        -----
-        DeprecationWarning
-            Always: use :attr:`design_omega`.
-        """
-        warnings.warn("QFTDesign.design_omegas is deprecated, use QFTDesign.design_omega", DeprecationWarning, stacklevel=2)
-        return self.design_omega
-
-    @property
-    def dense_omegas(self) -> np.ndarray:
-        """Deprecated name of :attr:`dense_omega`.
-
-        Warns
-        -----
-        DeprecationWarning
-            Always: use :attr:`dense_omega`.
-        """
-        warnings.warn("QFTDesign.dense_omegas is deprecated, use QFTDesign.dense_omega", DeprecationWarning, stacklevel=2)
-        return self.dense_omega
-
-    @property
     def n_states(self) -> int:
         """Total controller order (pitch + ATD states)."""
         return int(ct.ss(self.pitch_controller).nstates + ct.ss(self.atd_controller).nstates)
@@ -399,8 +375,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     TypeError
         If ``model`` is not a :class:`specdesign.turbine.TurbineModel`, an option is unknown
         (or belongs to the other design: ``speed_relax_db`` and the tuner's options need
-        ``spec="notch"`` or ``structure="fixed"``), or both a deprecated and a current keyword (``design_omegas=``/``design_omega=``,
-        ``dense_omegas=``/``dense_omega=``) are given.
+        ``spec="notch"`` or ``structure="fixed"``).
     ValueError
         If ``wind_speed`` is outside ``model.wind_range``; ``target_reduction`` is not
         strictly between 0 and 100 %; no certified specification reaches it ("infeasible
@@ -415,8 +390,6 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     RuntimeWarning
         When no relaxation of ``speed_relax_db`` gives a design that meets every
         specification (the last attempt is returned, ``success`` False).
-    DeprecationWarning
-        For the old keywords ``design_omegas=`` and ``dense_omegas=``.
 
     Examples
     --------
@@ -426,13 +399,6 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     >>> print(d.summary())  # doctest: +SKIP
     >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
     """
-    for old_name in ("design_omegas", "dense_omegas"):  # renamed: one name for frequency grids, omega
-        if old_name in kwargs:
-            new_name = old_name[:-1]
-            warnings.warn(f"design_qft({old_name}=...) is deprecated, use {new_name}=", DeprecationWarning, stacklevel=2)
-            if new_name in kwargs:
-                raise TypeError(f"design_qft got both {old_name}= and {new_name}=")
-            kwargs[new_name] = kwargs.pop(old_name)
     options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
     unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
     if unknown:  # named here, not as a TypeError of an internal function
