@@ -23,7 +23,9 @@ from loopshaping import hinf as lhinf
 from .._blas import one_blas_thread
 from ..closedloop import closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
+from ..fatigue import TOWER_M
 from ..feasibility import TargetSpecification, specification_for_target
+from ..qft.design import SPEED_RELAX_DB
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
@@ -35,7 +37,7 @@ if TYPE_CHECKING:
     from ..spec import Specification
     from ..turbine import TurbineModel
 
-__all__ = ['HinfDesign', 'QFT_SPEED_RELAX_DB', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
+__all__ = ['HinfDesign', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
 
 #: α (1/s) of the α-shifted synthesis in :func:`design_hinf`.
 DEFAULT_DECAY_RATE = 0.02
@@ -215,7 +217,7 @@ def _is_design(obj) -> bool:
 
 def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
                        spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                       keep_below: float = 0.6, m: float = 4.0,
+                       keep_below: float = 0.6, m: float = TOWER_M,
                        omega: ArrayLike | None = None) -> tuple[Specification, Specification, Specification]:
     """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
 
@@ -283,9 +285,6 @@ def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db
     return d.tower, d.speed, d.shaping.specification
 
 
-#: Relaxations (dB) of the generator-speed spec tried in turn by ``design_hinf(spec="qft")``:
-#: the ladder of :func:`specdesign.qft.design_qft`.
-QFT_SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
 
 
 def design_hinf(
@@ -300,10 +299,10 @@ def design_hinf(
     w_tower: Specification | ct.LTI | None = None,
     w_speed: Specification | ct.LTI | None = None,
     w_pitch: ct.LTI | float | None = None,
-    speed_relax_db: float | Sequence[float] = QFT_SPEED_RELAX_DB,
+    speed_relax_db: float | Sequence[float] = SPEED_RELAX_DB,
     tower_relax_db: float = 6.0,
     tower_relax_omega: float = 1.3,
-    m: float = 4.0,
+    m: float = TOWER_M,
     omega: ArrayLike | None = None,
     suboptimality: float = 0.05,
     reduction_method: str = "balanced",
@@ -344,7 +343,7 @@ def design_hinf(
         ``"qft"``: those of ``specdesign.qft.design_qft(spec="notch")``
         (:func:`qft_specifications`): the notch spec relaxed by ``tower_relax_db`` above
         ≈ ``tower_relax_omega`` and ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``; given a
-        sequence (default :data:`QFT_SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
+        sequence (default :data:`specdesign.qft.SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
         in turn and the smallest whose reduced design meets both specs on the refined grid
         (speed everywhere, tower over the tower-mode band) is kept, as QFT does (this
         function's default before the certified pair).
