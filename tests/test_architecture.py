@@ -353,3 +353,21 @@ def test_no_public_name_means_two_things_across_the_packages():
     clashes = {name: {pkg: sorted(ids.values()) for pkg, ids in by.items()} for name, by in homes.items()
                if len(by) == 2 and not set(by["specdesign"]) & set(by["loopshaping"]) and name not in SHARED_NAMES}
     assert not clashes, f"one public name, two objects (rename one, or list it in SHARED_NAMES with why): {clashes}"
+
+
+# ----------------------------------------------------------------------------- warnings (issue 32)
+def test_no_warning_is_silenced_wholesale():
+    # only named categories, in the narrowest block, with the reason beside it: a bare
+    # simplefilter("ignore") would also hide the DeprecationWarnings the tests make errors and
+    # every numerical warning of the block
+    bad = []
+    for path, _ in _modules():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                    and node.func.attr in ("simplefilter", "filterwarnings") and node.args
+                    and isinstance(node.args[0], ast.Constant) and node.args[0].value == "ignore"):
+                continue
+            position = 1 if node.func.attr == "simplefilter" else 2  # where `category` goes
+            if len(node.args) <= position and not any(k.arg == "category" for k in node.keywords):
+                bad.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    assert not bad, "warnings silenced without a category: " + ", ".join(bad)

@@ -298,7 +298,7 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
     >>> import warnings
     >>> from specdesign.rosco import iea15mw_discon
     >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore")  # its PS_Mode = 1
+    ...     warnings.simplefilter("ignore", UserWarning)  # its PS_Mode = 1: peak shaving not modelled
     ...     law = torque_law_from_discon(iea15mw_discon(), mode=1)
     >>> law.mode, round(law.min_speed, 4)
     (1, 0.5236)

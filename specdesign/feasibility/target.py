@@ -511,8 +511,8 @@ class _Cases:
         from .. import spec
         if self._unstable(controller):
             return None
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings():  # python-control's notes on the interconnection (unused signals)
+            warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             cl0 = closed_loop(self.plants[self.nom], controller, warn=False)
         roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
         roots += [system_roots(x.baseline) for x in specs if isinstance(x, spec.Specification)]

@@ -128,8 +128,8 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay):
     for n in range(min_order, full.nstates + 1):
         if n < full.nstates:
             try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
+                with warnings.catch_warnings():  # python-control's and SLICOT's notes on the reduction
+                    warnings.filterwarnings("ignore", category=UserWarning, module=r"(control|slycot)\.")
                     cand = ct.balred(full, n, method="truncate")
             except (ValueError, np.linalg.LinAlgError, ct.ControlArgument):
                 continue
@@ -140,8 +140,8 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay):
                 or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > w_speed)
                 or np.any(np.abs(1 / (1 + c * ob)) > ms)):
             continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
+            warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
         if decay >= min_decay:
             return cand, n

@@ -53,8 +53,8 @@ def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01
     if not enabled:
         return np.zeros(0)
     out = []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
+        warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
         for P, c in zip(prob.plants, prob.rosco):
             cl = closed_loop(P, c, warn=False)
             for y in ("gen_speed", "tower_base_my"):

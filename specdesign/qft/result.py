@@ -307,8 +307,8 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
     met = bounds_met(pitch_bounds, cb, pitch_t, prob.wd) and bounds_met(atd_bounds, ca, atd_t, prob.wd)
 
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
+        warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
         stable = [check_stability(closed_loop(P, cb, ca, warn=False), tol=0.0) for P in prob.plants]
         cl = closed_loop(prob.plants[nom], cb, ca, warn=False)
     all_stable = bool(np.all(stable))
