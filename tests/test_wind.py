@@ -106,7 +106,7 @@ def _spectrum(w):
     return wind.rotor_effective_spectrum(np.concatenate([[0.0], w]), U, R)[1:]
 
 
-def test_synthesize_reproducible_per_seed():
+def test_gaussian_series_reproducible_per_seed():
     batch = wind.gaussian_series(_spectrum, 200, 0.25, seeds=[1, 3, 5])
     alone = wind.gaussian_series(_spectrum, 200, 0.25, seeds=3)
     assert batch.shape == (3, 800) and alone.shape == (1, 800)
@@ -114,7 +114,7 @@ def test_synthesize_reproducible_per_seed():
     assert not np.allclose(batch[0], batch[1])
 
 
-def test_synthesize_variance_equals_discrete_integral():
+def test_gaussian_series_variance_equals_discrete_integral():
     duration, dt = 600.0, 0.2
     n = int(duration / dt)
     x = wind.gaussian_series(_spectrum, duration, dt, seeds=[0, 1], random_amplitude=False)
@@ -126,7 +126,7 @@ def test_synthesize_variance_equals_discrete_integral():
     assert_allclose(np.sum(_spectrum(wk)) * dw, np.trapezoid(_spectrum(omega), omega), rtol=1e-2)
 
 
-def test_synthesize_welch_matches_target():
+def test_gaussian_series_welch_matches_target():
     duration, dt = 1200.0, 0.25
     x = wind.gaussian_series(_spectrum, duration, dt, seeds=range(16))
     f, pxx = signal.welch(x, fs=1 / dt, nperseg=1200, axis=-1)  # one-sided per Hz
@@ -142,7 +142,7 @@ def test_synthesize_welch_matches_target():
     assert abs(x.var(axis=1).mean() / var_target - 1) < 0.1
 
 
-def test_synthesize_accepts_tabulated_spectrum():
+def test_gaussian_series_accepts_tabulated_spectrum():
     omega = np.linspace(0, 20, 4001)
     table = wind.rotor_effective_spectrum(omega, U, R)
     a = wind.gaussian_series((omega, table), 300, 0.1, seeds=7)
