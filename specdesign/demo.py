@@ -27,6 +27,7 @@ import numpy as np
 
 from loopshaping.freqresp import is_zero
 
+from . import validate
 from ._checks import del_target, positive_scalar, real_scalar
 from .plots.fatigue import plot_sensitivity
 from .plots.qft import plot_design_bode, plot_design_nichols
@@ -122,7 +123,6 @@ def check_demo_options(wind_speed=19.0, target_reduction=25.0, n_seeds=None, dur
         Naming the option and its range.
     """
     from .qft import check_design_speed
-    from .turbine import iea15mw
 
     v = check_design_speed(iea15mw() if model is None else model, real_scalar(wind_speed, "wind_speed"))
     t = del_target(target_reduction)
@@ -166,9 +166,7 @@ def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_D
     ValueError
         Naming the option and its range.
     """
-    from . import validate
     from .qft import check_design_speed
-    from .turbine import iea15mw
 
     n, d = _seeds_and_duration(n_seeds, duration, 3 if fast else 6, 300.0 if fast else 600.0)
     t = del_target(target_reduction)

@@ -17,11 +17,28 @@ def test_loopshaping_never_imports_specdesign():
     assert out.stdout.startswith("ok")
 
 
+#: Shipped files that differ from ../shared on purpose: file → (line in ../shared, line shipped,
+#: why). The DISCON.IN names its Cp table where the package ships it (beside it); the reference
+#: copy's ../IEA-15-240-RWT/ does not exist in the package, and ROSCO stops the process on it.
+SHIPPED_EDITS = {
+    "IEA-15-240-RWT-Monopile_DISCON.IN": (
+        '"../IEA-15-240-RWT/Cp_Ct_Cq.IEA15MW.txt"      ! PerfFileName',
+        '"Cp_Ct_Cq.IEA15MW.txt"                         ! PerfFileName',
+        "the Cp table's path as shipped"),
+}
+
+
 def test_package_ships_its_data(package_data, shared_data):
     for f in shared_data.iterdir():
         shipped = package_data / f.name
         assert shipped.is_file(), f"{f.name} is not shipped in specdesign/data/iea15mw"
-        assert shipped.read_bytes() == f.read_bytes(), f"{f.name} differs from ../shared"
+        ref, got = f.read_bytes(), shipped.read_bytes()
+        if f.name in SHIPPED_EDITS:  # the one documented line differs, nothing else
+            old, new, _ = SHIPPED_EDITS[f.name]
+            assert ref.count(old.encode()) == 1 and got.count(new.encode()) == 1, f.name
+            ref = ref.replace(old.encode(), new.encode())
+            assert (package_data / "Cp_Ct_Cq.IEA15MW.txt").is_file()
+        assert got == ref, f"{f.name} differs from ../shared"
 
 
 # ----------------------------------------------------------------------------- one home per concept (issue 13)
