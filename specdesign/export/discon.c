@@ -2,7 +2,7 @@
  * specdesign's exported pitch and torque controller behind the Bladed interface (DISCON).
  *
  * One source, compiled once by specdesign.export (cc -O2 -shared -fPIC), serves every design:
- * the design is the parameter file named by accINFILE ("specdesign-discon 1" format, written
+ * the design is the parameter file named by accINFILE ("specdesign-discon 2" format, written
  * by specdesign.export.export_discon and described in docs/export.md), read at the
  * initialisation call. The controller is the one specdesign.simulate's compiled loop runs
  * (specdesign/simulate/kernels.py, _run_one): the same discrete matrices (Tustin at the

@@ -1,7 +1,7 @@
 """The parameter file of the exported controller: :class:`DisconParameters`, written and read.
 
 A plain-text file, one keyword then its numbers, in a fixed order, ``#`` to the end of a line
-a comment; its first words are ``specdesign-discon 1`` (the format and its version). Numbers
+a comment; its first words are ``specdesign-discon 2`` (the format and its version). Numbers
 are written as Python's ``repr`` of a float (the shortest text that reads back to the same
 double, ``inf`` for infinity), so matrices round-trip exactly. The format, keyword by keyword,
 is in ``docs/export.md``; :func:`read_parameters` and the C library read it with the same rules.
