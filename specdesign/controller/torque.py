@@ -390,7 +390,9 @@ def steady_state(model: TurbineModel, law: TorqueLaw, wind_speed: float) -> tupl
     (2.5) until the torque reaches ``transition_torque``, and then the speed floats where
     Q(Ω) equals that torque (2.5s). K·Ω² is capped at min(``rated_torque``, ``max_torque``):
     if it reaches the cap below ``reference_speed`` (the IEA 15 MW's ROSCO tuning does, at
-    0.72 rad/s) region 2.5 never engages and the speed floats at that torque (2.5s). Modes 3 and 4 track the same curve in steady state.
+    0.72 rad/s) region 2.5 never engages and the speed floats at that torque (2.5s). With
+    constant power (``const_power``) the cap is min(``max_torque``, P/(η·Ω)) instead. Modes 3 and
+    4 track the same curve in steady state.
 
     Parameters
     ----------
@@ -439,18 +441,30 @@ def steady_state(model: TurbineModel, law: TorqueLaw, wind_speed: float) -> tupl
         return lo, t, beta, "1.5"
     # K·Ω² is capped at the torque limit: where it reaches it before the reference speed (the
     # IEA 15 MW's tuning does), the torque saturates there and the speed floats up to rated
-    cap = min(law.rated_torque, law.max_torque)
-    top = min(hi, math.sqrt(cap / law.k_opt))
+    # (with constant power the limit is min(VS_MaxTq, P/(η·Ω)), a function of the speed)
+    p_eta = law.rated_power / law.generator_efficiency
+
+    def ceiling(om):
+        return min(law.max_torque, p_eta / om) if law.const_power else min(law.rated_torque, law.max_torque)
+
+    if law.const_power:  # K·Ω² meets P/(η·Ω) at Ω³ = P/(η·K)
+        top = min(hi, math.sqrt(law.max_torque / law.k_opt), (p_eta / law.k_opt) ** (1.0 / 3.0))
+    else:
+        top = min(hi, math.sqrt(ceiling(hi) / law.k_opt))
     if g(top) < 0:
         om = brentq(g, lo, top, xtol=1e-14, rtol=1e-14)
         return float(om), law.k_opt * float(om) ** 2, beta, "2"
+    limit = ceiling
     if top == hi:
         t = q(hi)
-        cap = min(cap, law.transition_torque)
-        if t <= cap:
+
+        def limit(om):
+            return min(ceiling(om), law.transition_torque)
+
+        if t <= limit(hi):
             return hi, t, beta, "2.5"
-    om = brentq(lambda w: q(w) - cap, top, max(float(model.rated_rotor_speed), hi) * 1.5, xtol=1e-14, rtol=1e-14)
-    return float(om), cap, beta, "2.5s"
+    om = brentq(lambda w: q(w) - limit(w), top, max(float(model.rated_rotor_speed), hi) * 1.5, xtol=1e-14, rtol=1e-14)
+    return float(om), limit(float(om)), beta, "2.5s"
 
 
 def close_torque_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, law: TorqueLaw, omega: float,
