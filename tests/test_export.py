@@ -132,8 +132,11 @@ def test_rosco_power_exported_equals_the_simulators_constant_power_law(model, tm
     law = dataclasses.replace(model.torque_control, const_power=True)
     rec = export_discon(sc, tmp_path, model=model, torque="rosco_power")
     assert rec.torque == "rosco_power" and read_parameters(rec.parameters).torque_law[-1] == 1.0
-    # a constant-power law given as such exports as rosco_power too
+    # a constant-power law given as such, or the law of the model, exports as rosco_power too
     assert export_discon(sc, tmp_path / "law", model=model, torque=law).torque == "rosco_power"
+    cp_model = dataclasses.replace(model, torque_control=law)
+    assert export_discon(sc, tmp_path / "m", model=cp_model).torque == "rosco_power"
+    assert export_discon(sc, tmp_path / "r", model=cp_model, torque="rosco").torque == "rosco_power"
     a, b = _runs(model, sc, rec, [9.0, 13.0, 19.0], torque_control=law)
     _assert_equal_records(a, b)
     # constant power above rated changes the records: the comparison can fail

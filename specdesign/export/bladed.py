@@ -82,8 +82,10 @@ def _torque(torque, model: TurbineModel):
         raise ValueError(f"torque={torque!r} must be one of {tuple(TORQUE_MODES)}, None or a specdesign.rosco.TorqueLaw")
     if torque in ("rosco", "rosco_power") and law is None:
         raise ValueError(f"torque={torque!r} needs a model with a torque law (torque_control); pass a TorqueLaw instead")
-    if torque in ("rosco", "rosco_power"):  # the named region-3 law overrides the law's own
-        law = dataclasses.replace(law, const_power=torque == "rosco_power")
+    if torque == "rosco_power":
+        law = dataclasses.replace(law, const_power=True)
+    elif torque == "rosco" and law.const_power:  # the model's law as simulate(torque_control="rosco") runs it
+        return "rosco_power", law
     return torque, law
 
 
@@ -191,11 +193,12 @@ def export_discon(controller_or_design: object, folder: str | Path, *, dt: float
     torque : {"constant", "power", "rosco", "rosco_power"}, TorqueLaw or None, optional
         Generator torque: "constant" the rated torque (the simulator above rated); "power"
         P_rated/(η·Ω_f) capped at the law's maximum torque, everywhere (for runs above rated);
-        "rosco" the model's ROSCO torque law with the rated torque in region 3; "rosco_power"
-        that law with constant power in region 3 and its ceiling, as ROSCO runs
+        "rosco" the model's ROSCO torque law as ``simulate(..., torque_control="rosco")`` runs
+        it (rated torque in region 3, or rated power if its ``const_power`` is set);
+        "rosco_power" that law with constant power in region 3 and its ceiling, as ROSCO runs
         ``VS_ConstPower = 1`` (the simulator's law with ``const_power``); a given
         :class:`~specdesign.rosco.TorqueLaw` runs as it is (``simulate(..., torque_control=law)``).
-        None (default): the model's torque law as it is, if it has one, else "constant".
+        None (default): "rosco" if the model has a torque law, else "constant".
     pitch_rate_limit : float, optional
         Largest rate of the pitch command (rad/s); default inf (the workbench's controllers
         have none; its actuator model limits the pitch rate). For OpenFAST without a pitch
