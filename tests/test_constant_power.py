@@ -15,7 +15,12 @@ import numpy as np
 import pytest
 
 from specdesign.controller.discon_file import write_discon
-from specdesign.controller.torque import S_TQ, TORQUE_STATES, torque_law_from_discon, torque_step
+from specdesign.controller.torque import (
+    S_TQ,
+    TORQUE_STATES,
+    torque_law_from_discon,
+    torque_step,
+)
 from specdesign.fatigue import del_rainflow
 from specdesign.rosco import Discon, from_discon, rosco_scheduled, rosco_test_cases
 from specdesign.simulate import simulate

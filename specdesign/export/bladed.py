@@ -4,8 +4,8 @@ See :mod:`specdesign.export` for what the pair is and how OpenFAST and the workb
 """
 from __future__ import annotations
 
-import math
 import dataclasses
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -15,7 +15,11 @@ from loopshaping.freqresp import is_zero
 
 from .._checks import positive_scalar
 from ..controller.lti import as_lti, is_lti_like
-from ..controller.scheduled import ScheduledController, controller_bank, schedule_filter_coefficients
+from ..controller.scheduled import (
+    ScheduledController,
+    controller_bank,
+    schedule_filter_coefficients,
+)
 from ..controller.torque import TORQUE_PARAMS, TorqueLaw
 from ..turbine import TurbineModel, iea15mw
 from .library import discon_library
