@@ -15,11 +15,7 @@ from loopshaping.freqresp import is_zero
 
 from .._checks import positive_scalar
 from ..controller.lti import as_lti, is_lti_like
-from ..controller.scheduled import (
-    ScheduledController,
-    controller_bank,
-    schedule_filter_coefficients,
-)
+from ..controller.scheduled import ScheduledController, controller_bank, schedule_filter_coefficients
 from ..controller.torque import TORQUE_PARAMS, TorqueLaw
 from ..turbine import TurbineModel, iea15mw
 from .library import discon_library
