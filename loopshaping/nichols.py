@@ -275,6 +275,15 @@ def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes |
                     lab = None
             if lab is not None:  # no curve to carry the frequency's legend entry
                 ax.plot([], [], "-", color=colours[i], lw=1.5, label=lab)
+        if len(design) > 10:
+            # dozens of frequencies share a continuous colour map: a colour key says which
+            # colour is which frequency (a legend of dozens of entries would say nothing)
+            from matplotlib import colormaps
+            from matplotlib.cm import ScalarMappable
+            from matplotlib.colors import LogNorm
+
+            key = ScalarMappable(norm=LogNorm(design.min(), design.max()), cmap=colormaps["viridis"])
+            ax.figure.colorbar(key, ax=ax, pad=0.01, fraction=0.05, label="bound frequency ω (rad/s)")
         # Legend-only entries (no data) saying what the line styles mean, in a neutral grey.
         meaning = {"-": "solid: lower bound, L0 must pass above", "--": "dashed: upper bound, L0 must pass below"}
         for style in ("-", "--"):

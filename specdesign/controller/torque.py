@@ -51,7 +51,7 @@ from .discon_file import read_discon
 if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
 
-__all__ = ["TORQUE_MODES", "TORQUE_PARAMS", "TORQUE_STATES", "TORQUE_REGIONS", "TorqueLaw", "torque_law",
+__all__ = ["TORQUE_MODES", "TORQUE_PARAMS", "TORQUE_STATES", "TORQUE_REGIONS", "TRIM_TOL", "TorqueLaw", "torque_law",
            "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step"]
 
 #: Regions of a trim (:attr:`specdesign.turbine.OperatingPoint.region`): "1.5" minimum speed held
@@ -72,6 +72,10 @@ TORQUE_PARAMS = 25
 (S_WF, S_WF2, S_U1, S_U2, S_REF, S_REF_U, S_SSF, S_SS_U, S_IAR, S_IBR, S_AR, S_BR, S_STATE, S_TQ, S_PLAST) = range(15)
 #: Length of the state array of :func:`torque_step`.
 TORQUE_STATES = 16
+#: brentq's ``xtol`` and ``rtol`` for a trim's rotor speed (rad/s) and pitch (rad), here and in
+#: :meth:`specdesign.turbine.TurbineModel.trim`: a few ulps of values near 1, so a trim is
+#: converged to what float64 holds.
+TRIM_TOL = 1e-14
 
 
 @dataclass(frozen=True)
@@ -179,11 +183,6 @@ class TorqueLaw:
         """ROSCO's ``VS_MinOMTq`` = K·Ω_min², the torque at the start of region 2 (N·m)."""
         return self.k_opt * self.min_speed**2
 
-    @property
-    def max_speed_torque(self) -> float:
-        """ROSCO's ``VS_MaxOMTq`` = K·Ω_ref², the torque at the end of region 2 (N·m)."""
-        return self.k_opt * self.reference_speed**2
-
     def params(self) -> np.ndarray:
         """Flat float64 parameter array of :func:`torque_step`.
 
@@ -202,28 +201,6 @@ class TorqueLaw:
             self.reference_corner, float(self.setpoint_smoothing), self.ss_vs_gain, self.ss_pc_gain, self.ss_corner,
             self.pitch_switch, self.fine_pitch, float(self.const_power)]
         return p
-
-    def steady_torque(self, omega: float) -> float:
-        """The torque this law holds in steady state at rotor speed ``omega`` in region 2.
-
-        Parameters
-        ----------
-        omega : float
-            Rotor speed (rad/s).
-
-        Returns
-        -------
-        float
-            K·Ω² (N·m).
-
-        Examples
-        --------
-        >>> from specdesign.turbine import iea15mw
-        >>> law = iea15mw().torque_control
-        >>> bool(law.steady_torque(law.reference_speed) == law.max_speed_torque)
-        True
-        """
-        return self.k_opt * float(omega) ** 2
 
 
 def torque_law(model: TurbineModel, *, mode: int = 1, omega_vs: float = 0.12, zeta_vs: float = 0.85,
@@ -332,7 +309,7 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
     >>> import warnings
     >>> from specdesign.rosco import iea15mw_discon
     >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore")  # its PS_Mode = 1
+    ...     warnings.simplefilter("ignore", UserWarning)  # its PS_Mode = 1: peak shaving not modelled
     ...     law = torque_law_from_discon(iea15mw_discon(), mode=1)
     >>> law.mode, round(law.min_speed, 4)
     (1, 0.5236)
@@ -452,7 +429,7 @@ def steady_state(model: TurbineModel, law: TorqueLaw, wind_speed: float) -> tupl
     else:
         top = min(hi, math.sqrt(ceiling(hi) / law.k_opt))
     if g(top) < 0:
-        om = brentq(g, lo, top, xtol=1e-14, rtol=1e-14)
+        om = brentq(g, lo, top, xtol=TRIM_TOL, rtol=TRIM_TOL)
         return float(om), law.k_opt * float(om) ** 2, beta, "2"
     limit = ceiling
     if top == hi:
@@ -463,7 +440,8 @@ def steady_state(model: TurbineModel, law: TorqueLaw, wind_speed: float) -> tupl
 
         if t <= limit(hi):
             return hi, t, beta, "2.5"
-    om = brentq(lambda w: q(w) - limit(w), top, max(float(model.rated_rotor_speed), hi) * 1.5, xtol=1e-14, rtol=1e-14)
+    om = brentq(lambda w: q(w) - limit(w), top, max(float(model.rated_rotor_speed), hi) * 1.5, xtol=TRIM_TOL,
+                rtol=TRIM_TOL)
     return float(om), limit(float(om)), beta, "2.5s"
 
 

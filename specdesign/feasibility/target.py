@@ -7,8 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._blas import on_one_blas_thread
-from .._checks import as_omega, del_target
+from .._checks import MAX_BISECTIONS, as_omega, del_target, margin_db, search_options
 from ..closedloop import (
+    CERTIFICATE_MAX_SENSITIVITY,
     case_speeds,
     closed_loop,
     closed_map,
@@ -18,6 +19,7 @@ from ..closedloop import (
     siso_response,
     system_roots,
 )
+from ..fatigue import TOWER_M
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
@@ -94,7 +96,12 @@ class TargetSpecification:
     case_speeds: tuple = ()
     robustness_db: float = 0.0
     speed_slack_db: float = 0.0
-    m: float = 4.0
+    m: float = TOWER_M
+
+    @property
+    def wind_speed(self) -> float:
+        """The operating point the pair was made and certified at, m/s (its certificate's)."""
+        return float(self.design.wind_speed)
 
     @property
     def template_offsets(self) -> tuple:
@@ -111,8 +118,8 @@ class TargetSpecification:
 
 @on_one_blas_thread
 def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
-                             max_sensitivity=1.8, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
-                             m=4.0, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
+                             max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
+                             m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
                              dense_omega=None) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
@@ -146,14 +153,15 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         A fixed relaxation of the certificate's speed constraint, dB: the slack is then the
         largest that keeps the promise ≥ ``target_reduction`` (bisection to ``tolerance_db``).
     max_sensitivity : float
-        M_s of the certificate (-); below design_qft's 1.9 so that the plant cases and a
-        reduced-order controller keep their margins.
+        M_s of the certificate (-); below :data:`~specdesign.closedloop.DESIGN_MAX_SENSITIVITY`
+        so that the plant cases and a reduced-order controller keep their margins.
     max_pitch_rate_ratio : float
         Pitch-rate SD allowance relative to ROSCO's (-).
     max_relax_db : float
         Largest speed relaxation tried, dB.
     tolerance_db : float
-        Bisection tolerance on the relaxation, dB.
+        Bisection tolerance on the relaxation, dB (> 0; the bisection stops after
+        :data:`specdesign._checks.MAX_BISECTIONS` halvings in any case).
     m : float
         Wöhler exponent (-).
     omega : array_like, optional
@@ -173,8 +181,10 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
     Raises
     ------
+    TypeError
+        For a bool or a string where a number is meant (``target_reduction=True`` is not 1 %).
     ValueError
-        For a target outside (0, 100), a negative slack, invalid offsets, or when even
+        For a target outside (0, 100), a negative slack, a tolerance ≤ 0, invalid offsets, or when even
         ``max_relax_db`` does not reach the target (the message gives the promise reached there).
 
     Examples
@@ -185,6 +195,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     True
     """
     _check_target(target_reduction, slack_db, speed_slack_db)  # at the door, before the plant cases are built
+    search_options(tolerance_db, max_relax_db, speed_relax_db)
     search = CertificateSearch(model, wind_speed, max_sensitivity=max_sensitivity,
                                max_pitch_rate_ratio=max_pitch_rate_ratio, m=m, omega=omega, case_offsets=case_offsets,
                                dense_omega=dense_omega)
@@ -194,13 +205,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
 def _check_target(target_reduction, slack_db, speed_slack_db):
     """(target %, slack dB, speed slack dB), checked."""
-    t = del_target(target_reduction)
-    slack, sslack = float(slack_db), float(speed_slack_db)
-    if not (np.isfinite(slack) and slack >= 0):
-        raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")
-    if not (np.isfinite(sslack) and sslack >= 0):
-        raise ValueError(f"speed_slack_db={speed_slack_db!r} must be a finite margin ≥ 0 dB")
-    return t, slack, sslack
+    return del_target(target_reduction), margin_db(slack_db, "slack_db"), margin_db(speed_slack_db, "speed_slack_db")
 
 
 class CertificateSearch:
@@ -236,7 +241,7 @@ class CertificateSearch:
     True
     """
 
-    def __init__(self, model, wind_speed, *, max_sensitivity=1.8, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
+    def __init__(self, model, wind_speed, *, max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
                  case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None):
         from .. import spec
         self.model, self.m = model, float(m)
@@ -293,9 +298,9 @@ class CertificateSearch:
             As :func:`specification_for_target`.
         """
         t, slack, sslack = _check_target(target_reduction, slack_db, speed_slack_db)
+        tolerance_db, max_relax_db, g = search_options(tolerance_db, max_relax_db, speed_relax_db)
         model, v, speeds, base = self.model, self.wind_speed, self.case_speeds, self.base
         if speed_relax_db is not None:
-            g = float(speed_relax_db)
             design, best, rob = self._reached(g, 0.0)
             if design is None or rob is None:
                 raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {v:g} m/s over the plant "
@@ -304,7 +309,9 @@ class CertificateSearch:
                 raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s with the speed map relaxed by "
                                  f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs); relax it more")
             lo_s, hi_s = 0.0, 40.0
-            while hi_s - lo_s > tolerance_db:
+            for _ in range(MAX_BISECTIONS):  # bounded: a tolerance below float64's spacing is never reached
+                if hi_s - lo_s <= tolerance_db:
+                    break
                 mid = 0.5 * (lo_s + hi_s)
                 lo_s, hi_s = (mid, hi_s) if _slack_promise(design, base, mid + rob[0]) >= t else (lo_s, mid)
             return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t, self.m)
@@ -326,7 +333,9 @@ class CertificateSearch:
                              f"{slack:g} dB slack over the plant cases' needs); lower the target or the slack, or allow "
                              "more pitch activity")
         hi_g, best, best_rob = found
-        while hi_g - lo_g > tolerance_db:
+        for _ in range(MAX_BISECTIONS):
+            if hi_g - lo_g <= tolerance_db:
+                break
             mid = 0.5 * (lo_g + hi_g)
             d, red, rob = self._reached(mid, slack)
             if red >= t:
@@ -509,8 +518,8 @@ class _Cases:
         from .. import spec
         if self._unstable(controller):
             return None
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings():  # python-control's notes on the interconnection (unused signals)
+            warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             cl0 = closed_loop(self.plants[self.nom], controller, warn=False)
         roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
         roots += [system_roots(x.baseline) for x in specs if isinstance(x, spec.Specification)]

@@ -147,6 +147,7 @@ class NotchExplorer:
         self._sliders, self._sent, self._quiet = None, {}, False  # the widget's sliders, once built
         if hasattr(self.fig.canvas, "header_visible"):  # ipympl: no "Figure n" label above the plot
             self.fig.canvas.header_visible = False
+            self.fig.canvas.toolbar_position = "right"  # beside the figure, not over its labels
         self.update(self.notch.omega_n, self.notch.depth_db, self.notch.width)
 
     def update(self, omega_n: float, depth_db: float, width: float, *, redraw: bool = True) -> Promise:
@@ -293,8 +294,19 @@ class NotchExplorer:
             # The browser rounds each value set from Python to the slider's step and sends it
             # back, possibly after later cells have set others: within half a step of a value
             # Python set since the last move, it is such an echo, not a move.
-            dist = [abs(np.log10(new / v)) if name == "omega_n" else abs(new - v) for v in self._sent[name]]
-            if min(dist) < 0.5 * sliders[name].step:
+            gap = (lambda a, b: abs(np.log10(a / b))) if name == "omega_n" else (lambda a, b: abs(a - b))
+            if min(gap(new, v) for v in self._sent[name]) < 0.5 * sliders[name].step:
+                # an echo: not a move, but the slider now shows it; put back the value the figure
+                # draws (notebook 03 showed 2.80 dB over a 12 dB notch after Run All), unless the
+                # echo is that value rounded to the step (then it already says the same)
+                current = getattr(self.notch, name)
+                if gap(new, current) >= 0.5 * sliders[name].step:
+                    self._quiet = True
+                    try:
+                        sliders[name].value = current
+                        self._sent[name].append(sliders[name].value)
+                    finally:
+                        self._quiet = False
                 return
             self._sent[name] = [new]
             vals = dict(omega_n=self.notch.omega_n, depth_db=self.notch.depth_db, width=self.notch.width)

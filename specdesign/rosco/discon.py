@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import ctypes
 import importlib.metadata
+import os
 import re
 import shutil
 import tempfile
@@ -38,6 +39,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from .._checks import bad_measurements
 from ..controller.discon_file import read_discon
 
 __all__ = ["SWAP_SIZE", "DisconError", "rosco_library", "rosco_test_cases", "Discon"]
@@ -172,6 +174,35 @@ def _run_copy(discon_in: Path, folder: Path) -> Path:
     return out
 
 
+#: The files ROSCO opens, by the DISCON.IN key naming each and the mode key that makes it read
+#: it (ReadSetParameters.f90, ROSCO 2.9): ReadCpFile opens PerfFileName with STATUS='old' and
+#: no IOSTAT when WE_Mode > 0, so a missing table ends the whole process (gfortran's runtime
+#: error), taking the caller's interpreter with it.
+_OPENED_FILES = (("PerfFileName", "WE_Mode"), ("OL_Filename", "OL_Mode"), ("DLL_FileName", "Ext_Mode"))
+
+
+def _check_opened_files(discon_in: Path, entries: dict) -> None:
+    """Raise FileNotFoundError, naming the DISCON.IN, the line and the key, for a file ROSCO
+    will open that is missing or unreadable (checked before the library is loaded: ROSCO's
+    Fortran runtime would stop the process instead)."""
+    for key, mode in _OPENED_FILES:
+        e, m = entries.get(key), entries.get(mode)
+        try:
+            used = m is not None and int(float(m.values[0])) > 0
+        except (ValueError, IndexError):
+            raise ValueError(f"{discon_in}: line {m.line}: {mode} = {' '.join(m.values)!r} is not a whole number") from None
+        if not used:
+            continue
+        if e is None or not e.values or not e.values[0].strip('"'):
+            raise ValueError(f"{discon_in}: {mode} > 0 makes ROSCO read {key}, which is missing or empty")
+        name = e.values[0].strip('"')
+        path = Path(name) if Path(name).is_absolute() else discon_in.parent / name  # ROSCO: from the file's folder
+        if not path.is_file() or not os.access(path, os.R_OK):
+            why = "does not exist" if not path.exists() else "is not a readable file"
+            raise FileNotFoundError(f"{discon_in}: line {e.line}: {key} = {e.values[0]}: {path} {why}; ROSCO "
+                                    f"({mode} = {m.values[0]}) would stop the Python process opening it")
+
+
 class Discon:
     """ROSCO's compiled controller (its DISCON library) as a controller of :func:`specdesign.simulate.simulate`.
 
@@ -198,7 +229,12 @@ class Discon:
     Raises
     ------
     FileNotFoundError
-        If ``discon_in`` or ``library`` does not exist.
+        If ``discon_in`` or ``library`` does not exist, or a file ROSCO will open does not
+        (``PerfFileName`` with ``WE_Mode`` > 0, ``OL_Filename`` with ``OL_Mode`` > 0,
+        ``DLL_FileName`` with ``Ext_Mode`` > 0; relative names from the DISCON.IN's folder):
+        ROSCO's Fortran runtime would end the Python process on a missing performance table,
+        so every such file is checked before the library is loaded, and the message names the
+        DISCON.IN, the line and the key.
     ModuleNotFoundError
         Without ``library``, if the ``rosco`` package is not installed.
     ValueError
@@ -244,6 +280,7 @@ class Discon:
             self.gearbox_ratio, self.file_version = exported, _EXPORTED
             return
         entries, self.file_version = read_discon(self.discon_in)
+        _check_opened_files(self.discon_in, entries)  # before the library is loaded (it can end the process)
         e = entries.get("WE_GearboxRatio")
         try:
             ratio = float(e.values[0]) if e is not None else float("nan")
@@ -325,12 +362,13 @@ class Discon:
     def _message(self, r: int) -> str:
         return bytes(self._msg[r]).split(b"\0", 1)[0].decode(errors="replace").strip()
 
-    def _call_all(self, status: int) -> None:
+    def _call_all(self, status: int, skip=None) -> None:
         sw = self._swap
         sw[:, 0] = status
         fns, infile = self._fns, self._infile
         for r, (a, f, o, m) in enumerate(self._args):
-            fns[r](a, f, infile, o, m)
+            if skip is None or not skip[r]:  # a skipped run (a bad sample) keeps ROSCO's state and command
+                fns[r](a, f, infile, o, m)
         self._flush()
         if self._fail.min() < 0:
             r = int(np.flatnonzero(self._fail < 0)[0])
@@ -369,17 +407,37 @@ class Discon:
         RuntimeError
             If :meth:`start` was not called.
         ValueError
-            If ROSCO refuses the DISCON.IN at its initialisation (the parameter is named).
+            If ROSCO refuses the DISCON.IN at its initialisation (the parameter is named), or
+            a measurement is NaN or inf at the first call (ROSCO initialises on it).
         DisconError
             If ROSCO stops a run later.
+
+        Warns
+        -----
+        RuntimeWarning
+            Once per signal, for a NaN or inf measurement after the first call: ROSCO is not
+            called for that run at that step, which holds its last commands (and ROSCO its
+            state) until the signal is finite again (:func:`specdesign._checks.bad_measurements`,
+            the convention of every controller).
         """
         if not self._runs:
             raise RuntimeError("Discon.start(dt, wind, pitch, torque) must run first (simulate calls it)")
-        omega = np.ascontiguousarray(y["gen_speed"], dtype=float)
+        signals = ("gen_speed", "pitch", "power", "tower_top_acc")
+        if self._step == 0:
+            self._warned = set()
+            bad = [n for n in signals if not np.all(np.isfinite(np.asarray(y[n], float)))]
+            if bad:  # ROSCO initialises on this sample: no command to hold yet
+                raise ValueError(f"{self.__name__}: measurement {bad[0]!r} is not finite at the first call (t = "
+                                 f"{float(t):g} s): ROSCO initialises on it, and there is no command to hold yet")
+        bad = bad_measurements(y, signals, float(t), self._warned, self.__name__)
+        keep = self._swap[bad].copy() if bad.any() else None
+        omega = np.ascontiguousarray(np.where(bad, 0.0, y["gen_speed"]), dtype=float)  # the azimuth holds too
         _fill_swap(self._swap, float(t), omega, np.ascontiguousarray(y["pitch"], dtype=float),
                    np.ascontiguousarray(y["power"], dtype=float), np.ascontiguousarray(y["tower_top_acc"], dtype=float),
                    self.gearbox_ratio)
-        self._call_all(0 if self._step == 0 else 1)
+        if keep is not None:
+            self._swap[bad] = keep
+        self._call_all(0 if self._step == 0 else 1, skip=bad if keep is not None else None)
         self._step += 1
         pitch, torque = np.empty(self._runs), np.empty(self._runs)
         _read_swap(self._swap, omega, self._dt, self.gearbox_ratio, pitch, torque)

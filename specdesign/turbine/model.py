@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
-from ..controller.torque import close_torque_loop, steady_state, torque_law
+from ..controller.torque import TRIM_TOL, close_torque_loop, steady_state, torque_law
 
 if TYPE_CHECKING:  # pragma: no cover
     import control
@@ -292,6 +292,9 @@ class TurbineModel:
     def check_wind_speed(self, wind_speed: float) -> float:
         """``wind_speed`` as a float, checked to be within ``wind_range``.
 
+        Every model the design loop takes has it (:class:`specdesign.openfast.LinearTurbine`
+        shares this docstring).
+
         Parameters
         ----------
         wind_speed : float
@@ -305,7 +308,8 @@ class TurbineModel:
         Raises
         ------
         ValueError
-            Outside the above-rated range where the model is valid.
+            Outside ``wind_range``: for a TurbineModel the above-rated range where it is valid,
+            for a LinearTurbine its linearisations' speeds (it interpolates, never extrapolates).
         """
         v = positive_scalar(wind_speed, "wind_speed")
         lo, hi = self.wind_range
@@ -443,7 +447,7 @@ class TurbineModel:
         k = int(np.argmax(vals <= 0))
         if vals[k] > 0:
             raise ValueError(f"no pitch within the table balances the torque at wind_speed={v!r} m/s")
-        beta = brentq(surplus, grid[k - 1], grid[k], xtol=1e-14, rtol=1e-14)
+        beta = brentq(surplus, grid[k - 1], grid[k], xtol=TRIM_TOL, rtol=TRIM_TOL)
         tsr = omega * self.rotor_radius / v
         cp, ct = (float(c) for c in self.rotor_coefficients(tsr, beta))
         area = np.pi * self.rotor_radius**2
