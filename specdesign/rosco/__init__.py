@@ -38,7 +38,7 @@ from ..controller.torque import (
 )
 from ..turbine.baseline import RoscoSchedule, first_order_rotor_model, rosco_baseline, rosco_gain_schedule, speed_filter
 from .discon import Discon, DisconError, rosco_library, rosco_test_cases
-from .scheduled import iea15mw_discon, rosco_scheduled
+from .scheduled import TowerDamper, iea15mw_discon, rosco_scheduled, tower_mode_damping, tune_tower_damper
 
 __all__ = [
     "RoscoSchedule",
@@ -47,6 +47,9 @@ __all__ = [
     "speed_filter",
     "rosco_baseline",
     "rosco_scheduled",
+    "TowerDamper",
+    "tune_tower_damper",
+    "tower_mode_damping",
     "DisconEntry",
     "DisconSchedule",
     "iea15mw_discon",
