@@ -82,7 +82,7 @@ def test_workbench_damper_agrees_with_the_compiled_discon(tmp_path, model, dampe
     except ModuleNotFoundError as e:
         pytest.skip(f"the rosco package is not installed ({e})")
     on = write_discon(src, tmp_path / "td.IN", **damper.discon_values())
-    kw = dict(seeds=[1, 2], duration=200.0)
+    kw = {"seeds": [1, 2], "duration": 200.0}
     out = {}
     for key, path in (("off", src), ("on", on)):
         d = simulate(model, Discon(path), [19.0], **kw)
