@@ -5,7 +5,7 @@ with its gain set by ``rosco.tune_tower_damper`` (the smallest FA_KI giving the 
 fore-aft mode a damping ratio of 0.2 at every whole m/s of 12-25 m/s on the linear model with
 ROSCO's PI), run by ``rosco_scheduled(model, tower_damper=...)`` on the same speeds, paired seeds
 and durations as ``benchmarks/comparison.py``, beside ROSCO as shipped (tower damping off), QFT,
-H∞ and (unless ``--no-mpc``) the quadratic and health-aware MPCs. Every change is given against
+H∞ and (unless ``--no-mpc``) the quadratic MPC and the excursion MPC (``HealthMPC(health_weight=10)``). Every change is given against
 both baselines, with the paired-seed jackknife SE (``validate.paired_change``).
 
 Writes its tables between the markers ``<!-- tower_damper.py results: start/end -->`` of
@@ -88,7 +88,7 @@ def main():
                             atd={v: ct.ss(d.atd_controller) for v, d in hd.items() if d.atd_controller is not None}
                             or None, name="H∞")
     mpcs = {} if a.no_mpc else {"quadratic MPC": mpc.QuadraticMPC(model),
-                                "health MPC": mpc.HealthMPC(model, health_weight=10.0)}
+                                "excursion MPC": mpc.HealthMPC(model, health_weight=10.0)}
     camps, wall = {}, {}
 
     def run(group):
