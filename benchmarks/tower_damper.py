@@ -11,7 +11,10 @@ both baselines, with the paired-seed jackknife SE (``validate.paired_change``).
 Writes its tables between the markers ``<!-- tower_damper.py results: start/end -->`` of
 docs/comparison.md (written once after the LTI controllers, again after the MPCs).
 
-Run: python benchmarks/tower_damper.py [--no-mpc] [--quick --out /tmp/td.md]
+``--sweep Z1 Z2 ...``: instead, ROSCO + TD for each target damping ratio, printed (not written):
+the damper gain's trade-off between tower DEL and pitch activity.
+
+Run: python benchmarks/tower_damper.py [--no-mpc] [--quick --out /tmp/td.md] [--sweep 0.2 0.3 0.4 0.5]
 """
 from __future__ import annotations
 
@@ -59,12 +62,27 @@ def table(camps, baseline):
     return lines, per
 
 
+def sweep(model, speeds, seeds, duration, ratios):
+    """Print ROSCO + TD against ROSCO (TD off) for each target damping ratio of the rule."""
+    from specdesign.rosco import rosco_scheduled, tune_tower_damper
+    from specdesign.validate import run_campaign
+
+    kw = {"model": model, "duration": duration, "transient": 30.0, "predict": False, "progress": False}
+    camps = {"ROSCO (TD off)": run_campaign({"R": rosco_scheduled(model)}, list(speeds), seeds, **kw)}
+    for z in ratios:
+        td = tune_tower_damper(model, z)
+        name = f"ROSCO + TD, ζ = {z:g} (FA_KI = {td.gain:.5f} rad·s/m)"
+        camps[name] = run_campaign({"TD": rosco_scheduled(model, tower_damper=td)}, list(speeds), seeds, **kw)
+    print("\n".join(table(camps, "ROSCO (TD off)")[0]))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke test: 2 speeds, 2 seeds, 60 s")
     ap.add_argument("--no-mpc", action="store_true", help="LTI controllers only (seconds instead of minutes)")
     ap.add_argument("--damping-ratio", type=float, default=0.2)
     ap.add_argument("--out", default="docs/comparison.md")
+    ap.add_argument("--sweep", type=float, nargs="+", help="target damping ratios: print ROSCO + TD vs ROSCO for each")
     a = ap.parse_args()
     import control as ct
 
@@ -76,6 +94,9 @@ def main():
     speeds, seeds, duration = ((17.0, 21.0), [0, 1], 60.0) if a.quick else (SPEEDS, list(range(20)), 600.0)
     load, t_all = os.getloadavg(), time.perf_counter()
     model = turbine.iea15mw()
+    if a.sweep:
+        sweep(model, speeds, seeds, duration, a.sweep)
+        return
     td = tune_tower_damper(model, a.damping_ratio)
     zeta = {v: (tower_mode_damping(model, v, None), tower_mode_damping(model, v, td)) for v in speeds}
     ctrls = {"ROSCO (TD off)": rosco_scheduled(model),
