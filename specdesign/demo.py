@@ -122,7 +122,6 @@ def check_demo_options(wind_speed=19.0, target_reduction=25.0, n_seeds=None, dur
         Naming the option and its range.
     """
     from .qft import check_design_speed
-    from .turbine import iea15mw
 
     v = check_design_speed(iea15mw() if model is None else model, real_scalar(wind_speed, "wind_speed"))
     t = del_target(target_reduction)
@@ -166,9 +165,7 @@ def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_D
     ValueError
         Naming the option and its range.
     """
-    from . import validate
-    from .qft import check_design_speed
-    from .turbine import iea15mw
+    from . import qft, validate
 
     n, d = _seeds_and_duration(n_seeds, duration, 3 if fast else 6, 300.0 if fast else 600.0)
     t = del_target(target_reduction)
@@ -180,7 +177,7 @@ def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_D
     speeds = []
     for i, x in enumerate(design_speeds):
         try:
-            speeds.append(check_design_speed(m, real_scalar(x, "wind_speed")))
+            speeds.append(qft.check_design_speed(m, real_scalar(x, "wind_speed")))
         except (TypeError, ValueError) as e:  # check_design_speed names wind_speed: say which design speed
             raise type(e)(f"design_speeds[{i}]: {e}") from None
     speeds = tuple(speeds)
