@@ -76,3 +76,15 @@ def test_any_non_finite_coefficient_is_refused(finite, bad, at, which):
     d["num" if which == 0 else "den"] = coeffs
     with pytest.raises(ValueError, match=r"holds NaN or inf"):
         session_from_dict({"schema": SCHEMA, "version": VERSION, "controllers": {"K": d}})
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), True])
+def test_a_nan_gain_element_is_refused_on_load(bad):
+    data = {"schema": SCHEMA, "version": VERSION,
+            "specifications": {"W": {"name": "W", "context": {"wind_speed": 19.0, "output": "tower_base_my", "m": 4.0},
+                                     "baseline": {"num": [1.0], "den": [1.0, 1.0]},
+                                     "elements": [{"type": "Gain", "gain_db": bad}]}}}
+    with pytest.raises(ValueError, match=r"Gain.gain_db=.* must be a finite number of dB"):
+        session_from_dict(data)
+    with pytest.raises(ValueError, match="Gain.gain_db"):
+        spec.Gain(bad)
