@@ -27,6 +27,7 @@ import numpy as np
 
 from loopshaping.freqresp import is_zero
 
+from . import validate
 from ._checks import del_target, positive_scalar, real_scalar
 from .plots.fatigue import plot_sensitivity
 from .plots.qft import plot_design_bode, plot_design_nichols
@@ -165,7 +166,7 @@ def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_D
     ValueError
         Naming the option and its range.
     """
-    from . import qft, validate
+    from .qft import check_design_speed
 
     n, d = _seeds_and_duration(n_seeds, duration, 3 if fast else 6, 300.0 if fast else 600.0)
     t = del_target(target_reduction)
@@ -177,7 +178,7 @@ def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_D
     speeds = []
     for i, x in enumerate(design_speeds):
         try:
-            speeds.append(qft.check_design_speed(m, real_scalar(x, "wind_speed")))
+            speeds.append(check_design_speed(m, real_scalar(x, "wind_speed")))
         except (TypeError, ValueError) as e:  # check_design_speed names wind_speed: say which design speed
             raise type(e)(f"design_speeds[{i}]: {e}") from None
     speeds = tuple(speeds)

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -39,6 +39,7 @@ from loopshaping.controller import Controller, Element
 from . import closedloop, spectral, turbine, wind
 from ._checks import as_omega, as_psd, positive_scalar
 from .closedloop import siso_response
+from .fatigue import TOWER_M
 from .rosco import rosco_baseline, rosco_gain_schedule
 
 if TYPE_CHECKING:
@@ -47,6 +48,7 @@ if TYPE_CHECKING:
     from .turbine import TurbineModel
 
 __all__ = [
+    "SLSQP_OPTIONS",
     "Notch",
     "Gain",
     "LeadLag",
@@ -68,6 +70,10 @@ __all__ = [
     "specification_pair",
     "from_element",
 ]
+
+#: SciPy SLSQP settings of the workbench's constrained fits (the notch shaper here, the QFT
+#: tuner's polish): at most 300 iterations, converged when the cost changes by less than 1e-10.
+SLSQP_OPTIONS = {"maxiter": 300, "ftol": 1e-10}
 
 
 # --------------------------------------------------------------------------------------
@@ -548,26 +554,6 @@ class Specification:
         """
         return Controller(tuple(x for e in self.elements for x in e.to_elements()))
 
-    def with_elements(self, elements: Iterable) -> "Specification":
-        """A copy with the shaping elements replaced.
-
-        Parameters
-        ----------
-        elements : iterable
-            The new shaping elements (:class:`Notch`, :class:`Gain`, ...).
-
-        Returns
-        -------
-        Specification
-            The new specification (this one is unchanged).
-
-        Raises
-        ------
-        TypeError
-            If an element is not a shaping element.
-        """
-        return replace(self, elements=tuple(elements))
-
 
 def _check_proper_stable(sys, name):
     if isinstance(sys, ct.TransferFunction):
@@ -640,18 +626,12 @@ class Baseline:
     model: object = field(default=None, repr=False, compare=False)
 
     @property
-    def s_wind(self) -> np.ndarray:
-        """Deprecated name of :attr:`wind_psd` (one name for the wind PSD)."""
-        warnings.warn("Baseline.s_wind is deprecated, use Baseline.wind_psd", DeprecationWarning, stacklevel=2)
-        return self.wind_psd
-
-    @property
     def del_1hz(self) -> float:
         """DEL at 1 Hz of the baseline output, a range in the output's units (N·m for MyT)."""
         return float(self.damage_rate ** (1.0 / self.m))
 
 
-def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, wind_psd: ArrayLike, m: float = 4.0, *,
+def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, wind_psd: ArrayLike, m: float = TOWER_M, *,
                            method: str = "dirlik", reduction: float = 0.01, system: ct.LTI | None = None,
                            output: str = "", wind_speed: float = float("nan")) -> Baseline:
     """Baseline from a closed-loop frequency response T(jω) and an input spectrum S_W(ω).
@@ -797,7 +777,7 @@ def baseline_controllers(model, wind_speeds: Sequence[float]) -> list:
     return [rosco_baseline(model, float(v), schedule=schedule) for v in wind_speeds]
 
 
-def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tower_base_my", *, m: float = 4.0,
+def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tower_base_my", *, m: float = TOWER_M,
                       omega: ArrayLike | None = None, controller: ct.LTI | None = None, turbulence_class: str = "B",
                       method: str = "dirlik", reduction: float = 0.01) -> Baseline:
     """ΔD%(ω) of the baseline closed loop of ``model`` at ``wind_speed`` for ``output``.
@@ -1126,7 +1106,7 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
         res = minimize(
             cost, x0, method="SLSQP", bounds=bounds,
             constraints=[{"type": "ineq", "fun": lambda x: damage_reduction(x) - target_damage}],
-            options={"maxiter": 300, "ftol": 1e-10},
+            options=dict(SLSQP_OPTIONS),
         )
         x = res.x
         if damage_reduction(x) >= target_damage - tolerance:
@@ -1277,7 +1257,7 @@ def specification_pair(obj) -> tuple | None:
 
 def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
                           spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                          keep_below: float = 0.6, m: float = 4.0,
+                          keep_below: float = 0.6, m: float = TOWER_M,
                           omega: ArrayLike | None = None) -> DesignSpecifications:
     """The tower-load and generator-speed specifications that QFT and H∞ designs are given.
 
@@ -1342,12 +1322,3 @@ def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax
     tower = Specification(base.system, tuple(shaping.notches) + relax, name="W_tower_base_my")
     speed = speed_specification(model, v, margin_db=float(speed_relax_db))
     return DesignSpecifications(base, shaping, tower, speed)
-
-
-def __getattr__(name):
-    # spec.evaluate was renamed: loopshaping.qft.evaluate is a frequency response, this a promise
-    if name == "evaluate":
-        warnings.warn("specdesign.spec.evaluate is deprecated; use specdesign.spec.promise_of", DeprecationWarning,
-                      stacklevel=2)
-        return promise_of
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -17,11 +17,28 @@ def test_loopshaping_never_imports_specdesign():
     assert out.stdout.startswith("ok")
 
 
+#: Shipped files that differ from ../shared on purpose: file → (line in ../shared, line shipped,
+#: why). The DISCON.IN names its Cp table where the package ships it (beside it); the reference
+#: copy's ../IEA-15-240-RWT/ does not exist in the package, and ROSCO stops the process on it.
+SHIPPED_EDITS = {
+    "IEA-15-240-RWT-Monopile_DISCON.IN": (
+        '"../IEA-15-240-RWT/Cp_Ct_Cq.IEA15MW.txt"      ! PerfFileName',
+        '"Cp_Ct_Cq.IEA15MW.txt"                         ! PerfFileName',
+        "the Cp table's path as shipped"),
+}
+
+
 def test_package_ships_its_data(package_data, shared_data):
     for f in shared_data.iterdir():
         shipped = package_data / f.name
         assert shipped.is_file(), f"{f.name} is not shipped in specdesign/data/iea15mw"
-        assert shipped.read_bytes() == f.read_bytes(), f"{f.name} differs from ../shared"
+        ref, got = f.read_bytes(), shipped.read_bytes()
+        if f.name in SHIPPED_EDITS:  # the one documented line differs, nothing else
+            old, new, _ = SHIPPED_EDITS[f.name]
+            assert ref.count(old.encode()) == 1 and got.count(new.encode()) == 1, f.name
+            ref = ref.replace(old.encode(), new.encode())
+            assert (package_data / "Cp_Ct_Cq.IEA15MW.txt").is_file()
+        assert got == ref, f"{f.name} differs from ../shared"
 
 
 # ----------------------------------------------------------------------------- one home per concept (issue 13)
@@ -248,11 +265,17 @@ def test_the_parts_of_specdesign_form_no_cycle():
 
 
 def test_no_import_inside_a_function_unless_listed():
-    def listed(targets):
-        return any(t == p or t.startswith(p + ".") for t in targets for p in LOCAL_IMPORTS)
+    def listed(modname, targets):
+        # a module of the importer's own part is never listed: the part's package loads it anyway,
+        # so a local import there only hides a cycle between the part's modules
+        def own_part(t):
+            return t.split(".")[0] in PACKAGES and t.split(".")[:2] == modname.split(".")[:2]
+
+        return any((t == p or t.startswith(p + ".")) and not own_part(t) for t in targets for p in LOCAL_IMPORTS)
 
     bad = [f"{path.relative_to(ROOT)}:{node.lineno}: {ast.unparse(node)}"
-           for pkg in PACKAGES for path, _, node, targets, local in _imports(pkg) if local and not listed(targets)]
+           for pkg in PACKAGES for path, modname, node, targets, local in _imports(pkg)
+           if local and not listed(modname, targets)]
     assert not bad, ("imports inside functions (move them to the top, or list the dependency in LOCAL_IMPORTS "
                      "with the reason):\n" + "\n".join(bad))
 
@@ -269,3 +292,99 @@ def test_own_local_imports_are_heavy():
         if out.stdout.strip() == "[]":
             light.append(m)
     assert not light, f"listed in LOCAL_IMPORTS as heavy but load none of {HEAVY}: {light} (import them at the top)"
+
+
+# ----------------------------------------------------------------------------- one source per default (issue 32)
+def _signatures():
+    """(qualified name, inspect.Signature) of every function and method defined in specdesign."""
+    import importlib
+    import inspect
+
+    for path, modname in _modules():
+        if not modname.startswith("specdesign.") or modname.endswith("__main__"):
+            continue
+        mod = importlib.import_module(modname.removesuffix(".__init__"))
+        for name, obj in vars(mod).items():
+            if getattr(obj, "__module__", None) != mod.__name__:
+                continue
+            members = [(name, obj)]
+            if inspect.isclass(obj):
+                members += [(f"{name}.{k}", v) for k, v in vars(obj).items() if inspect.isfunction(v)]
+            for qual, f in members:
+                f = getattr(f, "py_func", f)  # numba dispatchers
+                if callable(f):
+                    try:
+                        yield f"{modname}.{qual}", inspect.signature(f)
+                    except (TypeError, ValueError):
+                        continue
+
+
+def test_shared_defaults_have_one_source():
+    # the defaults several signatures share are module constants, used by identity, so changing
+    # one changes all; a literal copy (1.9 here, 2.0 there) fails this test
+    from specdesign import closedloop, fatigue
+    from specdesign.qft import SPEED_RELAX_DB
+
+    # parameter → its constants: a float default must be one of them
+    shared = {
+        "max_sensitivity": (closedloop.MAX_SENSITIVITY, closedloop.DESIGN_MAX_SENSITIVITY,
+                            closedloop.CERTIFICATE_MAX_SENSITIVITY),
+        "m": (fatigue.TOWER_M,),
+    }
+    copies = [f"{qual}({p}={sig.parameters[p].default!r})" for qual, sig in _signatures() for p in shared
+              if p in sig.parameters and isinstance(sig.parameters[p].default, float)
+              and not any(sig.parameters[p].default is c for c in shared[p])]
+    # QFT's relaxation ladder, wherever it is the default (other ladders are other defaults)
+    copies += [f"{qual}(speed_relax_db={sig.parameters['speed_relax_db'].default!r})" for qual, sig in _signatures()
+               if "speed_relax_db" in sig.parameters and sig.parameters["speed_relax_db"].default == SPEED_RELAX_DB
+               and sig.parameters["speed_relax_db"].default is not SPEED_RELAX_DB]
+    assert not copies, "defaults written as literals instead of their module constant:\n" + "\n".join(copies)
+
+
+def test_ordered_constants_stay_ordered():
+    # the certificate is stricter than the designs that fit it, which are stricter than the
+    # feasibility verdict (each keeps margin on the next); all are sensitivity peaks above 1
+    from specdesign import closedloop
+
+    assert 1.0 < closedloop.CERTIFICATE_MAX_SENSITIVITY < closedloop.DESIGN_MAX_SENSITIVITY
+    assert closedloop.DESIGN_MAX_SENSITIVITY <= closedloop.MAX_SENSITIVITY
+
+
+# ----------------------------------------------------------------------------- one name, one meaning (issue 32)
+#: Public names that specdesign and loopshaping both export for different objects, with the
+#: reason. Empty: closedloop's closed_loop_poles is turbine_loop_poles (loopshaping.interactive
+#: keeps its own), wind's synthesize is gaussian_series (loopshaping.hinf.synthesize is H∞).
+SHARED_NAMES: dict = {}
+
+
+def test_no_public_name_means_two_things_across_the_packages():
+    import importlib
+
+    homes = {}
+    for path, modname in _modules():
+        if any(p.startswith("_") and p != "__init__" for p in modname.split(".")) or modname.endswith("__main__"):
+            continue
+        mod = importlib.import_module(modname.removesuffix(".__init__"))
+        for name in getattr(mod, "__all__", ()):
+            homes.setdefault(name, {}).setdefault(modname.split(".")[0], {})[id(getattr(mod, name))] = modname
+    clashes = {name: {pkg: sorted(ids.values()) for pkg, ids in by.items()} for name, by in homes.items()
+               if len(by) == 2 and not set(by["specdesign"]) & set(by["loopshaping"]) and name not in SHARED_NAMES}
+    assert not clashes, f"one public name, two objects (rename one, or list it in SHARED_NAMES with why): {clashes}"
+
+
+# ----------------------------------------------------------------------------- warnings (issue 32)
+def test_no_warning_is_silenced_wholesale():
+    # only named categories, in the narrowest block, with the reason beside it: a bare
+    # simplefilter("ignore") would also hide the DeprecationWarnings the tests make errors and
+    # every numerical warning of the block
+    bad = []
+    for path, _ in _modules():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                    and node.func.attr in ("simplefilter", "filterwarnings") and node.args
+                    and isinstance(node.args[0], ast.Constant) and node.args[0].value == "ignore"):
+                continue
+            position = 1 if node.func.attr == "simplefilter" else 2  # where `category` goes
+            if len(node.args) <= position and not any(k.arg == "category" for k in node.keywords):
+                bad.append(f"{path.relative_to(ROOT)}:{node.lineno}")
+    assert not bad, "warnings silenced without a category: " + ", ".join(bad)

@@ -5,7 +5,7 @@ import pytest
 from specdesign import turbine
 from specdesign.fatigue import del_rainflow
 from specdesign.validate import INDICATORS, indicators, paired_change, run_campaign
-from specdesign.validate.metrics import BLADE_M
+from specdesign.fatigue import BLADE_M
 
 
 @pytest.fixture(scope="module")

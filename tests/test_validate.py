@@ -381,7 +381,7 @@ def test_validate_imports_no_figures_and_no_loopshaping():
     assert r.returncode == 0, r.stderr
 
 
-def test_moved_names_are_reexported_or_deprecated():
+def test_moved_names_are_reexported_or_gone():
     import warnings
 
     from specdesign import openfast
@@ -389,8 +389,8 @@ def test_moved_names_are_reexported_or_deprecated():
     assert va.series_from_openfast is openfast.series_from_openfast
     assert va.OPENFAST_CHANNELS is openfast.OPENFAST_CHANNELS
     for name in ("ConfigError", "read_config", "load_controller", "run_config"):
-        with pytest.warns(DeprecationWarning, match=f"specdesign.cli.{name}"):
-            assert getattr(va, name) is getattr(cli, name)
+        assert not hasattr(va, name) and hasattr(cli, name), name  # the command line's, not validate's
+    assert not hasattr(va, "closed_loop_poles")  # the linear loop's, renamed turbine_loop_poles
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         for name in va.__all__:  # every public name is importable without a warning

@@ -30,14 +30,48 @@ Every closed-loop construction of the workbench lives here, one module a concern
 from __future__ import annotations
 
 from .grid import case_speeds, lightly_damped, refine_grid, system_roots
-from .interconnect import (PLANT_INPUTS, check_stability, closed_loop, closed_loop_mimo, named_siso, partial_loop,
-                           require_signals)
-from .maps import (LOOP_OUTPUTS, LoopMaps, close_responses, closed_loop_del, closed_map, frequency_response,
-                   general_coefficients, general_form, loop_maps, output_psd, plant_responses, siso_response,
-                   t_gen_speed_wind, t_output_wind, t_tower_wind)
-from .stability import (ORIGIN_TOL, UNSTABLE_CONTROLLER_RATE, ClosedLoopUnstableWarning, closed_loop_matrices,
-                        closed_loop_poles, hidden_origin_poles, local_response, loop_parts, trim_weights, unstable_message,
-                        unstable_poles)
+from .interconnect import (
+                           PLANT_INPUTS,
+                           check_stability,
+                           closed_loop,
+                           closed_loop_mimo,
+                           named_siso,
+                           partial_loop,
+                           require_signals,
+)
+from .maps import (
+                           LOOP_OUTPUTS,
+                           LoopMaps,
+                           close_responses,
+                           closed_loop_del,
+                           closed_map,
+                           frequency_response,
+                           general_coefficients,
+                           general_form,
+                           loop_maps,
+                           output_psd,
+                           plant_responses,
+                           siso_response,
+                           t_gen_speed_wind,
+                           t_output_wind,
+                           t_tower_wind,
+)
+from .stability import (
+                           CERTIFICATE_MAX_SENSITIVITY,
+                           DESIGN_MAX_SENSITIVITY,
+                           MAX_SENSITIVITY,
+                           ORIGIN_TOL,
+                           UNSTABLE_CONTROLLER_RATE,
+                           ClosedLoopUnstableWarning,
+                           closed_loop_matrices,
+                           hidden_origin_poles,
+                           local_response,
+                           loop_parts,
+                           trim_weights,
+                           turbine_loop_poles,
+                           unstable_message,
+                           unstable_poles,
+)
 
 __all__ = [
     "ClosedLoopUnstableWarning",
@@ -65,7 +99,7 @@ __all__ = [
     "local_response",
     "trim_weights",
     "closed_loop_matrices",
-    "closed_loop_poles",
+    "turbine_loop_poles",
     "hidden_origin_poles",
     "unstable_poles",
     "unstable_message",
@@ -75,6 +109,9 @@ __all__ = [
     "case_speeds",
     "ORIGIN_TOL",
     "UNSTABLE_CONTROLLER_RATE",
+    "MAX_SENSITIVITY",
+    "DESIGN_MAX_SENSITIVITY",
+    "CERTIFICATE_MAX_SENSITIVITY",
     "PLANT_INPUTS",
     "LOOP_OUTPUTS",
 ]

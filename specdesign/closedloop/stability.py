@@ -25,9 +25,9 @@ if TYPE_CHECKING:
 
     from ..turbine import TurbineModel
 
-__all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_loop_matrices", "closed_loop_poles",
+__all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_loop_matrices", "turbine_loop_poles",
            "hidden_origin_poles", "unstable_poles", "unstable_message", "trim_weights", "ORIGIN_TOL",
-           "UNSTABLE_CONTROLLER_RATE"]
+           "UNSTABLE_CONTROLLER_RATE", "MAX_SENSITIVITY", "DESIGN_MAX_SENSITIVITY", "CERTIFICATE_MAX_SENSITIVITY"]
 
 
 #: Growth rate (1/s) above which a controller's own pole counts as unstable (a controller with
@@ -35,6 +35,19 @@ __all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_
 #: wherever the pitch saturates the loop opens and the mode grows): slower modes grow less
 #: than e-fold over a 10-minute record.
 UNSTABLE_CONTROLLER_RATE = 1e-3
+
+#: Peak M_s of the pitch loop's sensitivity |S| = |1/(1 + C·P_{Ω,β})| the feasibility checks and
+#: the convex design impose by default: 2 (6 dB), the usual robustness rule (it guarantees a gain
+#: margin of at least M_s/(M_s − 1) = 2 and a phase margin of at least 2·asin(1/(2·M_s)) = 29°).
+MAX_SENSITIVITY = 2.0
+#: Peak of |S| the designers require (both loops and the actuator): design_qft, its bounds check
+#: and design_hinf's plant-case check; below :data:`MAX_SENSITIVITY`, so a design keeps margin on
+#: the feasibility verdict.
+DESIGN_MAX_SENSITIVITY = 1.9
+#: Peak of |S| of the certificate (specification_for_target, CertificateSearch): below
+#: :data:`DESIGN_MAX_SENSITIVITY`, so that the plant cases and a reduced-order controller fitted
+#: to the certificate keep their margins in the design.
+CERTIFICATE_MAX_SENSITIVITY = 1.8
 
 
 class ClosedLoopUnstableWarning(UserWarning):
@@ -287,7 +300,7 @@ def closed_loop_matrices(model: TurbineModel | KernelPlant | None, controller: A
 ORIGIN_TOL = 1e-9
 
 
-def closed_loop_poles(model: TurbineModel | KernelPlant | None, controller: Any, wind_speed: float) -> np.ndarray:
+def turbine_loop_poles(model: TurbineModel | KernelPlant | None, controller: Any, wind_speed: float) -> np.ndarray:
     """Poles of the linearised turbine at ``wind_speed`` closed by ``controller``.
 
     The loop is β = −C_β·Ω_g − C_atd·ẋ_top.
@@ -319,11 +332,11 @@ def closed_loop_poles(model: TurbineModel | KernelPlant | None, controller: Any,
     Examples
     --------
     >>> import numpy as np
-    >>> from specdesign.closedloop import closed_loop_poles
+    >>> from specdesign.closedloop import turbine_loop_poles
     >>> from specdesign.rosco import rosco_baseline
     >>> from specdesign.turbine import iea15mw
     >>> model = iea15mw()
-    >>> p = closed_loop_poles(model, rosco_baseline(model, 19.0), 19.0)
+    >>> p = turbine_loop_poles(model, rosco_baseline(model, 19.0), 19.0)
     >>> p.size, bool(np.all(p.real < 0))
     (8, True)
     """

@@ -7,7 +7,14 @@ import numpy as np
 
 from .._blas import on_one_blas_thread
 from .._checks import as_omega, positive_scalar, real_scalar
-from ..closedloop import closed_map, plant_responses, refine_grid, siso_response
+from ..closedloop import (
+    MAX_SENSITIVITY,
+    closed_map,
+    plant_responses,
+    refine_grid,
+    siso_response,
+)
+from ..fatigue import TOWER_M
 from ..spectral import trapezoid_weights
 from .achievable import YoulaProblem
 
@@ -15,7 +22,7 @@ __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_check
            "sensitivity_disks"]
 
 
-def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
+def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=MAX_SENSITIVITY):
     """The disks of the complex sensitivity S(jω) that each specification allows.
 
     Parameters
@@ -153,7 +160,7 @@ def _bands(omega, mask):
 
 
 @on_one_blas_thread
-def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitivity=2.0, omega=None,
+def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitivity=MAX_SENSITIVITY, omega=None,
                       cases=None) -> PitchFeasibility:
     """Whether a tower-load and a generator-speed specification can be met by pitch control.
 
@@ -262,7 +269,7 @@ class PitchChecker:
         return _verdict(self.omega, ~bad, binding, self.zeros, means, self.max_sensitivity)
 
 
-def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=None, cases=None) -> list:
+def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=MAX_SENSITIVITY, omega=None, cases=None) -> list:
     """One :class:`PitchChecker` per plant case, on one grid.
 
     Parameters
@@ -382,8 +389,8 @@ def _magnitude(spec_like, omega, name):
 
 
 @on_one_blas_thread
-def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8.0), *, max_sensitivity=2.0,
-                   max_pitch_rate_ratio=1.0, m=4.0, omega=None) -> dict:
+def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8.0), *, max_sensitivity=MAX_SENSITIVITY,
+                   max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None) -> dict:
     """The largest tower-base DEL reduction a pitch controller can promise, per speed relaxation.
 
     For each relaxation g (dB) of the generator-speed specification W_Ω = 10^(g/20)·|T^ROSCO_{Ω,w}|:

@@ -57,6 +57,7 @@ from ..closedloop import (
     siso_response,
     system_roots,
 )
+from ..fatigue import TOWER_M
 from .target import DENSE_POINTS_PER_WIDTH, CertificateSearch, recertify
 
 __all__ = ["BELOW_WEIGHT", "ENVELOPES", "ENVELOPE_LOSS_PP", "FIT_OMEGA", "FOLLOW", "FOLLOW_GAIN_DB", "HEADROOM_PP",
@@ -391,7 +392,7 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
 
 @on_one_blas_thread  # L-BFGS-B's small BLAS calls: 10× faster on one thread (specdesign._blas)
 def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_pp=HEADROOM_PP,
-                          max_notches=MAX_NOTCHES, m=4.0, omega=None, **target_options):
+                          max_notches=MAX_NOTCHES, m=TOWER_M, omega=None, **target_options):
     """A certified tower specification for ``target_reduction``, as ROSCO's map times shaping elements.
 
     See the module docstring for the problem solved.

@@ -9,6 +9,7 @@ import numpy as np
 from .._blas import on_one_blas_thread
 from .._checks import MAX_BISECTIONS, as_omega, del_target, margin_db, search_options
 from ..closedloop import (
+    CERTIFICATE_MAX_SENSITIVITY,
     case_speeds,
     closed_loop,
     closed_map,
@@ -18,6 +19,7 @@ from ..closedloop import (
     siso_response,
     system_roots,
 )
+from ..fatigue import TOWER_M
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
@@ -94,7 +96,7 @@ class TargetSpecification:
     case_speeds: tuple = ()
     robustness_db: float = 0.0
     speed_slack_db: float = 0.0
-    m: float = 4.0
+    m: float = TOWER_M
 
     @property
     def wind_speed(self) -> float:
@@ -116,8 +118,8 @@ class TargetSpecification:
 
 @on_one_blas_thread
 def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
-                             max_sensitivity=1.8, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
-                             m=4.0, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
+                             max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
+                             m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
                              dense_omega=None) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
@@ -151,8 +153,8 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         A fixed relaxation of the certificate's speed constraint, dB: the slack is then the
         largest that keeps the promise ≥ ``target_reduction`` (bisection to ``tolerance_db``).
     max_sensitivity : float
-        M_s of the certificate (-); below design_qft's 1.9 so that the plant cases and a
-        reduced-order controller keep their margins.
+        M_s of the certificate (-); below :data:`~specdesign.closedloop.DESIGN_MAX_SENSITIVITY`
+        so that the plant cases and a reduced-order controller keep their margins.
     max_pitch_rate_ratio : float
         Pitch-rate SD allowance relative to ROSCO's (-).
     max_relax_db : float
@@ -239,7 +241,7 @@ class CertificateSearch:
     True
     """
 
-    def __init__(self, model, wind_speed, *, max_sensitivity=1.8, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
+    def __init__(self, model, wind_speed, *, max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
                  case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None):
         from .. import spec
         self.model, self.m = model, float(m)
@@ -516,8 +518,8 @@ class _Cases:
         from .. import spec
         if self._unstable(controller):
             return None
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings():  # python-control's notes on the interconnection (unused signals)
+            warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             cl0 = closed_loop(self.plants[self.nom], controller, warn=False)
         roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
         roots += [system_roots(x.baseline) for x in specs if isinstance(x, spec.Specification)]

@@ -32,7 +32,7 @@ Sign convention of the workbench: β = −C_β·Ω_g − C_atd·v_tt. SLICOT clo
 from __future__ import annotations
 
 from .cases import CHECK_OMEGA, CONTINUATION_DB, CaseCheck, check_pair, refine_on_cases
-from .design import DEFAULT_DECAY_RATE, QFT_SPEED_RELAX_DB, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
+from .design import DEFAULT_DECAY_RATE, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
 from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, inverse_weight, siso_weight
 
@@ -44,7 +44,6 @@ __all__ = [
     "refine_on_cases",
     "GeneralizedPlant",
     "HinfDesign",
-    "QFT_SPEED_RELAX_DB",
     "design_hinf",
     "generalized_plant",
     "inverse_weight",

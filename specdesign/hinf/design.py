@@ -24,7 +24,9 @@ from .._blas import one_blas_thread
 from .._checks import finite_system, spec_made_at
 from ..closedloop import closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
+from ..fatigue import TOWER_M
 from ..feasibility import TargetSpecification, specification_for_target
+from ..qft.design import SPEED_RELAX_DB
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
@@ -36,7 +38,7 @@ if TYPE_CHECKING:
     from ..spec import Specification
     from ..turbine import TurbineModel
 
-__all__ = ['HinfDesign', 'QFT_SPEED_RELAX_DB', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
+__all__ = ['HinfDesign', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
 
 #: α (1/s) of the α-shifted synthesis in :func:`design_hinf`.
 DEFAULT_DECAY_RATE = 0.02
@@ -216,7 +218,7 @@ def _is_design(obj) -> bool:
 
 def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
                        spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                       keep_below: float = 0.6, m: float = 4.0,
+                       keep_below: float = 0.6, m: float = TOWER_M,
                        omega: ArrayLike | None = None) -> tuple[Specification, Specification, Specification]:
     """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
 
@@ -284,9 +286,6 @@ def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db
     return d.tower, d.speed, d.shaping.specification
 
 
-#: Relaxations (dB) of the generator-speed spec tried in turn by ``design_hinf(spec="qft")``:
-#: the ladder of :func:`specdesign.qft.design_qft`.
-QFT_SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
 
 
 def design_hinf(
@@ -295,17 +294,16 @@ def design_hinf(
     target_reduction: float = 25.0,
     *,
     spec: str | Any = "target",
-    specs: str | Any | None = None,
     spec_reduction: float = 15.0,
     measurements: Sequence[str] | None = None,
     order: int = 8,
     w_tower: Specification | ct.LTI | None = None,
     w_speed: Specification | ct.LTI | None = None,
     w_pitch: ct.LTI | float | None = None,
-    speed_relax_db: float | Sequence[float] = QFT_SPEED_RELAX_DB,
+    speed_relax_db: float | Sequence[float] = SPEED_RELAX_DB,
     tower_relax_db: float = 6.0,
     tower_relax_omega: float = 1.3,
-    m: float = 4.0,
+    m: float = TOWER_M,
     omega: ArrayLike | None = None,
     suboptimality: float = 0.05,
     reduction_method: str = "balanced",
@@ -346,7 +344,7 @@ def design_hinf(
         ``"qft"``: those of ``specdesign.qft.design_qft(spec="notch")``
         (:func:`qft_specifications`): the notch spec relaxed by ``tower_relax_db`` above
         ≈ ``tower_relax_omega`` and ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``; given a
-        sequence (default :data:`QFT_SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
+        sequence (default :data:`specdesign.qft.SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
         in turn and the smallest whose reduced design meets both specs on the refined grid
         (speed everywhere, tower over the tower-mode band) is kept, as QFT does (this
         function's default before the certified pair).
@@ -354,8 +352,6 @@ def design_hinf(
         exactly the specs that design met. ``"rosco"``: the unrelaxed notch spec and ROSCO's
         T_{Ω,w} (its ζ = 0.01 dip at the tower mode is a spec no well-damped loop can follow,
         docs/hinf.md).
-    specs : optional
-        Deprecated alias of ``spec`` (DeprecationWarning); give one of the two.
     spec_reduction : float
         % of tower-base damage the automatic notch specification
         (:func:`specdesign.spec.shape_to_target`) must promise with ``spec="qft"`` or
@@ -455,12 +451,6 @@ def design_hinf(
     True
     """
     from .. import spec as sp
-    if specs is not None:
-        warnings.warn("design_hinf(specs=...) is deprecated; use spec=... (the name design_qft uses)",
-                      DeprecationWarning, stacklevel=2)
-        if not (isinstance(spec, str) and spec == "target"):
-            raise ValueError(f"give spec={spec!r} or the deprecated specs={specs!r}, not both")
-        spec = specs
     specs, made = spec, False
     v = model.check_wind_speed(wind_speed)
     # a NaN plant: said here, naming the wind speed, before the specification search, the

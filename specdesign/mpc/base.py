@@ -408,6 +408,9 @@ class SampledController:
     def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
         """Subclass hook: command deviations (rad) of the runs at one operating point.
 
+        Each controller defines it (the QP's first move, the economic problem's first move, the
+        regressor's command within the actuator limits); they share this docstring.
+
         Parameters
         ----------
         pt : dict
@@ -421,6 +424,11 @@ class SampledController:
         -------
         numpy.ndarray
             (G,) new command deviations (rad).
+
+        Raises
+        ------
+        RuntimeError
+            If the controller's solver fails.
         """
         raise NotImplementedError
 

@@ -34,6 +34,7 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from .._checks import positive_scalar
+from .._docs import docstring_of
 from ..simulate import SimulationDivergedError, simulate
 from .base import MEASURED, SampledController, discretize_turbine
 from .economic import economic_problem, solve_cone
@@ -69,22 +70,6 @@ class Demonstrations:
     seeds: np.ndarray
     ts: float
     cpu_time: np.ndarray
-
-    def subset(self, seeds) -> Demonstrations:
-        """The rows of some seeds (a held-out split by wind record, not by sample).
-
-        Parameters
-        ----------
-        seeds : sequence of int
-            Seeds to keep.
-
-        Returns
-        -------
-        Demonstrations
-            The rows of those seeds.
-        """
-        keep = np.isin(self.seeds, np.asarray(seeds))
-        return Demonstrations(self.features[keep], self.targets[keep], self.seeds[keep], self.ts, self.cpu_time)
 
     def join(self, other: Demonstrations) -> Demonstrations:
         """These rows and ``other``'s (DAgger aggregates the rounds).
@@ -439,23 +424,9 @@ class ClonedController(SampledController):
         self.saturated = 0
         super().start(dt, wind, pitch, torque)
 
+    @docstring_of(SampledController)
     def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
-        """The regressor's command for every run at one operating point, within the actuator limits.
-
-        Parameters
-        ----------
-        pt : dict
-            :meth:`point` of the operating point.
-        xhat : numpy.ndarray
-            (G, n+1) state and wind estimates.
-        uprev : numpy.ndarray
-            (G,) previous command deviations (rad).
-
-        Returns
-        -------
-        numpy.ndarray
-            (G,) command deviations (rad).
-        """
+        # the regressor's command for every run, within the actuator limits
         t0 = time.process_time()
         dm = pt["model"]
         X = np.column_stack([xhat, uprev, np.full(uprev.size, dm.wind_speed)])

@@ -32,7 +32,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
-from ..fatigue import VarianceDamageFit, economic_cost, fit_variance_damage
+from .._docs import docstring_of
+from ..fatigue import (
+    BLADE_M,
+    TOWER_M,
+    VarianceDamageFit,
+    economic_cost,
+    fit_variance_damage,
+)
 from ..simulate import simulate
 from ..turbine import rosco_baseline
 from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine
@@ -40,8 +47,8 @@ from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbi
 __all__ = ["solve_cone", "FatigueTerm", "fit_fatigue_terms", "surrogate_cost", "economic_problem",
            "economic_open_loop", "OpenLoopResult", "EconomicMPC", "WOHLER"]
 
-#: Wöhler exponents of the priced components: steel tower (4), glass-fibre blade root (10).
-WOHLER = {"tower_base_my": 4.0, "blade_root_my": 10.0}
+#: Wöhler exponents of the priced components: steel tower, glass-fibre blade root.
+WOHLER = {"tower_base_my": TOWER_M, "blade_root_my": BLADE_M}
 
 
 def solve_cone(problem) -> bool:
@@ -442,28 +449,9 @@ class EconomicMPC(SampledController):
                                             rate_limit=float(self.model.pitch_rate_limit),
                                             pitch_limits=(float(self.model.pitch_min), float(self.model.pitch_max)))}
 
+    @docstring_of(SampledController)
     def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
-        """First move of the economic problem for every run at one operating point.
-
-        Parameters
-        ----------
-        pt : dict
-            :meth:`point` of the operating point.
-        xhat : numpy.ndarray
-            (G, n+1) state and wind estimates.
-        uprev : numpy.ndarray
-            (G,) previous command deviations (rad).
-
-        Returns
-        -------
-        numpy.ndarray
-            (G,) command deviations (rad).
-
-        Raises
-        ------
-        RuntimeError
-            If the solver fails.
-        """
+        # the first move of the economic problem of every run (RuntimeError if the solver fails)
         pb = pt["problem"]
         out = np.empty(uprev.size)
         for g in range(uprev.size):

@@ -14,15 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fatigue import del_rainflow
+from ..fatigue import BLADE_M, TOWER_M, del_rainflow
 from ..rosco import rosco_scheduled
 from ..simulate import simulate
 from .health import HealthMPC
 
-__all__ = ["TradeoffPoint", "health_tradeoff", "plot_tradeoff", "BLADE_M", "TOWER_M"]
+__all__ = ["TradeoffPoint", "health_tradeoff", "plot_tradeoff"]
 
-#: Wöhler exponents of the blade root (glass fibre) and the tower base (steel).
-BLADE_M, TOWER_M = 10.0, 4.0
 
 
 @dataclass(frozen=True)

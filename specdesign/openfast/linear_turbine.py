@@ -33,9 +33,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import positive_scalar
+from .._docs import docstring_of
 from ..rosco import rosco_baseline, rosco_gain_schedule
 from ..simulate import KernelPlant
 from ..simulate.kernels import linear_outputs, linear_plant_params, linear_rhs
+from ..turbine import TurbineModel
 from .lin import read_lin_file, read_linearization
 from .signals import plant_from_linearization
 
@@ -261,11 +263,6 @@ class LinearTurbine:
         return float(self.wind_speeds[0]), float(self.wind_speeds[-1])
 
     @property
-    def input_names(self) -> tuple:
-        """Names of the plant inputs."""
-        return tuple(self.plants[0].input_labels)
-
-    @property
     def output_names(self) -> tuple:
         """Names of the plant outputs."""
         return tuple(self.plants[0].output_labels)
@@ -275,24 +272,8 @@ class LinearTurbine:
         """Rotor-speed reference (rad/s): the operating points' rotor speed at the highest wind speed."""
         return float(self.operating_points[-1].rotor_speed)
 
+    @docstring_of(TurbineModel)
     def check_wind_speed(self, wind_speed: float) -> float:
-        """``wind_speed`` as a float, checked to be within the linearisations' speeds.
-
-        Parameters
-        ----------
-        wind_speed : float
-            Mean wind speed (m/s).
-
-        Returns
-        -------
-        float
-            The wind speed (m/s).
-
-        Raises
-        ------
-        ValueError
-            Outside ``wind_range`` (a LinearTurbine does not extrapolate).
-        """
         v = positive_scalar(wind_speed, "wind_speed")
         lo, hi = self.wind_range
         tol = _SAME_SPEED * hi

@@ -1,8 +1,9 @@
 """QFT design of the pitch controller C_β and an active tower damping (ATD) controller.
 
-Modules: :mod:`~specdesign.qft.design` (the design at one operating point and over a schedule,
-:class:`QFTDesign`), :mod:`~specdesign.qft.structure` (the fixed controller structures and their
-parameter vector), :mod:`~specdesign.qft.tuner` (objective, constraints, the tuner); the loop
+Modules: :mod:`~specdesign.qft.design` (the design at one operating point and over a schedule),
+:mod:`~specdesign.qft.result` (its record, :class:`QFTDesign`), :mod:`~specdesign.qft.structure`
+(the fixed controller structures and their parameter vector), :mod:`~specdesign.qft.tuner`
+(objective, constraints, the tuner); the loop
 algebra they use (general form, sequential closure) is :mod:`specdesign.closedloop`'s.
 
 The seed paper's Sect. 4 on the embedded turbine model, as a deterministic automatic
@@ -79,8 +80,8 @@ from __future__ import annotations
 
 from ..closedloop import general_form, partial_loop
 from .checks import fine_pitch_lift
-from .design import (DEFAULT_DESIGN_OMEGA, QFTDesign, check_design_speed, design_qft, design_schedule, design_table,
-                     format_table)
+from .design import SPEED_RELAX_DB, check_design_speed, design_qft, design_schedule, design_table, format_table
+from .result import DEFAULT_DESIGN_OMEGA, QFTDesign
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 
 __all__ = [
@@ -93,6 +94,7 @@ __all__ = [
     "design_table",
     "format_table",
     "DEFAULT_DESIGN_OMEGA",
+    "SPEED_RELAX_DB",
     "fine_pitch_lift",
     "TorqueDesign",
     "design_torque",

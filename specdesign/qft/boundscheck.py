@@ -23,12 +23,14 @@ import numpy as np
 from loopshaping import qft as lqft
 
 from ..closedloop import (
+    DESIGN_MAX_SENSITIVITY,
     case_speeds,
     closed_map,
     general_coefficients,
     plant_responses,
     siso_response,
 )
+from .result import DEFAULT_DESIGN_OMEGA
 
 __all__ = ["BoundsVerdict", "BoundsChecker", "bounds_checker"]
 
@@ -121,7 +123,7 @@ class BoundsChecker:
         return BoundsVerdict(w.copy(), empty, not bool(empty.any()))
 
 
-def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
+def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=DESIGN_MAX_SENSITIVITY,
                    template_offsets=(-1.0, -0.5, 0.5, 1.0), design_omega=None) -> BoundsChecker:
     """Precompute the pitch loop's QFT problem at ``wind_speed`` for live tower-spec checks.
 
@@ -138,7 +140,7 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     template_offsets : sequence of float
         Wind-speed offsets of the plant cases, m/s (clipped to ``model.wind_range``).
     design_omega : array_like, optional
-        Design frequencies, rad/s (default :data:`specdesign.qft.design.DEFAULT_DESIGN_OMEGA`).
+        Design frequencies, rad/s (default :data:`specdesign.qft.result.DEFAULT_DESIGN_OMEGA`).
 
     Returns
     -------
@@ -162,7 +164,6 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     """
     from .. import spec as sp
     from ..spec import baseline_controllers
-    from .design import DEFAULT_DESIGN_OMEGA
 
     if not max_sensitivity > 1:
         raise ValueError(f"max_sensitivity={max_sensitivity!r} must be > 1 (|1/(1+L)| bound)")

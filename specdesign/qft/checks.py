@@ -176,8 +176,8 @@ def spec_roots(spec_like) -> np.ndarray:
 
     if not isinstance(spec_like, Specification):
         return np.zeros(0, complex)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings():  # python-control's notes on the conversion to state space
+        warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
         b = control.ss(spec_like.baseline)
         out = [np.asarray(b.poles(), complex), np.asarray(b.zeros(), complex)]
     for e in spec_like.elements:

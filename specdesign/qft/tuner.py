@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike
 
 from .. import spectral
 from ..closedloop import closed_map, plant_responses, siso_response
+from ..spec import SLSQP_OPTIONS
 from .structure import controller_polys, vector_bounds
 
 if TYPE_CHECKING:
@@ -450,7 +451,7 @@ def tune(prob: TuningProblem, x0: ArrayLike, target: float | None, min_decay: fl
             try:
                 r = minimize(prob.objective, start, method="SLSQP", bounds=box,
                              constraints=[{"type": "ineq", "fun": prob.constraints, "args": (target, min_decay)}],
-                             options={"maxiter": 300, "ftol": 1e-10})
+                             options=dict(SLSQP_OPTIONS))
             except (ValueError, np.linalg.LinAlgError, FloatingPointError):
                 return None
         return np.clip(r.x, lo, hi) if np.all(np.isfinite(r.x)) else None

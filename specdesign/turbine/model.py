@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
-from ..controller.torque import close_torque_loop, steady_state, torque_law
+from ..controller.torque import TRIM_TOL, close_torque_loop, steady_state, torque_law
 
 if TYPE_CHECKING:  # pragma: no cover
     import control
@@ -292,6 +292,9 @@ class TurbineModel:
     def check_wind_speed(self, wind_speed: float) -> float:
         """``wind_speed`` as a float, checked to be within ``wind_range``.
 
+        Every model the design loop takes has it (:class:`specdesign.openfast.LinearTurbine`
+        shares this docstring).
+
         Parameters
         ----------
         wind_speed : float
@@ -305,7 +308,8 @@ class TurbineModel:
         Raises
         ------
         ValueError
-            Outside the above-rated range where the model is valid.
+            Outside ``wind_range``: for a TurbineModel the above-rated range where it is valid,
+            for a LinearTurbine its linearisations' speeds (it interpolates, never extrapolates).
         """
         v = positive_scalar(wind_speed, "wind_speed")
         lo, hi = self.wind_range
@@ -443,7 +447,7 @@ class TurbineModel:
         k = int(np.argmax(vals <= 0))
         if vals[k] > 0:
             raise ValueError(f"no pitch within the table balances the torque at wind_speed={v!r} m/s")
-        beta = brentq(surplus, grid[k - 1], grid[k], xtol=1e-14, rtol=1e-14)
+        beta = brentq(surplus, grid[k - 1], grid[k], xtol=TRIM_TOL, rtol=TRIM_TOL)
         tsr = omega * self.rotor_radius / v
         cp, ct = (float(c) for c in self.rotor_coefficients(tsr, beta))
         area = np.pi * self.rotor_radius**2
@@ -541,7 +545,9 @@ class TurbineModel:
         Below rated (a model with ``torque_control``) the torque loop is closed
         (:func:`specdesign.rosco.close_torque_loop`): the law's dT/dΩ enters A (region 2:
         2KΩ; regions 1.5 and 2.5: the transition PI, its integral an extra state
-        ``torque_pi``), and ``gen_torque`` is a torque added to the law's. The pitch loop is
+        ``torque_pi``), and ``gen_torque`` is a torque added to the law's. Above rated a law
+        with constant power (``VS_ConstPower = 1``) enters A the same way (dT/dΩ = −P/(η·Ω²));
+        one with constant torque leaves the torque an input. The pitch loop is
         open there: ROSCO's pitch PI sits at its minimum below rated.
 
         Parameters
@@ -576,7 +582,7 @@ class TurbineModel:
         op = self.trim(wind_speed)
         A, B, C, D = self.jacobians(op)
         inputs, states = list(INPUT_NAMES), list(STATE_NAMES)
-        if op.region != "3":
+        if self.torque_control is not None:  # above rated it matters only for constant power
             A, B, C, D, extra = close_torque_loop(A, B, C, D, self.torque_control, op.rotor_speed, op.region)
             states += extra
         if load_inputs:

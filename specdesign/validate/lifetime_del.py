@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
+from ..fatigue import TOWER_M
 from .stats import resampled_se
 
 __all__ = ["DEL_CHANNELS", "WindClimate", "weibull_bins", "wind_climate", "LifetimeDEL", "lifetime"]
@@ -299,7 +300,7 @@ def _speeds(v) -> str:
     return ", ".join(f"{x:g}" for x in np.asarray(v).tolist())
 
 
-def lifetime(campaign, wind_climate, *, controllers=None, channels=("tower_base_my",), m: float = 4.0,
+def lifetime(campaign, wind_climate, *, controllers=None, channels=("tower_base_my",), m: float = TOWER_M,
              availability: float = 1.0, baseline: str | None = None, method: str = "jackknife",
              n_boot: int = 2000, seed: int = 0) -> LifetimeDEL:
     """Lifetime DEL of each controller and channel, with its SE and the change vs a baseline.

@@ -10,6 +10,7 @@ from .. import spectral, wind
 from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind, unstable_message, unstable_poles
 from ..closedloop.maps import state_space_response
+from ..fatigue import TOWER_M
 from ..simulate import turbine_plant
 from ._loop import rotor_radius
 
@@ -127,7 +128,7 @@ def prediction_grid(duration: float = 600.0, omega_max: float = 30.0, n: int = 3
     return np.geomspace(2 * np.pi / positive_scalar(duration, "duration"), positive_scalar(omega_max, "omega_max"), int(n))
 
 
-def linear_prediction(model, controller, wind_speed: float, *, output: str = "tower_base_my", m: float = 4.0,
+def linear_prediction(model, controller, wind_speed: float, *, output: str = "tower_base_my", m: float = TOWER_M,
                       omega=None, turbulence_class: str = "B", method: str = "dirlik") -> LinearPrediction:
     """|T_{y,w}|²·S_W and its DEL by a spectral method (Dirlik by default) at one wind speed.
 

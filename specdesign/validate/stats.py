@@ -19,7 +19,8 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from .._checks import positive_scalar
-from .metrics import BLADE_M, INDICATORS
+from ..fatigue import BLADE_M, TOWER_M
+from .metrics import INDICATORS
 
 __all__ = ["WEIBULL_K", "WEIBULL_A", "weibull_weights", "welch_psd", "pool", "resampled_se", "PairedChange",
            "paired_change", "seeds_from"]
@@ -155,7 +156,7 @@ def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
     -------
     numpy.ndarray
         ``tower_del``: (mean DEL^m)^{1/m} (the DEL of the summed damage), ``blade_del``
-        the same with m = :data:`~specdesign.validate.metrics.BLADE_M`; ``mean_power``:
+        the same with m = :data:`~specdesign.fatigue.BLADE_M`; ``mean_power``:
         the mean; a standard deviation: √(mean of the variances).
 
     Examples
@@ -250,7 +251,7 @@ class PairedChange:
     n_seeds: int
 
 
-def paired_change(designed, baseline, indicator: str = "tower_del", *, m: float = 4.0, wind_speeds=None,
+def paired_change(designed, baseline, indicator: str = "tower_del", *, m: float = TOWER_M, wind_speeds=None,
                   method: str = "jackknife", n_boot: int = 2000, seed: int = 0) -> PairedChange:
     """Paired-seed relative change of an indicator, with jackknife (default) or bootstrap SE.
 

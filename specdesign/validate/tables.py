@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fatigue import TOWER_M
 from .campaign import Campaign
 from .lifetime_del import lifetime
 from .prediction import linear_prediction
@@ -465,7 +466,7 @@ def _at(controller, v, what):
     return controller
 
 
-def linear_table3(model, designed, wind_speeds, *, baseline=None, promised: Mapping | None = None, m: float = 4.0,
+def linear_table3(model, designed, wind_speeds, *, baseline=None, promised: Mapping | None = None, m: float = TOWER_M,
                   turbulence_class: str = "B", name: str = "designed") -> Table:
     """The linear rows of the paper's Table 3, without simulation: promised and predicted DEL reduction.
 

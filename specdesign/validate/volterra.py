@@ -9,7 +9,7 @@ import numpy as np
 
 from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind
-from ..fatigue import del_rainflow
+from ..fatigue import TOWER_M, del_rainflow
 from ..simulate import wind_series
 from ..turbine import OUTPUT_NAMES
 from ._loop import has_linear_form, rotor_radius
@@ -32,7 +32,7 @@ def volterra_response(model, controller, wind_speed: float, wind, dt: float, *, 
     the ``aero_torque`` and ``thrust`` inputs) to ½ z₁ᵀ H z₁, the quadratic loads along the
     linear trajectory z₁. Term 3 is its response to z₁ᵀ H z₂ + D³[z₁, z₁, z₁]/6, z₂ the
     second-order trajectory. Each product is formed in the time domain and filtered by FFT,
-    so ``wind`` must be periodic over its record (as :func:`specdesign.wind.synthesize`
+    so ``wind`` must be periodic over its record (as :func:`specdesign.wind.gaussian_series`
     makes it); no time stepping. With the aerodynamic nonlinearity of class-B turbulence the
     series to third order matches the tower-base DEL of the nonlinear simulation within a few
     tenths of a percent (docs/nonlinearity.md, section (i)).
@@ -153,7 +153,7 @@ class VolterraPrediction:
 
 
 def volterra_prediction(model, controller, wind_speed: float, *, seeds=range(1000, 1200), duration: float = 600.0,
-                        dt: float = 0.1, order: int = 3, m: float = 4.0, output: str = "tower_base_my",
+                        dt: float = 0.1, order: int = 3, m: float = TOWER_M, output: str = "tower_base_my",
                         turbulence_class: str = "B", chunk: int = 50) -> VolterraPrediction:
     """DEL of ``output`` predicted by the Volterra series over synthetic periodic wind records.
 
