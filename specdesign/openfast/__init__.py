@@ -5,6 +5,8 @@
 - :func:`series_from_openfast` (outputs → the workbench's SI series, :data:`OPENFAST_CHANNELS`)
 - :class:`LinearTurbine` (``.lin`` sets at several wind speeds → a model the design loop takes;
   signals by channel description, :data:`DEFAULT_SIGNALS`, :func:`plant_from_linearization`)
+- :func:`find_openfast`, :func:`build_openfast` (the executables: found, or built from source
+  into a cache; :class:`OpenFASTInstall`)
 """
 from __future__ import annotations
 
@@ -21,6 +23,11 @@ _LAZY = {
     "rotor_speed_model": ".linear_turbine",
     "DEFAULT_SIGNALS": ".signals",
     "plant_from_linearization": ".signals",
+    "OpenFASTInstall": ".install",
+    "OpenFASTNotFound": ".install",
+    "find_openfast": ".install",
+    "build_openfast": ".install",
+    "check_deck_version": ".install",
 }
 
 __all__ = list(_LAZY)
