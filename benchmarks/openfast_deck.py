@@ -64,6 +64,9 @@ def main() -> None:
         for k in (1, 2, 3):
             vt["Fst"][f"BDBldFile({k})"] = "unused"
         vt["ServoDyn"]["DLL_FileName"] = "libdiscon.so"  # named per case by write_case
+        # no HydroDyn joint outputs (none is read): openfast-io 5.0 writes a list of two
+        # joints space-separated and its reader, expecting commas, cannot read it back
+        vt["HydroDyn"]["NJOutputs"], vt["HydroDyn"]["JOutLst"] = 0, [0]
         if OUT.exists():
             shutil.rmtree(OUT)
         writer = InputWriter_OpenFAST()

@@ -7,6 +7,8 @@
   signals by channel description, :data:`DEFAULT_SIGNALS`, :func:`plant_from_linearization`)
 - :func:`find_openfast`, :func:`build_openfast` (the executables: found, or built from source
   into a cache; :class:`OpenFASTInstall`)
+- :class:`Deck`, :func:`iea15mw_monopile` (the shipped v5.0 deck), :func:`write_case`,
+  :func:`run_case` (case folders written with openfast-io and run in a subprocess)
 """
 from __future__ import annotations
 
@@ -28,6 +30,13 @@ _LAZY = {
     "find_openfast": ".install",
     "build_openfast": ".install",
     "check_deck_version": ".install",
+    "Deck": ".deck",
+    "Case": ".deck",
+    "OpenFASTRunError": ".deck",
+    "iea15mw_monopile": ".deck",
+    "write_case": ".deck",
+    "run_case": ".deck",
+    "CAMPAIGN_CHANNELS": ".deck",
 }
 
 __all__ = list(_LAZY)
