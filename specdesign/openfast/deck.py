@@ -13,6 +13,7 @@ import io
 import math
 import os
 import subprocess
+import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -154,6 +155,12 @@ class OpenFASTRunError(RuntimeError):
                          f"(folder {case.folder}); the end of its output:\n{tail}")
 
 
+# openfast-io's reader and writer print through sys.stdout, which is swapped to silence them:
+# one at a time, so that threads writing cases at once (a campaign) never leave it swapped
+_IO_LOCK = threading.Lock()
+_DECK_LOCK = threading.Lock()
+
+
 @lru_cache(maxsize=8)
 def _read_deck(fst: str, mtime: float) -> dict:
     """openfast-io's variable tree of a deck (cached per file and modification time)."""
@@ -162,7 +169,7 @@ def _read_deck(fst: str, mtime: float) -> dict:
     reader = InputReader_OpenFAST()
     reader.FAST_InputFile = os.path.basename(fst)
     reader.FAST_directory = os.path.dirname(fst)
-    with contextlib.redirect_stdout(io.StringIO()):  # ROSCO's DISCON reader prints what it loads
+    with _IO_LOCK, contextlib.redirect_stdout(io.StringIO()):  # ROSCO's DISCON reader prints what it loads
         reader.execute()
     return reader.fst_vt
 
@@ -235,7 +242,8 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
             raise ValueError(f"{key}={val!r} must be a positive number of seconds")
     if not (math.isfinite(wind_speed) and wind_speed >= 0):
         raise ValueError(f"wind_speed={wind_speed!r} must be a non-negative speed in m/s")
-    vt = copy.deepcopy(_read_deck(str(deck.fst), deck.fst.stat().st_mtime))
+    with _DECK_LOCK:  # one read of a deck, however many threads ask for it at once
+        vt = copy.deepcopy(_read_deck(str(deck.fst), deck.fst.stat().st_mtime))
     folder = Path(folder).expanduser().resolve()
     name = name or folder.name
     fst, sd, ifw, ed = vt["Fst"], vt["ServoDyn"], vt["InflowWind"], vt["ElastoDyn"]
@@ -280,7 +288,7 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
     writer.fst_vt = vt
     writer.FAST_runDirectory = str(folder)
     writer.FAST_namingOut = name
-    with contextlib.redirect_stdout(io.StringIO()):
+    with _IO_LOCK, contextlib.redirect_stdout(io.StringIO()):
         writer.execute()
     return Case(name=name, folder=folder, deck=deck, tmax=float(tmax), wind_speed=float(wind_speed),
                 seed=None if seed is None else int(seed), channels=tuple(channels))
