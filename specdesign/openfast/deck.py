@@ -164,7 +164,7 @@ _DECK_LOCK = threading.Lock()
 @lru_cache(maxsize=8)
 def _read_deck(fst: str, mtime: float) -> dict:
     """openfast-io's variable tree of a deck (cached per file and modification time)."""
-    from openfast_io.FAST_reader import InputReader_OpenFAST  # openfast-io is optional (the `openfast` extra)
+    from openfast_io.FAST_reader import InputReader_OpenFAST  # heavy: openfast-io imports ROSCO's toolbox; loaded when a case is written
 
     reader = InputReader_OpenFAST()
     reader.FAST_InputFile = os.path.basename(fst)
@@ -282,7 +282,7 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
     if not hydro:
         fst["CompSeaSt"], fst["CompHydro"] = 0, 0
     _set_outputs(vt, channels)
-    from openfast_io.FAST_writer import InputWriter_OpenFAST  # optional dependency, see _read_deck
+    from openfast_io.FAST_writer import InputWriter_OpenFAST  # heavy, as in _read_deck
 
     writer = InputWriter_OpenFAST()
     writer.fst_vt = vt

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
 
+from openfast_io.turbsim_util import TurbsimWriter
+
 from ..wind import seed_for
 from .install import OpenFASTInstall, find_openfast
 
@@ -170,7 +172,7 @@ def turbsim_field(wind_speed: float, seed: int, *, length: float = 660.0, hub_he
 
 def _write_input(path: Path, wind_speed: float, s: dict) -> None:
     """The TurbSim input file, written by openfast-io's TurbsimWriter."""
-    from openfast_io.turbsim_util import TurbsimWriter  # openfast-io is optional (the `openfast` extra)
+    from openfast_io.turbsim_util import TurbsimWriter  # heavy: openfast-io imports ROSCO's toolbox; loaded when a field is made
 
     n = s["grid_points"]
     inputs = SimpleNamespace(
