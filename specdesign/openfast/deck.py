@@ -140,6 +140,15 @@ class OpenFASTRunError(RuntimeError):
     """OpenFAST failed, timed out or wrote no outputs; the message names the case, its seed
     and the tail of OpenFAST's own message.
 
+    Parameters
+    ----------
+    case : Case
+        The case that failed.
+    reason : str
+        What went wrong ("failed (exit code 1, after 3 s)", "did not finish in 600 s").
+    tail : str
+        The last lines OpenFAST printed.
+
     Attributes
     ----------
     case : Case
