@@ -79,6 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     ofa = sub.add_parser("openfast", help="build OpenFAST and TurbSim from source, or show the ones found")
     ofa.add_argument("action", choices=("build", "find"), help="build: from SOURCE into the cache; find: print the executables")
     ofa.add_argument("source", nargs="?", help="build: an OpenFAST source tarball or folder")
+    ofa.add_argument("--source-version", default=None, help="build: the source's version X.Y.Z (default: from its name)")
     ofa.add_argument("--cache", default=None, help="build cache (default: $SPECDESIGN_OPENFAST_CACHE or ~/.cache/specdesign/openfast)")
     args = parser.parse_args(argv)
     _choose_backend()
@@ -133,7 +134,7 @@ def _openfast_command(args) -> None:
         if args.source is None:
             raise ConfigError("openfast build needs SOURCE: an OpenFAST source tarball or folder")
         try:
-            found = build_openfast(args.source, cache=args.cache)
+            found = build_openfast(args.source, cache=args.cache, version=args.source_version)
         except (ValueError, RuntimeError) as e:  # a bad source or missing tools: the message says which
             raise ConfigError(str(e)) from None
     else:

@@ -125,7 +125,7 @@ def test_build_from_tarball_then_cached(tmp_path, monkeypatch, capfd):
     src.mkdir()
     (src / "CMakeLists.txt").write_text(_FAKE_CMAKE)
     _fake_exe(src / "fake.sh", "9.9.9")
-    tar = tmp_path / "of.tar.gz"
+    tar = tmp_path / "openfast-v9.9.9-src.tar.gz"  # the version comes from the name
     with tarfile.open(tar, "w:gz") as t:
         t.add(src, arcname=src.name)
     monkeypatch.setattr(install, "_missing_tools", lambda: [])  # no gfortran needed by the fake project

@@ -121,7 +121,9 @@ def openfast_version(executable: str | os.PathLike, timeout: float = 60.0) -> st
     found = re.search(r"v(\d+)\.(\d+)\.(\d+)", text)
     if found is None:
         tail = " ".join(text.split())[-300:]
-        raise RuntimeError(f"{exe} -v printed no version 'vX.Y.Z' (it printed: {tail!r})")
+        hint = (" (built from a source without git information: rebuild with cmake -DGIT_DESCRIBE=vX.Y.Z, as "
+                "`python -m specdesign openfast build` does)") if "HEAD-HASH-NOTFOUND" in text else ""
+        raise RuntimeError(f"{exe} -v printed no version 'vX.Y.Z'{hint} (it printed: {tail!r})")
     return ".".join(found.groups())
 
 
@@ -284,8 +286,8 @@ def _manifest(folder: Path):
     return data if exe is not None and ts is not None else None
 
 
-def build_openfast(source: str | os.PathLike, cache: str | os.PathLike | None = None, *, jobs: int | None = None,
-                   progress: bool = True) -> OpenFASTInstall:
+def build_openfast(source: str | os.PathLike, cache: str | os.PathLike | None = None, *, version: str | None = None,
+                   jobs: int | None = None, progress: bool = True) -> OpenFASTInstall:
     """Build ``openfast`` and ``turbsim`` from a source tarball or folder, cached by the source's digest.
 
     cmake with :data:`CMAKE_OPTIONS` (Release, double precision, no tests), then only the
@@ -301,6 +303,11 @@ def build_openfast(source: str | os.PathLike, cache: str | os.PathLike | None = 
         holding its top ``CMakeLists.txt``).
     cache : str or os.PathLike, optional
         Cache folder; default :func:`default_cache`.
+    version : str, optional
+        The source's version (``"5.0.0"``), compiled into the executables (cmake
+        ``-DGIT_DESCRIBE``) so that they report it: a tarball has no git history to take it
+        from. Default: read from the source's name (``openfast-v5.0.0-src.tar.gz``); a git
+        checkout without it in its name uses ``git describe``.
     jobs : int, optional
         Parallel compile jobs; default the number of CPUs.
     progress : bool, default True
@@ -316,7 +323,8 @@ def build_openfast(source: str | os.PathLike, cache: str | os.PathLike | None = 
     FileNotFoundError
         ``source`` does not exist.
     ValueError
-        ``source`` is neither a tarball nor a folder with a ``CMakeLists.txt``.
+        ``source`` is neither a tarball nor a folder with a ``CMakeLists.txt``, or its
+        version is neither given nor in its name (nor a git checkout).
     RuntimeError
         gfortran, cmake, make or LAPACK/BLAS missing (naming the Debian packages), or cmake or
         make failed (the tail of its log and the log's path).
@@ -334,6 +342,14 @@ def build_openfast(source: str | os.PathLike, cache: str | os.PathLike | None = 
         raise ValueError(f"source={str(source)!r} is not a tar archive: give an OpenFAST source tarball or folder")
     if not is_tar and not (source / "CMakeLists.txt").is_file():
         raise ValueError(f"source={str(source)!r} has no CMakeLists.txt: give the OpenFAST source's top folder")
+    if version is None:
+        named = re.search(r"v?(\d+\.\d+\.\d+)", source.name)
+        if named is None and not (source.is_dir() and (source / ".git").exists()):
+            raise ValueError(f"source={str(source)!r}: its version is not in its name; pass version='X.Y.Z' "
+                             "(--source-version on the command line)")
+        version = named.group(1) if named else None
+    elif not re.fullmatch(r"\d+\.\d+\.\d+", str(version)):
+        raise ValueError(f"version={version!r} must be 'major.minor.patch', e.g. '5.0.0'")
     cache = Path(cache).expanduser() if cache is not None else default_cache()
     digest = _digest(source)[:16]
     folder = cache / digest
@@ -346,12 +362,12 @@ def build_openfast(source: str | os.PathLike, cache: str | os.PathLike | None = 
                 print(f"openfast build: another process is building {folder}; waiting for it", file=sys.stderr)
                 fcntl.flock(lock, fcntl.LOCK_EX)
             if _manifest(folder) is None:  # the other process may have finished it
-                _build(source, is_tar, folder, jobs or os.cpu_count() or 1, progress)
+                _build(source, is_tar, folder, version, jobs or os.cpu_count() or 1, progress)
     exe, ts = _from_folder(folder / "bin")
     return OpenFASTInstall(openfast=exe, turbsim=ts, version=json.loads((folder / "manifest.json").read_text())["version"])
 
 
-def _build(source: Path, is_tar: bool, folder: Path, jobs: int, progress: bool) -> None:
+def _build(source: Path, is_tar: bool, folder: Path, version, jobs: int, progress: bool) -> None:
     missing = _missing_tools()
     if missing:
         raise RuntimeError("building OpenFAST needs " + ", ".join(missing) + "; install them (Debian: apt-get install "
@@ -370,9 +386,13 @@ def _build(source: Path, is_tar: bool, folder: Path, jobs: int, progress: bool) 
                 raise ValueError(f"source={str(source)!r}: the tarball holds no folder with a CMakeLists.txt")
     build = folder / "build"
     t0 = time.monotonic()
-    if not (build / "Makefile").is_file():
-        _say(progress, f"openfast build: cmake {' '.join(CMAKE_OPTIONS)} (log: {folder / 'cmake.log'})")
-        _run(["cmake", "-S", str(src), "-B", str(build), *CMAKE_OPTIONS], folder / "cmake.log", False)
+    options = list(CMAKE_OPTIONS) + ([f"-DGIT_DESCRIBE=v{version}"] if version else [])
+    # configure when new, or when the version compiled in differs (an adopted build folder):
+    # a reconfigure recompiles only the version module and relinks
+    cached = (build / "CMakeCache.txt").read_text(errors="replace") if (build / "CMakeCache.txt").is_file() else ""
+    if not (build / "Makefile").is_file() or (version and f"GIT_DESCRIBE:UNINITIALIZED=v{version}" not in cached):
+        _say(progress, f"openfast build: cmake {' '.join(options)} (log: {folder / 'cmake.log'})")
+        _run(["cmake", "-S", str(src), "-B", str(build), *options], folder / "cmake.log", False)
     _say(progress, f"openfast build: make {' '.join(BUILD_TARGETS)} with {jobs} jobs; 11-34 min on 2 cores "
                    f"(log: {folder / 'make.log'})")
     _run(["cmake", "--build", str(build), "--target", *BUILD_TARGETS, "--", f"-j{jobs}"], folder / "make.log",
@@ -387,7 +407,7 @@ def _build(source: Path, is_tar: bool, folder: Path, jobs: int, progress: bool) 
         shutil.copy2(path, bin_ / name)
     version = openfast_version(bin_ / "openfast")
     manifest = {"version": version, "source": str(source), "digest16": folder.name,
-                "cmake_options": list(CMAKE_OPTIONS), "targets": list(BUILD_TARGETS),
+                "cmake_options": options, "targets": list(BUILD_TARGETS),
                 "build_seconds": round(time.monotonic() - t0, 1), "built": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
     (folder / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
     _say(progress, f"openfast build: OpenFAST v{version} in {bin_}")
