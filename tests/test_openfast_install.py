@@ -104,6 +104,8 @@ def test_build_names_missing_tools(tmp_path, monkeypatch):
     real = shutil.which
     monkeypatch.setattr(install.shutil, "which", lambda n: None if n in ("cmake", "gfortran") else real(n))
     with pytest.raises(RuntimeError, match=r"cmake \(Debian: cmake\).*gfortran \(Debian: gfortran\)"):
+        build_openfast(src, cache=tmp_path / "c", version="5.0.0", progress=False)
+    with pytest.raises(ValueError, match="pass version="):  # neither in the name nor a git checkout
         build_openfast(src, cache=tmp_path / "c", progress=False)
 
 
