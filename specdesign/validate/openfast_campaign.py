@@ -46,10 +46,14 @@ class DisconController:
         The compiled ``DISCON`` library.
     parameters : pathlib.Path
         The file it reads at initialisation (ServoDyn's ``DLL_InFile``).
+    dt : float or None
+        Its sample time (s), ServoDyn's ``DLL_DT`` (an exported design's ``dt``); None: the
+        deck's (ROSCO is called every time step).
     """
 
     library: Path
     parameters: Path
+    dt: float | None = None
 
 
 def as_discon(controller) -> DisconController:
@@ -91,7 +95,8 @@ def as_discon(controller) -> DisconController:
     for key, p in (("library", lib), ("parameters", par)):
         if not p.is_file():
             raise FileNotFoundError(f"controller {key} {p} does not exist")
-    return DisconController(lib.resolve(), par.resolve())
+    dt = getattr(controller, "dt", None)
+    return DisconController(lib.resolve(), par.resolve(), None if dt is None else float(dt))
 
 
 def _sha(path: Path) -> str:
@@ -230,7 +235,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         c = discon[name]
         init = trim(v) if trim is not None else (None, None)
         case = write_case(deck, _run_folder(root, run), tmax=transient + duration, wind_speed=v, wind_file=wind.path,
-                          seed=s, library=c.library, parameters=c.parameters, dt=dt, dt_out=record_dt,
+                          seed=s, library=c.library, parameters=c.parameters, controller_dt=c.dt, dt=dt, dt_out=record_dt,
                           channels=CAMPAIGN_CHANNELS, initial_pitch=init[0], initial_rotor_speed=init[1],
                           hydro=hydro, name=f"{_slug(name)}_{v:g}mps_seed{s}")
         out = run_case(case, install, timeout=timeout, nice=nice)
@@ -295,13 +300,13 @@ def _run_folder(root: Path, run) -> Path:
 
 def _meta(run, c: DisconController, settings) -> dict:
     name, v, s = run
-    return {"controller": name, "wind_speed": v, "seed": s, "library_sha": _sha(c.library),
+    return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt, "library_sha": _sha(c.library),
             "parameters_sha": _sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
             "settings": settings}
 
 
 def _same(a: dict, b: dict) -> bool:
-    keys = ("controller", "wind_speed", "seed", "library_sha", "parameters_sha")
+    keys = ("controller", "wind_speed", "seed", "controller_dt", "library_sha", "parameters_sha")
     return all(a.get(k) == b.get(k) for k in keys) and a.get("settings") == b.get("settings")
 
 
