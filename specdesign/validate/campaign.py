@@ -350,6 +350,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     if not isinstance(controllers, dict) or not controllers:
         raise TypeError("controllers must be a non-empty dict {name: controller}")
     if plant is not None:
+        if linear_twin or volterra or executor is not None:
+            raise ValueError("linear_twin, volterra and executor are options of the reduced model's campaign, not of "
+                             "an OpenFAST plant (its processes: openfast={'processes': n})")
         from .openfast_campaign import run_openfast_campaign  # openfast-io and the executables: only when asked
 
         return run_openfast_campaign(controllers, wind_speeds, seeds, deck=plant, duration=duration, transient=transient,
