@@ -40,9 +40,10 @@ VARIANTS = {
 
 
 def cpu_seconds(log: Path) -> float:
-    """OpenFAST's own 'Total CPU Time' from its screen output (s)."""
-    m = re.search(r"Total CPU Time:\s*([\d.]+)\s*seconds", log.read_text())
-    return float(m.group(1)) if m else float("nan")
+    """OpenFAST's own 'Total CPU Time' from its screen output (s; it prints seconds, minutes or hours)."""
+    m = re.search(r"Total CPU Time:\s*([\d.Ee+-]+)\s*(seconds|minutes|hours|days)", log.read_text())
+    scale = {"seconds": 1.0, "minutes": 60.0, "hours": 3600.0, "days": 86400.0}
+    return float(m.group(1)) * scale[m.group(2)] if m else float("nan")
 
 
 def main() -> None:

@@ -8,7 +8,7 @@ A long run (~1.3 s of CPU per simulated second per run: 2 controllers × 6 speed
 660 s ≈ 7 h of CPU), resumable and background-friendly: every finished run is kept in
 ``--out`` (a folder per run), a second call runs only what is missing; OpenFAST runs niced.
 
-    nohup nice python benchmarks/openfast_table3.py --processes 2 > table3.log 2>&1 &
+    nohup nice -n 10 python benchmarks/openfast_table3.py --processes 2 > table3.log 2>&1 &
     python benchmarks/openfast_table3.py --speeds 19 --seeds 1 --duration 30 --transient 10  # a smoke run
 
 Designs are made on the reduced model (``--plant reduced``, default) or, when
@@ -59,7 +59,7 @@ def main() -> None:
     ap.add_argument("--transient", type=float, default=60.0, help="discarded s per run")
     ap.add_argument("--target", type=float, default=25.0, help="DEL reduction target of the specification, %%")
     ap.add_argument("--processes", type=int, default=None, help="OpenFAST processes at a time (default: CPUs)")
-    ap.add_argument("--nice", type=int, default=10)
+    ap.add_argument("--nice", type=int, default=0, help="niceness added to OpenFAST (on top of this process's)")
     ap.add_argument("--plant", choices=("reduced", "openfast"), default="reduced")
     ap.add_argument("--rosco-only", action="store_true", help="run ROSCO only (no design, no Table 3)")
     ap.add_argument("--out", default="build/openfast_table3")

@@ -12,6 +12,8 @@ import copy
 import io
 import math
 import os
+import resource
+import signal
 import subprocess
 import threading
 import time
@@ -340,8 +342,8 @@ def _set_outputs(vt: dict, channels) -> None:
             vt[mod]["BldNd_BladesOut"] = 0
 
 
-def run_case(case: Case, install: OpenFASTInstall | None = None, *, timeout: float | None = None,
-             channels: Sequence[str] | None = None, nice: int = 0) -> OpenFASTOutput:
+def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: float | None = None,
+             timeout: float | None = None, channels: Sequence[str] | None = None, nice: int = 0) -> OpenFASTOutput:
     """Run OpenFAST on a case in a subprocess and read its outputs.
 
     Parameters
@@ -350,9 +352,13 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, timeout: flo
         From :func:`write_case`.
     install : OpenFASTInstall, optional
         The executables; default :func:`specdesign.openfast.find_openfast`.
+    cpu_limit : float, optional
+        CPU-time limit of the OpenFAST process (s); default 10 × ``case.tmax`` + 120 s
+        (OpenFAST runs the shipped deck at about 1.3 s of CPU per simulated second). A CPU
+        limit, unlike a wall-clock one, does not fire on a busy machine: a run that exceeds it
+        is stuck (e.g. a diverging simulation cutting its step), not starved.
     timeout : float, optional
-        Wall-clock limit (s); default 10 × ``case.tmax`` + 120 s (OpenFAST runs the shipped
-        deck at about 1.3 s of CPU per simulated second).
+        Wall-clock limit (s); default none.
     channels : sequence of str, optional
         Channels read; default the case's (every channel when the case kept the deck's list).
     nice : int, default 0
@@ -373,20 +379,30 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, timeout: flo
     """
     install = install or find_openfast(require_turbsim=False)
     check_deck_version(install, case.deck.version, case.deck.fst)
-    timeout = 10.0 * case.tmax + 120.0 if timeout is None else float(timeout)
+    cpu_limit = 10.0 * case.tmax + 120.0 if cpu_limit is None else float(cpu_limit)
     case.outb.unlink(missing_ok=True)
     t0 = time.monotonic()
-    pre = (lambda: os.nice(nice)) if nice else None
+
+    def limits():  # in the child, before OpenFAST starts
+        resource.setrlimit(resource.RLIMIT_CPU, (math.ceil(cpu_limit), math.ceil(cpu_limit) + 5))
+        if nice:
+            os.nice(nice)
+
+    # gfortran buffers a redirected stdout: unbuffered, the log keeps OpenFAST's last words
+    # even when the process is killed
+    env = dict(os.environ, GFORTRAN_UNBUFFERED_PRECONNECTED="y")
     with open(case.log, "w") as log:
         try:
             rc = subprocess.run([str(install.openfast), case.fst.name], cwd=case.folder, stdout=log,
                                 stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, timeout=timeout,
-                                preexec_fn=pre).returncode
+                                preexec_fn=limits, env=env).returncode
         except subprocess.TimeoutExpired:
             rc = None
     tail = _tail(case.log)
     if rc is None:
-        raise OpenFASTRunError(case, f"did not finish in {timeout:g} s", tail)
+        raise OpenFASTRunError(case, f"did not finish in {timeout:g} s of wall time", tail)
+    if rc in (-signal.SIGXCPU, -signal.SIGKILL) and time.monotonic() - t0 >= 0.9 * cpu_limit:
+        raise OpenFASTRunError(case, f"used more than its {cpu_limit:g} s of CPU time (cpu_limit)", tail)
     text = case.log.read_text(errors="replace")
     if rc != 0 or "Aborting OpenFAST" in text or not case.outb.is_file():
         raise OpenFASTRunError(case, f"failed (exit code {rc}, after {time.monotonic() - t0:.0f} s)", tail)

@@ -330,7 +330,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         is the deck's; the predictions are NaN.
     openfast : dict, optional
         With ``plant``: further options of ``run_openfast_campaign`` (``processes``,
-        ``grid_points``, ``hydro``, ``timeout``, ``nice``, ``install``, ``dt``).
+        ``grid_points``, ``hydro``, ``cpu_limit``, ``timeout``, ``nice``, ``install``, ``dt``).
 
     Returns
     -------

@@ -109,7 +109,8 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                           turbulence_class: str = "B", grid_points: int = TURBSIM_GRID["points"],
                           grid_size: float = TURBSIM_GRID["size"], hydro: bool = True, keep_series: bool | int = False,
                           nperseg: int | None = None, install: OpenFASTInstall | None = None,
-                          timeout: float | None = None, nice: int = 0, initial_conditions: bool = True) -> Campaign:
+                          cpu_limit: float | None = None, timeout: float | None = None, nice: int = 0,
+                          initial_conditions: bool = True) -> Campaign:
     """Run every controller at every wind speed and seed in OpenFAST with TurbSim winds.
 
     Every run is a folder ``<folder>/<controller>/<speed>mps_seed<seed>/`` holding the case
@@ -162,8 +163,10 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         Welch segment length (:func:`~specdesign.validate.welch_psd`).
     install : OpenFASTInstall, optional
         The executables; default :func:`specdesign.openfast.find_openfast`.
-    timeout : float, optional
-        Wall-clock limit per OpenFAST run (s); default :func:`specdesign.openfast.run_case`'s.
+    cpu_limit, timeout : float, optional
+        CPU-time and wall-clock limits per OpenFAST run (s); defaults those of
+        :func:`specdesign.openfast.run_case` (10 s of CPU per simulated second + 120 s; no
+        wall-clock limit).
     nice : int, default 0
         Niceness added to the OpenFAST processes.
     initial_conditions : bool, default True
@@ -238,7 +241,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                           seed=s, library=c.library, parameters=c.parameters, controller_dt=c.dt, dt=dt, dt_out=record_dt,
                           channels=CAMPAIGN_CHANNELS, initial_pitch=init[0], initial_rotor_speed=init[1],
                           hydro=hydro, name=f"{_slug(name)}_{v:g}mps_seed{s}")
-        out = run_case(case, install, timeout=timeout, nice=nice)
+        out = run_case(case, install, cpu_limit=cpu_limit, timeout=timeout, nice=nice)
         return _post(case, out, settings, meta, keep=s in kept, wind=wind)
 
     try:
