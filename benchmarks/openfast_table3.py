@@ -70,7 +70,7 @@ def main() -> None:
     t0 = time.monotonic()
     install = find_openfast()
     deck = iea15mw_monopile()
-    model = turbine.iea15mw()
+    model = reduced = turbine.iea15mw()
     discon_in = deck.fst.with_name(f"{deck.name}_DISCON.IN")
     export = None
     if not args.rosco_only:
@@ -87,9 +87,12 @@ def main() -> None:
     for v in speeds:
         controllers = {"ROSCO": discon_in}
         if export is not None:
-            # ROSCO's torque law below and constant power above rated, as the deck's DISCON
-            controllers["QFT"] = export(made[v]["design"], out / f"export_{v:g}", dt=0.005, torque="power",
-                                        name=f"QFT {v:g} m/s")
+            # the generator torque as the deck's DISCON runs it: ROSCO's law below rated, constant
+            # torque above (VS_ConstPower = 0); the pitch rate limited as ROSCO's PC_MaxRat; the
+            # tower-top velocity of an ATD loop high-passed (OpenFAST's acceleration has a bias)
+            controllers["QFT"] = export(made[v]["design"], out / f"export_{v:g}", dt=0.01, model=reduced,
+                                        torque="rosco", pitch_rate_limit=reduced.pitch_rate_limit,
+                                        atd_highpass=0.05, name=f"QFT {v:g} m/s")
         camps.append(validate.run_campaign(
             controllers, [v], args.seeds, plant=deck, duration=args.duration, transient=args.transient,
             store=out / "runs", progress=True,
