@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import pickle
 import sys
 import time
 from pathlib import Path
@@ -34,19 +33,15 @@ from specdesign.rosco.discon import rosco_library
 from specdesign.simulate import scheduled
 
 
-def designs(model, speeds, target, out: Path) -> dict:
-    """QFT design per speed (pickled in ``out``: designing takes minutes)."""
+def designs(model, speeds, target) -> dict:
+    """QFT design per speed. Deterministic: a resumed run designs again and exports the same
+    parameter files, so the runs already in the campaign folder are recognised (by digest)."""
     res = {}
     for v in speeds:
-        f = out / f"design_{v:g}.pkl"
-        if f.is_file():
-            res[v] = pickle.loads(f.read_bytes())
-            continue
         t = time.monotonic()
         spec = feasibility.specification_for_target(model, v, target)
         d = qft.design_qft(model, v, spec=spec)
         res[v] = {"design": d, "promise": float(spec.promise.exact_del)}
-        f.write_bytes(pickle.dumps(res[v]))
         print(f"design at {v:g} m/s: {time.monotonic() - t:.0f} s; {d.summary()}", file=sys.stderr, flush=True)
     return res
 
@@ -82,7 +77,7 @@ def main() -> None:
         from specdesign.openfast import linearize_deck  # issue 27's linearisations
 
         model = linearize_deck(deck.fst, speeds)
-    made = designs(model, speeds, args.target, out) if export is not None else {}
+    made = designs(model, speeds, args.target) if export is not None else {}
     camps = []
     for v in speeds:
         controllers = {"ROSCO": discon_in}
