@@ -1,4 +1,4 @@
-"""The second baseline of docs/comparison.md (issue 31): ROSCO with its tower damper on.
+"""The second baseline of docs/comparison.md: ROSCO with its tower damper on.
 
 ROSCO's fore-aft tower damper (``TD_Mode = 1``: pitch += FA_KI·∫HPF(tower-top acceleration))
 with its gain set by ``rosco.tune_tower_damper`` (the smallest FA_KI giving the first tower
