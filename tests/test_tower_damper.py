@@ -89,11 +89,12 @@ def test_workbench_damper_agrees_with_the_compiled_discon(tmp_path, model, dampe
         s = simulate(model, rosco_scheduled(model, schedule=from_discon(path), scheduling_filter="rosco"), [19.0], **kw)
         out[key] = [np.mean([del_rainflow(x, 4.0, 200.0) for x in r["tower_base_my"][0]]) for r in (d, s)]
         if key == "on":
-            # the damper's pitch contribution stays inside FA_IntSat, which the workbench omits
-            assert np.all(np.abs(s["pitch"] - d["pitch"]) < np.radians(5.0))
+            # the same pitch to 0.05° (measured: 0.003°; the workbench omits FA_IntSat, which the
+            # damper's contribution does not reach here) and the same pitch SD to 0.5 % (measured 0.02 %)
+            assert np.abs(s["pitch"] - d["pitch"]).max() < np.radians(0.05)
             sd = [r["pitch"].std(axis=2).mean() for r in (d, s)]
-            assert abs(sd[1] / sd[0] - 1) < 0.02, sd
+            assert abs(sd[1] / sd[0] - 1) < 0.005, sd
     (d_off, s_off), (d_on, s_on) = out["off"], out["on"]
-    assert abs(s_on / d_on - 1) < 0.01, (s_on, d_on)  # tower-base DEL, same 1 % as issue 15's check
+    assert abs(s_on / d_on - 1) < 0.005, (s_on, d_on)  # tower-base DEL to 0.5 % (measured 0.04 %)
     # the damper does what it is for, in both: a lower tower DEL than with TD_Mode = 0
     assert d_on < 0.95 * d_off and s_on < 0.95 * s_off, out
