@@ -28,3 +28,31 @@ def shared_data() -> Path:
 @pytest.fixture(scope="session")
 def package_data() -> Path:
     return ROOT / "specdesign" / "data" / "iea15mw"
+
+
+@pytest.fixture(scope="session")
+def openfast():
+    """OpenFAST for the tests that run it (``specdesign.openfast.OpenFASTInstall``).
+
+    With ``SPECDESIGN_OPENFAST_SOURCE`` (CI: the vendored source tarball, whose build ``.ci/run``
+    starts in the background before the suite) it is ``build_openfast(source)``: that waits for
+    a build in progress (its lock) and returns at once from the cache. Otherwise the OpenFAST a
+    user has (``find_openfast``). Skipped when there is none, failed instead when
+    ``SPECDESIGN_REQUIRE_OPENFAST=1``.
+    """
+    from specdesign.openfast import OpenFASTNotFound, build_openfast, find_openfast
+
+    required = os.environ.get("SPECDESIGN_REQUIRE_OPENFAST") == "1"
+    source = os.environ.get("SPECDESIGN_OPENFAST_SOURCE")
+    try:
+        return build_openfast(source) if source else find_openfast()
+    except (OpenFASTNotFound, RuntimeError, ValueError) as e:
+        if required:
+            pytest.fail(f"SPECDESIGN_REQUIRE_OPENFAST=1 but no OpenFAST: {e}")
+        pytest.skip(f"no OpenFAST: {e}")
+
+
+def pytest_collection_modifyitems(config, items):
+    # the tests that run OpenFAST go last: in CI its build (started in the background by
+    # .ci/run) has the rest of the suite's time to finish, and one `python -m pytest -q` runs all
+    items.sort(key=lambda item: "openfast" in getattr(item, "fixturenames", ()))

@@ -2,12 +2,10 @@
 a short run at 19 m/s (steady wind, then a small campaign on a TurbSim field), checked against
 the turbine's own limits.
 
-Skipped when no OpenFAST is found (``specdesign.openfast.find_openfast``), unless
-``SPECDESIGN_REQUIRE_OPENFAST=1`` (CI sets it after building OpenFAST): then a missing OpenFAST
-fails. Cost: about 60 s of simulated time in all, ~80 s of CPU.
+OpenFAST comes from the ``openfast`` fixture (tests/conftest.py): skipped when none is found,
+unless ``SPECDESIGN_REQUIRE_OPENFAST=1`` (CI sets it and builds OpenFAST): then it fails. Cost: about 60 s of simulated time in all, ~80 s of CPU.
 """
 import math
-import os
 
 import numpy as np
 import pytest
@@ -15,18 +13,13 @@ import pytest
 pytest.importorskip("openfast_io")
 pytest.importorskip("rosco")
 
-from specdesign.openfast import OpenFASTNotFound, find_openfast, iea15mw_monopile, run_case, write_case
+from specdesign.openfast import iea15mw_monopile, run_case, write_case
 from specdesign.rosco.discon import rosco_library
 
 
 @pytest.fixture(scope="module")
-def install():
-    try:
-        return find_openfast()
-    except OpenFASTNotFound as e:
-        if os.environ.get("SPECDESIGN_REQUIRE_OPENFAST") == "1":
-            pytest.fail(f"SPECDESIGN_REQUIRE_OPENFAST=1 but no OpenFAST: {e}")
-        pytest.skip(f"no OpenFAST: {e}")
+def install(openfast):
+    return openfast  # tests/conftest.py: found, or built in CI; skipped or failed without one
 
 
 def _discon():
