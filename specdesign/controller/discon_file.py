@@ -65,6 +65,7 @@ def read_discon(path: str | Path) -> tuple[dict, str | None]:
 
     Examples
     --------
+    >>> from specdesign.rosco import iea15mw_discon
     >>> entries, version = read_discon(iea15mw_discon())
     >>> version, entries["PC_GS_n"].values
     ('2.9.4', ('30',))
@@ -189,6 +190,7 @@ class DisconSchedule:
 
         Examples
         --------
+        >>> from specdesign.rosco import iea15mw_discon
         >>> s = from_discon(iea15mw_discon())
         >>> bool(s.gains(s.pitch[0])[0] == s.kp[0])
         True
@@ -241,6 +243,7 @@ def from_discon(path: str | Path) -> DisconSchedule:
 
     Examples
     --------
+    >>> from specdesign.rosco import iea15mw_discon
     >>> s = from_discon(iea15mw_discon())
     >>> s.pitch.size, round(s.filter_corner, 4), s.reference_speed
     (30, 1.0081, 0.79168)
@@ -316,6 +319,7 @@ def write_discon(source: str | Path, target: str | Path, **values) -> Path:
 
     Examples
     --------
+    >>> from specdesign.rosco import iea15mw_discon
     >>> import tempfile
     >>> out = write_discon(iea15mw_discon(), Path(tempfile.mkdtemp()) / "DISCON.IN", PS_Mode=0)
     >>> read_discon(out)[0]["PS_Mode"].values
