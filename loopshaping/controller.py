@@ -604,7 +604,8 @@ class Controller:
         Raises
         ------
         ValueError
-            If ``sys`` is not SISO.
+            If ``sys`` is not SISO, is zero (no loop to shape: a zero transfer function has no
+            factors), or has a non-finite coefficient.
         """
         import control as ct
 
@@ -612,6 +613,13 @@ class Controller:
         if sys.ninputs != 1 or sys.noutputs != 1:
             raise ValueError("sys must be SISO")
         num, den = np.trim_zeros(sys.num[0][0], "f"), np.trim_zeros(sys.den[0][0], "f")
+        if not (np.all(np.isfinite(num)) and np.all(np.isfinite(den))):
+            raise ValueError(f"sys has a non-finite coefficient (num {num!r}, den {den!r})")
+        if num.size == 0:
+            raise ValueError("sys is zero: a zero transfer function has no factors (no loop to shape); give a "
+                             "non-zero controller")
+        if den.size == 0:
+            raise ValueError("sys has a zero denominator")
         return cls.from_zpk(np.roots(num), np.roots(den), num[0] / den[0])
 
     def to_dict(self) -> dict:

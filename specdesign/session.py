@@ -40,7 +40,7 @@ from loopshaping.controller import Controller
 
 from . import spec as _spec_module
 from . import turbine
-from ._checks import distinct_keys
+from ._checks import distinct_keys, finite_system
 from .openfast import read_linearization
 
 __all__ = ["SCHEMA", "VERSION", "Session", "save_session", "load_session", "session_to_dict", "session_from_dict"]
@@ -138,6 +138,10 @@ class Session:
             if not isinstance(c, (Controller, ct.LTI)):
                 raise TypeError(f"controllers[{k!r}] must be a loopshaping Controller or a python-control LTI, "
                                 f"got {type(c).__name__}")
+            if isinstance(c, ct.LTI):  # a Controller's elements refuse NaN themselves
+                finite_system(c, f"controllers[{k!r}]")
+        for k, s in self.specifications.items():
+            finite_system(s.baseline, f"specifications[{k!r}].baseline")
         for name in _TABLES:
             _json_exact(getattr(self, name), name)
         if not isinstance(self.notes, str):
@@ -340,14 +344,33 @@ def _lti_to_dict(sys, where):
 
 def _lti_from_dict(d, where):
     if isinstance(d, dict) and set(d) == {"num", "den"}:
-        return ct.tf(np.asarray(d["num"], float), np.asarray(d["den"], float))
+        num, den = (_finite_list(d[k], f"{where}.{k}") for k in ("num", "den"))
+        if not np.any(den):
+            raise ValueError(f"{where}.den is all zeros: no transfer function has that denominator")
+        return ct.tf(num, den)
     if isinstance(d, dict) and set(d) == {"ss"} and isinstance(d["ss"], dict) and set(d["ss"]) == set("ABCD"):
         m = d["ss"]
-        n = len(m["A"])
+        n = len(m["A"]) if isinstance(m["A"], list) else -1
         shapes = {"A": (n, n), "B": (n, 1), "C": (1, n), "D": (1, 1)}
-        arrs = {k: np.asarray(m[k], float).reshape(shapes[k]) for k in "ABCD"}
-        return ct.ss(arrs["A"], arrs["B"], arrs["C"], arrs["D"])
+        arrs = {k: _finite_list(m[k], f"{where}.ss.{k}") for k in "ABCD"}
+        for k in "ABCD":
+            if arrs[k].size != max(shapes[k][0], 0) * shapes[k][1]:
+                raise ValueError(f"{where}.ss.{k} must have shape {shapes[k]} (A is {n}×{n}), got {arrs[k].size} values")
+        return ct.ss(*(arrs[k].reshape(shapes[k]) for k in "ABCD"))
     raise ValueError(f"{where} must be {{'num', 'den'}} or {{'ss': {{'A', 'B', 'C', 'D'}}}}, got {d!r:.120}")
+
+
+def _finite_list(value, where):
+    """A (nested) list of finite numbers as a float array; a NaN, an inf (json reads NaN and
+    Infinity), a bool or a string is refused naming ``where``."""
+    flat = np.ravel(np.asarray(value, dtype=object)) if isinstance(value, list) else None
+    if flat is None or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in flat):
+        raise ValueError(f"{where} must be a list of numbers, got {value!r:.80}")
+    a = np.asarray(value, float)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{where} holds NaN or inf ({value!r:.80}); a controller or specification needs finite "
+                         "coefficients")
+    return a
 
 
 def session_to_dict(session: Session) -> dict:

@@ -71,3 +71,29 @@ def test_the_same_campaign_twice_on_the_client(client, setup):
     for _ in range(2):
         again = run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, executor=client, progress=False, **KW)
         assert_bitwise_equal(again, local)
+
+
+def test_bitwise_whatever_blas_threads_the_workers_start_with(setup):
+    # dask starts workers with OPENBLAS/OMP/MKL_NUM_THREADS=1 (distributed.nanny.pre-spawn-environ);
+    # without that they run BLAS on every core, as a local run does by default. Every task runs
+    # BLAS on one thread itself (campaign_point), so neither the workers' environment nor the
+    # client's thread count changes a bit.
+    import dask
+    from threadpoolctl import threadpool_limits
+
+    model, ctrls, local = setup
+    import os
+
+    # dask.config.set merges dicts: the variables are overridden with the core count (what BLAS
+    # takes by default), not removed
+    every_core = {k: str(os.cpu_count()) for k in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": every_core}):
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster, distributed.Client(cluster) as c:
+            threads = c.run(lambda: __import__("threadpoolctl").threadpool_info())
+            on_cluster = run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, executor=c, progress=False, **KW)
+    # the workers really had more than one BLAS thread to start with (a 2-core machine: 2)
+    assert any(lib["num_threads"] > 1 for info in threads.values() for lib in info if lib["user_api"] == "blas")
+    assert_bitwise_equal(on_cluster, local)
+    with threadpool_limits(limits=2, user_api="blas"):  # the client with two BLAS threads asked for
+        assert_bitwise_equal(run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, progress=False, **KW), local)

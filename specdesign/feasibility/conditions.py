@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._blas import on_one_blas_thread
-from .._checks import as_omega, positive_scalar
+from .._checks import as_omega, positive_scalar, real_scalar
 from ..closedloop import (
     MAX_SENSITIVITY,
     closed_map,
@@ -30,7 +30,7 @@ def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=MAX_SENSIT
     plant : control.LTI
         Named plant (inputs ``wind``, ``pitch_cmd``; outputs ``gen_speed``, ``tower_base_my``).
     omega : array_like
-        Frequencies, rad/s.
+        Frequencies, rad/s (all > 0).
     w_tower, w_speed : array_like
         |W_MyT(jω)| (N·m per m/s) and |W_Ω(jω)| ((rad/s) per (m/s)) on ``omega``; ``np.inf``
         for no constraint.
@@ -45,7 +45,7 @@ def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=MAX_SENSIT
         ``open_loop`` = P_{MyT,w} − K∞ (the factor of S in T_{MyT,w}) and ``k_inf`` = K∞,
         all arrays on ``omega``.
     """
-    w = as_omega(omega, "omega")
+    w = as_omega(omega, "omega", allow_zero=False)  # ω = 0: the disks' 1/|P| at DC is no frequency-domain bound
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
     R = plant_responses([plant], w, ("tower_base_my", "gen_speed"), method="batched")
     a, yb = R[("tower_base_my", "wind")][:, 0], R[("tower_base_my", "pitch_cmd")][:, 0]
@@ -181,7 +181,7 @@ def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitiv
         condition, and the verdict holds for any controller acting through the pitch (an
         ATD loop included).
     omega : array_like, optional
-        Frequencies, rad/s (default :func:`specdesign.spec.default_omega`, refined around
+        Frequencies, rad/s, all > 0 (default :func:`specdesign.spec.default_omega`, refined around
         the right-half-plane zeros so the Poisson kernel is resolved).
     cases : sequence of float, optional
         Wind speeds (m/s) of the plant cases; default only ``wind_speed``.
@@ -283,7 +283,7 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=MAX_SENSITI
     max_sensitivity : float or None
         M_s (-), or None for none.
     omega : array_like, optional
-        Grid, rad/s (default :func:`specdesign.spec.default_omega` refined around the
+        Grid, rad/s, all > 0 (default :func:`specdesign.spec.default_omega` refined around the
         right-half-plane zeros of the nominal P_{Ω,β}).
     cases : sequence of float, optional
         Wind speeds (m/s) of the plant cases; default only ``wind_speed``.
@@ -294,11 +294,13 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=MAX_SENSITI
         Nominal case first when ``cases`` is None, else in the order given.
     """
     from .. import spec
-    v = float(wind_speed)
+    v = real_scalar(wind_speed, "wind_speed")
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
-    speeds = [v] if cases is None else [float(c) for c in cases]
+    speeds = [v] if cases is None else [real_scalar(c, f"cases[{i}]") for i, c in enumerate(cases)]
+    # the grid checked before any plant is linearised; ω must be > 0 (the Poisson kernel and the
+    # disks' radii divide by ω and by the plant's DC gain)
+    w = spec.default_omega() if omega is None else as_omega(omega, "omega", allow_zero=False)
     plants = [model.linearize(x) for x in speeds]
-    w = spec.default_omega() if omega is None else as_omega(omega, "omega")
     zeros0 = _rhp_zeros(plants[0])
     if omega is None and zeros0.size:
         w = refine_grid(w, zeros0, rel_width=0.2, rel_step=2e-4)

@@ -49,7 +49,7 @@ import numpy as np
 
 from .. import spectral
 from .._blas import on_one_blas_thread
-from .._checks import del_target
+from .._checks import del_target, margin_db, search_options
 from ..closedloop import (
     UNSTABLE_CONTROLLER_RATE,
     lightly_damped,
@@ -283,6 +283,8 @@ def _settle(promise, omega, x, n_notch, lift_db, aim):
         hi = 1.0
         while promise(e + hi, grad=False) > aim:
             hi *= 2
+            if hi > 80:  # bounded as _shift_to's search: 80 dB above any promise's reach
+                break
         dx = brentq(lambda g: promise(e + g, grad=False) - aim, 0.0, hi, xtol=1e-12, rtol=1e-14)
         x[0] += dx
         p = promise(e + dx, grad=False)
@@ -454,8 +456,14 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     heads = np.atleast_1d(np.asarray(headroom_pp, float))
     if heads.ndim != 1 or heads.size == 0 or not np.all(np.isfinite(heads)) or np.any(heads <= 0):
         raise ValueError(f"headroom_pp={headroom_pp!r} must be positive percentage points")
-    if int(max_notches) != max_notches or max_notches < 0:
+    if isinstance(max_notches, (bool, np.bool_)) or int(max_notches) != max_notches or max_notches < 0:
         raise ValueError(f"max_notches={max_notches!r} must be a whole number ≥ 0")
+    # the certificate's options checked here, before the baseline and the search are built (a
+    # tolerance ≤ 0 would otherwise only stop the first bisection, forever)
+    margin_db(target_options.get("slack_db", 0.5), "slack_db")
+    margin_db(target_options.get("speed_slack_db", 0.2), "speed_slack_db")
+    search_options(target_options.get("tolerance_db", 0.05), target_options.get("max_relax_db", 12.0),
+                   target_options.get("speed_relax_db"))
     v = model.check_wind_speed(wind_speed)
     base = spec.baseline_analysis(model, v, m=m, omega=FIT_OMEGA if omega is None else omega)
     promise = _Promise(base)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._blas import on_one_blas_thread
-from .._checks import as_omega, del_target
+from .._checks import MAX_BISECTIONS, as_omega, del_target, margin_db, search_options
 from ..closedloop import (
     CERTIFICATE_MAX_SENSITIVITY,
     case_speeds,
@@ -99,6 +99,11 @@ class TargetSpecification:
     m: float = TOWER_M
 
     @property
+    def wind_speed(self) -> float:
+        """The operating point the pair was made and certified at, m/s (its certificate's)."""
+        return float(self.design.wind_speed)
+
+    @property
     def template_offsets(self) -> tuple:
         """Offsets (m/s) of the non-nominal plant cases from the nominal speed.
 
@@ -155,7 +160,8 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     max_relax_db : float
         Largest speed relaxation tried, dB.
     tolerance_db : float
-        Bisection tolerance on the relaxation, dB.
+        Bisection tolerance on the relaxation, dB (> 0; the bisection stops after
+        :data:`specdesign._checks.MAX_BISECTIONS` halvings in any case).
     m : float
         Wöhler exponent (-).
     omega : array_like, optional
@@ -175,8 +181,10 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
     Raises
     ------
+    TypeError
+        For a bool or a string where a number is meant (``target_reduction=True`` is not 1 %).
     ValueError
-        For a target outside (0, 100), a negative slack, invalid offsets, or when even
+        For a target outside (0, 100), a negative slack, a tolerance ≤ 0, invalid offsets, or when even
         ``max_relax_db`` does not reach the target (the message gives the promise reached there).
 
     Examples
@@ -187,6 +195,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     True
     """
     _check_target(target_reduction, slack_db, speed_slack_db)  # at the door, before the plant cases are built
+    search_options(tolerance_db, max_relax_db, speed_relax_db)
     search = CertificateSearch(model, wind_speed, max_sensitivity=max_sensitivity,
                                max_pitch_rate_ratio=max_pitch_rate_ratio, m=m, omega=omega, case_offsets=case_offsets,
                                dense_omega=dense_omega)
@@ -196,13 +205,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
 def _check_target(target_reduction, slack_db, speed_slack_db):
     """(target %, slack dB, speed slack dB), checked."""
-    t = del_target(target_reduction)
-    slack, sslack = float(slack_db), float(speed_slack_db)
-    if not (np.isfinite(slack) and slack >= 0):
-        raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")
-    if not (np.isfinite(sslack) and sslack >= 0):
-        raise ValueError(f"speed_slack_db={speed_slack_db!r} must be a finite margin ≥ 0 dB")
-    return t, slack, sslack
+    return del_target(target_reduction), margin_db(slack_db, "slack_db"), margin_db(speed_slack_db, "speed_slack_db")
 
 
 class CertificateSearch:
@@ -295,9 +298,9 @@ class CertificateSearch:
             As :func:`specification_for_target`.
         """
         t, slack, sslack = _check_target(target_reduction, slack_db, speed_slack_db)
+        tolerance_db, max_relax_db, g = search_options(tolerance_db, max_relax_db, speed_relax_db)
         model, v, speeds, base = self.model, self.wind_speed, self.case_speeds, self.base
         if speed_relax_db is not None:
-            g = float(speed_relax_db)
             design, best, rob = self._reached(g, 0.0)
             if design is None or rob is None:
                 raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {v:g} m/s over the plant "
@@ -306,7 +309,9 @@ class CertificateSearch:
                 raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s with the speed map relaxed by "
                                  f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs); relax it more")
             lo_s, hi_s = 0.0, 40.0
-            while hi_s - lo_s > tolerance_db:
+            for _ in range(MAX_BISECTIONS):  # bounded: a tolerance below float64's spacing is never reached
+                if hi_s - lo_s <= tolerance_db:
+                    break
                 mid = 0.5 * (lo_s + hi_s)
                 lo_s, hi_s = (mid, hi_s) if _slack_promise(design, base, mid + rob[0]) >= t else (lo_s, mid)
             return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t, self.m)
@@ -328,7 +333,9 @@ class CertificateSearch:
                              f"{slack:g} dB slack over the plant cases' needs); lower the target or the slack, or allow "
                              "more pitch activity")
         hi_g, best, best_rob = found
-        while hi_g - lo_g > tolerance_db:
+        for _ in range(MAX_BISECTIONS):
+            if hi_g - lo_g <= tolerance_db:
+                break
             mid = 0.5 * (lo_g + hi_g)
             d, red, rob = self._reached(mid, slack)
             if red >= t:

@@ -21,6 +21,7 @@ from loopshaping import check, qft
 from loopshaping import hinf as lhinf
 
 from .._blas import one_blas_thread
+from .._checks import finite_system, spec_made_at
 from ..closedloop import closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
 from ..fatigue import TOWER_M
@@ -410,13 +411,15 @@ def design_hinf(
     ------
     ValueError
         If ``spec`` is not "target", "qft", "rosco", a design record or a pair, or both
-        ``spec`` and ``specs`` are given; ``target_reduction`` is not in (0, 100) % with
+        ``spec`` and ``specs`` are given; ``spec`` is a record made at another wind speed
+        (a TargetSpecification, a QFTDesign, DesignSpecifications: the same check as
+        :func:`specdesign.qft.design_qft`'s); the plant at ``wind_speed`` has a NaN or inf entry; ``target_reduction`` is not in (0, 100) % with
         ``spec="target"``; ``speed_relax_db`` is not a
         relaxation ≥ 0 dB or a sequence of them; no notch specification reaches
         ``spec_reduction``; ``wind_speed`` is outside ``model.wind_range``; or a weight,
         the generalized plant, the synthesis or the reduction rejects its arguments
         (:func:`inverse_weight`, :func:`generalized_plant`, :func:`loopshaping.hinf.synthesize`,
-        :func:`loopshaping.hinf.reduce`).
+        :func:`loopshaping.hinf.reduce`); an ill-posed synthesis names the wind speed.
     RuntimeError
         If the reduced controller of the last relaxation tried does not stabilise the
         turbine (raise ``order``).
@@ -449,7 +452,12 @@ def design_hinf(
     """
     from .. import spec as sp
     specs, made = spec, False
-    v = float(wind_speed)
+    v = model.check_wind_speed(wind_speed)
+    # a NaN plant: said here, naming the wind speed, before the specification search, the
+    # baseline analysis or SLICOT meet it ("SVD did not converge")
+    finite_system(model.linearize(v), f"the plant linearised at {v:g} m/s")
+    if not isinstance(specs, str):
+        spec_made_at(specs, v)  # the same check as design_qft's: a record's promise holds at its own speed only
     if isinstance(specs, str) and specs == "target":
         made = w_tower is None or w_speed is None
         try:
@@ -561,8 +569,11 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
             and not np.any(A_gp[:n_p, n_p:])):  # pragma: no cover - interconnect's state order
         raise RuntimeError("generalized plant does not start with the turbine's states, "
                            "followed by weights in series: the α-shift would be wrong")
-    res = lhinf.synthesize(gp.system, gp.n_meas, gp.n_ctrl, suboptimality=suboptimality,
-                           decay_rate=decay_rate, decay_states=np.arange(gp.system.nstates) < n_p)
+    try:
+        res = lhinf.synthesize(gp.system, gp.n_meas, gp.n_ctrl, suboptimality=suboptimality,
+                               decay_rate=decay_rate, decay_states=np.arange(gp.system.nstates) < n_p)
+    except ValueError as e:  # an ill-posed problem: say at which operating point
+        raise ValueError(f"H∞ design at {v:g} m/s: {e}") from e
     K_full = res.controller
     if gp.input_filter is not None:
         f = gp.input_filter

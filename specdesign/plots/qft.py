@@ -141,11 +141,13 @@ def _bounds_at(bounds, template, picks):
 
 def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05, 0.1, 0.3, 0.6, 1.0, 1.5, 3.0),
                         axes: Sequence[Axes] | None = None) -> Figure:
-    """Nichols charts of both QFT loops with their bounds: the paper's Figs. 5-6 analogue.
+    """Nichols charts of the QFT loops with their bounds: the paper's Figs. 5-6 analogue.
 
-    Left: the pitch loop C_β·P'_{Ω,β} (ATD closed); right: the ATD loop C_atd·P''_{z,β}
-    (pitch loop closed); magnitude in dB vs phase in degrees, nominal plant case, with the
-    bounds at the design frequencies nearest to ``picks``.
+    The pitch loop C_β·P'_{Ω,β} (with the ATD loop closed, where the design has one) and, for
+    a design with active tower damping, the ATD loop C_atd·P''_{z,β} (pitch loop closed) beside
+    it; magnitude in dB vs phase in degrees, nominal plant case, the bounds at the design
+    frequencies nearest to ``picks`` and the critical point (−180°, 0 dB). A pitch-only design
+    gets one panel.
 
     Parameters
     ----------
@@ -154,33 +156,38 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
     picks : sequence of float
         Frequencies, rad/s, whose nearest template frequencies get their bounds drawn.
     axes : sequence of matplotlib.axes.Axes, optional
-        Two axes side by side (pitch loop, ATD loop); default a new figure.
+        One axes per loop drawn (two with ATD, one without); default a new figure.
 
     Returns
     -------
     matplotlib.figure.Figure
         The figure.
+
+    Raises
+    ------
+    ValueError
+        If ``axes`` holds another number of axes than the design has loops.
     """
     import matplotlib.pyplot as plt
 
+    with_atd = not is_zero(design.atd_controller)
+    loops = [(design.pitch_bounds, design.pitch_template, design.pitch_controller, (-60, 60),
+              "Pitch loop $C_\\beta P'_{\\Omega,\\beta}$" + (" (ATD closed)" if with_atd else ""))]
+    if with_atd:
+        loops.append((design.atd_bounds, design.atd_template, design.atd_controller, (-60, 40),
+                      "ATD loop $C_{atd} P''_{z,\\beta}$ (pitch loop closed)"))
     if axes is None:
-        fig, axes = plt.subplots(1, 2, figsize=(14, 5.5))
-    else:
-        fig = axes[0].figure
+        fig, axes = plt.subplots(1, len(loops), figsize=(7 * len(loops), 5.5), squeeze=False)
+        axes = axes[0]
+    axes = np.atleast_1d(np.asarray(axes, dtype=object))
+    if axes.size != len(loops):
+        raise ValueError(f"axes holds {axes.size} axes; this design has {len(loops)} loop(s) to draw "
+                         f"({'pitch and ATD' if with_atd else 'pitch only'}): give one axes per loop")
+    fig = axes[0].figure
     w = np.logspace(-3, 1.5, 3000)
-    for ax, bounds, template, c, ylim, title in (
-        (axes[0], design.pitch_bounds, design.pitch_template, design.pitch_controller, (-60, 60),
-         "Pitch loop $C_\\beta P'_{\\Omega,\\beta}$ (ATD closed)"),
-        (axes[1], design.atd_bounds, design.atd_template, design.atd_controller, (-60, 40),
-         "ATD loop $C_{atd} P''_{z,\\beta}$ (pitch loop closed)"),
-    ):
+    for ax, (bounds, template, c, ylim, title) in zip(axes, loops):
         plant = template.systems[template.nominal]
-        if is_zero(c):  # no loop here (a pitch-only design)
-            ax.text(0.5, 0.5, "no ATD loop: pitch-only design", ha="center", va="center", transform=ax.transAxes)
-            ax.set_xlabel("Open-loop phase [deg]")
-            ax.set_ylabel("Open-loop magnitude [dB]")
-        else:
-            nichols.draw(_bounds_at(bounds, template, picks), loop=c * plant, ax=ax, omega=w, ylim=ylim)
+        nichols.draw(_bounds_at(bounds, template, picks), loop=c * plant, ax=ax, omega=w, ylim=ylim)
         ax.set_title(f"{title}, {design.wind_speed:g} m/s")
     fig.tight_layout()
     return fig

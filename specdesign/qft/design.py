@@ -18,7 +18,7 @@ from tqdm.auto import tqdm
 from loopshaping import qft as lqft
 
 from .. import turbine
-from .._checks import del_target, positive_scalar
+from .._checks import del_target, positive_scalar, spec_made_at
 from ..closedloop import (
     DESIGN_MAX_SENSITIVITY,
     case_speeds,
@@ -224,10 +224,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         if set(kwargs) - allowed:
             raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
                             f"got {sorted(set(kwargs) - allowed)}")
-        if model.check_wind_speed(wind_speed) != spec.design.wind_speed:
-            raise ValueError(f"spec was made at {spec.design.wind_speed:g} m/s, not at wind_speed={wind_speed!r}")
+        spec_made_at(spec, model.check_wind_speed(wind_speed))
         return design_from_certificate(model, spec, **kwargs)
     if spec is not None:
+        spec_made_at(spec, model.check_wind_speed(wind_speed))
         return _design_single(model, wind_speed, None, speed_relax_db=float(ladder[0]), given=_given_spec(spec), **kwargs)
     design = None
     for relax in ladder:
@@ -417,11 +417,12 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     Raises
     ------
     ValueError
-        If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` does not
-        broadcast to it, ``specification`` is unknown, or :func:`design_qft` (or, with
+        If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` is not one
+        DEL reduction in (0, 100) % or one per wind speed (every one checked before the first
+        design), ``specification`` is unknown, or :func:`design_qft` (or, with
         ``"target"``, :func:`specdesign.feasibility.specification_for_target`) raises.
     TypeError
-        As :func:`design_qft`.
+        As :func:`design_qft`; for a bool or a string as a target.
 
     Warns
     -----
@@ -441,11 +442,18 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     vs = np.atleast_1d(np.asarray(wind_speeds, float))
     if vs.ndim != 1 or vs.size == 0:
         raise ValueError("wind_speeds must be a non-empty 1-D sequence of wind speeds in m/s")
-    targets = np.broadcast_to(np.asarray(target_reduction, float), vs.shape)
     if specification not in ("notch", "target"):
         raise ValueError(f"specification={specification!r} must be 'notch' or 'target'")
     for v in vs:  # before any design: a speed below the design range is refused with its reason
         check_design_speed(model, float(v))
+    # every target too (a bool or a string is no target), before the first design
+    per_speed = np.ndim(target_reduction) != 0
+    if per_speed and np.shape(target_reduction) != vs.shape:
+        raise ValueError(f"target_reduction has {np.size(target_reduction)} values for {vs.size} wind speeds; give "
+                         "one number or one per wind speed")
+    targets = np.array([del_target(x, f"target_reduction[{i}]" if per_speed else "target_reduction") for i, x in
+                        enumerate(target_reduction if per_speed else [target_reduction] * vs.size)])
+
     out = []
     for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
                       disable=not progress):

@@ -6,6 +6,7 @@ See :mod:`specdesign.simulate` for the conventions (signs, scheduling, anti-wind
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -36,6 +37,8 @@ __all__ = [
 #: entry: half an IEC 2 m/s bin. The trim, the linearisation and the scheduling all use
 #: ``wind_speeds``, so a record from another bin would be simulated about the wrong point.
 WIND_MEAN_TOLERANCE = 1.0
+#: python-control's automatic system names ("sys[4]"): not the user's, so not used as a label.
+_AUTO_NAME = re.compile(r"sys\[\d+\]")
 
 
 class SimulationDivergedError(RuntimeError):
@@ -293,7 +296,10 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
                       plant.output_names, lim_idx, lim_val, status)
         _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
     else:
-        label = getattr(controller, "name", "controller")
+        label = getattr(controller, "name", None)
+        if label is None or _AUTO_NAME.fullmatch(str(label)):
+            # python-control names an unnamed system "sys[4]": a name the user never gave
+            label = "controller"
         # below rated the pitch loop is open (its PI sits at the minimum pitch): not checked there
         warn_unstable(plant, controller, vs[above], dt)
         sched_pitch, mats, fw, pi = controller_bank(controller, dt)

@@ -520,6 +520,15 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
     return _REBOUND[key]
 
 
+def _bad_inputs(given, t):
+    """The measurements handed to the controller (``given``, as it left them) that were not
+    finite at time ``t``, for the message of a non-finite command (a controller that passes a
+    NaN sample through names nothing itself)."""
+    bad = [(n, np.flatnonzero(~np.isfinite(np.asarray(v, dtype=float)))) for n, v in given.items()]
+    bad = [f"{n} (run {int(r[0])})" for n, r in bad if r.size]
+    return f" at t = {t:g} s; its measurements held NaN or inf in {', '.join(bad)}" if bad else f" at t = {t:g} s"
+
+
 def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: int, P: np.ndarray, X0: np.ndarray,
                  Wr: np.ndarray, wdt: float, dt: float, nsteps: int, rec_every: int, torque: np.ndarray,
                  beta0: np.ndarray, ny: int, Y: np.ndarray, names: Sequence[str], lim_idx: np.ndarray,
@@ -601,7 +610,8 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
                 over = np.argmax(np.abs(y[r][:, lim_idx]) > lim_val, axis=1)
                 status[r] = 64 * k + np.where(nonfinite, NONFINITE, over)
                 return
-        cmd = fn(t, {n: y[:, i].copy() for i, n in enumerate(names)})
+        given = {n: y[:, i].copy() for i, n in enumerate(names)}
+        cmd = fn(t, given)
         if isinstance(cmd, tuple):
             if len(cmd) != 2:
                 raise ValueError(f"controller callable must return pitch_cmd or (pitch_cmd, gen_torque), got {len(cmd)} items")
@@ -609,10 +619,11 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
             # a sum is finite iff every term is (barring overflow past 1e308): cheaper per step
             if torque.shape != (R,) or not math.isfinite(torque.sum()):
                 raise ValueError(f"controller callable must return a finite generator torque (N·m) of shape ({R},), "
-                                 f"got {torque.shape}")
+                                 f"got {torque.shape}" + _bad_inputs(given, t))
         cmd = np.asarray(cmd, dtype=float)
         if cmd.shape != (R,) or not math.isfinite(cmd.sum()):
-            raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}")
+            raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}"
+                             + _bad_inputs(given, t))
         if k % rec_every == 0:
             Y[:, :ny, j] = y
             Y[:, ny, j] = bcmd  # the command held during the previous step, as in the compiled loop

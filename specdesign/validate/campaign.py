@@ -15,6 +15,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from .. import turbine
+from .._blas import on_one_blas_thread
 from .._checks import positive_scalar
 from ..controller.torque import TorqueLaw
 from ..fatigue import TOWER_M
@@ -209,6 +210,7 @@ def check_campaign_step(model, controllers: Mapping, wind_speeds, dt: float) -> 
                 raise ValueError(f"campaign controller {name!r}: {err}") from None
 
 
+@on_one_blas_thread  # the tasks' own limit (campaign_point) nests in it: two local threads never undo it
 def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, duration: float = 600.0, dt: float = 0.02,
                  record_dt: float = 0.1, transient: float = 60.0, m: float = TOWER_M, predict: bool = True,
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
@@ -280,7 +282,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         runs already there and simulates only the missing ones: an interrupted campaign
         resumes, and one given more seeds, speeds or controllers runs only those. The
         result is bitwise that of an uninterrupted run. A store holding other settings,
-        another model or another controller under the same name is refused.
+        another model or another controller under the same name is refused; a stored cell
+        that fails verification (unreadable, another cell's coordinates, its checksum) is
+        recomputed with a RuntimeWarning naming its file.
     torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, default "auto"
         Generator torque of the simulations (:func:`specdesign.simulate.simulate`): "auto"
         runs the model's torque law below rated and holds the trim torque above; "rosco"

@@ -29,6 +29,9 @@ __all__ = ["DEL_CHANNELS", "WindClimate", "weibull_bins", "wind_climate", "Lifet
 
 #: Channel of a campaign → the per-run DEL indicator it holds.
 DEL_CHANNELS = {"tower_base_my": "tower_del"}
+#: Most wind bins :func:`weibull_bins` makes: 1000 bins of 0.022 m/s between 3 and 25 m/s,
+#: far finer than a campaign is ever run on (IEC 61400-1: 2 m/s).
+MAX_BINS = 1000
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
@@ -121,7 +124,8 @@ def weibull_bins(k: float = 2.0, mean_speed: float | None = None, *, scale: floa
     cut_in, cut_out : float, default 3.0, 25.0
         Cut-in and cut-out wind speeds (m/s).
     bin_width : float, default 2.0
-        Bin width (m/s); (cut_out − cut_in)/bin_width must be a whole number.
+        Bin width (m/s); (cut_out − cut_in)/bin_width must be a whole number, at most
+        :data:`MAX_BINS`.
 
     Returns
     -------
@@ -154,6 +158,9 @@ def weibull_bins(k: float = 2.0, mean_speed: float | None = None, *, scale: floa
     if hi <= lo:
         raise ValueError(f"cut_out={cut_out!r} must exceed cut_in={cut_in!r} (m/s)")
     n = (hi - lo) / w
+    if n > MAX_BINS:  # else a width like 1e-9 m/s asks for 2e10 bins (and as many simulations)
+        raise ValueError(f"bin_width={bin_width!r} m/s makes {n:.3g} bins from {lo:g} to {hi:g} m/s; at most "
+                         f"{MAX_BINS} (a width ≥ {(hi - lo) / MAX_BINS:.3g} m/s; IEC 61400-1 uses 2 m/s)")
     if abs(n - round(n)) > 1e-9:
         raise ValueError(f"bin_width={bin_width!r} m/s must divide cut_out − cut_in = {hi - lo:g} m/s into whole bins")
     centres = lo + w * np.arange(round(n) + 1)

@@ -191,7 +191,8 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
         if life is not None:
             row += (_lifetime_cell(campaign, designed, baseline, ind, life),)
         rows.append((_LABELS[ind], row))
-    note = (f"Relative change 100·(X_{designed}/X_{baseline} − 1) over {campaign.seeds.size} paired seeds of "
+    note = (f"Relative change 100·(X_{designed}/X_{baseline} − 1), negative: lower than {baseline} (Table 3 gives "
+            f"the DEL's as a reduction, positive), over {campaign.seeds.size} paired seeds of "
             f"{campaign.duration:g} s; DEL with m = {campaign.m:g}, 1 Hz. Mean: weighted by the Weibull pdf "
             f"(k = {k}, A = {scale} m/s) at the operating points, normalised.")
     marks = _unstable_marks(campaign, designed, baseline)
@@ -448,8 +449,9 @@ def table3(campaign: Campaign, designed: str, baseline: str, *, promised: Mappin
     return Table(
         title=f"Table 3: tower-base fatigue (DEL) reduction, {designed} vs {baseline}",
         columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
-        note=f"{acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with m = {campaign.m:g} at 1 Hz; "
-             "linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
+        note=f"Reduction 100·(1 − DEL_{designed}/DEL_{baseline}), positive: lower than {baseline} (Table 2 gives "
+             f"it as a change, negative); {acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with "
+             f"m = {campaign.m:g} at 1 Hz; linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
         row_fmt=tuple(pp),
         marks=_unstable_marks(campaign, designed, baseline),
     )
