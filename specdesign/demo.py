@@ -27,6 +27,7 @@ import numpy as np
 
 from loopshaping.freqresp import is_zero
 
+from . import feasibility, validate
 from ._checks import del_target, positive_scalar, real_scalar
 from .plots.fatigue import plot_sensitivity
 from .plots.qft import plot_design_bode, plot_design_nichols
@@ -122,7 +123,6 @@ def check_demo_options(wind_speed=19.0, target_reduction=25.0, n_seeds=None, dur
         Naming the option and its range.
     """
     from .qft import check_design_speed
-    from .turbine import iea15mw
 
     v = check_design_speed(iea15mw() if model is None else model, real_scalar(wind_speed, "wind_speed"))
     t = del_target(target_reduction)
@@ -166,9 +166,7 @@ def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_D
     ValueError
         Naming the option and its range.
     """
-    from . import validate
     from .qft import check_design_speed
-    from .turbine import iea15mw
 
     n, d = _seeds_and_duration(n_seeds, duration, 3 if fast else 6, 300.0 if fast else 600.0)
     t = del_target(target_reduction)
@@ -239,8 +237,9 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         Figure,  # figures only written to files: no pyplot, no backend
     )
 
-    from . import feasibility, qft, spec, validate
+    from . import qft, spec
     from .plots.spec import plot_specification
+
     if method not in ("target", "notch"):
         raise ValueError(f"method={method!r} must be 'target' (specification-driven) or 'notch'")
     model = iea15mw()
@@ -456,7 +455,7 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     """
     from matplotlib.figure import Figure
 
-    from . import qft, validate
+    from . import qft
     out = Path(out)
     model = iea15mw()
     # every option, the design speeds included, before the first design
