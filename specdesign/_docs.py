@@ -1,4 +1,4 @@
-"""One docstring for a method several classes define alike (issue 32: documented once, not copied)."""
+"""One docstring for a method several classes define alike (documented once, not copied)."""
 from __future__ import annotations
 
 from collections.abc import Callable

@@ -26,6 +26,7 @@ from loopshaping.controller import Controller
 
 from . import __version__, turbine
 from ._checks import distinct_keys
+from .openfast.install import build_openfast, find_openfast
 from .plots import validation as pv
 from .rosco import rosco_scheduled
 from .simulate import ScheduledController, scheduled
@@ -98,6 +99,11 @@ def main(argv: list[str] | None = None) -> int:
     val = sub.add_parser("validate", help="run an offline validation campaign described by a TOML/JSON file")
     val.add_argument("config", help="TOML or JSON campaign file (schema: docs/validation.md)")
     val.add_argument("--out", default=None, help="output folder (default: from the config file)")
+    ofa = sub.add_parser("openfast", help="build OpenFAST and TurbSim from source, or show the ones found")
+    ofa.add_argument("action", choices=("build", "find"), help="build: from SOURCE into the cache; find: print the executables")
+    ofa.add_argument("source", nargs="?", help="build: an OpenFAST source tarball or folder")
+    ofa.add_argument("--source-version", default=None, help="build: the source's version X.Y.Z (default: from its name)")
+    ofa.add_argument("--cache", default=None, help="build cache (default: $SPECDESIGN_OPENFAST_CACHE or ~/.cache/specdesign/openfast)")
     args = parser.parse_args(argv)
     _choose_backend()
     try:
@@ -136,6 +142,8 @@ def main(argv: list[str] | None = None) -> int:
                 output_folder(args.out, "--out")
                 run_demo(out=args.out, fast=args.fast, method=args.method or "target", wind_speed=speed,
                          target_reduction=target, n_seeds=seeds, duration=duration)
+        elif args.command == "openfast":
+            _openfast_command(args)
         else:
             run_config(args.config, out=args.out, echo=True)
     except (ConfigError, OSError) as e:
@@ -186,6 +194,20 @@ def _only_without_lifetime(args):
         if given is not None:
             raise ConfigError(f"{flag} belongs to the design demo; --lifetime designs at --design-speeds with the "
                               "target specification")
+
+
+def _openfast_command(args) -> None:
+    """``specdesign openfast build SOURCE`` / ``specdesign openfast find``: the executables' paths and version on stdout."""
+    if args.action == "build":
+        if args.source is None:
+            raise ConfigError("openfast build needs SOURCE: an OpenFAST source tarball or folder")
+        try:
+            found = build_openfast(args.source, cache=args.cache, version=args.source_version)
+        except (ValueError, RuntimeError) as e:  # a bad source or missing tools: the message says which
+            raise ConfigError(str(e)) from None
+    else:
+        found = find_openfast(require_turbsim=False)
+    print(f"openfast {found.openfast}\nturbsim {found.turbsim}\nversion {found.version}")
 
 
 def _speeds_arg(text, default):

@@ -1,6 +1,6 @@
 """Time-domain fatigue: ASTM E1049 rainflow counting, S-N curves, Palmgren-Miner, DEL.
 
-Conventions (see WORKBENCH.md): S-N curves are range-based, N(S) = (S_ref/S)^m with S the
+Conventions (the documentation's method page): S-N curves are range-based, N(S) = (S_ref/S)^m with S the
 cycle **range** (peak to valley, not the amplitude); half cycles count 0.5; the damage
 equivalent load uses the 1 Hz convention, DEL = (Σ n_i S_i^m / N_eq)^(1/m) with
 N_eq = duration · n_eq_rate (n_eq_rate = 1 Hz by default). Loads keep the units of the

@@ -180,6 +180,11 @@ class Gain:
 
     gain_db: float
 
+    def __post_init__(self):
+        # a NaN gain would make every response NaN (and a session saved with it unreadable)
+        if isinstance(self.gain_db, (bool, np.bool_, str, bytes)) or not np.isfinite(self.gain_db):
+            raise ValueError(f"Gain.gain_db={self.gain_db!r} must be a finite number of dB")
+
     def tf(self) -> ct.TransferFunction:
         """The gain as a static transfer function.
 

@@ -73,27 +73,32 @@ def test_the_same_campaign_twice_on_the_client(client, setup):
         assert_bitwise_equal(again, local)
 
 
-def test_bitwise_whatever_blas_threads_the_workers_start_with(setup):
+def _every_core_blas():
+    """Run on a worker: BLAS on every core (what it takes without dask's OPENBLAS_NUM_THREADS=1)."""
+    import os
+
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    threadpool_limits(limits=os.cpu_count(), user_api="blas")  # stays set: not used as a context
+    return max(lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas")
+
+
+def test_bitwise_whatever_blas_threads_the_workers_start_with(client, setup):
     # dask starts workers with OPENBLAS/OMP/MKL_NUM_THREADS=1 (distributed.nanny.pre-spawn-environ);
-    # without that they run BLAS on every core, as a local run does by default. Every task runs
-    # BLAS on one thread itself (campaign_point), so neither the workers' environment nor the
-    # client's thread count changes a bit.
-    import dask
+    # here the workers' BLAS is set to every core, as a local run has it by default. Every task
+    # runs BLAS on one thread itself (campaign_point), so neither the workers' thread count nor
+    # the client's changes a bit.
+    import os
+
     from threadpoolctl import threadpool_limits
 
     model, ctrls, local = setup
-    import os
-
-    # dask.config.set merges dicts: the variables are overridden with the core count (what BLAS
-    # takes by default), not removed
-    every_core = {k: str(os.cpu_count()) for k in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": every_core}):
-        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                      dashboard_address=None) as cluster, distributed.Client(cluster) as c:
-            threads = c.run(lambda: __import__("threadpoolctl").threadpool_info())
-            on_cluster = run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, executor=c, progress=False, **KW)
-    # the workers really had more than one BLAS thread to start with (a 2-core machine: 2)
-    assert any(lib["num_threads"] > 1 for info in threads.values() for lib in info if lib["user_api"] == "blas")
+    threads = client.run(_every_core_blas)
+    assert all(n == os.cpu_count() for n in threads.values()), threads
+    try:
+        on_cluster = run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, executor=client, progress=False, **KW)
+    finally:  # the module's other tests keep dask's default
+        client.run(lambda: __import__("threadpoolctl").threadpool_limits(limits=1, user_api="blas") and None)
     assert_bitwise_equal(on_cluster, local)
     with threadpool_limits(limits=2, user_api="blas"):  # the client with two BLAS threads asked for
         assert_bitwise_equal(run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, progress=False, **KW), local)

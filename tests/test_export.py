@@ -14,6 +14,7 @@ no velocity) by the trapezoid rule, where the Python controller reads the plant'
 that tolerance is derived from the integration error measured on the Python run itself.
 """
 import ctypes
+import dataclasses
 import fnmatch
 import math
 import pickle
@@ -122,6 +123,25 @@ def test_rosco_scheduled_gains_and_torque_law_exported_equal_python(model, tmp_p
     a, b = _runs(model, sc, rec, [9.0, 13.0, 19.0], torque_control="rosco")
     assert a["pitch_cmd"][0].min() == model.pitch_min  # at 9 m/s the command sits on its limit
     _assert_equal_records(a, b)
+
+
+def test_rosco_power_exported_equals_the_simulators_constant_power_law(model, tmp_path):
+    # ROSCO's law with VS_ConstPower = 1 (issue 27): the library's torque_mode 3 and the
+    # simulator's torque_step with const_power, below rated, near rated and above
+    sc = rosco_scheduled(model, scheduling_filter="rosco")
+    law = dataclasses.replace(model.torque_control, const_power=True)
+    rec = export_discon(sc, tmp_path, model=model, torque="rosco_power")
+    assert rec.torque == "rosco_power" and read_parameters(rec.parameters).torque_law[-1] == 1.0
+    # a constant-power law given as such, or the law of the model, exports as rosco_power too
+    assert export_discon(sc, tmp_path / "law", model=model, torque=law).torque == "rosco_power"
+    cp_model = dataclasses.replace(model, torque_control=law)
+    assert export_discon(sc, tmp_path / "m", model=cp_model).torque == "rosco_power"
+    assert export_discon(sc, tmp_path / "r", model=cp_model, torque="rosco").torque == "rosco_power"
+    a, b = _runs(model, sc, rec, [9.0, 13.0, 19.0], torque_control=law)
+    _assert_equal_records(a, b)
+    # constant power above rated changes the records: the comparison can fail
+    held = simulate(model, sc, [19.0], seeds=[1], duration=DURATION, transient=TRANSIENT, torque_control="rosco")
+    assert np.abs(held["power"][0] - a["power"][2]).max() > 1e3 * 100 * EPS32 * np.abs(a["power"]).max()
 
 
 def test_hinf_design_with_atd_exported_equals_python(model, tmp_path):

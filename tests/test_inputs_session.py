@@ -68,10 +68,23 @@ def test_a_nan_specification_baseline_is_refused():
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=1, max_size=4).filter(
-    lambda xs: not all(np.isfinite(xs))), st.integers(0, 1))
-def test_any_non_finite_coefficient_is_refused(coeffs, which):
+@given(st.lists(st.floats(allow_nan=False, allow_infinity=False), max_size=3),
+       st.sampled_from([float("nan"), float("inf"), float("-inf")]), st.integers(0, 3), st.integers(0, 1))
+def test_any_non_finite_coefficient_is_refused(finite, bad, at, which):
+    coeffs = finite[:at] + [bad] + finite[at:]  # a non-finite value anywhere among finite ones
     d = {"num": [1.0], "den": [1.0, 1.0]}
     d["num" if which == 0 else "den"] = coeffs
     with pytest.raises(ValueError, match=r"holds NaN or inf"):
         session_from_dict({"schema": SCHEMA, "version": VERSION, "controllers": {"K": d}})
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), True])
+def test_a_nan_gain_element_is_refused_on_load(bad):
+    data = {"schema": SCHEMA, "version": VERSION,
+            "specifications": {"W": {"name": "W", "context": {"wind_speed": 19.0, "output": "tower_base_my", "m": 4.0},
+                                     "baseline": {"num": [1.0], "den": [1.0, 1.0]},
+                                     "elements": [{"type": "Gain", "gain_db": bad}]}}}
+    with pytest.raises(ValueError, match=r"Gain.gain_db=.* must be a finite number of dB"):
+        session_from_dict(data)
+    with pytest.raises(ValueError, match="Gain.gain_db"):
+        spec.Gain(bad)

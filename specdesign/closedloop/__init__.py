@@ -1,6 +1,6 @@
 """Closed-loop maps wind → output for a pitch controller and an optional tower-damping loop.
 
-Sign convention (WORKBENCH.md): the pitch command is
+Sign convention (the documentation's method page): the pitch command is
 
     β_cmd = −C_β·Ω_g − C_atd·z,
 

@@ -10,6 +10,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from loopshaping.freqresp import as_siso
+
 from .._checks import positive_scalar
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -66,9 +68,6 @@ def as_lti(c: object, name: str) -> control.LTI:
         If it is not SISO, or is discrete-time.
     """
     import control
-
-    # kept here: the validation side (simulate, closedloop, validate) loads without loopshaping
-    from loopshaping.freqresp import as_siso
 
     if hasattr(c, "tf") and callable(c.tf) and not isinstance(c, control.LTI):
         c = c.tf()

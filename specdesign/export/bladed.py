@@ -4,6 +4,7 @@ See :mod:`specdesign.export` for what the pair is and how OpenFAST and the workb
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -68,16 +69,23 @@ def _as_controller(obj: object, name: str | None):
 
 
 def _torque(torque, model: TurbineModel):
-    """(mode name, TorqueLaw or None) of the ``torque`` argument."""
+    """(mode name, TorqueLaw or None) of the ``torque`` argument; ROSCO's law is "rosco_power"
+    exactly when it holds constant power above rated (its ``const_power``, ``VS_ConstPower``)."""
     if isinstance(torque, TorqueLaw):
-        return "rosco", torque
+        return ("rosco_power" if torque.const_power else "rosco"), torque
     law = getattr(model, "torque_control", None)
     if torque is None:
-        return ("rosco", law) if law is not None else ("constant", None)
+        if law is None:
+            return "constant", None
+        return ("rosco_power" if law.const_power else "rosco"), law
     if torque not in TORQUE_MODES:
         raise ValueError(f"torque={torque!r} must be one of {tuple(TORQUE_MODES)}, None or a specdesign.rosco.TorqueLaw")
     if torque in ("rosco", "rosco_power") and law is None:
         raise ValueError(f"torque={torque!r} needs a model with a torque law (torque_control); pass a TorqueLaw instead")
+    if torque == "rosco_power":
+        law = dataclasses.replace(law, const_power=True)
+    elif torque == "rosco" and law.const_power:  # the model's law as simulate(torque_control="rosco") runs it
+        return "rosco_power", law
     return torque, law
 
 
@@ -185,11 +193,12 @@ def export_discon(controller_or_design: object, folder: str | Path, *, dt: float
     torque : {"constant", "power", "rosco", "rosco_power"}, TorqueLaw or None, optional
         Generator torque: "constant" the rated torque (the simulator above rated); "power"
         P_rated/(η·Ω_f) capped at the law's maximum torque, everywhere (for runs above rated);
-        "rosco" the model's ROSCO torque law (``simulate(..., torque_control="rosco")``) or a
-        given :class:`~specdesign.rosco.TorqueLaw`; "rosco_power" that law with constant power
-        in region 3 and its ceiling, as ROSCO runs ``VS_ConstPower = 1`` (not modelled by the
-        simulator: no equality check there). None (default): "rosco" if the model has a
-        torque law, else "constant".
+        "rosco" the model's ROSCO torque law as ``simulate(..., torque_control="rosco")`` runs
+        it (rated torque in region 3, or rated power if its ``const_power`` is set);
+        "rosco_power" that law with constant power in region 3 and its ceiling, as ROSCO runs
+        ``VS_ConstPower = 1`` (the simulator's law with ``const_power``); a given
+        :class:`~specdesign.rosco.TorqueLaw` runs as it is (``simulate(..., torque_control=law)``).
+        None (default): "rosco" if the model has a torque law, else "constant".
     pitch_rate_limit : float, optional
         Largest rate of the pitch command (rad/s); default inf (the workbench's controllers
         have none; its actuator model limits the pitch rate). For OpenFAST without a pitch

@@ -2,7 +2,7 @@
  * specdesign's exported pitch and torque controller behind the Bladed interface (DISCON).
  *
  * One source, compiled once by specdesign.export (cc -O2 -shared -fPIC), serves every design:
- * the design is the parameter file named by accINFILE ("specdesign-discon 1" format, written
+ * the design is the parameter file named by accINFILE ("specdesign-discon 2" format, written
  * by specdesign.export.export_discon and described in docs/export.md), read at the
  * initialisation call. The controller is the one specdesign.simulate's compiled loop runs
  * (specdesign/simulate/kernels.py, _run_one): the same discrete matrices (Tustin at the
@@ -49,13 +49,13 @@
 #include <string.h>
 
 #define FORMAT_NAME "specdesign-discon"
-#define FORMAT_VERSION 1
+#define FORMAT_VERSION 2
 #define MAX_DIM 4096
 
 /* layout of the ROSCO torque law's parameters and states: specdesign/rosco/torque.py */
 enum { T_MODE, T_K, T_KP, T_KI, T_MIN_SPEED, T_VS_REF, T_PC_REF, T_RATED_TQ, T_MAX_TQ, T_AR_SAT, T_MIN_TQ,
        T_MAX_RATE, T_RATED_POWER, T_GEN_EFF, T_FILT_TYPE, T_FILT_CORNER, T_FILT_DAMP, T_REF_CORNER, T_SS_MODE,
-       T_SS_VS, T_SS_PC, T_SS_CORNER, T_PC_SWITCH, T_PITCH_MIN, TORQUE_PARAMS };
+       T_SS_VS, T_SS_PC, T_SS_CORNER, T_PC_SWITCH, T_PITCH_MIN, T_CONST_POWER, TORQUE_PARAMS };
 enum { S_WF, S_WF2, S_U1, S_U2, S_REF, S_REF_U, S_SSF, S_SS_U, S_IAR, S_IBR, S_AR, S_BR, S_STATE, S_TQ, S_PLAST };
 #define TORQUE_STATES 16
 
@@ -242,6 +242,9 @@ static int parse(Controller *c, Reader *r)
                                     "or 4");
     if (c->torque_mode == TQ_ROSCO_POWER && !(c->tq[T_RATED_POWER] > 0 && c->tq[T_GEN_EFF] > 0))
         return fail(r, r->tok_line, "torque_mode 3 (constant power) needs the torque_law's rated power and efficiency");
+    if (c->torque_mode >= TQ_ROSCO && (c->tq[T_CONST_POWER] != 0.0) != (c->torque_mode == TQ_ROSCO_POWER))
+        return fail(r, r->tok_line, "torque_law's last entry (VS_ConstPower) must be 1 with torque_mode 3 and 0 with "
+                                    "torque_mode 2");
     if (integer(r, "schedule_filter", 1, 5, &c->nsf))
         return -1;
     if (c->nsf != 1 && c->nsf != 5)

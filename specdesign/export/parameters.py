@@ -1,7 +1,7 @@
 """The parameter file of the exported controller: :class:`DisconParameters`, written and read.
 
 A plain-text file, one keyword then its numbers, in a fixed order, ``#`` to the end of a line
-a comment; its first words are ``specdesign-discon 1`` (the format and its version). Numbers
+a comment; its first words are ``specdesign-discon 2`` (the format and its version). Numbers
 are written as Python's ``repr`` of a float (the shortest text that reads back to the same
 double, ``inf`` for infinity), so matrices round-trip exactly. The format, keyword by keyword,
 is in ``docs/export.md``; :func:`read_parameters` and the C library read it with the same rules.
@@ -21,7 +21,7 @@ __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "TORQUE_MODES", "DisconParameters", 
 #: First word of a parameter file.
 FORMAT_NAME = "specdesign-discon"
 #: Version of the format this package writes and its library reads.
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 #: ``torque_mode`` codes of the file: the rated torque held, constant power P/(η·Ω_f), ROSCO's law,
 #: ROSCO's law with constant power in region 3 (``VS_ConstPower = 1``).
 TORQUE_MODES = {"constant": 0, "power": 1, "rosco": 2, "rosco_power": 3}
@@ -61,7 +61,8 @@ class DisconParameters:
     speed_filter : tuple of float
         (corner rad/s, damping) of the 2nd-order low-pass Ω_f of constant power.
     torque_law : numpy.ndarray
-        (24,) :meth:`specdesign.rosco.TorqueLaw.params` (zeros unless mode 2).
+        (25,) :meth:`specdesign.rosco.TorqueLaw.params` (zeros unless mode 2 or 3; its last
+        entry, ``VS_ConstPower``, is 1 in mode 3 and 0 in mode 2).
     schedule_filter : numpy.ndarray
         (1,) or (5,) :func:`specdesign.controller.scheduled.schedule_filter_coefficients`.
     atd_highpass : float
@@ -176,7 +177,7 @@ def write_parameters(p: DisconParameters, path: str | Path, *, comment: str = ""
             "# gearbox_ratio); e = rated_speed - rotor speed (rad/s), v = tower-top fore-aft velocity (m/s).",
             _line("dt", [p.dt]), _line("gearbox_ratio", [p.gearbox_ratio]), _line("rated_speed", [p.rated_speed]),
             _line("pitch_limits", p.pitch_limits), _line("pitch_rate_limit", [p.pitch_rate_limit]),
-            "# torque: 0 constant rated_torque, 1 constant power, 2 ROSCO's law (torque_law, 24 numbers),",
+            "# torque: 0 constant rated_torque, 1 constant power, 2 ROSCO's law (torque_law, 25 numbers),",
             "# 3 ROSCO's law with constant power in region 3",
             f"torque_mode {int(p.torque_mode)}", _line("rated_torque", [p.rated_torque]),
             _line("max_torque", [p.max_torque]), _line("rated_power", [p.rated_power]),

@@ -22,7 +22,7 @@ def shape_whole_band(base: Baseline, target_reduction: float, *, quantity: str =
                      **certify_options: Any) -> ShapingResult:
     """Shape the certified whole-band tower specification that promises a target reduction.
 
-    Issue 14's specification-driven design (use it when the specification is to be handed to
+    The specification-driven design (use it when the specification is to be handed to
     a design): the whole band where ΔD% pays, below the tower mode too, with the
     generator-speed specification as the constraint that protects power regulation and
     Bode's cost inside the specification, as ROSCO's map × a gain, a lag, a lead and

@@ -1,4 +1,4 @@
-"""Behavioural cloning of the long-horizon economic optimiser (seed 000, Section 4).
+"""Behavioural cloning of the long-horizon economic optimiser (Collet et al., behavioural cloning of a fatigue-oriented economic MPC, Section 4).
 
 The expert is the economic problem of :func:`~specdesign.mpc.economic_problem` over a long
 horizon (default 20 s; the paper's 10-100 s), solved open loop from a given state: its first
@@ -243,7 +243,7 @@ def clone(model, wind_speeds, seeds, terms, *, rounds: int = 2, ts: float = 0.2,
 
 
 class CloningRegressor:
-    """Linear regression plus gradient-boosted trees on its residual (seed 000, Eqs. 19-22).
+    """Linear regression plus gradient-boosted trees on its residual (Collet et al., Eqs. 19-22).
 
     Parameters
     ----------

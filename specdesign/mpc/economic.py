@@ -1,4 +1,4 @@
-"""Fatigue-oriented economic MPC (seed 000): the variance-damage surrogate cost of Eq. (4),
+"""Fatigue-oriented economic MPC (after Collet et al.): the variance-damage surrogate cost of Eq. (4),
 
     J̃_fat(y) = Σ_i π_i e^{b_i} / L_ult,i^{m_i} · Var(y_i)^{a_i},
 
@@ -283,7 +283,7 @@ def economic_problem(dm: DiscreteTurbine, terms, horizon: int, *, speed_weight: 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class OpenLoopResult:
-    """The long-horizon optimum on the linear model (the expert of seed 000).
+    """The long-horizon optimum on the linear model (the expert of Collet et al.'s behavioural cloning).
 
     Parameters
     ----------
@@ -319,7 +319,7 @@ class OpenLoopResult:
 def economic_open_loop(model, wind_speed: float, wind, wind_dt: float, terms, *, ts: float = 0.2,
                        speed_weight: float = 100.0, activity_weight: float = 1.0, dm: DiscreteTurbine | None = None,
                        problem: dict | None = None) -> OpenLoopResult:
-    """Minimise the economic cost over the whole wind record, open loop, wind known (seed 000 Eq. 14).
+    """Minimise the economic cost over the whole wind record, open loop, wind known (Collet et al., Eq. 14).
 
     Starts at the trim of ``wind_speed``; the wind is sampled at ``ts`` and held over each
     sample (zero-order hold, as the discrete model assumes).

@@ -1,4 +1,4 @@
-"""Health-aware LPV MPC of the pitch (seed 002), trading speed (power) tracking against the
+"""Health-aware LPV MPC of the pitch (after Boutrous, Nejjari and Puig, *Health-aware LPV model predictive control of wind turbines*), trading speed (power) tracking against the
 growth of the blades' accumulated fatigue damage.
 
 Seed 002 (Boutrous, Nejjari, Puig) augments an LPV turbine model with the accumulated
@@ -225,7 +225,7 @@ def health_scale(damage: float, t: float, m: float, prior: float) -> float:
 
 
 class HealthMPC(SampledController):
-    """Health-aware LPV MPC (seed 002), a callable controller for ``simulate`` and ``run_campaign``.
+    """Health-aware LPV MPC (after Boutrous et al.), a callable controller for ``simulate`` and ``run_campaign``.
 
     See the module docstring for the problem; the observer and sampling are those of
     :class:`specdesign.mpc.base.SampledController`. The generator torque stays at its trim.
@@ -244,7 +244,7 @@ class HealthMPC(SampledController):
     health_weight : float, default 0
         ψ, the weight of the blade moment's excursions about its mean (the damage-growth proxy).
     stress_weight : float, default 0
-        ψ_acc, seed 002's weight of the accumulated blade moment (derating).
+        ψ_acc, Boutrous et al.'s weight of the accumulated blade moment (derating).
     blade_m : float, default 10
         Wöhler exponent of the blade's online damage D(k).
     del_budget : float, optional

@@ -1,7 +1,7 @@
 """The trade-off of the health-aware MPC: energy against blade and tower fatigue as its weights vary.
 
 :func:`health_tradeoff` simulates :class:`specdesign.mpc.health.HealthMPC` for a sweep of the
-health weight ψ (blade-moment excursions) and of seed 002's accumulated-stress weight ψ_acc, on
+health weight ψ (blade-moment excursions) and of Boutrous, Nejjari and Puig's accumulated-stress weight ψ_acc, on
 the same wind (speeds × seeds, :func:`specdesign.simulate.simulate`), and returns one
 :class:`TradeoffPoint` per controller; :func:`plot_tradeoff` draws the curve. Aggregation over
 the runs: mean power over every run; DELs pooled by fatigue, DEL = (mean_runs DEL_r^m)^{1/m}
@@ -88,7 +88,7 @@ def health_tradeoff(model, wind_speeds, seeds, *, health_weights=(0.0, 3.0, 10.0
     health_weights : sequence of float, optional
         ψ values (ψ_acc = 0); the first is the reference of the damage ratios.
     stress_weights : sequence of float, optional
-        ψ_acc values (ψ = 0): seed 002's derating term.
+        ψ_acc values (ψ = 0): Boutrous et al.'s derating term.
     duration, transient : float, optional
         Recorded and discarded time per run (s).
     baseline : bool, optional
@@ -146,7 +146,7 @@ def plot_tradeoff(points, *, reference: str | None = None):
     fig = Figure(figsize=(9, 3.8), layout="constrained")
     axes = fig.subplots(1, 2)
     series = (("health weight ψ (excursions)", [p for p in mpc if p.stress_weight == 0], "o-"),
-              ("seed 002's ψ_acc (accumulated moment)", [p for p in mpc if p.stress_weight > 0 or p is ref], "s--"))
+              ("Boutrous et al.'s ψ_acc (accumulated moment)", [p for p in mpc if p.stress_weight > 0 or p is ref], "s--"))
     for ax, attr, m, title in ((axes[0], "blade_del", BLADE_M, "blade-root flapwise"),
                                (axes[1], "tower_del", TOWER_M, "tower-base fore-aft")):
         for name, pts, style in series:

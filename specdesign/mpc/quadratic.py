@@ -1,5 +1,5 @@
 """Quadratic (tracking) MPC on the linearised turbine: the "finely tuned quadratic MPC" baseline
-of seed 000.
+of Collet et al.'s behavioural-cloning paper.
 
 At every sample k, from the Kalman estimate (x̂, d̂) of :mod:`specdesign.mpc.base` and the
 previous command u₋₁ (all deviations from the trim), solve over N steps::

@@ -12,7 +12,7 @@ specification pair for a DEL target (:func:`specdesign.feasibility.specification
 then its certificate reduced to the lowest order that meets the pair at every plant case
 (:mod:`~specdesign.qft.certificate`), checked as below. ``design_qft(spec="notch")`` is the
 fixed-structure design of the sections below (notch specification, DEL target, tuner).
-Sign convention (WORKBENCH.md, :mod:`specdesign.closedloop`):
+Sign convention (:mod:`specdesign.closedloop`):
 
     β_cmd = −C_β·Ω_g − C_atd·z,    z = tower-top fore-aft velocity (m/s),
 
@@ -31,7 +31,7 @@ every wind map in QFT's general form |(A + B·G)/(C + D·G)| with, per plant cas
     A = P'_{y,w},  B = P'_{y,w}P'_{n,β} − P'_{y,β}P'_{n,w},  C = 1,  D = P'_{n,β}
 
 (B = 0 when y = n). For the pitch controller (G = C_β, n = Ω_g, ATD closed) and y = MyT this
-is WORKBENCH.md's tower-load form with the primed plant; for the ATD (G = C_atd, n = z,
+is the tower-load form of :mod:`specdesign.closedloop` with the primed plant; for the ATD (G = C_atd, n = z,
 pitch loop closed) the roles swap. :func:`specdesign.closedloop.general_form` computes A..D; the tests check
 (A + B·G)/(C + D·G) against ``control.interconnect`` to 1e-9.
 

@@ -67,8 +67,11 @@ runs as above: below rated its error is negative and its command sits at the min
 (ROSCO's form clamps its integrator there, an LTI controller's integrator is clamped or
 frozen, see :func:`simulate`), so the pitch is held at fine pitch as ROSCO holds it.
 ``torque_control="auto"`` (default) runs the law in the runs whose wind speed is below rated
-and holds the trim torque in the others (bit for bit the results before the law existed);
-``"rosco"`` runs it in every run (region 3 is then rated torque, with the transitions);
+and holds the trim torque in the others (bit for bit the results before the law existed),
+except a law with constant power above rated (``VS_ConstPower = 1``, e.g. the NREL 5 MW's
+DISCON.IN), which runs in every run as the linearisation has it;
+``"rosco"`` runs it in every run (region 3 is then rated torque, or rated power
+P/(η·Ω_f) with ``VS_ConstPower = 1``, with the transitions);
 a ``TorqueLaw`` runs that law in every run; ``None`` holds the trim torque everywhere.
 The pitch loop's stability check (:func:`warn_unstable`) covers the speeds at or above rated
 only: below rated the pitch loop is open.

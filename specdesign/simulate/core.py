@@ -143,9 +143,10 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, optional
         Generator torque of the compiled loop (see :mod:`specdesign.simulate`): "auto" runs
         the plant's torque law (the model's ``torque_control``) in the runs below rated and
-        holds the trim torque above; "rosco" runs it in every run; a TorqueLaw runs that one
-        in every run; None holds the trim torque everywhere. Ignored with ``linear=True``
-        (the linearisation closes the law below rated) and for a callable controller (it
+        holds the trim torque above (a constant-power law runs in every run); "rosco" runs it
+        in every run; a TorqueLaw runs that one in every run; None holds the trim torque
+        everywhere. Ignored with ``linear=True`` (the linearisation closes the law below
+        rated, and above rated a constant-power one) and for a callable controller (it
         commands the torque itself, or holds the trim torque).
 
     Returns
@@ -367,8 +368,8 @@ def _torque_params(plant, torque_control, vs, S, linear):
             raise ValueError("torque_control='rosco' needs a plant with a torque law (a TurbineModel with "
                              "torque_control, e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw instead")
         on[:] = True
-    elif torque_control == "auto":
-        on = ~above if law is not None else on
+    elif torque_control == "auto":  # a constant-power law (VS_ConstPower = 1) acts above rated too
+        on = (~above | law.const_power) if law is not None else on
     elif torque_control is not None:
         raise ValueError(f"torque_control={torque_control!r} must be 'auto', 'rosco', None or a specdesign.rosco.TorqueLaw")
     if linear:

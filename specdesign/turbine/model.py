@@ -545,7 +545,9 @@ class TurbineModel:
         Below rated (a model with ``torque_control``) the torque loop is closed
         (:func:`specdesign.rosco.close_torque_loop`): the law's dT/dΩ enters A (region 2:
         2KΩ; regions 1.5 and 2.5: the transition PI, its integral an extra state
-        ``torque_pi``), and ``gen_torque`` is a torque added to the law's. The pitch loop is
+        ``torque_pi``), and ``gen_torque`` is a torque added to the law's. Above rated a law
+        with constant power (``VS_ConstPower = 1``) enters A the same way (dT/dΩ = −P/(η·Ω²));
+        one with constant torque leaves the torque an input. The pitch loop is
         open there: ROSCO's pitch PI sits at its minimum below rated.
 
         Parameters
@@ -580,7 +582,7 @@ class TurbineModel:
         op = self.trim(wind_speed)
         A, B, C, D = self.jacobians(op)
         inputs, states = list(INPUT_NAMES), list(STATE_NAMES)
-        if op.region != "3":
+        if self.torque_control is not None:  # above rated it matters only for constant power
             A, B, C, D, extra = close_torque_loop(A, B, C, D, self.torque_control, op.rotor_speed, op.region)
             states += extra
         if load_inputs:
