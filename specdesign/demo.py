@@ -456,6 +456,7 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     from matplotlib.figure import Figure
 
     from . import qft
+
     out = Path(out)
     model = iea15mw()
     # every option, the design speeds included, before the first design

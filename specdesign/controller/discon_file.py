@@ -319,7 +319,6 @@ def write_discon(source: str | Path, target: str | Path, **values) -> Path:
 
     Examples
     --------
-    >>> from specdesign.rosco import iea15mw_discon
     >>> import tempfile
     >>> from specdesign.rosco import iea15mw_discon
     >>> out = write_discon(iea15mw_discon(), Path(tempfile.mkdtemp()) / "DISCON.IN", PS_Mode=0)
