@@ -27,7 +27,7 @@ import numpy as np
 
 from loopshaping.freqresp import is_zero
 
-from . import validate
+from . import feasibility, validate
 from ._checks import del_target, positive_scalar, real_scalar
 from .plots.fatigue import plot_sensitivity
 from .plots.qft import plot_design_bode, plot_design_nichols
@@ -237,8 +237,9 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         Figure,  # figures only written to files: no pyplot, no backend
     )
 
-    from . import feasibility, qft, spec, validate
+    from . import qft, spec
     from .plots.spec import plot_specification
+
     if method not in ("target", "notch"):
         raise ValueError(f"method={method!r} must be 'target' (specification-driven) or 'notch'")
     model = iea15mw()
@@ -454,7 +455,8 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     """
     from matplotlib.figure import Figure
 
-    from . import qft, validate
+    from . import qft
+
     out = Path(out)
     model = iea15mw()
     # every option, the design speeds included, before the first design

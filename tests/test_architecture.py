@@ -161,10 +161,10 @@ def test_no_module_chooses_the_matplotlib_backend():
 #: other import is at the top of its module. The own modules listed are heavy because they
 #: import python-control at load time (checked by test_own_local_imports_are_heavy).
 LOCAL_IMPORTS = {
-    "control": "python-control loads matplotlib.pyplot and scipy.signal at import (1-3 s)",
-    "scipy": "scipy's subpackages (optimize, interpolate, signal, linalg, stats) take 0.5-2.7 s each",
-    "matplotlib": "figures only: 0.4 s, 1.4 s with pyplot; never loaded by a computation",
-    "cvxpy": "the convex solvers of the feasibility certificate and the MPC: ~3 s",
+    "control": "python-control loads matplotlib.pyplot and scipy.signal at import (3.3 s measured on the shared machine)",
+    "scipy": "scipy's subpackages (optimize, interpolate, signal, linalg, stats): 0.6-2.7 s each on the same machine",
+    "matplotlib": "figures only (0.4 s, 1.4 s with pyplot there); never loaded by a computation",
+    "cvxpy": "the convex solvers of the feasibility certificate and the MPC (2.9 s there)",
     "sklearn": "optional extra `surrogate` (the Gaussian-process surrogate)",
     "slycot": "optional for loopshaping as a whole, needed by its H-infinity routines only",
     "IPython": "notebook display only",

@@ -161,7 +161,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         Largest speed relaxation tried, dB.
     tolerance_db : float
         Bisection tolerance on the relaxation, dB (> 0; the bisection stops after
-        :data:`specdesign._checks.MAX_BISECTIONS` halvings in any case).
+        100 halvings in any case, ``MAX_BISECTIONS``).
     m : float
         Wöhler exponent (-).
     omega : array_like, optional

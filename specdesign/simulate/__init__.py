@@ -48,7 +48,7 @@ shaft, which the controller then commands; a ``start(dt, wind, pitch, torque)`` 
 has one, is called once before the first step; use it for MPC or other time-domain
 controllers, and for ROSCO's compiled controller, :class:`specdesign.rosco.Discon`). A
 callable must return finite commands; a NaN or inf measurement is handled alike by every
-controller of the package (:func:`specdesign._checks.bad_measurements`): the run holds its
+controller of the package (one private helper, ``bad_measurements``): the run holds its
 last command and its state until the signal is finite again, with one RuntimeWarning per
 signal naming it, the time and the run. A callable that returns a non-finite command anyway
 is stopped with a ValueError naming the time and the measurements that were not finite.
