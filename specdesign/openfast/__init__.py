@@ -12,6 +12,8 @@
 """
 from __future__ import annotations
 
+import importlib
+
 _LAZY = {
     "read_linearization": ".lin",
     "LinearizationData": ".lin",
@@ -44,7 +46,5 @@ __all__ = list(_LAZY)
 
 def __getattr__(name):  # the adapters import openfast-io only when used
     if name in _LAZY:
-        import importlib
-
         return getattr(importlib.import_module(_LAZY[name], __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

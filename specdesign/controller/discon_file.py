@@ -16,30 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["DisconEntry", "DisconSchedule", "iea15mw_discon", "read_discon", "from_discon", "write_discon"]
-
-
-def iea15mw_discon() -> Path:
-    """Path of the shipped DISCON.IN of the IEA 15 MW monopile (ROSCO 2.9.4 tuning).
-
-    Its ``PerfFileName`` points outside the package: it reads as a schedule
-    (:func:`from_discon`) but the compiled ROSCO cannot run it as it is.
-
-    Returns
-    -------
-    pathlib.Path
-        ``specdesign/data/iea15mw/IEA-15-240-RWT-Monopile_DISCON.IN``.
-
-    Examples
-    --------
-    >>> iea15mw_discon().name
-    'IEA-15-240-RWT-Monopile_DISCON.IN'
-    """
-    from importlib import resources
-
-    from ..turbine.tables import DATA_DIR
-
-    return Path(str(resources.files("specdesign").joinpath(f"{DATA_DIR}/IEA-15-240-RWT-Monopile_DISCON.IN")))
+__all__ = ["DisconEntry", "DisconSchedule", "read_discon", "from_discon", "write_discon"]
 
 
 @dataclass(frozen=True)
@@ -88,6 +65,7 @@ def read_discon(path: str | Path) -> tuple[dict, str | None]:
 
     Examples
     --------
+    >>> from specdesign.rosco import iea15mw_discon
     >>> entries, version = read_discon(iea15mw_discon())
     >>> version, entries["PC_GS_n"].values
     ('2.9.4', ('30',))
@@ -212,6 +190,7 @@ class DisconSchedule:
 
         Examples
         --------
+        >>> from specdesign.rosco import iea15mw_discon
         >>> s = from_discon(iea15mw_discon())
         >>> bool(s.gains(s.pitch[0])[0] == s.kp[0])
         True
@@ -264,6 +243,7 @@ def from_discon(path: str | Path) -> DisconSchedule:
 
     Examples
     --------
+    >>> from specdesign.rosco import iea15mw_discon
     >>> s = from_discon(iea15mw_discon())
     >>> s.pitch.size, round(s.filter_corner, 4), s.reference_speed
     (30, 1.0081, 0.79168)
@@ -340,6 +320,7 @@ def write_discon(source: str | Path, target: str | Path, **values) -> Path:
     Examples
     --------
     >>> import tempfile
+    >>> from specdesign.rosco import iea15mw_discon
     >>> out = write_discon(iea15mw_discon(), Path(tempfile.mkdtemp()) / "DISCON.IN", PS_Mode=0)
     >>> read_discon(out)[0]["PS_Mode"].values
     ('0',)
