@@ -26,6 +26,7 @@ from loopshaping.controller import Controller
 
 from . import __version__, turbine
 from ._checks import distinct_keys
+from .openfast.install import build_openfast, find_openfast
 from .plots import validation as pv
 from .rosco import rosco_scheduled
 from .simulate import ScheduledController, scheduled
@@ -197,8 +198,6 @@ def _only_without_lifetime(args):
 
 def _openfast_command(args) -> None:
     """``specdesign openfast build SOURCE`` / ``specdesign openfast find``: the executables' paths and version on stdout."""
-    from specdesign.openfast.install import build_openfast, find_openfast
-
     if args.action == "build":
         if args.source is None:
             raise ConfigError("openfast build needs SOURCE: an OpenFAST source tarball or folder")

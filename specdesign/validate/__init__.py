@@ -41,7 +41,8 @@ figures) live in :mod:`specdesign.cli`; this package imports neither matplotlib 
 from __future__ import annotations
 
 from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
-from .campaign import Campaign, check_campaign_step, check_plant_step, concat_campaigns, run_campaign
+from .campaign import check_campaign_step, check_plant_step, concat_campaigns, run_campaign
+from .campaign_record import Campaign
 from .lifetime_del import DEL_CHANNELS, LifetimeDEL, WindClimate, lifetime, weibull_bins, wind_climate
 from .metrics import INDICATORS, Indicators, indicators
 from .prediction import LinearPrediction, closed_loop_response, linear_prediction, loop_plant, prediction_grid

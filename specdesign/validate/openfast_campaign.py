@@ -19,15 +19,20 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
 
+from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
 from ..openfast.series import series_from_openfast
 from ..openfast.turbsim import TURBSIM_GRID, turbsim_field
+from ..rosco.discon import rosco_library
+from ..simulate import SimulationResult
+from ..turbine import iea15mw
 from ._point import SPECTRA
-from .campaign import Campaign, seeds_from
+from .campaign_record import Campaign
 from .metrics import INDICATORS, indicators
-from .stats import welch_psd
+from .stats import seeds_from, welch_psd
 
 __all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES"]
 
@@ -81,7 +86,6 @@ def as_discon(controller) -> DisconController:
         The library or parameter file does not exist.
     """
     if isinstance(controller, (str, Path)):
-        from ..rosco.discon import rosco_library  # the rosco package is optional
 
         lib, par = rosco_library(), Path(controller)
     elif hasattr(controller, "library") and hasattr(controller, "parameters"):
@@ -104,7 +108,7 @@ def _sha(path: Path) -> str:
 
 
 def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Deck, duration: float = 600.0,
-                          transient: float = 60.0, dt: float | None = None, record_dt: float = 0.05, m: float = 4.0,
+                          transient: float = 60.0, dt: float | None = None, record_dt: float = 0.05, m: float = TOWER_M,
                           folder=None, processes: int | None = None, progress: bool | None = None,
                           turbulence_class: str = "B", grid_points: int = TURBSIM_GRID["points"],
                           grid_size: float = TURBSIM_GRID["size"], hydro: bool = True, keep_series: bool | int = False,
@@ -225,7 +229,6 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         else:
             todo.append((run, meta))
     show = sys.stderr.isatty() if progress is None else bool(progress)
-    from tqdm.auto import tqdm
 
     bar = tqdm(total=len(runs), initial=len(results), desc="OpenFAST", unit="run", disable=not show)
     failures = {}
@@ -281,7 +284,6 @@ def _trim(deck: Deck):
     IEA-15-240-RWT deck; None for another deck (its own initial conditions are kept)."""
     if not deck.name.startswith("IEA-15-240-RWT"):
         return None
-    from ..turbine import iea15mw  # heavy (builds the reduced model); only when used
 
     model = iea15mw()
 
@@ -386,7 +388,6 @@ def _assemble(results, names, vs, seeds, settings, n_keep) -> Campaign:
                     welch[k][ci, wi] = np.mean(acc[k], axis=0)
     series = {}
     if n_keep and keep:
-        from ..simulate import SimulationResult
 
         for name, outs in keep.items():
             series[name] = SimulationResult(time=np.arange(n) * dt, wind_speeds=vs, seeds=seeds[:n_keep],

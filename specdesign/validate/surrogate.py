@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..wind import TURBULENCE_CLASSES
-from .campaign import Campaign
+from .campaign_record import Campaign
 from .metrics import INDICATORS
 
 __all__ = ["CONDITIONS", "DelData", "del_data", "SurrogatePrediction", "GPSurrogate", "fit_gp", "LookupTable",

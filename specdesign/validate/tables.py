@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..fatigue import TOWER_M
-from .campaign import Campaign
+from .campaign_record import Campaign
 from .lifetime_del import lifetime
 from .prediction import linear_prediction
 from .stats import (
