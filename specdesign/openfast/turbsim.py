@@ -26,9 +26,11 @@ from .install import OpenFASTInstall, find_openfast
 __all__ = ["WindField", "turbsim_field", "turbsim_cache", "TURBSIM_GRID"]
 
 #: Default grid: points per side (square, odd so one point sits at hub height) and side (m).
-#: 270 m covers the IEA 15 MW rotor (240 m) and the tower top at 150 m hub height; 13 × 13
-#: points (22.5 m spacing) were chosen for cost (docs/openfast.md: times per grid).
-TURBSIM_GRID = {"points": 13, "size": 270.0}
+#: 290 m about the 150 m hub reaches from 5 m to 295 m: the IEA 15 MW rotor (240 m) and the
+#: whole tower down to the transition piece at 15 m, whose aerodynamic nodes InflowWind must
+#: find inside the field (TurbSim writes no tower points under a grid this low); 13 × 13
+#: points (24.2 m spacing) were chosen for cost (docs/openfast.md: times per grid).
+TURBSIM_GRID = {"points": 13, "size": 290.0}
 
 
 @dataclass(frozen=True)
@@ -91,8 +93,10 @@ def turbsim_field(wind_speed: float, seed: int, *, length: float = 660.0, hub_he
         Hub height (m), the grid's centre.
     grid_points : int, default 13
         Points per side of the square grid (odd: one at hub height).
-    grid_size : float, default 270.0
-        Side of the grid (m); must be below twice the hub height.
+    grid_size : float, default 290.0
+        Side of the grid (m); must be below twice the hub height. It must reach below the
+        lowest aerodynamic tower node (AeroDyn's tower, 15 m on the monopile): InflowWind
+        stops a run whose node leaves the field.
     time_step : float, default 0.05
         Time step of the field (s).
     turbulence_class : {"A", "B", "C"}, default "B"
@@ -171,16 +175,13 @@ def turbsim_field(wind_speed: float, seed: int, *, length: float = 660.0, hub_he
 
 
 def _write_input(path: Path, wind_speed: float, s: dict) -> None:
-    """The TurbSim input file, written by openfast-io's TurbsimWriter. Tower points below the
-    grid are written (``WrADTWR``): AeroDyn's tower nodes reach the transition piece at 15 m,
-    under the grid's bottom, and a monopile dipping by millimetres took the lowest one out of
-    the grid (InflowWind's fatal "G3D wind array boundaries violated")."""
+    """The TurbSim input file, written by openfast-io's TurbsimWriter."""
     from openfast_io.turbsim_util import TurbsimWriter  # heavy: openfast-io imports ROSCO's toolbox; loaded when a field is made
 
     n = s["grid_points"]
     inputs = SimpleNamespace(
         Echo=False, RandSeed1=s["RandSeed1"], RandSeed2=s["RandSeed2"], WrBHHTP=False, WrFHHTP=False, WrADHH=False,
-        WrADFF=True, WrBLFF=False, WrADTWR=True, WrFMTFF=False, WrACT=False, Clockwise=True, ScaleIEC=0,
+        WrADFF=True, WrBLFF=False, WrADTWR=False, WrFMTFF=False, WrACT=False, Clockwise=True, ScaleIEC=0,
         NumGrid_Z=n, NumGrid_Y=n, TimeStep=s["time_step"], AnalysisTime=s["length"], UsableTime=s["length"],
         HubHt=s["hub_height"], GridHeight=s["grid_size"], GridWidth=s["grid_size"], VFlowAng=0.0, HFlowAng=0.0,
         TurbModel='"IECKAI"', UserFile='"unused"', IECstandard='"1-ED3"', IECturbc=f'"{s["turbulence_class"]}"',
