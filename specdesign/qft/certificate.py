@@ -21,10 +21,24 @@ from typing import Any
 import control as ct
 import numpy as np
 
+from loopshaping import reduction
+
 from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response
 from .checks import spec_ratio, spec_roots
 
-__all__ = ["design_from_certificate"]
+__all__ = ["ORDER_AXIS_TOL", "ORDER_MARGIN_DB", "design_from_certificate"]
+
+#: A pole p of the certificate counts as stable, and is balanced-truncated, only if
+#: Re p < −ORDER_AXIS_TOL·max(1, |p|); the rest (the integrator S(0) = 0 puts at ±1e-16 rad/s)
+#: is kept exactly (:func:`loopshaping.reduction.reduce`). Deciding by the sign of a pole at
+#: ±1e-16 (python-control's ``balred``) truncated the integrator at one speed and kept it at
+#: the speed 1e-9 m/s away: order 19 at 23 m/s, 12 at 23 + 1e-9 m/s.
+ORDER_AXIS_TOL = 1e-6
+#: Margin (dB) by which a reduced controller must meet every specification and the M_s bound
+#: on the dense grid over every plant case to be chosen, and relative margin on the decay
+#: rate: the lowest order that meets them by less is not chosen, so that an order that meets
+#: them by a hair at one operating point and misses by a hair 1e-9 m/s away does not decide.
+ORDER_MARGIN_DB = 0.01
 
 
 def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_decay: float = 0.02,
@@ -112,31 +126,32 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
 
 
 def _lowest_order(prob, full, omega, min_order, ms, min_decay):
-    """The lowest-order balanced truncation of ``full`` that meets every specification on ``omega``
-    at every plant case, is stable with decay ≥ ``min_decay`` and keeps |S| ≤ ``ms``; else ``full``."""
+    """The lowest-order balanced truncation of ``full`` (its stable part; poles within
+    :data:`ORDER_AXIS_TOL` of the axis kept) that meets every specification on ``omega`` at every
+    plant case, keeps |S| ≤ ``ms`` and is stable with decay ≥ ``min_decay``, each with the margin
+    :data:`ORDER_MARGIN_DB`; else ``full``."""
     from ..closedloop import plant_responses
 
     R = plant_responses(prob.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
     w_speed, w_tower = prob.weights(omega)
     ob = R[("gen_speed", "pitch_cmd")]
+    shrink = 10 ** (-ORDER_MARGIN_DB / 20)
     for n in range(min_order, full.nstates + 1):
         if n < full.nstates:
             try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    cand = ct.balred(full, n, method="truncate")
+                cand = reduction.reduce(full, n, axis_tol=ORDER_AXIS_TOL).controller
             except (ValueError, np.linalg.LinAlgError, ct.ControlArgument):
-                continue
+                continue  # e.g. n below the kept (marginal or unstable) part's order
         else:
             cand = full
         c = siso_response(cand, omega)[:, None]
-        if (np.any(np.abs(closed_map(R, c, 0.0, "tower_base_my")) > w_tower)
-                or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > w_speed)
-                or np.any(np.abs(1 / (1 + c * ob)) > ms)):
+        if (np.any(np.abs(closed_map(R, c, 0.0, "tower_base_my")) > shrink * w_tower)
+                or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > shrink * w_speed)
+                or np.any(np.abs(1 / (1 + c * ob)) > shrink * ms)):
             continue
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
-        if decay >= min_decay:
+        if decay >= min_decay / shrink:
             return cand, n
     return full, full.nstates
