@@ -9,7 +9,7 @@ from .._blas import on_one_blas_thread
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
-           "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
+           "SEARCH_MARGIN_PP", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
 
 
 #: Wind-speed offsets (m/s) of the plant cases a target specification is certified on: the
@@ -32,6 +32,12 @@ HOPELESS_DB = 6.0
 #: Relaxations of the speed map (dB) tried in turn by :func:`specification_for_target` before
 #: its bisection.
 RELAX_LADDER_DB = (0.5, 1.0, 1.5, 2.0, 3.0, 4.5, 6.0, 8.0)
+#: Margin (pp) by which a certificate's promise must exceed the target for the ladder and the
+#: bisections of :func:`specification_for_target` to count it as reaching the target: far
+#: above what moves the promise at a given relaxation between runs or under a 1e-9 m/s step
+#: (~1e-6 pp, the solver's path), so no decision of the search rests on the last digits of a
+#: promise, and the pair returned promises at least the target plus this margin.
+SEARCH_MARGIN_PP = 0.01
 
 
 @dataclass(frozen=True)
@@ -108,7 +114,8 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     generator-speed map: the smallest g whose
     :func:`achievable_pitch` design, with its tower map raised by ``slack_db`` (room for a
     designer's own controller) and by what the neighbouring plant cases need, still promises
-    ``target_reduction`` % DEL (exact Dirlik, 1 Hz). Or, with ``speed_relax_db`` given, the
+    ``target_reduction`` % DEL (exact Dirlik, 1 Hz; by :data:`SEARCH_MARGIN_PP` at least, so
+    that no step of the search is decided by the last digits of a promise). Or, with ``speed_relax_db`` given, the
     other way round: the design at that relaxation and the largest slack that still promises
     the target (the most room for a low-order design).
 
@@ -293,13 +300,14 @@ class CertificateSearch:
             if design is None or rob is None:
                 raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {v:g} m/s over the plant "
                                  f"cases {speeds} m/s")
-            if best < t:
+            if best < t + SEARCH_MARGIN_PP:
                 raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s with the speed map relaxed by "
                                  f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs); relax it more")
             lo_s, hi_s = 0.0, 40.0
             while hi_s - lo_s > tolerance_db:
                 mid = 0.5 * (lo_s + hi_s)
-                lo_s, hi_s = (mid, hi_s) if _slack_promise(design, base, mid + rob[0]) >= t else (lo_s, mid)
+                reaches = _slack_promise(design, base, mid + rob[0]) >= t + SEARCH_MARGIN_PP
+                lo_s, hi_s = (mid, hi_s) if reaches else (lo_s, mid)
             return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t, self.m)
         # a ladder first, then bisection inside the first rung that reaches the target: the promise
         # over the plant cases is not monotone in g (bolder designs are less robust), so a bisection
@@ -309,7 +317,7 @@ class CertificateSearch:
         for g in ladder:
             d, red, rob = self._reached(g, slack)
             best_red = max(best_red, red)
-            if red >= t:
+            if red >= t + SEARCH_MARGIN_PP:
                 found = (g, d, rob)
                 break
             lo_g = g
@@ -322,7 +330,7 @@ class CertificateSearch:
         while hi_g - lo_g > tolerance_db:
             mid = 0.5 * (lo_g + hi_g)
             d, red, rob = self._reached(mid, slack)
-            if red >= t:
+            if red >= t + SEARCH_MARGIN_PP:
                 hi_g, best, best_rob = mid, d, rob
             else:
                 lo_g = mid
