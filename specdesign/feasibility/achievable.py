@@ -15,6 +15,10 @@ __all__ = ["SOLVER_FALLBACK_OPTIONS", "SOLVER_OPTIONS", "YOULA_REAL_POLES", "YOU
 #: (ζ = 0.2) around the tower mode, where the specification is shaped.
 YOULA_REAL_POLES = np.geomspace(0.03, 10.0, 6)
 YOULA_PAIRS = (0.9, 1.02, 1.1, 1.25)
+#: Lowest frequency of the high-frequency gain bound (rad/s) when one is asked for
+#: (``YoulaProblem(max_hf_gain_ratio=...)``): above the tower mode (~1.1 rad/s on the IEA 15 MW,
+#: where the specification asks for pitch action) and below 3P (2.375 rad/s).
+HF_OMEGA = 2.0
 #: Clarabel's stopping tolerances. A gap of 1e-6 on an objective of order 1 moves the promise by
 #: < 1e-5 pp; tighter gaps (1e-7, 1e-8) are reached only after the primal residual of the
 #: near-degenerate |S| cones at the lowest frequencies (S(0) = 0 forces them nearly tight) has
@@ -195,10 +199,18 @@ class YoulaProblem:
         with b given to :meth:`solve` (``tower_bound_db``): the design then meets a given tower
         specification, as when shaping elements are certified
         (:func:`specdesign.feasibility.element_specification`).
+    max_hf_gain_ratio : float, optional
+        κ_hf: bound the controller's high-frequency gain by |Y(jω)| ≤ κ_hf·|C_ROSCO(jω)| on the
+        grid from ``hf_omega`` to its end (10 rad/s by default, 3P included), with Y(∞) = 0 so
+        that C is strictly proper. Y = C·S is C where the loop has rolled off (S → 1), so the
+        bound is on the controller's gain there, and it is convex. None (default): no bound.
+        Its cost on the IEA 15 MW is large (docs/feasibility.md, "A high-frequency gain bound").
+    hf_omega : float, optional
+        Lowest frequency of that bound, rad/s (default :data:`HF_OMEGA`).
     """
 
     def __init__(self, model, wind_speed, *, max_sensitivity=2.0, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
-                 base=None, integral_action=True, tower_bound=False):
+                 base=None, integral_action=True, tower_bound=False, max_hf_gain_ratio=None, hf_omega=None):
         import cvxpy as cp
 
         from .. import spec
@@ -251,6 +263,22 @@ class YoulaProblem:
             p0 = float(np.real(plant["gen_speed", "pitch_cmd"].dcgain()))
             phi0 = np.linalg.solve(self.rr.T, np.real(_youla_basis(np.zeros(1, complex))[0]))
             constraints.append(p0 * (phi0 @ y) == 1.0)
+        self.hf_gain = None
+        if max_hf_gain_ratio is not None:
+            # |Y| ≤ κ·|C_ROSCO| from hf_omega to the grid's end: above the loop's crossover S → 1
+            # and C = Y/S → Y (KS = Y exactly), so this bounds the controller's gain there, and
+            # is convex in Y (one 3-cone per frequency); Y(∞) = 0 makes C strictly proper
+            kappa_hf = positive_scalar(max_hf_gain_ratio, "max_hf_gain_ratio")
+            w_hf = HF_OMEGA if hf_omega is None else positive_scalar(hf_omega, "hf_omega")
+            band = w >= w_hf
+            if not band.any():
+                raise ValueError(f"hf_omega={hf_omega!r} rad/s lies above the grid's end {w[-1]:g} rad/s")
+            self.hf_gain = (kappa_hf, w_hf)
+            c_hf = kappa_hf * np.abs(c_ref[band])
+            yl = phi_o[band] / c_hf[:, None]
+            constraints.append(cp.SOC(np.ones(int(band.sum())), cp.vstack([yl.real @ y, yl.imag @ y]), axis=0))
+            inf_row = np.linalg.solve(self.rr.T, np.eye(phi.shape[1])[0])  # Y(∞) = coef[0] = (R⁻¹y)[0]
+            constraints.append(inf_row @ y == 0.0)
         self.t_bound = None
         if tower_bound:  # |T_MyT|/|T^ROSCO| ≤ 10^(b/20): one 3-cone per frequency, in units of ROSCO's map
             ref = np.abs(base.t_response)
