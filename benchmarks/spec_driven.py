@@ -102,6 +102,17 @@ def main(argv=None):
         "and checks it as any QFT design (exact bounds at the design frequencies, dense checks of both loops, "
         "stability of every case). Pitch only (no ATD).",
         "",
+        "Band: every spectral figure of the design step (promise, linear prediction) counts the variance about "
+        "each 600 s record's mean, S_W·(1 − sinc²(ωT/2)) (`spec.record_window`), on 0.001-10 rad/s (400 points, "
+        "`spec.default_omega`): halving the lowest frequency or doubling the density moves the promise by "
+        "< 0.01 pp at 15 and 19 m/s (tests/test_spectral_band.py). Reproducibility: the certificate search counts "
+        "a relaxation as reaching the target only by `SEARCH_MARGIN_PP` (0.01 pp), the order is the lowest that "
+        "meets every specification by `ORDER_MARGIN_DB` (0.01 dB), and poles within `ORDER_AXIS_TOL` of the axis "
+        "(the integrator) are kept out of the truncation; the designs at 17 − 1e-9 and 23 + 1e-9 m/s equal those "
+        "at 17 and 23 m/s (same order, promise and prediction within 0.01 pp, responses within 1e-6: "
+        "tests/test_reproducible.py). The Table 3 rows below come from `validate` (its own grid from 2π/600 s, "
+        "no window).",
+        "",
         f"## Designs for a {args.target:g} % target",
         "",
     ] + HEADER + rows + [
