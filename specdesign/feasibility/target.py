@@ -3,13 +3,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import control
 import numpy as np
 
 from .._blas import on_one_blas_thread
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
-           "SEARCH_MARGIN_PP", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
+           "SEARCH_MARGIN_PP", "UNSTABLE_POLE_TOL", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
 
 
 #: Wind-speed offsets (m/s) of the plant cases a target specification is certified on: the
@@ -32,6 +33,9 @@ HOPELESS_DB = 6.0
 #: Relaxations of the speed map (dB) tried in turn by :func:`specification_for_target` before
 #: its bisection.
 RELAX_LADDER_DB = (0.5, 1.0, 1.5, 2.0, 3.0, 4.5, 6.0, 8.0)
+#: A certificate's pole p counts as unstable when Re p > UNSTABLE_POLE_TOL·max(1, |p|) (1/s): the
+#: integrator that S(0) = 0 puts at ±1e-16 is not, a pair at 0.013 ± 1.39j (15 m/s) is.
+UNSTABLE_POLE_TOL = 1e-6
 #: Margin (pp) by which a certificate's promise must exceed the target for the ladder and the
 #: bisections of :func:`specification_for_target` to count it as reaching the target: far
 #: above what moves the promise at a given relaxation between runs or under a 1e-9 m/s step
@@ -76,6 +80,11 @@ class TargetSpecification:
     m : float
         Wöhler exponent of the promise (-); :func:`recertify` computes the edited pair's promise
         with it.
+    strict_excess : tuple
+        The pair read strictly: for "W_MyT" and "W_Ω", (label, largest excess dB, its ω rad/s,
+        its case speed m/s) of the certificate's maps at any plant case over the nominal W itself
+        (not the per-case W_i above), on the dense check's grid; > 0 where a plant case exceeds
+        the W the user sees (its resonance moved, its gain changed with its operating point).
     """
 
     tower: object
@@ -89,6 +98,7 @@ class TargetSpecification:
     robustness_db: float = 0.0
     speed_slack_db: float = 0.0
     m: float = 4.0
+    strict_excess: tuple = ()
 
     @property
     def template_offsets(self) -> tuple:
@@ -253,13 +263,22 @@ class CertificateSearch:
 
     def _design(self, g):
         """(design, (tower robustness, speed relaxation needed) dB) at relaxation g, dB; None for
-        what does not exist (no design, or a plant case destabilised)."""
+        what does not exist (no design, an unstable controller, or a plant case destabilised)."""
         if g not in self._designs:
             try:
                 d = self._youla.solve(g)
             except RuntimeError:
                 d = None
-            self._designs[g] = (d, None if d is None else self._cases.excess(d.controller(self.model), self.dense))
+            rob = None
+            if d is not None:
+                controller = d.controller(self.model)
+                # a certificate that is itself unstable (zeros of S in the right half-plane) gives
+                # no implementable design: design_qft refuses such a controller (its loop opens
+                # wherever the pitch saturates), so that relaxation counts as one with no design
+                p = np.asarray(control.ss(controller).poles())
+                if not np.any(p.real > UNSTABLE_POLE_TOL * np.maximum(1.0, np.abs(p))):
+                    rob = self._cases.excess(controller, self.dense)
+            self._designs[g] = (d, rob)
         return self._designs[g]
 
     def _reached(self, g, slack):
@@ -308,7 +327,8 @@ class CertificateSearch:
                 mid = 0.5 * (lo_s + hi_s)
                 reaches = _slack_promise(design, base, mid + rob[0]) >= t + SEARCH_MARGIN_PP
                 lo_s, hi_s = (mid, hi_s) if reaches else (lo_s, mid)
-            return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t, self.m)
+            return self._cases.with_strict(_target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t,
+                                                          self.m), self.dense)
         # a ladder first, then bisection inside the first rung that reaches the target: the promise
         # over the plant cases is not monotone in g (bolder designs are less robust), so a bisection
         # over the whole range could step past the smallest relaxation that works
@@ -334,7 +354,8 @@ class CertificateSearch:
                 hi_g, best, best_rob = mid, d, rob
             else:
                 lo_g = mid
-        return _target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t, self.m)
+        return self._cases.with_strict(_target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t,
+                                                      self.m), self.dense)
 
     def for_tower(self, tower, target_reduction, *, relax_ladder_db=(0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0),
                   max_relax_db=12.0, speed_slack_db=0.2, margin_steps=4) -> TargetSpecification:
@@ -457,7 +478,7 @@ class _Cases:
     def __init__(self, model, speeds, v):
         from ..spec import baseline_controllers
 
-        self.speeds = tuple(speeds)
+        self.model, self.speeds = model, tuple(speeds)
         self.plants = [model.linearize(s) for s in speeds]
         self.rosco = baseline_controllers(model, speeds)  # ROSCO's schedule fitted once for every case
         self.nom = speeds.index(v)
@@ -529,7 +550,10 @@ class _Cases:
         """(tower robustness, speed relaxation needed), dB, or None if a case is unstable.
 
         The tower robustness is the largest excess of a case's |T_MyT|/|T^ROSCO_MyT| over the
-        nominal case's; the speed relaxation the largest |T_Ω|/|T^ROSCO_Ω| (:meth:`_closed`'s grid).
+        nominal case's, and of its |T_MyT| over the nominal |T_MyT|; the speed relaxation the
+        largest |T_Ω|/|T^ROSCO_Ω| of a case over its own ROSCO map and over the nominal one
+        (:meth:`_closed`'s grid). Both readings: the pair raised by these is met at every case
+        both as W_i = T^ROSCO_i·W/T^ROSCO (per case) and as the nominal W itself (read strictly).
         """
         from ..closedloop import closed_map
 
@@ -537,10 +561,28 @@ class _Cases:
         if closed is None:
             return None
         _, R, rt, rs, c = closed
-        ratio = np.abs(closed_map(R, c, 0.0, "tower_base_my")) / rt
-        speed_db = float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / rs)))
-        tower_db = float(20 * np.log10(np.max(ratio / ratio[:, self.nom:self.nom + 1])))
-        return max(tower_db, 0.0), speed_db
+        t = np.abs(closed_map(R, c, 0.0, "tower_base_my"))
+        ratio = t / rt
+        s = np.abs(closed_map(R, c, 0.0, "gen_speed"))
+        speed = max(np.max(s / rs), np.max(s / rs[:, self.nom:self.nom + 1]))
+        tower = max(np.max(ratio / ratio[:, self.nom:self.nom + 1]), np.max(t / t[:, self.nom:self.nom + 1]))
+        return max(float(20 * np.log10(tower)), 0.0), float(20 * np.log10(speed))
+
+    def with_strict(self, record, omega):
+        """``record`` with its :attr:`TargetSpecification.strict_excess` filled in (its certificate
+        against its own nominal pair at every case, on :meth:`_closed`'s grid)."""
+        from dataclasses import replace
+
+        from ..closedloop import closed_map
+
+        w, R, _, _, c = self._closed(record.design.controller(self.model), omega, (record.tower, record.speed))
+        out = []
+        for label, spec_like, name in (("W_MyT", record.tower, "tower_base_my"), ("W_Ω", record.speed, "gen_speed")):
+            excess = 20 * np.log10(np.abs(closed_map(R, c, 0.0, name))
+                                   / np.abs(np.asarray(spec_like.response(w)))[:, None])
+            k, i = np.unravel_index(np.argmax(excess), excess.shape)
+            out.append((label, float(excess[k, i]), float(w[k]), self.speeds[i]))
+        return replace(record, strict_excess=tuple(out))
 
     def spec_excess(self, controller, tower, speed, omega):
         """Where the certificate ``controller`` exceeds the pair (``tower``, ``speed``) over the
@@ -684,5 +726,7 @@ def _checked_record(model, target, cases, tower, speed, w, t0, rs0):
     margin = float(20 * np.log10(np.min(np.abs(np.asarray(tower.response(w))) / t0)))
     base = spec.baseline_analysis(model, design.wind_speed, m=target.m, omega=design.omega)
     relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs0)))
-    return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, design,
-                               target.target_reduction, cases.speeds, target.robustness_db, target.speed_slack_db, target.m)
+    record = TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, design,
+                                 target.target_reduction, cases.speeds, target.robustness_db, target.speed_slack_db,
+                                 target.m)
+    return cases.with_strict(record, w)

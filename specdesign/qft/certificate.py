@@ -69,7 +69,8 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
     specdesign.qft.design.QFTDesign
         The design (``atd_controller`` zero; ``parameters`` holds the order), ``success`` when
         every check passes; ``promise`` is the specification's and ``target_reduction`` its
-        exact DEL promise.
+        exact DEL promise. Every plant case meets its own W_i and the nominal W itself (read
+        strictly); ``options["strict_excess_db"]`` says by how much (dB, tower and speed).
 
     Raises
     ------
@@ -111,7 +112,8 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
         prob.set_design(np.unique(np.r_[prob.wd, sharp]))
     wdense = refine_grid(wdense, roots)
     full = ct.ss(target.design.controller(model))
-    cb, order = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay)
+    strict = (np.abs(np.asarray(target.speed.response(wdense))), np.abs(np.asarray(target.tower.response(wdense))))
+    cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict)
     ca = ct.tf([0.0], [1.0])
     c = siso_response(cb, base.omega)[:, None]
     performance = prob.performance_of(c, np.zeros_like(c))
@@ -122,18 +124,23 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
                            parameters={"order": float(order)},
                            options=dict(structure="certificate", template_offsets=target.template_offsets,
                                         speed_relax_db=target.speed_relax_db, tower_slack_db=target.slack_db,
+                                        strict_excess_db=strict_excess,
                                         max_sensitivity=max_sensitivity, min_decay=min_decay))
 
 
-def _lowest_order(prob, full, omega, min_order, ms, min_decay):
+def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
     """The lowest-order balanced truncation of ``full`` (its stable part; poles within
     :data:`ORDER_AXIS_TOL` of the axis kept) that meets every specification on ``omega`` at every
     plant case, keeps |S| ≤ ``ms`` and is stable with decay ≥ ``min_decay``, each with the margin
-    :data:`ORDER_MARGIN_DB`; else ``full``."""
+    :data:`ORDER_MARGIN_DB`; else ``full``. Each case must meet both its own W_i (ROSCO's map at
+    its speed times the nominal ratio) and the nominal |W| itself, ``strict`` = (|W_Ω|, |W_MyT|) on
+    ``omega``: the one W the user sees, read strictly. Returns (controller, order, (largest
+    excess over the nominal W_MyT, over W_Ω) dB at any case)."""
     from ..closedloop import plant_responses
 
     R = plant_responses(prob.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
     w_speed, w_tower = prob.weights(omega)
+    w_speed, w_tower = np.minimum(w_speed, strict[0][:, None]), np.minimum(w_tower, strict[1][:, None])
     ob = R[("gen_speed", "pitch_cmd")]
     shrink = 10 ** (-ORDER_MARGIN_DB / 20)
     for n in range(min_order, full.nstates + 1):
@@ -153,5 +160,12 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay):
             warnings.simplefilter("ignore")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
         if decay >= min_decay / shrink:
-            return cand, n
-    return full, full.nstates
+            return cand, n, _strict_excess(R, cand, omega, strict)
+    return full, full.nstates, _strict_excess(R, full, omega, strict)
+
+
+def _strict_excess(R, controller, omega, strict):
+    """(largest |T_MyT,w|/|W_MyT|, largest |T_Ω,w|/|W_Ω|) over the plant cases, dB, against the nominal W."""
+    c = siso_response(controller, omega)[:, None]
+    return (float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "tower_base_my")) / strict[1][:, None]))),
+            float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / strict[0][:, None]))))
