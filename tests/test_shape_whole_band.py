@@ -35,7 +35,7 @@ def base25(model):
 
 def test_the_baseline_keeps_its_model_and_operating_point(model, base25):
     assert base25.model is model and base25.wind_speed == 25.0
-    assert base25.extras == {"turbulence_class": "B", "controller": None}
+    assert base25.extras == {"turbulence_class": "B", "controller": None, "record_length": 600.0}
 
 
 def test_bad_whole_band_requests_are_named(model, base25):

@@ -186,7 +186,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     --------
     >>> from specdesign.turbine import iea15mw
     >>> t = specification_for_target(iea15mw(), 19.0, 25.0)
-    >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 5.0)
+    >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 2.0)
     True
     """
     _check_target(target_reduction, slack_db, speed_slack_db)  # at the door, before the plant cases are built
@@ -370,9 +370,8 @@ class CertificateSearch:
         over W_MyT (its own resonance, which no margin moves) ends the rung at once, and three
         such rungs in a row end the search. The speed specification
         is ROSCO's relaxed by what the design needs over the cases plus ``speed_slack_db``.
-        The cases are held to their own W_i = T^ROSCO_i·W/T^ROSCO here (not yet to the nominal
-        W itself, as :func:`specification_for_target` holds them): the record's
-        ``strict_excess`` says by how much a case exceeds the nominal W.
+        The cases are held to their own W_i = T^ROSCO_i·W/T^ROSCO (as everywhere in this
+        module): the record's ``strict_excess`` says by how much a case exceeds the nominal W.
 
         Parameters
         ----------
@@ -410,7 +409,7 @@ class CertificateSearch:
         >>> search = CertificateSearch(iea15mw(), 19.0)
         >>> t = search.for_target(25.0)
         >>> deeper = search.for_tower(t.tower.add(spec.Notch(1.0, 2.0, 0.3)), 25.0)  # 2 dB more at the tower mode
-        >>> bool(deeper.promise.exact_del > t.promise.exact_del)
+        >>> bool(deeper.promise.exact_del > t.promise.exact_del and deeper.speed_relax_db >= t.speed_relax_db - 0.5)
         True
         """
         from .. import spec
@@ -553,12 +552,11 @@ class _Cases:
         """(tower robustness, speed relaxation needed), dB, or None if a case is unstable.
 
         The tower robustness is the largest excess of a case's |T_MyT|/|T^ROSCO_MyT| over the
-        nominal case's, and of its |T_MyT| over the nominal |T_MyT|: W_MyT raised by it is met at
-        every case both as W_i = T^ROSCO_i·W/T^ROSCO (per case) and as the nominal W itself (read
-        strictly). The speed relaxation is the largest |T_Ω|/|T^ROSCO_Ω| of a case over its own
-        ROSCO map (:meth:`_closed`'s grid): W_Ω is read per case, ROSCO's own speed map at each
-        case (ROSCO itself exceeds the nominal one at the neighbouring cases; the strict excess is
-        reported beside it, :attr:`TargetSpecification.strict_excess`).
+        nominal case's; the speed relaxation the largest |T_Ω|/|T^ROSCO_Ω| (:meth:`_closed`'s grid).
+        The pair is read per case, W_i = T^ROSCO_i·W/T^ROSCO: how far a case exceeds the nominal
+        W itself is reported beside it (:attr:`TargetSpecification.strict_excess`). Holding the
+        cases to the nominal W_MyT as well costs, at 19 m/s on the IEA 15 MW, a speed relaxation
+        of 4.42 dB instead of 1.44 dB for a 25 % target, and leaves no 32 % pair at 25 m/s.
         """
         from ..closedloop import closed_map
 
@@ -566,12 +564,10 @@ class _Cases:
         if closed is None:
             return None
         _, R, rt, rs, c = closed
-        t = np.abs(closed_map(R, c, 0.0, "tower_base_my"))
-        ratio = t / rt
-        s = np.abs(closed_map(R, c, 0.0, "gen_speed"))
-        speed = np.max(s / rs)
-        tower = max(np.max(ratio / ratio[:, self.nom:self.nom + 1]), np.max(t / t[:, self.nom:self.nom + 1]))
-        return max(float(20 * np.log10(tower)), 0.0), float(20 * np.log10(speed))
+        ratio = np.abs(closed_map(R, c, 0.0, "tower_base_my")) / rt
+        speed_db = float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / rs)))
+        tower_db = float(20 * np.log10(np.max(ratio / ratio[:, self.nom:self.nom + 1])))
+        return max(tower_db, 0.0), speed_db
 
     def with_strict(self, record, omega):
         """``record`` with its :attr:`TargetSpecification.strict_excess` filled in (its certificate

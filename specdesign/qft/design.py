@@ -134,10 +134,8 @@ class QFTDesign:
         ``speed_relax_db``, ``tower_relax_db``, ``tower_relax_omega``, ``max_sensitivity``,
         ``min_decay``) and ``refine_rounds``; a design from a target specification's certificate
         also ``strict_excess_db``: (largest |T_MyT,w|/|W_MyT|, largest |T_Ω,w|/|W_Ω|) at any plant
-        case against the nominal W itself, dB, on the dense grid (the tower part ≤ −0.01 dB unless
-        the certificate itself was kept: the order is chosen to meet the nominal W_MyT at every
-        case; W_Ω is met per case, ROSCO's own speed map at each case, and its strict excess is
-        reported).
+        case against the nominal W itself, dB, on the dense grid (the cases meet their own W_i =
+        T^ROSCO_i·W/T^ROSCO; this is the pair read strictly, reported beside it).
 
     Examples
     --------
