@@ -68,7 +68,8 @@ def fit_centre():
 def tradeoff(args):
     from matplotlib import use  # noqa: F401  (the Figure below needs no backend)
 
-    from specdesign.mpc.health_report import BLADE_M, TOWER_M, health_tradeoff, plot_tradeoff
+    from specdesign.fatigue import BLADE_M, TOWER_M
+    from specdesign.mpc.health_report import health_tradeoff, plot_tradeoff
 
     m = turbine.iea15mw()
     t0 = time.perf_counter()

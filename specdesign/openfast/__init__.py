@@ -5,8 +5,14 @@
 - :func:`series_from_openfast` (outputs → the workbench's SI series, :data:`OPENFAST_CHANNELS`)
 - :class:`LinearTurbine` (``.lin`` sets at several wind speeds → a model the design loop takes;
   signals by channel description, :data:`DEFAULT_SIGNALS`, :func:`plant_from_linearization`)
+- :func:`find_openfast`, :func:`build_openfast` (the executables: found, or built from source
+  into a cache; :class:`OpenFASTInstall`)
+- :class:`Deck`, :func:`iea15mw_monopile` (the shipped v5.0 deck), :func:`write_case`,
+  :func:`run_case` (case folders written with openfast-io and run in a subprocess)
 """
 from __future__ import annotations
+
+import importlib
 
 _LAZY = {
     "read_linearization": ".lin",
@@ -21,6 +27,18 @@ _LAZY = {
     "rotor_speed_model": ".linear_turbine",
     "DEFAULT_SIGNALS": ".signals",
     "plant_from_linearization": ".signals",
+    "OpenFASTInstall": ".install",
+    "OpenFASTNotFound": ".install",
+    "find_openfast": ".install",
+    "build_openfast": ".install",
+    "check_deck_version": ".install",
+    "Deck": ".deck",
+    "Case": ".deck",
+    "OpenFASTRunError": ".deck",
+    "iea15mw_monopile": ".deck",
+    "write_case": ".deck",
+    "run_case": ".deck",
+    "CAMPAIGN_CHANNELS": ".deck",
 }
 
 __all__ = list(_LAZY)
@@ -28,7 +46,5 @@ __all__ = list(_LAZY)
 
 def __getattr__(name):  # the adapters import openfast-io only when used
     if name in _LAZY:
-        import importlib
-
         return getattr(importlib.import_module(_LAZY[name], __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -7,7 +7,7 @@ shape of such a specification (a ≥ 25 % promise asks for T_{MyT,w} reduced ove
 wind band); the certificate can. :func:`design_from_certificate` balances-and-truncates it
 to the lowest order (from ``min_order`` up) whose loop meets every specification on the
 dense grid over every plant case, then runs the same checks and records the same
-:class:`~specdesign.qft.design.QFTDesign` as the fixed-structure design (exact bounds at the
+:class:`~specdesign.qft.result.QFTDesign` as the fixed-structure design (exact bounds at the
 design frequencies, dense checks of both loops, stability of every case). No ATD (pitch
 only), no tuning, no DEL penalty: the specification carries the target.
 
@@ -21,10 +21,22 @@ from typing import Any
 import control as ct
 import numpy as np
 
+from loopshaping import qft as lqft
 from loopshaping import reduction
 
-from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response
+from ..closedloop import (
+    DESIGN_MAX_SENSITIVITY,
+    closed_loop,
+    closed_map,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+)
+from ..feasibility import TargetSpecification
 from .checks import spec_ratio, spec_roots
+from .result import DEFAULT_DESIGN_OMEGA, assemble_design
+from .tuner import TuningProblem
 
 __all__ = ["ORDER_AXIS_TOL", "ORDER_MARGIN_DB", "design_from_certificate"]
 
@@ -41,7 +53,7 @@ ORDER_AXIS_TOL = 1e-6
 ORDER_MARGIN_DB = 0.01
 
 
-def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_decay: float = 0.02,
+def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MAX_SENSITIVITY, min_decay: float = 0.02,
                             min_order: int = 4, design_omega=None, dense_omega=None) -> Any:
     """QFT design at a target specification's operating point from its certificate.
 
@@ -59,14 +71,14 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
         Lowest controller order tried (states, ≥ 1).
     design_omega : array_like, optional
         QFT design frequencies, rad/s (default
-        :data:`specdesign.qft.design.DEFAULT_DESIGN_OMEGA` plus the specification's sharp features).
+        :data:`specdesign.qft.result.DEFAULT_DESIGN_OMEGA` plus the specification's sharp features).
     dense_omega : array_like, optional
         Grid of the final check, rad/s (default 600 points, 0.005-20 rad/s, refined around the
         lightly damped roots of the specification).
 
     Returns
     -------
-    specdesign.qft.design.QFTDesign
+    specdesign.qft.result.QFTDesign
         The design (``atd_controller`` zero; ``parameters`` holds the order), ``success`` when
         every check passes; ``promise`` is the specification's and ``target_reduction`` its
         exact DEL promise. Every plant case meets its own W_i = T^ROSCO_i·W/T^ROSCO (the
@@ -81,12 +93,7 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
     ValueError
         If ``max_sensitivity`` ≤ 1, ``min_decay`` ≤ 0 or ``min_order`` < 1.
     """
-    from loopshaping import qft as lqft
-
     from .. import spec as sp
-    from ..feasibility import TargetSpecification
-    from .design import DEFAULT_DESIGN_OMEGA, assemble_design
-    from .tuner import TuningProblem
 
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a feasibility.TargetSpecification, got {type(target).__name__}")
@@ -138,8 +145,6 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
     times the nominal ratio). Returns (controller, order, (largest excess over the nominal W_MyT,
     over the nominal W_Ω) dB at any case: the pair read strictly, ``strict`` = (|W_Ω|, |W_MyT|) on
     ``omega``, reported beside it))."""
-    from ..closedloop import plant_responses
-
     R = plant_responses(prob.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
     w_speed, w_tower = prob.weights(omega)
     ob = R[("gen_speed", "pitch_cmd")]
@@ -157,8 +162,8 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
                 or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > shrink * w_speed)
                 or np.any(np.abs(1 / (1 + c * ob)) > shrink * ms)):
             continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
+            warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
         if decay >= min_decay / shrink:
             return cand, n, _strict_excess(R, cand, omega, strict)
