@@ -152,8 +152,9 @@ def test_a_specification_for_a_target_promises_it(model, target19):
     # the promise recomputed independently: Dirlik DEL of |W_MyT|²·S_W against ROSCO's |T|²·S_W
     from specdesign import spectral, wind
 
-    w = np.geomspace(0.01, 10.0, 2000)
-    s_w = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius)
+    w = np.geomspace(0.001, 10.0, 2000)
+    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    s_w = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     t_r = closedloop.t_tower_wind(model.linearize(19.0), rosco_baseline(model, 19.0), w)
     red = 100 * (1 - spectral.del_spectral(w, np.abs(target19.tower.response(w)) ** 2 * s_w, 4.0)
                  / spectral.del_spectral(w, np.abs(t_r) ** 2 * s_w, 4.0))
@@ -283,21 +284,26 @@ def test_a_certificate_search_answers_several_targets_as_specification_for_targe
 
 def test_a_solver_failure_is_a_relaxation_with_no_design_not_a_crash(model, monkeypatch):
     # Clarabel can stop with "insufficient progress" on a design it had nearly solved; cvxpy
-    # raises SolverError for it. The Youla problem says so as its documented RuntimeError, and
+    # raises SolverError for it. The Youla problem then tries its fallback settings
+    # (SOLVER_FALLBACK_OPTIONS); when both fail it says so as its documented RuntimeError, and
     # a certificate search counts that relaxation as one with no design (the ladder goes on).
     import cvxpy as cp
 
     search = fz.CertificateSearch(model, 19.0)
     solve = search._youla.problem.solve
-    calls = []
+    calls, failures = [], [1]
 
     def failing_first(*args, **kwargs):
-        calls.append(1)
-        if len(calls) == 1:
+        calls.append(kwargs)
+        if len(calls) <= len(failures):
             raise cp.error.SolverError("Solver 'CLARABEL' failed.")
         return solve(*args, **kwargs)
 
     monkeypatch.setattr(search._youla.problem, "solve", failing_first)
+    d = search._youla.solve(1.0)  # the first settings fail, the fallback solves it
+    assert d.status == "optimal" and calls[1] == {"solver": cp.CLARABEL, **fz.achievable.SOLVER_FALLBACK_OPTIONS}
+    calls.clear()
+    failures.append(1)  # both settings fail
     with pytest.raises(RuntimeError, match=r"19 m/s: the solver failed"):
         search._youla.solve(1.0)
     calls.clear()

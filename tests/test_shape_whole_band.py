@@ -35,7 +35,7 @@ def base25(model):
 
 def test_the_baseline_keeps_its_model_and_operating_point(model, base25):
     assert base25.model is model and base25.wind_speed == 25.0
-    assert base25.extras == {"turbulence_class": "B", "controller": None}
+    assert base25.extras == {"turbulence_class": "B", "controller": None, "record_length": 600.0}
 
 
 def test_bad_whole_band_requests_are_named(model, base25):
@@ -92,9 +92,10 @@ def test_the_whole_band_specification_at_25_mps_promises_the_target_and_is_met(m
     assert res.success and res.specification is ts.tower
     assert {type(e).__name__ for e in ts.tower.elements} <= {"Gain", "LeadLag", "Notch"}
     # the promise, recomputed independently: Dirlik DEL on |W|²S_W against ROSCO's |T|²S_W
-    w = np.geomspace(0.005, 20.0, 4000)
+    w = np.geomspace(0.0005, 20.0, 4000)
     t_rosco = np.abs(closedloop.t_tower_wind(model.linearize(25.0), rosco_baseline(model, 25.0), w))
-    psd = wind.rotor_effective_spectrum(w, 25.0, model.rotor_radius)
+    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    psd = wind.rotor_effective_spectrum(w, 25.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     del_w = spectral.del_spectral(w, np.abs(ts.tower.response(w)) ** 2 * psd, 4.0)
     del_r = spectral.del_spectral(w, t_rosco**2 * psd, 4.0)
     assert res.promise.exact_del >= 25.0

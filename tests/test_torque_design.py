@@ -48,7 +48,8 @@ def test_closed_loop_map_matches_interconnect(model, design):
 def test_promise_recomputed_independently(model, design):
     # Dirlik on |T|²S_W (interconnect map, wind spectrum from specdesign.wind) vs the open-torque-controller baseline
     w = design.omega
-    s_w = rotor_effective_spectrum(w, 8.0, model.rotor_radius, turbulence_class="B")
+    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    s_w = rotor_effective_spectrum(w, 8.0, model.rotor_radius, turbulence_class="B") * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     base = ct.frequency_response(model.linearize(8.0)["tower_base_my", "wind"], w).complex.ravel()
     closed = ct.frequency_response(_closed_by_interconnect(model, 8.0, design.gain), w).complex.ravel()
     promise = 100 * (1 - del_spectral(w, np.abs(closed) ** 2 * s_w, 4.0) / del_spectral(w, np.abs(base) ** 2 * s_w, 4.0))
@@ -85,8 +86,9 @@ def test_refusals(model):
     # the limit G → ∞ at 8 m/s is ≈ 41.5 % (docs/below_rated.md section 3: DEL Ω held −42 %)
     with pytest.raises(ValueError, match=r"G -> inf \(rotor speed held\) gives 41"):
         qft.design_torque(model, 8.0, target_reduction=45.0)
-    # 25 % costs ≈ 0.84 % power (test above): a 0.5 % budget is refused, naming the loss and the gain
-    with pytest.raises(ValueError, match=r"power loss 0\.8\d % exceeds max_power_loss_pct=0\.5 at k = "):
+    # 25 % costs ≈ 0.69 % power (on the spectrum windowed to 600 s records; 0.84 % on the bare one):
+    # a 0.5 % budget is refused, naming the loss and the gain
+    with pytest.raises(ValueError, match=r"power loss 0\.6\d % exceeds max_power_loss_pct=0\.5 at k = "):
         qft.design_torque(model, 8.0, target_reduction=25.0, max_power_loss_pct=0.5)
     for kw, name in (({"target_reduction": 0.0}, "target_reduction"), ({"target_reduction": float("nan")}, "target_reduction"),
                      ({"max_power_loss_pct": -1.0}, "max_power_loss_pct"), ({"m": 0.0}, "m="),

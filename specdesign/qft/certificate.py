@@ -22,6 +22,7 @@ import control as ct
 import numpy as np
 
 from loopshaping import qft as lqft
+from loopshaping import reduction
 
 from ..closedloop import (
     DESIGN_MAX_SENSITIVITY,
@@ -37,7 +38,19 @@ from .checks import spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, assemble_design
 from .tuner import TuningProblem
 
-__all__ = ["design_from_certificate"]
+__all__ = ["ORDER_AXIS_TOL", "ORDER_MARGIN_DB", "design_from_certificate"]
+
+#: A pole p of the certificate counts as stable, and is balanced-truncated, only if
+#: Re p < −ORDER_AXIS_TOL·max(1, |p|); the rest (the integrator S(0) = 0 puts at ±1e-16 rad/s)
+#: is kept exactly (:func:`loopshaping.reduction.reduce`). Deciding by the sign of a pole at
+#: ±1e-16 (python-control's ``balred``) truncated the integrator at one speed and kept it at
+#: the speed 1e-9 m/s away: order 19 at 23 m/s, 12 at 23 + 1e-9 m/s.
+ORDER_AXIS_TOL = 1e-6
+#: Margin (dB) by which a reduced controller must meet every specification and the M_s bound
+#: on the dense grid over every plant case to be chosen, and relative margin on the decay
+#: rate: the lowest order that meets them by less is not chosen, so that an order that meets
+#: them by a hair at one operating point and misses by a hair 1e-9 m/s away does not decide.
+ORDER_MARGIN_DB = 0.01
 
 
 def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MAX_SENSITIVITY, min_decay: float = 0.02,
@@ -68,7 +81,10 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
     specdesign.qft.result.QFTDesign
         The design (``atd_controller`` zero; ``parameters`` holds the order), ``success`` when
         every check passes; ``promise`` is the specification's and ``target_reduction`` its
-        exact DEL promise.
+        exact DEL promise. Every plant case meets its own W_i = T^ROSCO_i·W/T^ROSCO (the
+        specification at that case's speed); ``options["strict_excess_db"]`` gives the largest
+        excess of any case over the nominal W_MyT and W_Ω themselves (dB, the pair read strictly:
+        > 0 where a case exceeds the W the user sees).
 
     Raises
     ------
@@ -105,7 +121,8 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
         prob.set_design(np.unique(np.r_[prob.wd, sharp]))
     wdense = refine_grid(wdense, roots)
     full = ct.ss(target.design.controller(model))
-    cb, order = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay)
+    strict = (np.abs(np.asarray(target.speed.response(wdense))), np.abs(np.asarray(target.tower.response(wdense))))
+    cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict)
     ca = ct.tf([0.0], [1.0])
     c = siso_response(cb, base.omega)[:, None]
     performance = prob.performance_of(c, np.zeros_like(c))
@@ -116,33 +133,45 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
                            parameters={"order": float(order)},
                            options=dict(structure="certificate", template_offsets=target.template_offsets,
                                         speed_relax_db=target.speed_relax_db, tower_slack_db=target.slack_db,
+                                        strict_excess_db=strict_excess,
                                         max_sensitivity=max_sensitivity, min_decay=min_decay))
 
 
-def _lowest_order(prob, full, omega, min_order, ms, min_decay):
-    """The lowest-order balanced truncation of ``full`` that meets every specification on ``omega``
-    at every plant case, is stable with decay ≥ ``min_decay`` and keeps |S| ≤ ``ms``; else ``full``."""
+def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
+    """The lowest-order balanced truncation of ``full`` (its stable part; poles within
+    :data:`ORDER_AXIS_TOL` of the axis kept) that meets every specification on ``omega`` at every
+    plant case, keeps |S| ≤ ``ms`` and is stable with decay ≥ ``min_decay``, each with the margin
+    :data:`ORDER_MARGIN_DB`; else ``full``. Each case meets its own W_i (ROSCO's map at its speed
+    times the nominal ratio). Returns (controller, order, (largest excess over the nominal W_MyT,
+    over the nominal W_Ω) dB at any case: the pair read strictly, ``strict`` = (|W_Ω|, |W_MyT|) on
+    ``omega``, reported beside it))."""
     R = plant_responses(prob.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
     w_speed, w_tower = prob.weights(omega)
     ob = R[("gen_speed", "pitch_cmd")]
+    shrink = 10 ** (-ORDER_MARGIN_DB / 20)
     for n in range(min_order, full.nstates + 1):
         if n < full.nstates:
             try:
-                with warnings.catch_warnings():  # python-control's and SLICOT's notes on the reduction
-                    warnings.filterwarnings("ignore", category=UserWarning, module=r"(control|slycot)\.")
-                    cand = ct.balred(full, n, method="truncate")
+                cand = reduction.reduce(full, n, axis_tol=ORDER_AXIS_TOL).controller
             except (ValueError, np.linalg.LinAlgError, ct.ControlArgument):
-                continue
+                continue  # e.g. n below the kept (marginal or unstable) part's order
         else:
             cand = full
         c = siso_response(cand, omega)[:, None]
-        if (np.any(np.abs(closed_map(R, c, 0.0, "tower_base_my")) > w_tower)
-                or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > w_speed)
-                or np.any(np.abs(1 / (1 + c * ob)) > ms)):
+        if (np.any(np.abs(closed_map(R, c, 0.0, "tower_base_my")) > shrink * w_tower)
+                or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > shrink * w_speed)
+                or np.any(np.abs(1 / (1 + c * ob)) > shrink * ms)):
             continue
         with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
             warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
-        if decay >= min_decay:
-            return cand, n
-    return full, full.nstates
+        if decay >= min_decay / shrink:
+            return cand, n, _strict_excess(R, cand, omega, strict)
+    return full, full.nstates, _strict_excess(R, full, omega, strict)
+
+
+def _strict_excess(R, controller, omega, strict):
+    """(largest |T_MyT,w|/|W_MyT|, largest |T_Ω,w|/|W_Ω|) over the plant cases, dB, against the nominal W."""
+    c = siso_response(controller, omega)[:, None]
+    return (float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "tower_base_my")) / strict[1][:, None]))),
+            float(20 * np.log10(np.max(np.abs(closed_map(R, c, 0.0, "gen_speed")) / strict[0][:, None]))))

@@ -129,7 +129,10 @@ class QFTDesign:
     options : dict
         The options the design was made with (``spec_reduction``, ``template_offsets``,
         ``speed_relax_db``, ``tower_relax_db``, ``tower_relax_omega``, ``max_sensitivity``,
-        ``min_decay``) and ``refine_rounds``.
+        ``min_decay``) and ``refine_rounds``; a design from a target specification's certificate
+        also ``strict_excess_db``: (largest |T_MyT,w|/|W_MyT|, largest |T_Ω,w|/|W_Ω|) at any plant
+        case against the nominal W itself, dB, on the dense grid (the cases meet their own W_i =
+        T^ROSCO_i·W/T^ROSCO; this is the pair read strictly, reported beside it).
 
     Examples
     --------

@@ -1,0 +1,40 @@
+"""Issue 28 item 4: the default (transfer-function) design path is reproducible under 1e-9 m/s.
+
+At 17 and 17 − 1e-9 m/s, and at 23 and 23 + 1e-9 m/s (the two cases the issue measured: the
+promise moved by 7.9 pp and the controller order by 7 states), ``design_qft(model, v, 25.0)``
+must give the same controller order, promise and prediction within 0.01 pp, and pitch
+controllers whose responses agree to 1e-6 relative. What a 1e-9 m/s step may legitimately
+change is ~1e-9 relative (the plant is smooth in the wind speed); the interior-point solver's
+path amplifies it to ~1e-8-1e-7 relative, which sets the tolerance's margin.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from specdesign.closedloop import siso_response
+from specdesign.qft import design_qft
+from specdesign.turbine import iea15mw
+
+
+@pytest.fixture(scope="module")
+def model():
+    return iea15mw()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("v, nudged", [(17.0, 17.0 - 1e-9), (23.0, 23.0 + 1e-9)])
+def test_a_nudged_wind_speed_gives_the_same_design(model, v, nudged):
+    a, b = design_qft(model, v, 25.0), design_qft(model, nudged, 25.0)
+    assert a.success and b.success
+    assert b.parameters["order"] == a.parameters["order"]
+    assert abs(b.promise.exact_del - a.promise.exact_del) <= 0.01
+    assert abs(b.del_reduction - a.del_reduction) <= 0.01
+    assert b.options["speed_relax_db"] == pytest.approx(a.options["speed_relax_db"], abs=1e-6)
+    # over the control band and 3P up to 10 rad/s, relative to |C| at each frequency except
+    # within the dips of C (|C| < 1 % of its peak), where the ratio measures how well a dip's depth
+    # is conditioned rather than the controller; there the error is bounded relative to the peak
+    w = np.geomspace(0.005, 10.0, 800)
+    ca, cb = siso_response(a.pitch_controller, w), siso_response(b.pitch_controller, w)
+    floor = 1e-2 * np.max(np.abs(ca))
+    assert np.max(np.abs(cb - ca) / np.maximum(np.abs(ca), floor)) <= 1e-6
