@@ -37,7 +37,7 @@ from loopshaping import controller as lc
 from loopshaping.controller import Controller, Element
 
 from . import closedloop, spectral, turbine, wind
-from ._checks import as_omega, as_psd, positive_scalar
+from ._checks import as_omega, as_psd, positive_scalar, real_scalar
 from .closedloop import siso_response
 from .fatigue import TOWER_M
 from .rosco import rosco_baseline, rosco_gain_schedule
@@ -49,6 +49,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "SLSQP_OPTIONS",
+    "check_shaping_request",
     "Notch",
     "Gain",
     "LeadLag",
@@ -1043,6 +1044,48 @@ def _notch_mag2(omega, params):
     return np.prod(np.abs(n) ** 2, axis=0)
 
 
+def check_shaping_request(base: Baseline, target_reduction: float, quantity: str) -> float:
+    """The door checks shared by the shapers (:func:`shape_to_target` and
+    :func:`specdesign.feasibility.shape_whole_band`): the target as a float.
+
+    Parameters
+    ----------
+    base : Baseline
+        The baseline to shape.
+    target_reduction : float
+        Requested reduction, % (strictly between 0 and 100).
+    quantity : {"damage", "del"}
+        What the target is a reduction of.
+
+    Returns
+    -------
+    float
+        ``target_reduction``.
+
+    Raises
+    ------
+    TypeError
+        If ``base`` is not a :class:`Baseline` or the target is not a real number.
+    ValueError
+        If ``quantity`` is unknown or the target is not in (0, 100).
+
+    Examples
+    --------
+    >>> from specdesign.spec import baseline_analysis, check_shaping_request
+    >>> from specdesign.turbine import iea15mw
+    >>> check_shaping_request(baseline_analysis(iea15mw(), 19.0), 25, "del")
+    25.0
+    """
+    if not isinstance(base, Baseline):
+        raise TypeError(f"base must be a Baseline (see baseline_analysis), got {type(base).__name__}")
+    if quantity not in ("damage", "del"):
+        raise ValueError(f"quantity={quantity!r} must be 'damage' or 'del'")
+    t = real_scalar(target_reduction, "target_reduction")
+    if not 0 < t < 100:
+        raise ValueError(f"target_reduction={target_reduction!r} must be a percentage strictly between 0 and 100")
+    return t
+
+
 def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", keep_below: float = 0.6,
                     n_notches: int | None = None, max_notches: int = 3, max_depth_db: float = 30.0,
                     width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5) -> ShapingResult:
@@ -1112,13 +1155,7 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
     """
     from scipy.optimize import minimize
 
-    if not isinstance(base, Baseline):
-        raise TypeError(f"base must be a Baseline (see baseline_analysis), got {type(base).__name__}")
-    if quantity not in ("damage", "del"):
-        raise ValueError(f"quantity={quantity!r} must be 'damage' or 'del'")
-    t = float(target_reduction)
-    if not 0 < t < 100:
-        raise ValueError(f"target_reduction={target_reduction!r} must be a percentage strictly between 0 and 100")
+    t = check_shaping_request(base, target_reduction, quantity)
     omega = base.omega
     keep_below = float(keep_below)
     if not omega[0] <= keep_below < omega[-1]:

@@ -79,18 +79,12 @@ def shape_whole_band(base: Baseline, target_reduction: float, *, quantity: str =
     (True, (24.0, 24.5, 25.0))
     """
     from ..spec import (  # heavy: python-control (feasibility loads without it)
-        Baseline,
         Notch,
         ShapingResult,
+        check_shaping_request,
     )
 
-    if not isinstance(base, Baseline):
-        raise TypeError(f"base must be a Baseline (see baseline_analysis), got {type(base).__name__}")
-    if quantity not in ("damage", "del"):
-        raise ValueError(f"quantity={quantity!r} must be 'damage' or 'del'")
-    t = float(target_reduction)
-    if not 0 < t < 100:
-        raise ValueError(f"target_reduction={target_reduction!r} must be a percentage strictly between 0 and 100")
+    t = check_shaping_request(base, target_reduction, quantity)
     why = ["it carries no model (make it with baseline_analysis(model, v))" if base.model is None else "",
            f"its output is {base.output!r}, not 'tower_base_my'" if base.output != "tower_base_my" else "",
            "it was made with another controller than ROSCO's" if base.extras.get("controller") is not None else "",

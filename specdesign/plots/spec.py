@@ -117,7 +117,7 @@ class NotchExplorer:
     >>> explorer = NotchExplorer(baseline_analysis(iea15mw(), 19.0))
     >>> p = explorer.update(1.0, 6.0, 0.2, redraw=False)
     >>> print(f"damage −{p.exact_damage:.1f} %")
-    damage −28.4 %
+    damage −28.1 %
     """
 
     def __init__(self, base: Baseline, notch: Notch | None = None, *, checker: Any = None,

@@ -258,11 +258,24 @@ class TowerDamper:
             object.__setattr__(self, k, positive_scalar(getattr(self, k), k))
 
     def controller(self) -> control.TransferFunction:
-        """C_atd(s) = −K·s/(s + ω_c) on tower-top velocity (m/s → rad; β −= C_atd·ẋ_top)."""
+        """C_atd(s) = −K·s/(s + ω_c) on tower-top velocity (m/s → rad; β −= C_atd·ẋ_top).
+
+        Returns
+        -------
+        control.TransferFunction
+            The damper as the workbench's ATD controller (input ``tower_top_vel``, output
+            ``pitch_cmd``).
+        """
         return control.tf([-self.gain, 0.0], [1.0, self.hpf_corner], inputs="tower_top_vel", outputs="pitch_cmd")
 
     def discon_values(self) -> dict:
-        """The DISCON.IN entries that switch ROSCO's damper on with this gain (for ``write_discon``)."""
+        """The DISCON.IN entries that switch ROSCO's damper on with this gain (for ``write_discon``).
+
+        Returns
+        -------
+        dict
+            ``TD_Mode``, ``FA_KI`` (rad·s/m), ``FA_HPFCornerFreq`` (rad/s), ``FA_IntSat`` (rad).
+        """
         return {"TD_Mode": 1, "FA_KI": self.gain, "FA_HPFCornerFreq": self.hpf_corner, "FA_IntSat": self.int_sat}
 
 
@@ -307,6 +320,15 @@ def tower_mode_damping(model: TurbineModel | None, wind_speed: float, damper: To
     On the linearisation at ``wind_speed`` (m/s), the speed loop closed with
     :func:`rosco_baseline`, the damper's gain raised from 0 in small steps with the tower
     pole followed from the fixed-pitch plant's (so the mode is the tower's, not the PI's).
+
+    Parameters
+    ----------
+    model : TurbineModel or None
+        The turbine (default :func:`specdesign.turbine.iea15mw`).
+    wind_speed : float
+        Operating point, m/s.
+    damper : TowerDamper or None
+        The damper (None: ROSCO without one).
 
     Returns
     -------
