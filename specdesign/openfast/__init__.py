@@ -5,6 +5,8 @@
 - :func:`series_from_openfast` (outputs → the workbench's SI series, :data:`OPENFAST_CHANNELS`)
 - :class:`LinearTurbine` (``.lin`` sets at several wind speeds → a model the design loop takes;
   signals by channel description, :data:`DEFAULT_SIGNALS`, :func:`plant_from_linearization`)
+- :func:`linearize_deck` (a deck → OpenFAST trim-and-linearise runs at several wind speeds →
+  :class:`LinearTurbine`; :func:`write_linearization_case` writes one case)
 """
 from __future__ import annotations
 
@@ -21,6 +23,9 @@ _LAZY = {
     "rotor_speed_model": ".linear_turbine",
     "DEFAULT_SIGNALS": ".signals",
     "plant_from_linearization": ".signals",
+    "linearize_deck": ".linearize",
+    "write_linearization_case": ".linearize",
+    "LinearizationCase": ".linearize",
 }
 
 __all__ = list(_LAZY)
