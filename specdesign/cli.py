@@ -76,6 +76,11 @@ def main(argv: list[str] | None = None) -> int:
     val = sub.add_parser("validate", help="run an offline validation campaign described by a TOML/JSON file")
     val.add_argument("config", help="TOML or JSON campaign file (schema: docs/validation.md)")
     val.add_argument("--out", default=None, help="output folder (default: from the config file)")
+    ofa = sub.add_parser("openfast", help="build OpenFAST and TurbSim from source, or show the ones found")
+    ofa.add_argument("action", choices=("build", "find"), help="build: from SOURCE into the cache; find: print the executables")
+    ofa.add_argument("source", nargs="?", help="build: an OpenFAST source tarball or folder")
+    ofa.add_argument("--source-version", default=None, help="build: the source's version X.Y.Z (default: from its name)")
+    ofa.add_argument("--cache", default=None, help="build cache (default: $SPECDESIGN_OPENFAST_CACHE or ~/.cache/specdesign/openfast)")
     args = parser.parse_args(argv)
     _choose_backend()
     try:
@@ -99,6 +104,8 @@ def main(argv: list[str] | None = None) -> int:
                                   design_speeds=_speeds_arg(args.design_speeds, LIFETIME_DESIGN_SPEEDS))
             else:
                 run_demo(out=args.out, fast=args.fast, method=args.method)
+        elif args.command == "openfast":
+            _openfast_command(args)
         else:
             run_config(args.config, out=args.out, echo=True)
     except (ConfigError, OSError) as e:
@@ -117,6 +124,22 @@ def main(argv: list[str] | None = None) -> int:
 _DESCRIPTION = ("Fatigue-based pitch-controller design: 'specdesign demo' runs the 19 m/s design loop, "
                 "'specdesign validate CONFIG' reruns an offline validation campaign from a TOML/JSON file "
                 "(also 'python -m specdesign').")
+
+
+def _openfast_command(args) -> None:
+    """``specdesign openfast build SOURCE`` / ``specdesign openfast find``: the executables' paths and version on stdout."""
+    from specdesign.openfast.install import build_openfast, find_openfast
+
+    if args.action == "build":
+        if args.source is None:
+            raise ConfigError("openfast build needs SOURCE: an OpenFAST source tarball or folder")
+        try:
+            found = build_openfast(args.source, cache=args.cache, version=args.source_version)
+        except (ValueError, RuntimeError) as e:  # a bad source or missing tools: the message says which
+            raise ConfigError(str(e)) from None
+    else:
+        found = find_openfast(require_turbsim=False)
+    print(f"openfast {found.openfast}\nturbsim {found.turbsim}\nversion {found.version}")
 
 
 def _speeds_arg(text, default):

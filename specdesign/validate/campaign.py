@@ -244,7 +244,8 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                  record_dt: float = 0.1, transient: float = 60.0, m: float = 4.0, predict: bool = True,
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
                  volterra: int = 0, executor=None, progress: bool | None = None,
-                 nperseg: int | None = None, store=None, torque_control="auto") -> Campaign:
+                 nperseg: int | None = None, store=None, torque_control="auto", plant=None,
+                 openfast: Mapping | None = None) -> Campaign:
     """Run every controller at every wind speed on the same seeds and post-process.
 
     Parameters
@@ -311,7 +312,8 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         runs already there and simulates only the missing ones: an interrupted campaign
         resumes, and one given more seeds, speeds or controllers runs only those. The
         result is bitwise that of an uninterrupted run. A store holding other settings,
-        another model or another controller under the same name is refused.
+        another model or another controller under the same name is refused. With an
+        OpenFAST ``plant``: the campaign folder (a folder per run, resumable).
     torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, default "auto"
         Generator torque of the simulations (:func:`specdesign.simulate.simulate`): "auto"
         runs the model's torque law below rated and holds the trim torque above; "rosco"
@@ -319,6 +321,16 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         ROSCO does: docs/validation.md "Below rated"). Callable controllers command the
         torque themselves: they run with "auto" (or None when None is asked). The linear
         twin and the predictions use the linearisation (the law closed below rated).
+    plant : specdesign.openfast.Deck, optional
+        Run the campaign in OpenFAST on this deck instead of the reduced ``model``
+        (:func:`specdesign.validate.openfast_campaign.run_openfast_campaign`: TurbSim winds per
+        speed and seed, compiled Bladed-interface controllers, OpenFAST processes in
+        parallel). ``duration``, ``transient``, ``record_dt``, ``m``, ``turbulence_class``,
+        ``keep_series``, ``nperseg``, ``progress`` and ``store`` keep their meaning; ``dt``
+        is the deck's; the predictions are NaN.
+    openfast : dict, optional
+        With ``plant``: further options of ``run_openfast_campaign`` (``processes``,
+        ``grid_points``, ``hydro``, ``timeout``, ``nice``, ``install``, ``dt``).
 
     Returns
     -------
@@ -337,6 +349,13 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     """
     if not isinstance(controllers, dict) or not controllers:
         raise TypeError("controllers must be a non-empty dict {name: controller}")
+    if plant is not None:
+        from .openfast_campaign import run_openfast_campaign  # openfast-io and the executables: only when asked
+
+        return run_openfast_campaign(controllers, wind_speeds, seeds, deck=plant, duration=duration, transient=transient,
+                                     record_dt=record_dt, m=m, turbulence_class=turbulence_class,
+                                     keep_series=keep_series, nperseg=nperseg, progress=progress, folder=store,
+                                     **dict(openfast or {}))
     if model is None:
         from .. import turbine
 

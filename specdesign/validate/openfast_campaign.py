@@ -1,0 +1,389 @@
+"""Campaigns in OpenFAST: controllers × wind speeds × seeds on a deck, TurbSim winds, OpenFAST
+processes in parallel, one folder per run (resumable), the same :class:`Campaign` record as
+on the reduced model.
+
+:func:`specdesign.validate.run_campaign` dispatches here when given
+``plant=specdesign.openfast.Deck(...)``.
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import hashlib
+import json
+import os
+import sys
+import tempfile
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, write_case
+from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
+from ..openfast.series import series_from_openfast
+from ..openfast.turbsim import TURBSIM_GRID, turbsim_field
+from ._point import SPECTRA
+from .campaign import Campaign, seeds_from
+from .metrics import INDICATORS, indicators
+from .stats import welch_psd
+
+__all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES"]
+
+#: OpenFAST channel → workbench series of an OpenFAST campaign (SI after reading).
+OPENFAST_SERIES = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power",
+                   "RootMyb1": "blade_root_my"}
+
+
+@dataclass(frozen=True)
+class DisconController:
+    """A Bladed-interface controller as OpenFAST's ServoDyn runs it: a library and its parameter file.
+
+    Parameters
+    ----------
+    library : pathlib.Path
+        The compiled ``DISCON`` library.
+    parameters : pathlib.Path
+        The file it reads at initialisation (ServoDyn's ``DLL_InFile``).
+    """
+
+    library: Path
+    parameters: Path
+
+
+def as_discon(controller) -> DisconController:
+    """A campaign controller as a :class:`DisconController`.
+
+    Parameters
+    ----------
+    controller : object
+        One with ``library`` and ``parameters`` (an exported design,
+        ``specdesign.export.export_discon``'s record), a ``specdesign.rosco.Discon``
+        (``library`` and ``discon_in``), or a path to a ROSCO ``DISCON.IN`` (run with the
+        ``rosco`` package's library).
+
+    Returns
+    -------
+    DisconController
+        The library and parameter file, both existing.
+
+    Raises
+    ------
+    TypeError
+        Anything else (e.g. an LTI controller: OpenFAST runs compiled controllers; export it
+        with ``specdesign.export.export_discon`` first).
+    FileNotFoundError
+        The library or parameter file does not exist.
+    """
+    if isinstance(controller, (str, Path)):
+        from ..rosco.discon import rosco_library  # the rosco package is optional
+
+        lib, par = rosco_library(), Path(controller)
+    elif hasattr(controller, "library") and hasattr(controller, "parameters"):
+        lib, par = Path(controller.library), Path(controller.parameters)
+    elif hasattr(controller, "library") and hasattr(controller, "discon_in"):
+        lib, par = Path(controller.library), Path(controller.discon_in)
+    else:
+        raise TypeError(f"an OpenFAST campaign runs Bladed-interface controllers: an object with .library and "
+                        f".parameters (specdesign.export.export_discon), a specdesign.rosco.Discon or a DISCON.IN "
+                        f"path; got {type(controller).__name__} (export it with export_discon first)")
+    for key, p in (("library", lib), ("parameters", par)):
+        if not p.is_file():
+            raise FileNotFoundError(f"controller {key} {p} does not exist")
+    return DisconController(lib.resolve(), par.resolve())
+
+
+def _sha(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+
+
+def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Deck, duration: float = 600.0,
+                          transient: float = 60.0, dt: float | None = None, record_dt: float = 0.05, m: float = 4.0,
+                          folder=None, processes: int | None = None, progress: bool | None = None,
+                          turbulence_class: str = "B", grid_points: int = TURBSIM_GRID["points"],
+                          grid_size: float = TURBSIM_GRID["size"], hydro: bool = True, keep_series: bool | int = False,
+                          nperseg: int | None = None, install: OpenFASTInstall | None = None,
+                          timeout: float | None = None, nice: int = 0, initial_conditions: bool = True) -> Campaign:
+    """Run every controller at every wind speed and seed in OpenFAST with TurbSim winds.
+
+    Every run is a folder ``<folder>/<controller>/<speed>mps_seed<seed>/`` holding the case
+    OpenFAST ran and ``result.npz`` (indicators, Welch spectra, the kept series) with
+    ``run.json`` (what it ran: settings, controller files' digests, TurbSim seeds). Run again
+    with the same folder, the finished runs are read back and only the missing ones run: an
+    interrupted campaign resumes. A folder holding a run of other settings or another
+    controller under the same name is refused. A failed run (OpenFAST error, timeout,
+    TurbSim failure) is reported with its case, seed and the tail of OpenFAST's message, in
+    a warning and in ``<folder>/failures.txt``; its values are NaN, its (controller, speed)
+    is flagged ``unstable``, and the other runs are kept.
+
+    Parameters
+    ----------
+    controllers : dict
+        Name → Bladed-interface controller (:func:`as_discon`: an exported design's record, a
+        ``specdesign.rosco.Discon``, or a ROSCO ``DISCON.IN`` path).
+    wind_speeds : array_like
+        Mean hub-height wind speeds (m/s).
+    seeds : int or sequence of int
+        :func:`~specdesign.validate.seeds_from`; TurbSim's seed is
+        ``specdesign.wind.seed_for(speed, seed)``, the same field for every controller.
+    deck : Deck
+        The OpenFAST deck (e.g. ``specdesign.openfast.iea15mw_monopile()``).
+    duration : float, default 600.0
+        Recorded time per run (s).
+    transient : float, default 60.0
+        Time simulated first and discarded (s).
+    dt : float, optional
+        OpenFAST's time step (s); default the deck's.
+    record_dt : float, default 0.05
+        Output spacing (s), a multiple of the time step.
+    m : float, default 4.0
+        Wöhler exponent of the tower-base DEL (the blade-root DEL uses m = 10).
+    folder : str or os.PathLike, optional
+        The campaign folder (resumable); default a temporary folder deleted at the end.
+    processes : int, optional
+        OpenFAST (and TurbSim) processes at a time; default the number of CPUs.
+    progress : bool, optional
+        A tqdm bar over the runs; None → only when stderr is a terminal.
+    turbulence_class : {"A", "B", "C"}, default "B"
+        IEC NTM class of the TurbSim winds.
+    grid_points, grid_size : int, float
+        TurbSim grid (:data:`specdesign.openfast.turbsim.TURBSIM_GRID`).
+    hydro : bool, default True
+        SeaState and HydroDyn on (as the deck has them).
+    keep_series : bool or int, default False
+        Keep the recorded series of the first k seeds (True: all) in ``Campaign.series``.
+    nperseg : int, optional
+        Welch segment length (:func:`~specdesign.validate.welch_psd`).
+    install : OpenFASTInstall, optional
+        The executables; default :func:`specdesign.openfast.find_openfast`.
+    timeout : float, optional
+        Wall-clock limit per OpenFAST run (s); default :func:`specdesign.openfast.run_case`'s.
+    nice : int, default 0
+        Niceness added to the OpenFAST processes.
+    initial_conditions : bool, default True
+        Start each run at the reduced IEA 15 MW model's trim (pitch, rotor speed) when the
+        deck is an IEA-15-240-RWT deck: a shorter start-up transient.
+
+    Returns
+    -------
+    Campaign
+        Indicators (C, W, S), seed-averaged Welch spectra; ``predicted_del`` and
+        ``predicted_psd`` are NaN (compiled controllers have no linear form here: take the
+        prediction from the design).
+
+    Raises
+    ------
+    TypeError
+        ``controllers`` is not a non-empty dict, or holds a controller OpenFAST cannot run.
+    ValueError
+        Bad seeds, durations or steps, a deck of another OpenFAST version than the
+        executable's, a folder holding another campaign's runs.
+    """
+    if not isinstance(controllers, dict) or not controllers:
+        raise TypeError("controllers must be a non-empty dict {name: controller}")
+    if not isinstance(deck, Deck):
+        raise TypeError(f"deck must be a specdesign.openfast.Deck, got {type(deck).__name__}")
+    discon = {str(n): as_discon(c) for n, c in controllers.items()}
+    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    seeds = seeds_from(seeds)
+    for key, val in (("duration", duration), ("record_dt", record_dt)):
+        if not val > 0:
+            raise ValueError(f"{key}={val!r} must be positive (s)")
+    if not transient >= 0:
+        raise ValueError(f"transient={transient!r} must be ≥ 0 (s)")
+    install = install or find_openfast()
+    check_deck_version(install, deck.version, deck.fst)
+    n_keep = len(seeds) if keep_series is True else int(keep_series)
+    settings = {"deck": str(deck.fst), "deck_sha": _sha(deck.fst), "duration": float(duration),
+                "transient": float(transient), "dt": dt, "record_dt": float(record_dt), "m": float(m),
+                "turbulence_class": turbulence_class, "grid_points": int(grid_points), "grid_size": float(grid_size),
+                "hydro": bool(hydro), "openfast": install.version, "initial_conditions": bool(initial_conditions),
+                "nperseg": None if nperseg is None else int(nperseg)}
+    trim = _trim(deck) if initial_conditions else None
+    tmp = None
+    if folder is None:
+        tmp = tempfile.TemporaryDirectory(prefix="specdesign_openfast_")
+        folder = tmp.name
+    root = Path(folder).expanduser().resolve()
+    root.mkdir(parents=True, exist_ok=True)
+    runs = [(n, float(v), int(s)) for v in vs for s in seeds for n in discon]
+    results, todo = {}, []
+    for run in runs:
+        meta = _meta(run, discon[run[0]], settings)
+        done = _load(root, run, meta)
+        if done is not None:
+            results[run] = done
+        else:
+            todo.append((run, meta))
+    show = sys.stderr.isatty() if progress is None else bool(progress)
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=len(runs), initial=len(results), desc="OpenFAST", unit="run", disable=not show)
+    failures = {}
+    kept = set(seeds[:n_keep].tolist())
+
+    def one(run, meta):
+        name, v, s = run
+        wind = turbsim_field(v, s, length=transient + duration, grid_points=grid_points, grid_size=grid_size,
+                             turbulence_class=turbulence_class, install=install)
+        c = discon[name]
+        init = trim(v) if trim is not None else (None, None)
+        case = write_case(deck, _run_folder(root, run), tmax=transient + duration, wind_speed=v, wind_file=wind.path,
+                          seed=s, library=c.library, parameters=c.parameters, dt=dt, dt_out=record_dt,
+                          channels=CAMPAIGN_CHANNELS, initial_pitch=init[0], initial_rotor_speed=init[1],
+                          hydro=hydro, name=f"{_slug(name)}_{v:g}mps_seed{s}")
+        out = run_case(case, install, timeout=timeout, nice=nice)
+        return _post(case, out, settings, meta, keep=s in kept, wind=wind)
+
+    try:
+        with cf.ThreadPoolExecutor(processes or _cpus()) as pool:  # threads wait on OpenFAST processes
+            futs = {pool.submit(one, run, meta): run for run, meta in todo}
+            try:
+                for f in cf.as_completed(futs):
+                    run = futs[f]
+                    try:
+                        results[run] = f.result()
+                    except (OpenFASTRunError, RuntimeError, ValueError, OSError) as e:
+                        failures[run] = str(e)
+                    bar.update(1)
+            except BaseException:
+                for f in futs:
+                    f.cancel()
+                raise
+    finally:
+        bar.close()
+    if failures:
+        text = "\n\n".join(f"{n} at {v:g} m/s, seed {s}: {msg}" for (n, v, s), msg in failures.items())
+        (root / "failures.txt").write_text(text + "\n")
+        warnings.warn(f"{len(failures)} of {len(runs)} OpenFAST runs failed (values NaN, flagged unstable; "
+                      f"{root / 'failures.txt'}):\n{text}", RuntimeWarning, stacklevel=2)
+    camp = _assemble(results, tuple(discon), vs, seeds, settings, n_keep)
+    if tmp is not None:
+        tmp.cleanup()
+    return camp
+
+
+def _cpus() -> int:
+    return os.cpu_count() or 1
+
+
+def _trim(deck: Deck):
+    """(pitch rad, rotor speed rad/s) at a wind speed from the reduced IEA 15 MW model, for an
+    IEA-15-240-RWT deck; None for another deck (its own initial conditions are kept)."""
+    if not deck.name.startswith("IEA-15-240-RWT"):
+        return None
+    from ..turbine import iea15mw  # heavy (builds the reduced model); only when used
+
+    model = iea15mw()
+
+    def at(v):
+        op = model.trim(v)
+        return float(op.pitch), float(op.rotor_speed)
+
+    return at
+
+
+def _slug(name: str) -> str:
+    return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in name)
+
+
+def _run_folder(root: Path, run) -> Path:
+    name, v, s = run
+    return root / _slug(name) / f"{v:g}mps_seed{s}"
+
+
+def _meta(run, c: DisconController, settings) -> dict:
+    name, v, s = run
+    return {"controller": name, "wind_speed": v, "seed": s, "library_sha": _sha(c.library),
+            "parameters_sha": _sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
+            "settings": settings}
+
+
+def _same(a: dict, b: dict) -> bool:
+    keys = ("controller", "wind_speed", "seed", "library_sha", "parameters_sha")
+    return all(a.get(k) == b.get(k) for k in keys) and a.get("settings") == b.get("settings")
+
+
+def _load(root: Path, run, meta):
+    """A finished run's results, or None; a run of other settings there is refused."""
+    f = _run_folder(root, run)
+    js, npz = f / "run.json", f / "result.npz"
+    if not (js.is_file() and npz.is_file()):
+        return None
+    old = json.loads(js.read_text())
+    if not _same(old, meta):
+        raise ValueError(f"{f} holds a run of other settings or another controller under the name {run[0]!r} "
+                         "(run.json differs): use another folder, or delete that run to redo it")
+    with np.load(npz) as z:
+        return {k: z[k] for k in z.files}
+
+
+def _post(case: Case, out, settings, meta, keep: bool, wind) -> dict:
+    """Indicators, Welch spectra and (kept) series of one OpenFAST run, saved in its folder."""
+    t0 = settings["transient"]
+    n = int(round(settings["duration"] / settings["record_dt"]))
+    series, dt = series_from_openfast(out, OPENFAST_SERIES)
+    i0 = int(np.searchsorted(out.time, t0 - 1e-9))
+    if out.time.size - i0 < n:
+        raise OpenFASTRunError(case, f"wrote {out.time[-1]:g} s, fewer than transient + duration "
+                                     f"({t0 + settings['duration']:g} s)", "")
+    rec = {k: a[0, i0:i0 + n] for k, a in series.items()}
+    ind = indicators({k: a[None] for k, a in rec.items()}, dt, settings["m"]).as_dict()
+    res = {f"value_{k}": np.asarray(ind[k][0], float) for k in INDICATORS}
+    for k in SPECTRA:
+        omega, p = welch_psd(rec[k], dt, settings["nperseg"])
+        res[f"welch_{k}"] = p
+    res["omega"] = omega
+    res["dt"] = np.asarray(dt)
+    if keep:
+        for k, a in rec.items():
+            res[f"series_{k}"] = a
+    np.savez(case.folder / "result.npz", **res)
+    meta = dict(meta, turbsim=wind.settings, wind_file=str(wind.path))
+    (case.folder / "run.json").write_text(json.dumps(meta, indent=1) + "\n")
+    # the case's big files go: the outputs are in result.npz, the inputs are rewritten on demand
+    case.outb.unlink(missing_ok=True)
+    return res
+
+
+def _assemble(results, names, vs, seeds, settings, n_keep) -> Campaign:
+    C, W, S = len(names), vs.size, seeds.size
+    some = next(iter(results.values()), None)
+    omega = some["omega"] if some is not None else np.zeros(1)
+    values = {k: np.full((C, W, S), np.nan) for k in INDICATORS}
+    welch = {k: np.full((C, W, omega.size), np.nan) for k in SPECTRA}
+    unstable = np.zeros((C, W), bool)
+    dt = float(some["dt"]) if some is not None else settings["record_dt"]
+    n = int(round(settings["duration"] / settings["record_dt"]))
+    keep = {}
+    for ci, name in enumerate(names):
+        for wi, v in enumerate(vs):
+            acc = {k: [] for k in SPECTRA}
+            for si, s in enumerate(seeds):
+                r = results.get((name, float(v), int(s)))
+                if r is None:
+                    unstable[ci, wi] = True
+                    continue
+                for k in INDICATORS:
+                    values[k][ci, wi, si] = float(r[f"value_{k}"])
+                for k in SPECTRA:
+                    acc[k].append(r[f"welch_{k}"])
+                if si < n_keep:
+                    for k in OPENFAST_SERIES.values():
+                        keep.setdefault(name, {}).setdefault(k, np.full((W, n_keep, n), np.nan))[wi, si] = \
+                            r.get(f"series_{k}", np.nan)
+            for k in SPECTRA:
+                if acc[k]:
+                    welch[k][ci, wi] = np.mean(acc[k], axis=0)
+    series = {}
+    if n_keep and keep:
+        from ..simulate import SimulationResult
+
+        for name, outs in keep.items():
+            series[name] = SimulationResult(time=np.arange(n) * dt, wind_speeds=vs, seeds=seeds[:n_keep],
+                                            outputs=outs, dt=dt, sim_dt=settings["dt"] or dt, controller=name)
+    return Campaign(controllers=names, wind_speeds=vs, seeds=seeds, duration=settings["duration"], dt=dt,
+                    m=settings["m"], values=values, predicted_del=np.full((C, W), np.nan), omega=omega, welch=welch,
+                    predicted_psd={k: np.full((C, W, omega.size), np.nan) for k in SPECTRA}, series=series,
+                    unstable=unstable)
