@@ -1,6 +1,6 @@
 """OpenFAST linearisation cases of a deck (specdesign.openfast.linearize).
 
-The case writer is checked on the IEA 15 MW monopile deck without OpenFAST: the keys a
+The case writer is checked on the shipped IEA 15 MW monopile deck without OpenFAST: the keys a
 trim-and-linearise case must set, the defaults it takes from the deck's DISCON.IN, the
 files openfast-io writes. The run machinery (cache, failure messages) is checked with a
 stand-in executable that "writes" the shipped sample .lin file. The end-to-end test runs
@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import shutil
 import stat
 import sys
 import time
@@ -23,8 +22,13 @@ import pytest
 
 pytest.importorskip("openfast_io")
 
-from specdesign.openfast import LinearTurbine  # noqa: E402
-from specdesign.openfast.linearize import (  # noqa: E402
+from specdesign.openfast import (
+    LinearTurbine,
+    OpenFASTInstall,
+    OpenFASTRunError,
+    iea15mw_monopile,
+)
+from specdesign.openfast.linearize import (
     DEFAULT_DOFS,
     LIN_OUTPUTS,
     _read_deck,
@@ -39,29 +43,9 @@ RATED_TORQUE = 19786800.0  # N·m: VS_RtTq of the deck's DISCON.IN
 
 
 @pytest.fixture(scope="module")
-def deck(tmp_path_factory) -> Path:
-    """The IEA 15 MW monopile deck of ROSCO's test cases, hydrodynamics switched off.
-
-    openfast-io 5.0 cannot read that deck's HydroDyn file (written for an older OpenFAST),
-    and the linearisation case switches hydrodynamics off anyway.
-    """
-    rosco = pytest.importorskip("specdesign.rosco")
-    try:
-        src = rosco.rosco_test_cases() / "IEA-15-240-RWT"
-    except ModuleNotFoundError:
-        pytest.skip("the rosco package (its OpenFAST decks) is not installed")
-    root = tmp_path_factory.mktemp("deck")
-    for sub in ("IEA-15-240-RWT", "IEA-15-240-RWT-Monopile"):
-        shutil.copytree(src / sub, root / sub, ignore=shutil.ignore_patterns("__pycache__", "*.outb", "*.out"))
-    fst = root / "IEA-15-240-RWT-Monopile" / "IEA-15-240-RWT-Monopile.fst"
-    lines = []
-    for line in fst.read_text().splitlines():
-        words = line.split()
-        if len(words) > 1 and words[1] in ("CompHydro", "CompSeaSt"):
-            line = "0 " + line.split(None, 1)[1]
-        lines.append(line)
-    fst.write_text("\n".join(lines) + "\n")
-    return fst
+def deck():
+    """The shipped IEA 15 MW monopile deck (OpenFAST v5.0 format)."""
+    return iea15mw_monopile()
 
 
 @pytest.fixture(scope="module")
@@ -98,7 +82,7 @@ def test_case_sets_the_trim_and_linearisation_keys(fst_vt):
 
 
 def test_case_options_and_refusals(fst_vt):
-    kw = dict(rotor_speed=RATED_SPEED, gen_torque=RATED_TORQUE, initial_pitch=0.2)
+    kw = {"rotor_speed": RATED_SPEED, "gen_torque": RATED_TORQUE, "initial_pitch": 0.2}
     vt = linearization_case(fst_vt, 15.0, dofs=("GenDOF", "TwFADOF1", "FlapDOF1"), trim_tol=1e-4, trim_gain=0.02,
                             dt=0.01, hydrodynamics=True, overrides={("InflowWind", "PLExp"): 0.0}, **kw)
     ed = vt["ElastoDyn"]
@@ -132,41 +116,47 @@ def test_written_case_takes_rated_point_from_the_discon(deck, fst_vt, tmp_path):
     assert back["ServoDyn"]["VSContrl"] == 1 and back["ServoDyn"]["PCMode"] == 0
 
 
-def _fake_openfast(folder: Path, body: str) -> Path:
+def _fake_openfast(folder: Path, name: str, body: str) -> OpenFASTInstall:
     """A stand-in ``openfast``: a Python script run in the case folder with the .fst as its argument."""
-    exe = folder / "openfast"
+    exe = folder / name
     exe.write_text(f"#!{sys.executable}\nimport sys, shutil, pathlib\n{body}\n")
     exe.chmod(exe.stat().st_mode | stat.S_IXUSR)
-    return exe
+    return OpenFASTInstall(exe, None, "5.0.0")
 
 
 def test_runs_cache_and_failures_with_a_stand_in(deck, tmp_path):
+    from test_openfast_outputs import write_binary  # OpenFAST's binary output layout
+
+    outb = tmp_path / "template.outb"
+    write_binary(outb, np.column_stack([np.arange(3) * 0.1, np.full(3, 7.56)]), names=["Time", "GenSpeed"],
+                 units=["(s)", "(rpm)"])
     # "linearises" by copying the shipped 19 m/s sample (its header says 19 m/s) and counts its runs
     runs = tmp_path / "runs"
     sample = DATA / "sample_floating_19mps.1.lin"
-    exe = _fake_openfast(tmp_path, f"""
-if sys.argv[1:] in (['-v'], ['-h']):
-    print('OpenFAST-v5.0.0'); sys.exit(0)
+    fake = _fake_openfast(tmp_path, "openfast", f"""
 with open({str(runs)!r}, 'a') as f: f.write('x')
 root = pathlib.Path(sys.argv[1]).stem
 shutil.copy({str(sample)!r}, root + '.1.lin')
+shutil.copy({str(outb)!r}, root + '.outb')
 print('OpenFAST terminated normally.')""")
     cache = tmp_path / "cache"
-    lt = linearize_deck(deck, [19.0], n_azimuths=1, openfast=exe, cache=cache, progress=False)
+    lt = linearize_deck(deck, [19.0], n_azimuths=1, openfast=fake, cache=cache, progress=False)
     assert isinstance(lt, LinearTurbine) and lt.wind_range == (19.0, 19.0)
     assert set(lt.input_names) >= {"wind", "pitch_cmd"} and "tower_base_my" in lt.output_names
-    again = linearize_deck(deck, [19.0], n_azimuths=1, openfast=exe, cache=cache, progress=False)
+    again = linearize_deck(deck, [19.0], n_azimuths=1, openfast=fake, cache=cache, progress=False)
     assert runs.read_text() == "x"  # the second call was served from the cache
     np.testing.assert_array_equal(again.linearize(19.0).A, lt.linearize(19.0).A)
 
-    bad = _fake_openfast(tmp_path / "cache", """
-if sys.argv[1:] in (['-v'], ['-h']):
-    print('OpenFAST-v5.0.0'); sys.exit(0)
+    bad = _fake_openfast(tmp_path, "bad", """
 print('FAST_InitializeAll:SrvD_Init:VSContrl must be 0 or 1 for linearization.'); sys.exit(1)""")
-    with pytest.raises(RuntimeError, match=r"(?s)17 m/s.*VSContrl must be 0 or 1"):
+    with pytest.raises(OpenFASTRunError, match=r"(?s)17 m/s.*VSContrl must be 0 or 1"):
         linearize_deck(deck, [17.0], n_azimuths=1, openfast=bad, cache=cache, progress=False)
+    nolin = _fake_openfast(tmp_path, "nolin", f"""
+shutil.copy({str(outb)!r}, pathlib.Path(sys.argv[1]).stem + '.outb')""")
+    with pytest.raises(OpenFASTRunError, match=r"16 m/s.*no \.lin"):
+        linearize_deck(deck, [16.0], n_azimuths=1, openfast=nolin, cache=cache, progress=False)
     with pytest.raises(ValueError, match="wind_speeds"):
-        linearize_deck(deck, [19.0, 19.0], openfast=exe, cache=cache)
+        linearize_deck(deck, [19.0, 19.0], openfast=fake, cache=cache)
 
 
 def _openfast_or_skip():
@@ -190,13 +180,12 @@ def test_openfast_linearisation_at_19_mps(deck, tmp_path):
     """
     install = _openfast_or_skip()
     t0 = time.perf_counter()
-    lt = linearize_deck(deck, [19.0], n_azimuths=2, trim_tol=1e-2, openfast=install.openfast, cache=tmp_path,
-                        progress=False)
+    lt = linearize_deck(deck, [19.0], n_azimuths=2, trim_tol=1e-2, openfast=install, cache=tmp_path, progress=False)
     seconds = time.perf_counter() - t0
     print(f"end-to-end linearisation at 19 m/s: {seconds:.0f} s")
     from specdesign.openfast.linear_turbine import rotor_speed_model
 
-    a, b_beta, b_wind = rotor_speed_model(lt.linearize(19.0))
+    _, b_beta, _ = rotor_speed_model(lt.linearize(19.0))
     ref = {r["U"]: r for r in json.loads((DATA / "rotor_linearization_reference.json").read_text())}[19.0]
     assert b_beta == pytest.approx(ref["OF_B_beta"], rel=0.15)
     op = lt.trim(19.0)

@@ -59,12 +59,13 @@ case whose digest has a finished result in ``cache`` is not run again.
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import copy
 import hashlib
+import io
 import math
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -78,10 +79,20 @@ import numpy as np
 from .._checks import positive_scalar
 from ..rosco.discon_file import from_discon, read_discon
 from ..turbine.openfast_deck import read_cp_table
+from .deck import _IO_LOCK, Case, Deck, OpenFASTRunError, _tail, run_case
+from .deck import _read_deck as _read_deck_cached
+from .install import OpenFASTInstall, find_openfast, openfast_version
 from .linear_turbine import LinearTurbine
 
-__all__ = ["DEFAULT_DOFS", "LIN_OUTPUTS", "LinearizationCase", "linearization_case", "write_linearization_case",
-           "linearize_deck", "default_lin_cache"]
+__all__ = [
+    "DEFAULT_DOFS",
+    "LIN_OUTPUTS",
+    "LinearizationCase",
+    "default_lin_cache",
+    "linearization_case",
+    "linearize_deck",
+    "write_linearization_case",
+]
 
 #: ElastoDyn degrees of freedom switched on in a linearisation case (every other one is off).
 DEFAULT_DOFS = ("GenDOF", "TwFADOF1", "PtfmSgDOF", "PtfmPDOF")
@@ -98,7 +109,7 @@ LIN_OUTPUTS = {
 }
 _RATED_SPEED_MARGIN = 0.99  # VS_RtGnSp / rated generator speed: constant-torque region at the trim point
 _FORCED = "Steady state not found before end of simulation"
-_LOG_TAIL = 2000  # characters of OpenFAST's output quoted in an error
+_CASE = "lin"  # file root of every case: <folder>/lin.fst, lin.1.lin, ...
 
 
 def default_lin_cache() -> Path:
@@ -135,22 +146,22 @@ class LinearizationCase:
     initial_pitch: float
 
 
-def _read_deck(fst_path):
-    """openfast-io's dictionary of a deck (``fst_vt``); FileNotFoundError/ValueError naming the deck."""
-    from openfast_io.FAST_reader import InputReader_OpenFAST  # heavy optional dependency, imported when a deck is read
+def _as_deck(fst_path) -> Deck:
+    if isinstance(fst_path, Deck):
+        return fst_path
+    if not isinstance(fst_path, (str, os.PathLike)):
+        raise TypeError(f"fst_path must be a path to a .fst file or a Deck, got {type(fst_path).__name__}")
+    return Deck(Path(fst_path))
 
-    fst = Path(fst_path)
-    if not fst.is_file():
-        raise FileNotFoundError(f"fst_path={str(fst)!r} does not exist: give the deck's .fst file")
-    reader = InputReader_OpenFAST()
-    reader.FAST_InputFile = fst.name
-    reader.FAST_directory = str(fst.parent.resolve())
+
+def _read_deck(fst_path) -> dict:
+    """openfast-io's dictionary of a deck (``fst_vt``; cached, not to be modified), errors naming the deck."""
+    fst = _as_deck(fst_path).fst
     try:
-        reader.execute()
+        return _read_deck_cached(str(fst), fst.stat().st_mtime)
     except (ValueError, IndexError, KeyError) as exc:
         raise ValueError(f"openfast-io cannot read the deck {str(fst)!r} ({type(exc).__name__}: {exc}); it must be in "
-                         "the format of the openfast-io installed (OpenFAST v5.0.0 for openfast-io 5.0)") from exc
-    return reader.fst_vt
+                         "the format of the openfast-io installed (OpenFAST v5.0 for openfast-io 5.0)") from exc
 
 
 def _discon_path(fst: Path, fst_vt) -> Path | None:
@@ -320,17 +331,17 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
 
 def write_linearization_case(fst_path, wind_speed: float, folder, *, fst_vt: dict | None = None,
                              rotor_speed: float | None = None, gen_torque: float | None = None,
-                             initial_pitch=None, name: str = "lin", **case_options) -> LinearizationCase:
+                             initial_pitch=None, **case_options) -> LinearizationCase:
     """Write the trim-and-linearise case of a deck at one wind speed into ``folder`` (openfast-io's writer).
 
     Parameters
     ----------
-    fst_path : str or os.PathLike
+    fst_path : str, os.PathLike or Deck
         The deck's ``.fst``.
     wind_speed : float
         Hub-height steady wind speed (m/s).
     folder : str or os.PathLike
-        Where the case is written (created).
+        Where the case is written (created): ``lin.fst`` and the files it names.
     fst_vt : dict, optional
         The deck already read (openfast-io's dictionary), to read it once for many speeds.
     rotor_speed : float, optional
@@ -341,8 +352,6 @@ def write_linearization_case(fst_path, wind_speed: float, folder, *, fst_vt: dic
         Pitch the trim starts from (rad), or {speed: rad}, or speed → rad; default where the
         DISCON.IN's Cp table gives rated torque × rated speed (the feathering side), else
         ElastoDyn's ``BlPitch(1)``.
-    name : str, optional
-        File root of the case (``<name>.fst``, ``<name>.1.lin``, ...).
     **case_options
         :func:`linearization_case`'s options (``n_azimuths``, ``dofs``, ``tmax``, ...).
 
@@ -358,9 +367,11 @@ def write_linearization_case(fst_path, wind_speed: float, folder, *, fst_vt: dic
     ValueError
         As :func:`linearization_case`, or no DISCON.IN for a default rated speed or torque.
     """
-    from openfast_io.FAST_writer import InputWriter_OpenFAST  # heavy optional dependency, imported when a case is written
+    from openfast_io.FAST_writer import (
+        InputWriter_OpenFAST,  # heavy: openfast-io imports ROSCO's toolbox; loaded when a case is written
+    )
 
-    fst = Path(fst_path)
+    fst = _as_deck(fst_path).fst
     vt = _read_deck(fst) if fst_vt is None else fst_vt
     v = positive_scalar(wind_speed, "wind_speed")
     speed, torque, gb, discon = _rated(fst, vt, rotor_speed, gen_torque)
@@ -371,9 +382,10 @@ def write_linearization_case(fst_path, wind_speed: float, folder, *, fst_vt: dic
     writer = InputWriter_OpenFAST()
     writer.fst_vt = case
     writer.FAST_runDirectory = str(out)
-    writer.FAST_namingOut = name
-    writer.execute()
-    return LinearizationCase(v, out, out / f"{name}.fst", speed, torque, pitch)
+    writer.FAST_namingOut = _CASE
+    with _IO_LOCK, contextlib.redirect_stdout(io.StringIO()):  # openfast-io and ROSCO's writer print what they write
+        writer.execute()
+    return LinearizationCase(v, out, out / f"{_CASE}.fst", speed, torque, pitch)
 
 
 def _digest(folder: Path, version: str) -> str:
@@ -384,45 +396,29 @@ def _digest(folder: Path, version: str) -> str:
     return h.hexdigest()[:16]
 
 
-def _openfast_version(exe: str) -> str:
-    try:
-        from .install import openfast_version  # helper of the OpenFAST install module
-    except ImportError:  # pragma: no cover - the install module is the project's; kept for a bare executable
-        return os.path.realpath(exe)
-    return openfast_version(exe)
+def _install(openfast) -> OpenFASTInstall:
+    if isinstance(openfast, OpenFASTInstall):
+        return openfast
+    if openfast is None:
+        return find_openfast(require_turbsim=False)
+    exe = Path(shutil.which(os.fspath(openfast)) or os.fspath(openfast))
+    return OpenFASTInstall(exe, None, openfast_version(exe))
 
 
-def _find_openfast(openfast):
-    if openfast is not None:
-        exe = shutil.which(os.fspath(openfast)) or os.fspath(openfast)
-        if not os.path.isfile(exe):
-            raise FileNotFoundError(f"openfast={os.fspath(openfast)!r} is not an executable file")
-        return exe
-    from .install import find_openfast  # the install module locates or explains how to build OpenFAST
-
-    return str(find_openfast(require_turbsim=False).openfast)
+def _lin_files(folder: Path) -> list:
+    return sorted(folder.glob(f"{_CASE}.*.lin"), key=lambda p: int(p.suffixes[-2][1:]))
 
 
-def _run_case(exe: str, case: LinearizationCase, timeout: float):
-    """Run one case; (lin files, seconds, forced) or raise RuntimeError naming the speed and OpenFAST's message."""
-    log = case.folder / "openfast.log"
+def _run_case(install: OpenFASTInstall, deck: Deck, case: LinearizationCase, tmax: float, timeout: float, nice: int):
+    """Run one case: (lin files, seconds, trim forced); OpenFASTRunError naming the speed and OpenFAST's message."""
+    run = Case(name=_CASE, folder=case.folder, deck=deck, tmax=tmax, wind_speed=case.wind_speed, seed=None,
+               channels=("GenSpeed",))
     t0 = time.perf_counter()
-    with open(log, "w") as fh:
-        try:
-            rc = subprocess.run([exe, case.fst.name], cwd=case.folder, stdout=fh, stderr=subprocess.STDOUT,
-                                timeout=timeout).returncode
-        except subprocess.TimeoutExpired:
-            rc = None
-    text = log.read_text(errors="replace")
-    tail = text[-_LOG_TAIL:]
-    if rc is None:
-        raise RuntimeError(f"OpenFAST linearisation at {case.wind_speed:g} m/s did not finish in timeout={timeout:g} s "
-                           f"(case {case.folder}); the end of its output:\n{tail}")
-    lins = sorted(case.folder.glob(f"{case.fst.stem}.*.lin"), key=lambda p: int(p.suffixes[-2][1:]))
-    if rc != 0 or not lins:
-        raise RuntimeError(f"OpenFAST linearisation at {case.wind_speed:g} m/s failed (exit code {rc}, "
-                           f"{len(lins)} .lin files; case {case.folder}); the end of its output:\n{tail}")
-    return lins, time.perf_counter() - t0, _FORCED in text
+    run_case(run, install, timeout=timeout, nice=nice)
+    lins = _lin_files(case.folder)
+    if not lins:
+        raise OpenFASTRunError(run, "wrote no .lin files", _tail(run.log))
+    return lins, time.perf_counter() - t0, _FORCED in run.log.read_text(errors="replace")
 
 
 def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequence[str] = DEFAULT_DOFS,
@@ -430,7 +426,8 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
                    tmax: float = 600.0, trim_tol: float | None = None, trim_gain: float | None = None,
                    dt: float | None = None, hydrodynamics: bool = False, overrides: Mapping | None = None,
                    signals: dict | None = None, openfast=None, cache=None, processes: int = 2,
-                   timeout: float = 3600.0, progress: bool | None = None, name: str | None = None) -> LinearTurbine:
+                   timeout: float = 3600.0, nice: int = 0, progress: bool | None = None,
+                   name: str | None = None) -> LinearTurbine:
     """OpenFAST's linear models of a deck at ``wind_speeds``, as the :class:`LinearTurbine` the design loop takes.
 
     Each speed is written as a trim-and-linearise case (the module docstring says what the
@@ -439,8 +436,10 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
 
     Parameters
     ----------
-    fst_path : str or os.PathLike
-        The deck's ``.fst`` (a format the installed openfast-io and OpenFAST read).
+    fst_path : str, os.PathLike or Deck
+        The deck's ``.fst`` (a format the installed openfast-io and OpenFAST read), e.g.
+        ``specdesign.openfast.iea15mw_monopile()`` (a :class:`~specdesign.openfast.Deck`
+        carries its format version, checked against the executable's).
     wind_speeds : float or sequence of float
         Hub-height steady wind speeds (m/s), distinct.
     n_azimuths : int, optional
@@ -451,7 +450,7 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
         As :func:`write_linearization_case` and :func:`linearization_case`.
     signals : dict, optional
         Overrides of :data:`specdesign.openfast.signals.DEFAULT_SIGNALS`.
-    openfast : str or os.PathLike, optional
+    openfast : OpenFASTInstall, str or os.PathLike, optional
         The ``openfast`` executable; default :func:`specdesign.openfast.find_openfast`'s.
     cache : str or os.PathLike, optional
         Results folder (default :func:`default_lin_cache`): one sub-folder per case digest
@@ -460,6 +459,8 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
         OpenFAST processes at a time (default 2).
     timeout : float, optional
         Wall-time limit of one OpenFAST run (s).
+    nice : int, optional
+        Niceness added to the OpenFAST processes (POSIX), for runs in the background.
     progress : bool, optional
         Print a line per finished speed to stderr (default: when stderr is a terminal).
     name : str, optional
@@ -477,16 +478,16 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
         The deck or the executable does not exist, or no OpenFAST is found.
     ValueError
         Bad arguments (named), or a deck openfast-io cannot read.
-    RuntimeError
-        An OpenFAST run failed or timed out: the message names the wind speed, the case folder
-        and quotes the end of OpenFAST's output.
+    OpenFASTRunError
+        An OpenFAST run failed, timed out or wrote no ``.lin`` file: the message names the
+        wind speed, the case folder and quotes the end of OpenFAST's output.
 
     Warns
     -----
     UserWarning
         A speed whose trim did not converge within ``tmax`` (OpenFAST linearised anyway).
     """
-    fst = Path(fst_path)
+    deck = _as_deck(fst_path)
     speeds = np.atleast_1d(np.asarray(wind_speeds, float))
     if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
         raise ValueError(f"wind_speeds={wind_speeds!r} must be one or more positive wind speeds in m/s")
@@ -495,24 +496,23 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
     if isinstance(processes, bool) or not isinstance(processes, (int, np.integer)) or processes < 1:
         raise ValueError(f"processes={processes!r} must be a positive integer")
     timeout = positive_scalar(timeout, "timeout")
-    exe = _find_openfast(openfast)
-    version = _openfast_version(exe)
+    install = _install(openfast)
     root = Path(cache) if cache is not None else default_lin_cache()
     root.mkdir(parents=True, exist_ok=True)
     show = sys.stderr.isatty() if progress is None else bool(progress)
-    vt = _read_deck(fst)
-    options = dict(n_azimuths=n_azimuths, dofs=dofs, tmax=tmax, trim_tol=trim_tol, trim_gain=trim_gain, dt=dt,
-                   hydrodynamics=hydrodynamics, overrides=overrides)
+    vt = _read_deck(deck)
+    options = {"n_azimuths": n_azimuths, "dofs": dofs, "tmax": tmax, "trim_tol": trim_tol, "trim_gain": trim_gain, "dt": dt,
+                   "hydrodynamics": hydrodynamics, "overrides": overrides}
 
     todo, done = [], {}
     for v in speeds:
         tmp = Path(tempfile.mkdtemp(prefix=f"lin{v:g}-", dir=root))
-        case = write_linearization_case(fst, float(v), tmp, fst_vt=vt, rotor_speed=rotor_speed, gen_torque=gen_torque,
+        case = write_linearization_case(deck, float(v), tmp, fst_vt=vt, rotor_speed=rotor_speed, gen_torque=gen_torque,
                                         initial_pitch=initial_pitch, **options)
-        final = root / f"{v:g}mps-{_digest(tmp, version)}"
+        final = root / f"{v:g}mps-{_digest(tmp, install.version)}"
         if (final / "done").is_file():
             shutil.rmtree(tmp)
-            done[float(v)] = sorted(final.glob("lin.*.lin"), key=lambda p: int(p.suffixes[-2][1:]))
+            done[float(v)] = _lin_files(final)
             if show:
                 print(f"linearize_deck: {v:g} m/s from the cache ({final})", file=sys.stderr, flush=True)
             continue
@@ -525,7 +525,7 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
     if todo:
         t0 = time.perf_counter()
         with concurrent.futures.ThreadPoolExecutor(max_workers=int(processes)) as pool:
-            futures = {pool.submit(_run_case, exe, c, timeout): c for c in todo}
+            futures = {pool.submit(_run_case, install, deck, c, float(tmax), timeout, nice): c for c in todo}
             try:
                 for k, fut in enumerate(concurrent.futures.as_completed(futures), 1):
                     c = futures[fut]
@@ -545,4 +545,4 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 12, dofs: Sequenc
                 raise
 
     files = [f for v in speeds for f in done[float(v)]]
-    return LinearTurbine.from_lin_files(files, signals, name=name or fst.stem)
+    return LinearTurbine.from_lin_files(files, signals, name=name or deck.name)
