@@ -192,13 +192,35 @@ def test_case_speeds_clip_and_list_each_operating_point_once():
 
 def test_batched_siso_response_equals_python_controls():
     # siso_response(method="batched") evaluates a state space at every frequency at once
-    # (state_space_response); python-control's per-frequency evaluation is the oracle
+    # (state_space_response); python-control's per-frequency evaluation is the oracle.
+    # The system is drawn from a seeded generator (control.rss draws from numpy's global state,
+    # so it changed with every run and with the test order): 12 lightly to well damped modes
+    # and a real pole, rotated by an orthogonal matrix so the eigenvalues are well conditioned
     rng = np.random.default_rng(3)
-    sys = control.rss(25, 1, 1)
-    sys = control.ss(sys.A - 0.05 * np.eye(25), sys.B, sys.C, rng.normal(size=(1, 1)))
+    wn = np.geomspace(0.01, 15.0, 12)
+    zeta = rng.uniform(0.02, 0.5, wn.size)
+    blocks = [np.array([[-z * w, w * np.sqrt(1 - z * z)], [-w * np.sqrt(1 - z * z), -z * w]])
+              for w, z in zip(wn, zeta)]
+    a0 = np.zeros((25, 25))
+    for k, blk in enumerate(blocks):
+        a0[2 * k:2 * k + 2, 2 * k:2 * k + 2] = blk
+    a0[-1, -1] = -0.3
+    q, _ = np.linalg.qr(rng.normal(size=(25, 25)))
+    a, b, c = q @ a0 @ q.T, rng.normal(size=(25, 1)), rng.normal(size=(1, 25))
+    sys = control.ss(a, b, c, rng.normal(size=(1, 1)))
     w = np.geomspace(0.005, 20.0, 700)
-    np.testing.assert_allclose(cl.siso_response(sys, w, method="batched"), cl.siso_response(sys, w),
-                               rtol=1e-9)
+    got, ref = cl.siso_response(sys, w, method="batched"), cl.siso_response(sys, w)
+    # Tolerance from the conditioning, not a fixed rtol: each method solves (jωI − A) x = B in
+    # floating point, with a backward-stable error ‖δx‖ ≲ n·ε·κ(jωI − A)·‖x‖ (Higham, ch. 7);
+    # C·δx is then at most ‖C‖·‖δx‖, and the two methods may err in opposite directions (×2).
+    # The factor 10 covers the constants the bound leaves out.
+    eye = np.eye(25)
+    kappa = np.array([np.linalg.cond(1j * wk * eye - a) for wk in w])
+    xnorm = np.array([np.linalg.norm(np.linalg.solve(1j * wk * eye - a, b)) for wk in w])
+    bound = 2 * 10 * 25 * np.finfo(float).eps * kappa * np.linalg.norm(c) * xnorm
+    assert np.all(np.abs(got - ref) <= bound)
+    # and the bound is not vacuous: far below the response itself at every frequency
+    assert np.all(bound < 1e-6 * np.abs(ref))
     tf = control.tf([1.0, 2.0], [1.0, 0.3, 1.0])  # a transfer function: its polynomials either way
     assert np.array_equal(cl.siso_response(tf, w, method="batched"), cl.siso_response(tf, w))
     with pytest.raises(ValueError, match="method"):

@@ -169,3 +169,68 @@ def test_doctests_are_fenced_outside_examples_only():
     g = _roles()
     text = "Use:\n\n>>> f(1)\n2\n\nExamples\n--------\n>>> f(2)\n3"
     assert g.fence_doctests(text) == "Use:\n\n```pycon\n>>> f(1)\n2\n```\n\nExamples\n--------\n>>> f(2)\n3"
+
+
+# ----------------------------------------------------------------------------- offline: no CDN, math as math
+def test_math_hook_renders_every_kind_of_equation_and_refuses_bad_tex():
+    pytest.importorskip("latex2mathml", reason='the docs extra is not installed: pip install -e ".[docs]"')
+    sys.path.insert(0, str(ROOT / "docs" / "hooks"))
+    try:
+        math = importlib.import_module("mathml")
+    finally:
+        sys.path.pop(0)
+    page = ('<p><span class="arithmatex">\\(a &lt; b\\)</span></p><div class="arithmatex">\\[x^2\\]</div>'
+            '<div class="jp-Cell"><div class="jp-RenderedMarkdown jp-MarkdownOutput"><p>$y_1$ and $$z$$</p>'
+            '<div>nested</div></div></div><pre>$not math$</pre>')
+    out = math.render_math(page)
+    assert out.count("<math") == 4 and 'display="block"' in out and "&lt;" not in out.split("<math")[1][:40]
+    assert "$not math$" in out  # outside a notebook's Markdown cell, a dollar is text
+    assert "arithmatex" not in out and "$y_1$" not in out
+    with pytest.raises(ValueError, match="cannot render"):
+        math.render_math('<span class="arithmatex">\\(\\phi\'\'^2\\)</span>', where="x.md")
+
+
+@pytest.mark.slow  # shares the site build; starts Debian's chromium
+def test_site_renders_equations_and_figures_with_the_network_off(site):
+    # the issue "Layers without cycles ... docs that work offline": every request that is not a
+    # file of the built site is refused, and the page still shows MathML equations laid out by
+    # the browser (height > 0) and, on a notebook page, its figures
+    import shutil
+
+    out, code, _ = site
+    assert code == 0
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    if chromium is None:
+        pytest.skip("Debian's chromium is not installed (apt-get install -y chromium; .ci/run does it)")
+    from playwright.sync_api import sync_playwright
+
+    refused = []
+
+    def only_files(route):
+        if route.request.url.startswith("file://"):
+            route.continue_()
+        else:
+            refused.append(route.request.url)
+            route.abort()
+
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=chromium, headless=True,
+                               args=["--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu"])
+        try:
+            page = b.new_page()
+            page.route("**/*", only_files)
+            page.goto((out / "turbines" / "index.html").as_uri())
+            boxes = page.eval_on_selector_all("math", "els => els.map(e => e.getBoundingClientRect().height)")
+            assert len(boxes) >= 10 and min(boxes) > 0, boxes
+            text = page.inner_text("article")
+            assert "\\int" not in text and "$" not in text  # no raw TeX left on the page (the page has no dollar amounts)
+            hooks = _hooks()
+            fresh = [nb for nb in hooks.notebooks() if hooks.executed_copy(nb) is not None]
+            if fresh:  # the gallery shows executed copies only after tests/test_notebooks.py ran
+                page.goto((out / "notebooks" / fresh[0].stem / "index.html").as_uri())
+                sizes = page.eval_on_selector_all(
+                    "img", "els => els.filter(e => e.src.startsWith('data:image/png')).map(e => e.naturalWidth)")
+                assert sizes and min(sizes) > 0
+        finally:
+            b.close()
+    assert not refused, f"the site asked the network for {refused[:5]}"
