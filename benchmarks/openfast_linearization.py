@@ -20,7 +20,7 @@ speeds (``specification_for_target``, ``design_qft``, ``design_hinf``) and print
 headline numbers beside the reduced model's.
 
 Run: nice python benchmarks/openfast_linearization.py --deck PATH.fst --speeds 18 19 20
-     [--azimuths 12] [--cache /tmp/lin-cache] [--design 19] [--markdown docs/openfast_linearization_table.md]
+     [--azimuths 4] [--cache /tmp/lin-cache] [--design 19] [--markdown docs/openfast_linearization_table.md]
 """
 from __future__ import annotations
 
@@ -100,7 +100,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--deck", required=True, help="the deck's .fst")
     ap.add_argument("--speeds", type=float, nargs="+", default=[18.0, 19.0, 20.0])
-    ap.add_argument("--azimuths", type=int, default=12)
+    ap.add_argument("--azimuths", type=int, default=4)
     ap.add_argument("--cache", default=None)
     ap.add_argument("--openfast", default=None)
     ap.add_argument("--design", type=float, nargs="*", default=[])
