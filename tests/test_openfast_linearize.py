@@ -172,25 +172,30 @@ def _openfast_or_skip():
 
 @pytest.mark.slow
 def test_openfast_linearisation_at_19_mps(deck, tmp_path):
-    """One speed, two azimuths, a loose trim: OpenFAST's plant has the rotor and tower of the reference.
+    """One speed, one azimuth: OpenFAST's plant has the rotor and the tower of the references.
 
     Reference figures: rotor_linearization_reference.json (OpenFAST linearisations of the
-    IEA 15 MW rotor, floating, 12 azimuths): ∂Ω̇/∂β = -0.865 rad/s² per rad at 19 m/s; the
-    first tower fore-aft mode of monopile + tower + RNA, tower_fe.json: 0.172 Hz.
+    IEA 15 MW rotor, floating, 12 azimuths): ∂Ω̇/∂β = -0.865 rad/s² per rad at 19 m/s;
+    ROSCO's tuning (rosco_gain_schedule.json): 16.5° of pitch at 19 m/s; the first tower
+    fore-aft mode of monopile + tower + rotor-nacelle assembly, tower_fe.json: 0.172 Hz.
+    Measured here (2 cores shared with other jobs): the trim converges after ~31 s of
+    simulated time (~1 min of CPU); the one linearisation takes ~4.5 min of CPU, most of it
+    in the LU solve of OpenFAST's glue system on the reference BLAS (docs/openfast_linearization.md).
     """
     install = _openfast_or_skip()
     t0 = time.perf_counter()
-    lt = linearize_deck(deck, [19.0], n_azimuths=2, trim_tol=1e-2, openfast=install, cache=tmp_path, progress=False)
-    seconds = time.perf_counter() - t0
-    print(f"end-to-end linearisation at 19 m/s: {seconds:.0f} s")
+    lt = linearize_deck(deck, [19.0], n_azimuths=1, openfast=install, cache=tmp_path, progress=False)
+    print(f"end-to-end linearisation at 19 m/s: {time.perf_counter() - t0:.0f} s")
     from specdesign.openfast.linear_turbine import rotor_speed_model
 
-    _, b_beta, _ = rotor_speed_model(lt.linearize(19.0))
+    plant = lt.linearize(19.0)
+    _, b_beta, _ = rotor_speed_model(plant)
     ref = {r["U"]: r for r in json.loads((DATA / "rotor_linearization_reference.json").read_text())}[19.0]
     assert b_beta == pytest.approx(ref["OF_B_beta"], rel=0.15)
     op = lt.trim(19.0)
     assert op.rotor_speed == pytest.approx(RATED_SPEED, rel=2e-3)
-    assert math.degrees(op.pitch) == pytest.approx(16.5, abs=1.5)
+    assert math.degrees(op.pitch) == pytest.approx(16.5, abs=1.0)
     fe = json.loads((DATA / "tower_fe.json").read_text())["with gravity (P-delta)"]["f1_Hz"]
-    wn = np.abs(np.linalg.eigvals(lt.linearize(19.0).A)) / (2 * np.pi)
-    assert np.min(np.abs(wn - fe)) < 0.15 * fe
+    lam = np.linalg.eigvals(np.asarray(plant.A, float))
+    f = np.abs(lam[lam.imag > 0]) / (2 * np.pi)
+    assert np.min(np.abs(f - fe)) < 0.05 * fe
