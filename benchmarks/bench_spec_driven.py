@@ -6,7 +6,7 @@ At one operating point (default 19 m/s), best of ``--repeat`` runs, beside the i
 2. the specification for a 25 % target (``feasibility.specification_for_target``: the convex
    Youla design on the ladder and the bisection, each certified over 5 plant cases);
 3. the same target as a whole-band element specification, the user's entry point
-   ``spec.shape_to_target(base, 25, quantity="del", band="whole")`` (the elements follow a
+   ``feasibility.shape_whole_band(base, 25)`` (the elements follow a
    certificate's envelope and are certified by a Youla design that meets them at every plant case);
 4. the design that meets it (``qft.design_qft(spec=...)``: reduction + QFT checks);
 5. the fixed-structure QFT design at the same point (``qft.design_qft``), for comparison.
@@ -45,12 +45,12 @@ def main(argv=None):
     t_check, res = best_of(lambda: fz.pitch_feasibility(model, v, ts.tower, ts.speed), args.repeat)
     t_design, d = best_of(lambda: design_qft(model, v, spec=ts), args.repeat)
     base = spec.baseline_analysis(model, v)
-    t_whole, whole = best_of(lambda: spec.shape_to_target(base, 25.0, quantity="del", band="whole"), args.repeat)
+    t_whole, whole = best_of(lambda: fz.shape_whole_band(base, 25.0), args.repeat)
     print(f"{'step at ' + format(v, 'g') + ' m/s':<52}{'time':>9}{'target':>9}{'ratio':>8}   (load {os.getloadavg()[0]:.1f})")
     for name, t, target in (("pitch_feasibility (check of the pair)", t_check, None),
                             ("specification_for_target (25 %, 5 plant cases)", t_spec, None),
                             ("  check + specification", t_check + t_spec, 1.0),
-                            ("shape_to_target(band='whole') (25 %, elements)", t_whole, None),
+                            ("shape_whole_band (25 %, elements)", t_whole, None),
                             ("  check + element specification", t_check + t_whole, 1.0),
                             ("design_qft(spec=...) (reduction + QFT checks)", t_design, 10.0)):
         ratio = f"{t / target:7.2f}×" if target else ""

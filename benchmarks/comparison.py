@@ -1,18 +1,21 @@
 """One comparison (issue 17 part 4): ROSCO, QFT, H∞, the quadratic MPC, behavioural cloning, the
-health-aware MPC and the economic MPC on the same wind speeds and paired seeds (docs/comparison.md).
+excursion MPC and the economic MPC on the same wind speeds and paired seeds (docs/comparison.md).
 
 Controllers (IEA 15 MW reduced model, class-B turbulence, ``run_campaign``; one campaign per
 controller, each timed, all on the same (wind speed, seed) winds, so the runs are paired):
 
-- ROSCO: ``rosco_scheduled`` (gain-scheduled PI, tower damping off), the baseline of every change;
+- ROSCO: ``rosco_scheduled`` (gain-scheduled PI, tower damping off, ``TD_Mode = 0``), the baseline of
+  every change here (ROSCO with its tower damper on is the second baseline, in
+  ``benchmarks/tower_damper.py``, which writes its own tables into the same page);
 - QFT: ``qft.design_schedule(model, speeds)`` (specification-driven), scheduled by
   ``simulate.scheduled`` on the trim pitch (pitch only: the certified designs have no ATD);
 - H∞: ``hinf.design_hinf(model, v)`` per design speed (its default: the certified pair of a 25 %
   DEL target met at every plant case, pitch only, as QFT's), its ``pitch_controller`` scheduled
   the same way;
-- quadratic MPC (``mpc.QuadraticMPC``), behavioural cloning (``mpc.clone``: expert = the
-  economic problem, trained on seeds 100-103, never the evaluation seeds), health-aware MPC
-  (``mpc.HealthMPC(health_weight=10)``);
+- quadratic MPC (``mpc.QuadraticMPC``: collective, hand-tuned weights), behavioural cloning
+  (``mpc.clone``: expert = the causal economic problem, trained on seeds 100-103, never the
+  evaluation seeds), the excursion MPC (``mpc.HealthMPC(health_weight=10)``: the workbench's
+  blade-moment excursion penalty; Boutrous et al.'s health-aware accumulated-moment term is off);
 - economic MPC (``mpc.EconomicMPC``, ~35 ms per step): on a documented subset of speeds and seeds.
 
 Indicators as changes vs ROSCO with the paired-seed jackknife SE (``validate.paired_change``):
@@ -71,7 +74,8 @@ def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101
                           duration=20.0 if quick else 60.0)
     say(f"clone: {demos.targets.size} demonstrations at {cs} m/s, {time.perf_counter() - t0:.0f} s")
     out["behavioural cloning"] = bc
-    out["health MPC"] = mpc.HealthMPC(model, health_weight=10.0)
+    # the excursion penalty (health_weight), not Boutrous et al.'s accumulated-moment term (stress_weight = 0)
+    out["excursion MPC"] = mpc.HealthMPC(model, health_weight=10.0)
     out["economic MPC"] = mpc.EconomicMPC(model, terms, ts=0.2)
     kinds = {n: ("mpc" if hasattr(c, "solve_times") else "lti") for n, c in out.items()}
     return out, kinds
@@ -255,7 +259,7 @@ def main():
         allc = {**ctrls, **econ} if done_econ else ctrls
         head = (f"Command: `python benchmarks/comparison.py{' --quick' if a.quick else ''}`; {len(speeds)} speeds "
                 f"({', '.join(f'{v:g}' for v in speeds)} m/s) × {len(seeds)} paired seeds × {duration:g} s (after "
-                f"30 s of transient); economic MPC on {', '.join(f'{v:g}' for v in econ_speeds)} m/s × "
+                f"30 s of transient); baseline ROSCO with tower damping off; economic MPC on {', '.join(f'{v:g}' for v in econ_speeds)} m/s × "
                 f"{len(econ_seeds)} seeds (vs ROSCO on the same subset)"
                 + ("" if done_econ else " NOT YET RUN (this file was written before its campaign)")
                 + f". Took {took:.0f} s wall; load average {load[0]:.1f} at the start, {load_end[0]:.1f} at the end "

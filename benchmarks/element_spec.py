@@ -1,6 +1,6 @@
 """The certified tower specification in shaping elements, 15-25 m/s (issue 14): writes docs/spec_elements.md.
 
-For each wind speed: ``spec.shape_to_target(base, target, quantity="del", band="whole")``, the
+For each wind speed: ``feasibility.shape_whole_band(base, target)``, the
 user's entry point to ``feasibility.element_specification(model, v, target)`` (ROSCO's map ×
 gain, lag, lead and notches/bumps that follow a certificate's envelope, then certified
 themselves by a Youla design that meets them at every plant case), its elements, promise and speed relaxation beside those
@@ -35,8 +35,8 @@ average {load:.1f} at the end; each row gives the load when it was timed).
 
 `feasibility.specification_for_target` certifies a tower specification W_MyT that is the
 certifying design's own map (a transfer function of ~25 states): feasible by construction, but
-not something a designer reads or edits element by element. `spec.shape_to_target(base, {target:g},
-quantity="del", band="whole")` (on `base = spec.baseline_analysis(model, v)`; it calls
+not something a designer reads or edits element by element. `feasibility.shape_whole_band(base,
+{target:g})` (on `base = spec.baseline_analysis(model, v)`; it calls
 `feasibility.element_specification(model, v, {target:g})`) writes a certified specification the
 way the seed paper's shaping does, as ROSCO's map times a few elements of `specdesign.spec`, over
 the whole band (no protected band): a gain, a lag (the DC level), a lead (the level above
@@ -74,9 +74,9 @@ The result carries a `TargetSpecification` like any other (`res.certified`), edi
 (`res.certified.tower.add(spec.Notch(...))`, then `feasibility.recertify`), and
 `qft.design_qft(spec=res.certified)` meets it.
 
-Which shaper when: `band="whole"` (the default for a DEL target, `quantity="del"`) is the
-specification to hand to a design; `band="above"` (the default for a damage target,
-`shape_to_target(base, t)`) is the seed paper's notches above 0.6 rad/s, with no feasibility
+Which shaper when: `feasibility.shape_whole_band(base, t)` (a DEL target by default) is the
+specification to hand to a design; `spec.shape_to_target(base, t)` (a damage target by
+default) is the seed paper's notches above 0.6 rad/s, with no feasibility
 guarantee (the notch designs of notebooks 04-06).
 
 | column | meaning |
@@ -87,7 +87,7 @@ guarantee (the notch designs of notebooks 04-06).
 | transfer-function spec | `specification_for_target`'s promise and relaxation for the same target |
 | design | `design_qft(spec=...)`: every spec met at every case, controller states, predicted DEL reduction (%) |
 | independent | the promise recomputed on 4000 points, 0.005-20 rad/s (Dirlik DEL on abs(W)²S_W vs ROSCO's abs(T)²S_W, T by the explicit SISO formula), and the design's largest 20·log10(abs(T_MyT,w)/abs(W_MyT)) there, dB (the issue: ≥ 24.5 % within 0.5 pp of the promise; ≤ 0.1 dB) |
-| time | wall seconds of `shape_to_target`: total; inside `CertificateSearch` (the certificates followed and `for_tower`'s designs that meet the elements, each speed relaxation solved once); inside `recertify` (the fallback's); the rest, the shaping itself (baseline, envelope, fits, shift) |
+| time | wall seconds of `shape_whole_band`: total; inside `CertificateSearch` (the certificates followed and `for_tower`'s designs that meet the elements, each speed relaxation solved once); inside `recertify` (the fallback's); the rest, the shaping itself (baseline, envelope, fits, shift) |
 | load | 1-minute load average when the row was timed |
 | path | how the elements were certified: following the certificate for the target + h pp (its ±x % envelope), or the fallback |
 
@@ -186,7 +186,7 @@ def _shape(model, v, t, clock):
     """(result, seconds: total, certificates, recertify, shaping, load average) of one whole-band shaping."""
     clock.spent.clear()
     t0 = time.perf_counter()
-    res = spec.shape_to_target(spec.baseline_analysis(model, v), t, quantity="del", band="whole")
+    res = feasibility.shape_whole_band(spec.baseline_analysis(model, v), t)
     total = time.perf_counter() - t0
     cert, recert = clock.spent.get("certificates", 0.0), clock.spent.get("recertify", 0.0)
     return res, (total, cert, recert, total - cert - recert, os.getloadavg()[0])

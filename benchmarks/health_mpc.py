@@ -1,10 +1,10 @@
-"""Health-aware LPV MPC (issue 17 part 2, seed 002): the energy / blade and tower damage
-trade-off as the health weight varies (docs/health_mpc.md), and the fit of the blade-root
+"""Health-aware LPV MPC (issue 17 part 2; Boutrous, Nejjari and Puig): the energy / blade and
+tower damage trade-off as the health weight varies (docs/health_mpc.md), and the fit of the blade-root
 moment's centre of thrust to OpenFAST (specdesign/turbine/kernel.py).
 
 Trade-off: ROSCO (gain-scheduled) and HealthMPC with ψ ∈ {0, 3, 10, 30, 100} (blade-moment
-excursions) and ψ_acc ∈ {10, 30, 100} (seed 002's accumulated moment), IEA 15 MW, the same
-class-B wind for all (speeds × seeds), DELs fatigue-pooled over the runs
+excursions, the workbench's penalty) and ψ_acc ∈ {10, 30, 100} (Boutrous et al.'s health-aware
+accumulated-moment term), IEA 15 MW, the same class-B wind for all (speeds × seeds), DELs fatigue-pooled over the runs
 (specdesign.mpc.health_report). Writes docs/figures/health_mpc.png and prints a markdown table.
 
 --fit-centre: reads the IEA-15-240-RWT UMaineSemi linearisation deck shipped with the rosco
@@ -68,7 +68,8 @@ def fit_centre():
 def tradeoff(args):
     from matplotlib import use  # noqa: F401  (the Figure below needs no backend)
 
-    from specdesign.mpc.health_report import BLADE_M, TOWER_M, health_tradeoff, plot_tradeoff
+    from specdesign.fatigue import BLADE_M, TOWER_M
+    from specdesign.mpc.health_report import health_tradeoff, plot_tradeoff
 
     m = turbine.iea15mw()
     t0 = time.perf_counter()

@@ -8,7 +8,7 @@
     compiled into the simulator and has none).
 (b) Open loop vs closed loop (the *linearised* turbine at 19 m/s, ``simulate(linear=True)``,
     every run from the trim, the wind held over each 0.2 s sample as the optimiser assumes):
-    the fatigue surrogate J̃ (seed 000 Eq. 4) and the tower DEL over a 100 s record of the
+    the fatigue surrogate J̃ (Collet et al., Eq. 4) and the tower DEL over a 100 s record of the
     perfect-preview open-loop optimum (``economic_open_loop``, replayed), the quadratic MPC,
     the economic MPC and the clone, relative to ROSCO's, on the same records.
 

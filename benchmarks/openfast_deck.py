@@ -9,7 +9,8 @@ current superposed; ``NAddDOF = 0``: no additional WAMIT degrees of freedom, unu
 ``PotMod = 0``; ``HstMod = 0``: hydrostatics up to the still-water level), then openfast-io
 reads the whole deck with its reader and writes it with its writer (v5.0 format): no
 hand-written deck. BeamDyn is off in the deck (``CompElast = 1``) and not shipped; the
-controller library is named per case by :func:`specdesign.openfast.write_case`.
+controller library is named per case by :func:`specdesign.openfast.write_case`; ROSCO's debug
+output is off (``LoggingLevel = 0``).
 
 Run: ``python benchmarks/openfast_deck.py`` (a few seconds).
 """
@@ -46,6 +47,17 @@ def _insert_after(path: Path, key: str, line: str) -> None:
     path.write_text("".join(lines))
 
 
+def _unused_paths(tree, scratch: str) -> None:
+    """The reader makes every file name absolute, "unused" and "none" too: those go back to
+    the plain word (the others are rewritten by the writer under the deck's names)."""
+    items = tree.items() if isinstance(tree, dict) else enumerate(tree) if isinstance(tree, list) else ()
+    for k, val in items:
+        if isinstance(val, str) and val.startswith(scratch) and Path(val).name.lower() in ("unused", "none"):
+            tree[k] = Path(val).name
+        elif isinstance(val, (dict, list)):
+            _unused_paths(val, scratch)
+
+
 def main() -> None:
     src = rosco_test_cases() / "IEA-15-240-RWT"
     with tempfile.TemporaryDirectory() as tmp:
@@ -60,10 +72,13 @@ def main() -> None:
         with contextlib.redirect_stdout(io.StringIO()):  # ROSCO's reader prints what it loads
             reader.execute()
         vt = reader.fst_vt
+        _unused_paths(vt, str(scratch))
         vt["BeamDyn"] = {}  # CompElast = 1: ElastoDyn blades; BeamDyn is never read
         for k in (1, 2, 3):
             vt["Fst"][f"BDBldFile({k})"] = "unused"
         vt["ServoDyn"]["DLL_FileName"] = "libdiscon.so"  # named per case by write_case
+        # ROSCO's debug file (.RO.dbg, every step of every run) off: campaigns read OpenFAST's outputs
+        vt["DISCON_in"]["LoggingLevel"] = 0
         # no HydroDyn joint outputs (none is read): openfast-io 5.0 writes a list of two
         # joints space-separated and its reader, expecting commas, cannot read it back
         vt["HydroDyn"]["NJOutputs"], vt["HydroDyn"]["JOutLst"] = 0, [0]

@@ -1,4 +1,4 @@
-"""The ipywidgets controls of :class:`loopshaping.interactive.Designer` (imported by its ``widget``).
+"""The ipywidgets controls of :class:`loopshaping.interactive.Designer` (built by its ``widget``).
 
 Kept apart so that the designer's numbers and figure import no widget library.
 """

@@ -24,11 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
-from .bounds import Bounds, BoundsWarning, bounds, intersect
+from .bounds import Bounds, BoundsWarning, as_specs, bounds, intersect
+from .check import check
 from .controller import Controller
 from .freqresp import check_grid, evaluate
-from .specs import as_specs
 from .templates import Template
 
 __all__ = ["InfeasibleError", "RefineResult", "refine", "shape"]
@@ -83,7 +82,6 @@ def _fixed_poles(poles, omega):
     return p
 
 
-@renamed_keywords(hf_omegas="hf_omega")
 def shape(bounds: Bounds, poles: object = None, *, n_zeros: int | None = None, initial: object = None,
           hf_omega: ArrayLike | None = None, margin_db: float = 0.0, max_iter: int = 40, tol: float = 1e-5,
           solver: str | None = None) -> Controller:
@@ -105,7 +103,7 @@ def shape(bounds: Bounds, poles: object = None, *, n_zeros: int | None = None, i
         lowest design frequency.
     hf_omega : array_like, optional
         Grid (rad/s) where the largest controller gain is minimised; default 30 points from
-        2 × to 1000 × the highest design frequency. (Former keyword ``hf_omegas``: deprecated.)
+        2 × to 1000 × the highest design frequency.
     margin_db : float
         Every weight is tightened by this many dB, a cushion for the response between
         design frequencies.
@@ -263,7 +261,6 @@ class RefineResult:
         return bool(self.check.passed)
 
 
-@renamed_keywords(omega_dense="omega", hf_omegas="hf_omega")
 def refine(template: Template, specs: "Bounds | Spec | Sequence[Spec]", omega: ArrayLike, poles: object = None, *,
            max_rounds: int = 6, margin_db: float = 0.01, phases_deg: ArrayLike | None = None,
            **shape_kwargs) -> RefineResult:
@@ -286,8 +283,7 @@ def refine(template: Template, specs: "Bounds | Spec | Sequence[Spec]", omega: A
         The specifications (of a Bounds, its specs); weights and general-form coefficients
         must be numbers, LTI or callables of ω.
     omega : array_like
-        Strictly increasing grid of the check, rad/s. (Former keyword ``omega_dense``:
-        deprecated.)
+        Strictly increasing grid of the check, rad/s.
     poles : array_like or Controller, optional
         As :func:`shape`.
     max_rounds : int
@@ -317,8 +313,6 @@ def refine(template: Template, specs: "Bounds | Spec | Sequence[Spec]", omega: A
     ValueError
         If the template has no systems, a disk radius that varies, or ``max_rounds`` < 1.
     """
-    from .check import check
-
     if not isinstance(template, Template):
         raise TypeError(f"template must be a loopshaping.qft.Template; got {type(template).__name__}")
     if template.systems is None:

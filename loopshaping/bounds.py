@@ -20,17 +20,17 @@ Frequencies in rad/s; magnitudes in dB only in the bound tables (``forbidden_db`
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_attribute, renamed_keywords
 from .freqresp import DEFAULT_PHASES_DEG, check_phases, grid_indices
 from .specs import Spec
 from .templates import Template, tracking_pairs
 
-__all__ = ["DEFAULT_PHASES_DEG", "Bounds", "BoundsWarning", "bounds", "intersect"]
+__all__ = ["DEFAULT_PHASES_DEG", "Bounds", "BoundsWarning", "bounds", "intersect", "as_specs"]
 
 # Phases × cases evaluated at once: small enough to stay in cache (measured optimum).
 _BLOCK = 50_000
@@ -189,8 +189,6 @@ class _Part:
     W: np.ndarray
     forbidden_db: np.ndarray  # (n_f, n_phase, k, 2)
 
-    omegas = renamed_attribute("omegas", "omega")
-
     def ok(self, fi, L0, rtol=1e-9):
         """Spec met at frequency index fi for nominal loop values L0 (any shape) → bool."""
         G = L0[..., None] / self.p0[fi]
@@ -307,7 +305,7 @@ class Bounds:
     Parameters
     ----------
     omega : numpy.ndarray
-        (n_omega,) design frequencies, rad/s. (Former name ``omegas``: deprecated.)
+        (n_omega,) design frequencies, rad/s.
     phases_deg : numpy.ndarray
         (n_phase,) phase grid of L0, degrees.
     forbidden_db : numpy.ndarray
@@ -322,8 +320,6 @@ class Bounds:
     phases_deg: np.ndarray
     forbidden_db: np.ndarray
     parts: tuple
-
-    omegas = renamed_attribute("omegas", "omega")
 
     @property
     def names(self) -> tuple:
@@ -538,4 +534,35 @@ def intersect(*bounds_list: Bounds) -> Bounds:
     return Bounds(omega, phases, np.stack([lo, hi], -1), parts)
 
 
-Bounds.__init__ = renamed_keywords(omegas="omega")(Bounds.__init__)
+def as_specs(specs: Bounds | Spec | Iterable[Spec]) -> list:
+    """A Bounds (its specs), one Spec, or an iterable of Spec → a non-empty list of Spec.
+
+    Parameters
+    ----------
+    specs : Bounds or Spec or iterable of Spec
+        The specifications.
+
+    Returns
+    -------
+    list of Spec
+        Non-empty.
+
+    Raises
+    ------
+    TypeError
+        If ``specs`` is empty or holds something else than :class:`Spec`.
+
+    Examples
+    --------
+    >>> [sp.name for sp in as_specs(Spec("stability", 1.2))]
+    ['stability']
+    """
+    if isinstance(specs, Bounds):
+        specs = list(specs.specs)
+    elif isinstance(specs, Spec):
+        specs = [specs]
+    else:
+        specs = list(specs)
+    if not specs or not all(isinstance(sp, Spec) for sp in specs):
+        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
+    return specs

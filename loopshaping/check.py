@@ -9,19 +9,17 @@ phase margins.
 """
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_attribute, renamed_keywords
+from .bounds import as_specs
 from .controller import Controller
 from .freqresp import check_grid, evaluate, is_lti
-from .specs import as_specs
 from .templates import Template
 
-__all__ = ["CheckResult", "check", "closed_loop_poles", "feedback_poles"]
+__all__ = ["CheckResult", "check", "feedback_poles"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,7 +29,7 @@ class CheckResult:
     Parameters
     ----------
     omega : numpy.ndarray
-        (n,) dense grid, rad/s. (Former name ``omegas``: deprecated.)
+        (n,) dense grid, rad/s.
     names : tuple of str
         Spec names, one per row of ``margins_db``.
     margins_db : numpy.ndarray
@@ -61,8 +59,6 @@ class CheckResult:
     gain_margin_db: np.ndarray
     phase_margin_deg: np.ndarray
     tol_db: float = 1e-9
-
-    omegas = renamed_attribute("omegas", "omega")
 
     @property
     def spec_passed(self) -> np.ndarray:
@@ -207,26 +203,6 @@ def feedback_poles(plant: "Controller | control.LTI", controller: "Controller | 
     return np.roots(np.polyadd(num, den))
 
 
-def closed_loop_poles(controller: "Controller | control.LTI", plant: "Controller | control.LTI") -> np.ndarray:
-    """Deprecated: use :func:`feedback_poles` ``(plant, controller)``.
-
-    Parameters
-    ----------
-    controller : control LTI or Controller
-        SISO controller G.
-    plant : control LTI or Controller
-        SISO plant P.
-
-    Returns
-    -------
-    numpy.ndarray
-        ``feedback_poles(plant, controller)``.
-    """
-    warnings.warn("loopshaping.check.closed_loop_poles(controller, plant) is deprecated, use "
-                  "loopshaping.check.feedback_poles(plant, controller)", DeprecationWarning, stacklevel=2)
-    return feedback_poles(plant, controller)
-
-
 def _margins(L, omega):
     """Per case (columns of L): gain margin nearest 0 dB and smallest phase margin, on the grid."""
     n = L.shape[1]
@@ -257,7 +233,6 @@ def _margins(L, omega):
     return gm, pm
 
 
-@renamed_keywords(controller_or_tf="controller", template_or_plants="plants", omega_dense="omega")
 def check(plants: "Template | Sequence[control.LTI]", controller: "Controller | control.LTI",
           specs: "Bounds | Spec | Sequence[Spec]",
           omega: ArrayLike) -> CheckResult:
@@ -267,16 +242,15 @@ def check(plants: "Template | Sequence[control.LTI]", controller: "Controller | 
     ----------
     plants : Template or sequence of control LTI
         A :class:`~loopshaping.templates.Template` built from systems, or the SISO LTI plant
-        cases. (Former keyword ``template_or_plants``; the former argument order
-        ``check(controller, plants, ...)`` is detected and works with a DeprecationWarning.)
+        cases.
     controller : Controller or control LTI
-        The controller G (former keyword ``controller_or_tf``).
+        The controller G.
     specs : Bounds or Spec or list of Spec
         Of a Bounds its specs are re-evaluated. Weights and general-form coefficients must be
         numbers, LTI or callables of ω (arrays given only at the design frequencies cannot be
         evaluated on the dense grid). Disk uncertainty is not applied.
     omega : array_like
-        Strictly increasing dense grid, rad/s (former keyword ``omega_dense``).
+        Strictly increasing dense grid, rad/s.
 
     Returns
     -------
@@ -298,13 +272,6 @@ def check(plants: "Template | Sequence[control.LTI]", controller: "Controller | 
     >>> res.passed
     True
     """
-    if isinstance(plants, Controller) or is_lti(plants):
-        # The former order check(controller, plants, ...): a controller is never a Template
-        # nor a list of plant cases, so the swap is detected reliably. stacklevel 3: the
-        # caller, above the renamed_keywords wrapper.
-        warnings.warn("check(controller, plants, specs, omega) is deprecated: pass the plant cases first, "
-                      "check(plants, controller, specs, omega)", DeprecationWarning, stacklevel=3)
-        plants, controller = controller, plants
     w = check_grid(omega, "omega")
     if isinstance(plants, Template):
         if plants.systems is None:
@@ -344,6 +311,3 @@ def check(plants: "Template | Sequence[control.LTI]", controller: "Controller | 
     max_re = np.array([np.max(p.real, initial=-np.inf) for p in poles])
     gm, pm = _margins(L, w)
     return CheckResult(w, tuple(sp.name for sp in specs), margins, worst, max_re < 0, max_re, gm, pm)
-
-
-CheckResult.__init__ = renamed_keywords(omegas="omega")(CheckResult.__init__)

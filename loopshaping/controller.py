@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
 
 __all__ = [
     "KINDS", "MAX_DEGREE", "MAX_NOTCH_ZETA", "MAX_OMEGA", "MAX_ORDER", "MIN_OMEGA", "Controller", "Element",
@@ -165,7 +164,6 @@ class Element:
         w = p["omega"]
         return np.array([1.0, 2 * p["zeta_zero"] * w, w * w]), np.array([1.0, 2 * p["zeta_pole"] * w, w * w])
 
-    @renamed_keywords(omegas="omega")
     def response(self, omega: ArrayLike) -> np.ndarray:
         """Complex response at s = jω.
 
@@ -534,7 +532,6 @@ class Controller:
         num, den = self.polys()
         return ct.tf(num, den)
 
-    @renamed_keywords(omegas="omega")
     def response(self, omega: ArrayLike) -> np.ndarray:
         """Complex response at s = jω, evaluated factor by factor.
 
@@ -607,7 +604,8 @@ class Controller:
         Raises
         ------
         ValueError
-            If ``sys`` is not SISO.
+            If ``sys`` is not SISO, is zero (no loop to shape: a zero transfer function has no
+            factors), or has a non-finite coefficient.
         """
         import control as ct
 
@@ -615,6 +613,13 @@ class Controller:
         if sys.ninputs != 1 or sys.noutputs != 1:
             raise ValueError("sys must be SISO")
         num, den = np.trim_zeros(sys.num[0][0], "f"), np.trim_zeros(sys.den[0][0], "f")
+        if not (np.all(np.isfinite(num)) and np.all(np.isfinite(den))):
+            raise ValueError(f"sys has a non-finite coefficient (num {num!r}, den {den!r})")
+        if num.size == 0:
+            raise ValueError("sys is zero: a zero transfer function has no factors (no loop to shape); give a "
+                             "non-zero controller")
+        if den.size == 0:
+            raise ValueError("sys has a zero denominator")
         return cls.from_zpk(np.roots(num), np.roots(den), num[0] / den[0])
 
     def to_dict(self) -> dict:

@@ -17,7 +17,6 @@ import numbers
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
 
 __all__ = ["DEFAULT_PHASES_DEG", "as_siso", "check_grid", "check_phases", "evaluate", "grid_indices", "is_lti",
            "is_zero"]
@@ -143,7 +142,6 @@ def as_siso(sys: object, name: str = "system", *, proper: bool = True) -> "contr
     return sys
 
 
-@renamed_keywords(omegas="omega")
 def evaluate(obj: object, omega: ArrayLike, name: str = "system") -> np.ndarray:
     """Complex response of ``obj`` at s = jω.
 

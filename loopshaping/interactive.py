@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._designer_widget import build_widget
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
 from .freqresp import check_grid, evaluate
@@ -446,6 +447,8 @@ class Designer:
             fig, (ax_n, ax_b) = plt.subplots(1, 2, figsize=(10, 5.2))
         if hasattr(fig.canvas, "header_visible"):  # ipympl: the title says it all, no "Figure n" label
             fig.canvas.header_visible = False
+            # the toolbar beside the figure, not over the panels' labels
+            fig.canvas.toolbar_position = "right"
         draw(self.bounds, loop=None, ax=ax_n, legend=False)
         st = self.state()
         # the loop and the markers wrapped into the chart's phase window, as the bounds repeat
@@ -464,6 +467,21 @@ class Designer:
         ax_n.legend(*zip(*keep), fontsize=7, loc="lower right")
         (t_line,) = ax_b.semilogx(self.omega, st.worst_T_db, label="max over cases |T| (dB)")
         (s_line,) = ax_b.semilogx(self.omega, st.worst_S_db, label="max over cases |S| (dB)")
+        # the views cover the design: the closed-loop band from a third of the lowest design
+        # frequency to three times the highest (the dense grid runs ×100 beyond for the checks),
+        # and the magnitudes the loop takes there and the finite bounds, with a 10 dB margin
+        # (the loop's roll-off far above the band spanned −250 dB)
+        d = self.bounds.omega
+        band = (self.omega >= d.min() / 3) & (self.omega <= d.max() * 3)
+        ax_b.set_xlim(d.min() / 3, d.max() * 3)
+        lower, upper = self.bounds.edges()
+        edges = np.concatenate([lower[np.isfinite(lower)], upper[np.isfinite(upper)]])
+        seen = np.concatenate([st.magnitude_db[band], np.clip(edges, -120.0, 120.0)])
+        ax_n.set_ylim(np.floor((seen.min() - 10.0) / 10.0) * 10.0, np.ceil((seen.max() + 10.0) / 10.0) * 10.0)
+        curves = np.concatenate([st.worst_T_db[band], st.worst_S_db[band]])
+        curves = curves[np.isfinite(curves)]
+        if curves.size:
+            ax_b.set_ylim(max(curves.min(), -60.0) - 5.0, curves.max() + 5.0)
         ax_b.set_xlabel("frequency ω (rad/s)")
         ax_b.set_ylabel("closed-loop magnitude (dB)")
         ax_b.grid(True, which="both", lw=0.3)
@@ -596,8 +614,6 @@ class Designer:
         ImportError
             Without ipywidgets.
         """
-        from ._designer_widget import build_widget
-
         if self.figure is None:
             self.draw()
         return build_widget(self)

@@ -13,7 +13,6 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
 from .bounds import Bounds
 from .controller import Controller
 from .freqresp import check_grid, evaluate
@@ -22,7 +21,6 @@ from .templates import Template
 __all__ = ["draw", "loop_nichols", "m_contour", "plot_templates", "template_nichols", "wrap_phase"]
 
 
-@renamed_keywords(omegas="omega")
 def loop_nichols(loop: object, omega: ArrayLike, phase_window: tuple = (-360.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """Phase (degrees, unwrapped) and magnitude (dB) of a loop on the grid ``omega``.
 
@@ -277,6 +275,15 @@ def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes |
                     lab = None
             if lab is not None:  # no curve to carry the frequency's legend entry
                 ax.plot([], [], "-", color=colours[i], lw=1.5, label=lab)
+        if len(design) > 10:
+            # dozens of frequencies share a continuous colour map: a colour key says which
+            # colour is which frequency (a legend of dozens of entries would say nothing)
+            from matplotlib import colormaps
+            from matplotlib.cm import ScalarMappable
+            from matplotlib.colors import LogNorm
+
+            key = ScalarMappable(norm=LogNorm(design.min(), design.max()), cmap=colormaps["viridis"])
+            ax.figure.colorbar(key, ax=ax, pad=0.01, fraction=0.05, label="bound frequency ω (rad/s)")
         # Legend-only entries (no data) saying what the line styles mean, in a neutral grey.
         meaning = {"-": "solid: lower bound, L0 must pass above", "--": "dashed: upper bound, L0 must pass below"}
         for style in ("-", "--"):
@@ -304,6 +311,12 @@ def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes |
         for i, w in enumerate(design):
             j = int(np.argmin(np.abs(grid - w)))
             ax.plot(lo + np.mod(ph[j] - lo, 360.0), mag[j], "o", color=colours[i], mec="k", ms=7)
+    # the critical point (−180° + k·360°, 0 dB) in every period the window shows: the loop's
+    # distance to it is the stability margin a reader looks for first
+    crit = [p for p in -180.0 + 360.0 * np.arange(np.floor((lo + 180.0) / 360.0), np.ceil((hi + 180.0) / 360.0) + 1)
+            if lo <= p <= hi]
+    if crit:
+        ax.plot(crit, np.zeros(len(crit)), "+", color="r", ms=12, mew=2, zorder=5, label="critical point (−180°, 0 dB)")
     ax.set_xlim(lo, hi)
     if ylim is not None:
         ax.set_ylim(*ylim)

@@ -4,8 +4,8 @@ The code lives in
 
 - :mod:`loopshaping.templates`: :class:`Template` (plant cases at the design
   frequencies), :func:`tracking_pairs`;
-- :mod:`loopshaping.specs`: :class:`Spec`, :data:`KINDS`, :func:`as_specs`;
-- :mod:`loopshaping.bounds`: :func:`bounds`, :class:`Bounds`, :func:`intersect`,
+- :mod:`loopshaping.specs`: :class:`Spec`, :data:`KINDS`;
+- :mod:`loopshaping.bounds`: :func:`bounds`, :class:`Bounds`, :func:`intersect`, :func:`as_specs`,
   :class:`BoundsWarning` and the closed-form solver;
 - :mod:`loopshaping.freqresp`: :func:`evaluate` and the grid checks.
 
@@ -15,10 +15,16 @@ bound tables (``forbidden_db``).
 """
 from __future__ import annotations
 
-from .bounds import DEFAULT_PHASES_DEG, Bounds, BoundsWarning, bounds, intersect
+from .bounds import (
+    DEFAULT_PHASES_DEG,
+    Bounds,
+    BoundsWarning,
+    as_specs,
+    bounds,
+    intersect,
+)
 from .freqresp import check_grid, evaluate
-from .freqresp import check_grid as _check_grid  # noqa: F401  (the former private name, for old callers)
-from .specs import KINDS, Spec, as_specs
+from .specs import KINDS, Spec
 from .templates import Template, tracking_pairs
 
 __all__ = [

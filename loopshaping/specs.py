@@ -3,7 +3,7 @@
 Every specification is written in the general form |(A + B·G)/(C + D·G)| ≤ W per case; the
 classic kinds (:data:`KINDS`) only choose A, B, C, D from the plant P. :class:`Spec` holds
 one specification (kind, weight, band, name, kind arguments) and evaluates its weight and
-coefficients at any frequencies; :func:`as_specs` normalises "a Bounds, a Spec or a list of
+coefficients at any frequencies; :func:`loopshaping.bounds.as_specs` normalises "a Bounds, a Spec or a list of
 Spec" arguments.
 
 Frequencies in rad/s; weights are linear magnitudes (not dB).
@@ -16,10 +16,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_keywords
 from .freqresp import evaluate, is_lti
 
-__all__ = ["KINDS", "Spec", "as_specs"]
+__all__ = ["KINDS", "Spec"]
 
 KINDS = ("stability", "sensitivity", "input_disturbance", "control_effort", "noise", "tracking", "general")
 _KIND_ARGS = {
@@ -111,7 +110,6 @@ class Spec:
         if self.name is None:
             object.__setattr__(self, "name", self.kind)
 
-    @renamed_keywords(omegas="omega")
     def in_band(self, omega: ArrayLike) -> np.ndarray:
         """Where the spec applies.
 
@@ -130,7 +128,6 @@ class Spec:
             return np.ones(omega.shape, bool)
         return (omega >= self.band[0]) & (omega <= self.band[1])
 
-    @renamed_keywords(omegas="omega")
     def weights(self, omega: ArrayLike, n_cases: int, design: ArrayLike | None = None) -> np.ndarray:
         """|W| at ``omega``; for tracking, the allowed ratio.
 
@@ -197,7 +194,6 @@ class Spec:
                              "(|T| ≤ 0 cannot be met; a zero of the weighting function on the jω axis?)")
         return w
 
-    @renamed_keywords(omegas="omega")
     def coefficients(self, omega: ArrayLike, plants: np.ndarray, design: ArrayLike | None = None) -> tuple:
         """General-form coefficients A, B, C, D at ``omega`` for the plant responses ``plants``.
 
@@ -282,39 +278,3 @@ def _static_gain(sys):
     if isinstance(sys, ct.StateSpace) and sys.nstates == 0:
         return float(np.real(sys.D[0, 0]))
     return None
-
-
-def as_specs(specs: "Bounds | Spec | Iterable[Spec]") -> list:
-    """A Bounds (its specs), one Spec, or an iterable of Spec → a non-empty list of Spec.
-
-    Parameters
-    ----------
-    specs : Bounds or Spec or iterable of Spec
-        The specifications.
-
-    Returns
-    -------
-    list of Spec
-        Non-empty.
-
-    Raises
-    ------
-    TypeError
-        If ``specs`` is empty or holds something else than :class:`Spec`.
-
-    Examples
-    --------
-    >>> [sp.name for sp in as_specs(Spec("stability", 1.2))]
-    ['stability']
-    """
-    from .bounds import Bounds  # bounds imports this module
-
-    if isinstance(specs, Bounds):
-        specs = list(specs.specs)
-    elif isinstance(specs, Spec):
-        specs = [specs]
-    else:
-        specs = list(specs)
-    if not specs or not all(isinstance(sp, Spec) for sp in specs):
-        raise TypeError("specs must be a Bounds, a Spec or a non-empty list of Spec")
-    return specs

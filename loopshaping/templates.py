@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._deprecation import renamed_attribute, renamed_keywords
 from .freqresp import check_grid, evaluate, grid_indices
 
 __all__ = ["Template", "tracking_pairs"]
@@ -30,8 +29,7 @@ class Template:
     Parameters
     ----------
     omega : array_like
-        (n_omega,) design frequencies, rad/s, strictly increasing. (Former name ``omegas``:
-        a deprecated keyword and attribute.)
+        (n_omega,) design frequencies, rad/s, strictly increasing.
     responses : array_like
         (n_omega, n_cases) complex frequency responses P_i(jω) (a 1-D array: one case).
     nominal : int
@@ -95,8 +93,6 @@ class Template:
         if self.systems is not None:
             object.__setattr__(self, "systems", tuple(self.systems))
 
-    omegas = renamed_attribute("omegas", "omega")
-
     @property
     def n_cases(self) -> int:
         """Number of plant cases."""
@@ -132,7 +128,6 @@ class Template:
         ring = self.responses[:, :, None] * (1 + self.disk_radius[:, None, None] * psi)
         return np.concatenate([self.responses, ring.reshape(len(self.omega), -1)], axis=1)
 
-    @renamed_keywords(omegas="omega")
     def at(self, omega: ArrayLike) -> Template:
         """The template restricted to some of its design frequencies.
 
@@ -158,7 +153,6 @@ class Template:
 
     # -- constructors
     @classmethod
-    @renamed_keywords(omegas="omega")
     def from_responses(cls, omega: ArrayLike, responses: ArrayLike, nominal: int = 0, disk_radius: ArrayLike | None = None) -> Template:
         """From frequency responses.
 
@@ -181,7 +175,6 @@ class Template:
         return cls(omega, responses, nominal, disk_radius)
 
     @classmethod
-    @renamed_keywords(omegas="omega")
     def from_systems(cls, systems: Sequence, omega: ArrayLike, nominal: int = 0, disk_radius: ArrayLike | None = None) -> Template:
         """From SISO python-control LTI plant cases, evaluated at ``omega``.
 
@@ -215,7 +208,6 @@ class Template:
         return cls(w, resp, nominal, disk_radius, tuple(systems))
 
     @classmethod
-    @renamed_keywords(omegas="omega")
     def from_parameter_grid(cls, fn: Callable, ranges: dict, omega: ArrayLike, n: int | dict = 10,
                             edges_only: bool = False, nominal: dict | None = None,
                             disk_radius: ArrayLike | None = None) -> Template:
@@ -289,7 +281,6 @@ class Template:
         return cls(t.omega, t.responses, nom_idx, t.disk_radius, t.systems, grid, names)
 
     @classmethod
-    @renamed_keywords(omegas="omega")
     def from_operating_points(cls, systems: Sequence, omega: ArrayLike, nominal: int = 0, n_between: int = 0,
                               disk_radius: ArrayLike | None = None) -> Template:
         """From linear models at neighbouring operating points (ordered, e.g. by wind speed).
@@ -369,6 +360,3 @@ def tracking_pairs(P: np.ndarray) -> tuple:
     i, j = np.nonzero(~np.eye(n, dtype=bool))
     Pi, Pj = P[:, i], P[:, j]
     return Pi, Pi * Pj, Pj, Pi * Pj
-
-
-Template.__init__ = renamed_keywords(omegas="omega")(Template.__init__)

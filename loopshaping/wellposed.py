@@ -116,6 +116,10 @@ def check_well_posed(generalized_plant: ct.StateSpace | ct.TransferFunction, n_m
     p = partition(P, n_meas, n_ctrl)
     A, B1, B2, C1, C2, D12, D21 = (p[k] for k in ("A", "B1", "B2", "C1", "C2", "D12", "D21"))
     n = A.shape[0]
+    for key in ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22"):  # else LAPACK: "SVD did not converge"
+        if not np.all(np.isfinite(p[key])):
+            raise ValueError(f"ill-posed H∞ problem: the generalized plant's {key} has NaN or inf entries; check the "
+                             "plant and the weights it was built from")
 
     # (A2): rank conditions. A rank-deficient D12 is the classic "spins forever" case.
     s12 = sla.svdvals(D12) if D12.size else np.zeros(0)

@@ -17,7 +17,7 @@ The design loop, one module a step:
 - :mod:`specdesign.validate`: rainflow validation, indicators, the paper's tables, lifetime DEL,
   campaigns, the GP surrogate.
 - :mod:`specdesign.mpc`: the related methods as controllers: quadratic MPC, fatigue-oriented
-  economic MPC (seed 000 Eq. 4), behavioural cloning, health-aware LPV-MPC (seed 002).
+  economic MPC (Collet et al.'s Eq. 4), behavioural cloning, health-aware LPV-MPC (Boutrous, Nejjari and Puig).
 - :mod:`specdesign.fatigue_online`: streaming rainflow + Miner (accumulated damage D(k)).
 - :mod:`specdesign.openfast`: OpenFAST file adapters (.lin, .out/.outb) and
   :class:`~specdesign.openfast.LinearTurbine` (designs on OpenFAST linearisations).

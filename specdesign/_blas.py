@@ -13,14 +13,14 @@ from __future__ import annotations
 import functools
 from contextlib import AbstractContextManager
 
+from threadpoolctl import ThreadpoolController
+
 __all__ = ["on_one_blas_thread", "one_blas_thread"]
 
 
 @functools.lru_cache(maxsize=1)
 def _controller():
     """threadpoolctl's controller, built once: it scans the loaded libraries (milliseconds)."""
-    from threadpoolctl import ThreadpoolController
-
     return ThreadpoolController()
 
 

@@ -17,12 +17,30 @@ import json
 import math
 import os
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from .validate import (INDICATORS, Campaign, acceptance, check_campaign_step, check_plant_step, run_campaign,
-                       seeds_from, table2, table3)
+from loopshaping.controller import Controller
+
+from . import __version__, turbine
+from ._checks import distinct_keys
+from .openfast.install import build_openfast, find_openfast
+from .plots import validation as pv
+from .rosco import rosco_scheduled
+from .simulate import ScheduledController, scheduled
+from .validate import (
+    INDICATORS,
+    Campaign,
+    acceptance,
+    check_campaign_step,
+    check_plant_step,
+    run_campaign,
+    seeds_from,
+    table2,
+    table3,
+)
 
 __all__ = ["main", "ConfigError", "read_config", "load_controller", "run_config", "output_folder"]
 
@@ -51,26 +69,31 @@ def main(argv: list[str] | None = None) -> int:
     >>> main(["--version"])  # doctest: +SKIP
     specdesign 0.1.0
     """
-    from specdesign import __version__
-
     parser = argparse.ArgumentParser(prog="specdesign", description=_DESCRIPTION,
                                      epilog="Campaign file schema: docs/validation.md.")
     parser.add_argument("--version", action="version", version=f"specdesign {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    demo = sub.add_parser("demo", help="run the 19 m/s design loop and write its tables and figures")
+    demo = sub.add_parser("demo", help="run the design loop at one wind speed (19 m/s by default) and write its tables "
+                                        "and figures")
     demo.add_argument("--out", default="specdesign_output", help="output folder (default: %(default)s)")
     demo.add_argument("--fast", action="store_true", help="reduced sizes (fewer seeds, shorter runs)")
-    demo.add_argument("--method", choices=("target", "notch"), default="target",
-                      help="target: the specification for a 25 %% DEL target and the design that meets it "
+    demo.add_argument("--method", choices=("target", "notch"), default=None,
+                      help="target: the specification for the DEL target and the design that meets it "
                            "(default); notch: the notch specification and the fixed-structure design")
+    demo.add_argument("--wind-speed", default=None, metavar="M_S",
+                      help="operating point of the design in m/s, within the design range (default 19)")
+    demo.add_argument("--target", default=None, metavar="PCT",
+                      help="tower-base DEL reduction to design for, %% between 0 and 100 (default 25)")
     demo.add_argument("--lifetime", action="store_true",
                       help="instead: ROSCO vs the scheduled QFT designs from cut-in to cut-out over a Weibull climate, "
                            "the lifetime tower-base DEL change with its SE")
-    demo.add_argument("--seeds", type=int, default=None, help="--lifetime: paired seeds per wind bin (default 6; 3 with --fast)")
-    demo.add_argument("--duration", type=float, default=None,
-                      help="--lifetime: recorded seconds per run (default 600; 300 with --fast)")
-    demo.add_argument("--bin-width", type=float, default=2.0,
-                      help="--lifetime: wind bin width in m/s, dividing cut-out minus cut-in (default: %(default)s)")
+    demo.add_argument("--seeds", default=None, metavar="N",
+                      help="paired seeds (per wind bin with --lifetime), at least 2 (default 50, 8 with --fast; "
+                           "--lifetime: 6, 3 with --fast)")
+    demo.add_argument("--duration", default=None, metavar="S",
+                      help="recorded seconds per run, 1-86400 (default 600; 300 with --fast)")
+    demo.add_argument("--bin-width", default=None, metavar="M_S",
+                      help="--lifetime: wind bin width in m/s, dividing cut-out minus cut-in (default 2)")
     demo.add_argument("--design-speeds", default=None,
                       help="--lifetime: comma-separated wind speeds of the QFT designs in m/s (default 15,17,...,25)")
     val = sub.add_parser("validate", help="run an offline validation campaign described by a TOML/JSON file")
@@ -85,25 +108,40 @@ def main(argv: list[str] | None = None) -> int:
     _choose_backend()
     try:
         if args.command == "demo":
-            from specdesign.demo import run_demo
+            from specdesign.demo import check_demo_options, check_lifetime_options, run_demo
 
-            output_folder(args.out, "--out")
+            # every option checked before any design or simulation: a user error is one line
+            seeds = _number_arg(args.seeds, "--seeds", integer=True)
+            duration = _number_arg(args.duration, "--duration")
+            target = _number_arg(args.target, "--target")
+            target = 25.0 if target is None else target
             if args.lifetime:
                 from specdesign.demo import LIFETIME_DESIGN_SPEEDS, run_lifetime_demo
-                from specdesign.validate import weibull_bins
 
-                if args.seeds is not None and args.seeds < 2:
-                    raise ConfigError(f"--seeds={args.seeds}: the lifetime change's SE needs at least 2 paired seeds")
+                _only_without_lifetime(args)
+                bin_width = _number_arg(args.bin_width, "--bin-width")
+                bin_width = 2.0 if bin_width is None else bin_width
+                speeds = _speeds_arg(args.design_speeds, LIFETIME_DESIGN_SPEEDS)
                 try:
-                    weibull_bins(bin_width=args.bin_width)
-                except ValueError as e:
-                    raise ConfigError(f"--bin-width: {e}") from None
-
-                run_lifetime_demo(out=args.out, fast=args.fast, n_seeds=args.seeds, duration=args.duration,
-                                  bin_width=args.bin_width,
-                                  design_speeds=_speeds_arg(args.design_speeds, LIFETIME_DESIGN_SPEEDS))
+                    check_lifetime_options(seeds, duration, speeds, bin_width, fast=args.fast, target_reduction=target)
+                except (TypeError, ValueError) as e:
+                    raise _option_error(e) from None
+                output_folder(args.out, "--out")
+                run_lifetime_demo(out=args.out, fast=args.fast, n_seeds=seeds, duration=duration, bin_width=bin_width,
+                                  design_speeds=speeds, target_reduction=target)
             else:
-                run_demo(out=args.out, fast=args.fast, method=args.method)
+                for flag, given in (("--bin-width", args.bin_width), ("--design-speeds", args.design_speeds)):
+                    if given is not None:
+                        raise ConfigError(f"{flag} belongs to --lifetime; the design demo designs at --wind-speed")
+                speed = _number_arg(args.wind_speed, "--wind-speed")
+                speed = 19.0 if speed is None else speed
+                try:
+                    check_demo_options(speed, target, seeds, duration, fast=args.fast)
+                except (TypeError, ValueError) as e:
+                    raise _option_error(e) from None
+                output_folder(args.out, "--out")
+                run_demo(out=args.out, fast=args.fast, method=args.method or "target", wind_speed=speed,
+                         target_reduction=target, n_seeds=seeds, duration=duration)
         elif args.command == "openfast":
             _openfast_command(args)
         else:
@@ -121,15 +159,45 @@ def main(argv: list[str] | None = None) -> int:
 
 
 # argparse prints these as they are: plain text, no reST markup (the module docstring has it)
-_DESCRIPTION = ("Fatigue-based pitch-controller design: 'specdesign demo' runs the 19 m/s design loop, "
+_DESCRIPTION = ("Fatigue-based pitch-controller design: 'specdesign demo' runs the design loop (19 m/s by default), "
                 "'specdesign validate CONFIG' reruns an offline validation campaign from a TOML/JSON file "
                 "(also 'python -m specdesign').")
 
 
+#: The demo functions' argument names → the command line's options, for their messages.
+_DEMO_FLAGS = {"wind_speed": "--wind-speed", "target_reduction": "--target", "n_seeds": "--seeds",
+               "duration": "--duration", "bin_width": "--bin-width", "design_speeds": "--design-speeds"}
+
+
+def _option_error(e: BaseException) -> ConfigError:
+    """A demo option's ValueError/TypeError as a ConfigError naming the command-line option."""
+    text = _one_line(e)
+    name = next((n for n in _DEMO_FLAGS if text.startswith(n)), None)
+    return ConfigError(text if name is None else _DEMO_FLAGS[name] + text[len(name):])
+
+
+def _number_arg(text, flag, *, integer=False):
+    """A numeric option's text as a float (an int with ``integer``), None when not given; else a
+    ConfigError naming ``flag`` (argparse's own error is two lines and a usage)."""
+    if text is None:
+        return None
+    try:
+        return int(text) if integer else float(text)
+    except ValueError:
+        what = "a whole number" if integer else "a number"
+        raise ConfigError(f"{flag}={text!r} must be {what}") from None
+
+
+def _only_without_lifetime(args):
+    """Refuse the design demo's options given with --lifetime (silently unused otherwise)."""
+    for flag, given in (("--wind-speed", args.wind_speed), ("--method", args.method)):
+        if given is not None:
+            raise ConfigError(f"{flag} belongs to the design demo; --lifetime designs at --design-speeds with the "
+                              "target specification")
+
+
 def _openfast_command(args) -> None:
     """``specdesign openfast build SOURCE`` / ``specdesign openfast find``: the executables' paths and version on stdout."""
-    from specdesign.openfast.install import build_openfast, find_openfast
-
     if args.action == "build":
         if args.source is None:
             raise ConfigError("openfast build needs SOURCE: an OpenFAST source tarball or folder")
@@ -284,9 +352,6 @@ def load_controller(spec: dict, base: str | os.PathLike, model, *, config: str |
     """
     import control
 
-    from .rosco import rosco_scheduled
-    from .simulate import ScheduledController, scheduled
-
     where = f"controllers.{name}"
     base = Path(base)
     src = config if config is not None else base
@@ -323,8 +388,6 @@ def load_controller(spec: dict, base: str | os.PathLike, model, *, config: str |
 
     def tf(d, key):
         if isinstance(d, dict) and "elements" in d:
-            from loopshaping.controller import Controller
-
             try:
                 num, den = Controller.from_dict(d).polys()
             except (TypeError, ValueError) as e:
@@ -398,8 +461,6 @@ def _wind_speeds(vs, model, path, key, operating=False) -> list:
 
 def _load_json(text: bytes, path: Path, what: str):
     """JSON with every object's keys distinct (a repeated key would silently keep the last)."""
-    from ._checks import distinct_keys
-
     def repeated(k):
         return ConfigError(f"{path}: key {k!r} appears twice in one object; keep one")
 
@@ -415,8 +476,6 @@ def _read_config(path: Path) -> dict:
     except OSError as e:
         raise type(e)(f"{path}: cannot read the campaign file ({e.strerror or e})") from None
     if path.suffix.lower() == ".toml":
-        import tomllib
-
         try:
             return tomllib.loads(text.decode())
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
@@ -471,8 +530,6 @@ def read_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -
     OSError
         A file that cannot be read or an output folder that cannot be written, naming it.
     """
-    from . import turbine
-
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"config file {path} does not exist")
@@ -629,8 +686,6 @@ def _write_figures(camp: Campaign, out: Path, designed, baseline) -> list[Path]:
     """Figs. 8-10 as PNG files (the paths written): figures made without pyplot, so no backend
     is involved."""
     from matplotlib.figure import Figure
-
-    from .plots import validation as pv
 
     written = []
     for v in camp.wind_speeds:

@@ -19,15 +19,172 @@ from __future__ import annotations
 import json
 import os
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import control as ct
 import numpy as np
 
-__all__ = ["run_demo", "run_lifetime_demo", "LIFETIME_DESIGN_SPEEDS"]
+from loopshaping.freqresp import is_zero
+
+from . import validate
+from ._checks import del_target, positive_scalar, real_scalar
+from .plots.fatigue import plot_sensitivity
+from .plots.qft import plot_design_bode, plot_design_nichols
+from .plots.validation import plot_lifetime_damage, plot_spectra, plot_time_series
+from .rosco import rosco_baseline, rosco_scheduled
+from .simulate import scheduled
+from .turbine import iea15mw
+
+__all__ = ["run_demo", "run_lifetime_demo", "LIFETIME_DESIGN_SPEEDS", "check_demo_options", "check_lifetime_options",
+           "DemoOptions"]
 
 #: Wind speeds (m/s) of the QFT designs the lifetime demo schedules (the seed paper's range).
 LIFETIME_DESIGN_SPEEDS = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
+#: Shortest recorded time per run, s: 10 output samples at the campaigns' record_dt of 0.1 s
+#: (the campaign file's own minimum).
+MIN_DURATION = 1.0
+#: Longest recorded time per run, s: one day (the campaign file's own maximum).
+MAX_DURATION = 86400.0
+
+
+@dataclass(frozen=True)
+class DemoOptions:
+    """The demos' options, checked (:func:`check_demo_options`, :func:`check_lifetime_options`).
+
+    Parameters
+    ----------
+    wind_speed : float or None
+        Operating point of the design demo, m/s (None for the lifetime demo).
+    target_reduction : float
+        Tower-base DEL reduction, %.
+    n_seeds : int
+        Paired seeds (per wind bin for the lifetime demo).
+    duration : float
+        Recorded time per run, s.
+    design_speeds : tuple of float
+        Wind speeds of the lifetime demo's designs, m/s (``()`` for the design demo).
+    """
+
+    wind_speed: float | None
+    target_reduction: float
+    n_seeds: int
+    duration: float
+    design_speeds: tuple = ()
+
+
+def _seeds_and_duration(n_seeds, duration, default_seeds, default_duration):
+    """(seeds, duration s) checked: ≥ 2 paired seeds (a standard error needs two) and a duration in
+    [:data:`MIN_DURATION`, :data:`MAX_DURATION`] s; None takes the default (0 is no default)."""
+    n = default_seeds if n_seeds is None else n_seeds
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
+        raise TypeError(f"n_seeds={n_seeds!r} must be a whole number of paired seeds (≥ 2)")
+    if n < 2:
+        raise ValueError(f"n_seeds={n_seeds!r}: the paired change's standard error needs at least 2 paired seeds")
+    d = default_duration if duration is None else positive_scalar(duration, "duration")
+    if not MIN_DURATION <= d <= MAX_DURATION:
+        raise ValueError(f"duration={duration!r} s must lie in {MIN_DURATION:g}-{MAX_DURATION:g} s (10 output samples "
+                         "at 0.1 s to one day per run)")
+    return int(n), float(d)
+
+
+def check_demo_options(wind_speed=19.0, target_reduction=25.0, n_seeds=None, duration=None, *, fast=False,
+                       spec_reduction=15.0, model=None) -> DemoOptions:
+    """The design demo's options (:func:`run_demo`), checked before any work.
+
+    Parameters
+    ----------
+    wind_speed : float
+        Operating point, m/s: one where a pitch controller can be designed
+        (:func:`specdesign.qft.check_design_speed`).
+    target_reduction : float
+        Tower-base DEL reduction, % (0-100).
+    n_seeds : int, optional
+        Paired seeds (≥ 2); default 50, 8 with ``fast``.
+    duration : float, optional
+        Recorded time per run, s (1-86400); default 600, 300 with ``fast``.
+    fast : bool
+        The reduced defaults.
+    spec_reduction : float
+        Damage reduction of the notch specification, % (0-100).
+    model : specdesign.turbine.TurbineModel, optional
+        The turbine (default :func:`specdesign.turbine.iea15mw`).
+
+    Returns
+    -------
+    DemoOptions
+        The options with their defaults filled in.
+
+    Raises
+    ------
+    TypeError
+        For a bool or a string where a number is meant.
+    ValueError
+        Naming the option and its range.
+    """
+    from .qft import check_design_speed
+
+    v = check_design_speed(iea15mw() if model is None else model, real_scalar(wind_speed, "wind_speed"))
+    t = del_target(target_reduction)
+    del_target(spec_reduction, "spec_reduction")
+    n, d = _seeds_and_duration(n_seeds, duration, 8 if fast else 50, 300.0 if fast else 600.0)
+    return DemoOptions(v, t, n, d)
+
+
+def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_DESIGN_SPEEDS, bin_width=2.0, *,
+                           fast=False, target_reduction=25.0, cut_in=3.0, cut_out=25.0, k=None, scale=None,
+                           model=None) -> DemoOptions:
+    """The lifetime demo's options (:func:`run_lifetime_demo`), checked before any design.
+
+    Parameters
+    ----------
+    n_seeds : int, optional
+        Paired seeds per bin (≥ 2); default 6, 3 with ``fast``.
+    duration : float, optional
+        Recorded time per run, s (1-86400); default 600, 300 with ``fast``.
+    design_speeds : sequence of float
+        Wind speeds of the designs, m/s: distinct, each where a pitch controller can be
+        designed (:func:`specdesign.qft.check_design_speed`).
+    bin_width, cut_in, cut_out, k, scale
+        The climate, as :func:`specdesign.validate.weibull_bins` takes them.
+    fast : bool
+        The reduced defaults.
+    target_reduction : float
+        Tower-base DEL reduction of every design, % (0-100).
+    model : specdesign.turbine.TurbineModel, optional
+        The turbine (default :func:`specdesign.turbine.iea15mw`).
+
+    Returns
+    -------
+    DemoOptions
+        The options with their defaults filled in (``wind_speed`` None).
+
+    Raises
+    ------
+    TypeError
+        For a bool or a string where a number is meant.
+    ValueError
+        Naming the option and its range.
+    """
+    from .qft import check_design_speed
+
+    n, d = _seeds_and_duration(n_seeds, duration, 3 if fast else 6, 300.0 if fast else 600.0)
+    t = del_target(target_reduction)
+    validate.weibull_bins(validate.WEIBULL_K if k is None else k, scale=validate.WEIBULL_A if scale is None else scale,
+                          cut_in=cut_in, cut_out=cut_out, bin_width=bin_width)
+    if isinstance(design_speeds, (str, bytes)) or np.ndim(design_speeds) != 1 or len(design_speeds) == 0:
+        raise ValueError(f"design_speeds={design_speeds!r} must be a non-empty sequence of wind speeds in m/s")
+    m = iea15mw() if model is None else model
+    speeds = []
+    for i, x in enumerate(design_speeds):
+        try:
+            speeds.append(check_design_speed(m, real_scalar(x, "wind_speed")))
+        except (TypeError, ValueError) as e:  # check_design_speed names wind_speed: say which design speed
+            raise type(e)(f"design_speeds[{i}]: {e}") from None
+    speeds = tuple(speeds)
+    if len(set(speeds)) != len(speeds):
+        raise ValueError(f"design_speeds={design_speeds!r} repeats a wind speed; give each once")
+    return DemoOptions(None, t, n, d, speeds)
 
 
 def _say(msg):
@@ -58,9 +215,9 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         Tower-base DEL reduction (%): the specification's promise (``"target"``) or the QFT
         design's DEL target (``"notch"``).
     n_seeds : int, optional
-        Paired seeds of the validation (overrides ``fast``).
+        Paired seeds of the validation (≥ 2; overrides ``fast``).
     duration : float, optional
-        Recorded time per run (s; overrides ``fast``).
+        Recorded time per run (s, 1-86400; overrides ``fast``).
     method : {"target", "notch"}, default "target"
         ``"target"``: specification-driven (:func:`specdesign.feasibility.specification_for_target`,
         then ``design_qft(spec=...)``); ``"notch"``: the notch specification and the
@@ -70,29 +227,27 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     -------
     dict
         The headline numbers (DELs in MN·m, reductions in %, deviations in pp, run time in s).
-    """
-    from matplotlib.figure import Figure  # figures only written to files: no pyplot, no backend
 
-    from loopshaping.freqresp import is_zero
+    Raises
+    ------
+    TypeError, ValueError
+        For an option out of range (:func:`check_demo_options`), before any work.
+    """
+    from matplotlib.figure import (
+        Figure,  # figures only written to files: no pyplot, no backend
+    )
 
     from . import feasibility, qft, spec, validate
-    from .plots.fatigue import plot_sensitivity
-    from .plots.qft import plot_design_bode, plot_design_nichols
     from .plots.spec import plot_specification
-    from .plots.validation import plot_spectra, plot_time_series
-    from .rosco import rosco_baseline
-    from .simulate import scheduled
-    from .turbine import iea15mw
-
     if method not in ("target", "notch"):
         raise ValueError(f"method={method!r} must be 'target' (specification-driven) or 'notch'")
+    model = iea15mw()
+    opts = check_demo_options(wind_speed, target_reduction, n_seeds, duration, fast=fast,
+                              spec_reduction=spec_reduction, model=model)
+    v, target_reduction, n_seeds, duration = opts.wind_speed, opts.target_reduction, opts.n_seeds, opts.duration
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    n_seeds = n_seeds or (8 if fast else 50)
-    duration = duration or (300.0 if fast else 600.0)
     t_start = time.perf_counter()
-    model = iea15mw()
-    v = float(wind_speed)
 
     _say(f"[1/4] damage sensitivity of the ROSCO loop at {v:g} m/s (tower-base moment, Dirlik, m = 4)")
     base = spec.baseline_analysis(model, v)
@@ -143,8 +298,9 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     _say(f"      C_β(s) = {_tf_text(pitch)}")
     if atd is not None:
         _say(f"      C_ATD(s) = {_tf_text(atd)}")
-    fig = Figure(figsize=(14, 5.5))
-    plot_design_nichols(design, axes=fig.subplots(1, 2))
+    n_loops = 1 if atd is None else 2  # a pitch-only design has no ATD chart to draw
+    fig = Figure(figsize=(7 * n_loops, 5.5))
+    plot_design_nichols(design, axes=fig.subplots(1, n_loops, squeeze=False)[0])
     fig.savefig(out / "3_nichols.png", dpi=120)
     fig = Figure(figsize=(9, 7.5))
     plot_design_bode(design, model, axes=fig.subplots(2, 1, sharex=True))
@@ -238,7 +394,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
 def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False, n_seeds: int | None = None,
                       duration: float | None = None, design_speeds=LIFETIME_DESIGN_SPEEDS, bin_width: float = 2.0,
                       cut_in: float = 3.0, cut_out: float = 25.0, k: float | None = None,
-                      scale: float | None = None) -> dict:
+                      scale: float | None = None, target_reduction: float = 25.0) -> dict:
     """Lifetime comparison, ROSCO vs the designed controller, from cut-in to cut-out.
 
     The designed controller: the specification-driven QFT designs of
@@ -275,6 +431,8 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
         Weibull shape; default the seed paper's 2.2 (:data:`specdesign.validate.WEIBULL_K`).
     scale : float, optional
         Weibull scale A (m/s); default the seed paper's 11.29 (:data:`specdesign.validate.WEIBULL_A`).
+    target_reduction : float, default 25.0
+        Tower-base DEL reduction every design's specification promises, %.
 
     Returns
     -------
@@ -287,34 +445,31 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
 
     Raises
     ------
+    TypeError
+        For a bool or a string where a number is meant.
     ValueError
-        Bad climate parameters (:func:`specdesign.validate.weibull_bins`), fewer than 2 seeds
-        (no standard error), or errors of the design and the campaign.
+        Any option out of range (:func:`check_lifetime_options`: bad climate parameters, fewer
+        than 2 seeds, a duration outside 1-86400 s, a design speed outside the design range),
+        all checked before the first design; or errors of the design and the campaign.
     """
     from matplotlib.figure import Figure
 
-    from loopshaping.freqresp import is_zero
-
     from . import qft, validate
-    from .plots.validation import plot_lifetime_damage
-    from .rosco import rosco_scheduled
-    from .simulate import scheduled
-    from .turbine import iea15mw
-
     out = Path(out)
-    n_seeds = n_seeds or (3 if fast else 6)
-    duration = duration or (300.0 if fast else 600.0)
-    if n_seeds < 2:
-        raise ValueError(f"n_seeds={n_seeds!r}: the lifetime change's standard error needs at least 2 paired seeds")
+    model = iea15mw()
+    # every option, the design speeds included, before the first design
+    opts = check_lifetime_options(n_seeds, duration, design_speeds, bin_width, fast=fast,
+                                  target_reduction=target_reduction, cut_in=cut_in, cut_out=cut_out, k=k, scale=scale,
+                                  model=model)
+    n_seeds, duration, speeds = opts.n_seeds, opts.duration, opts.design_speeds
     climate = validate.weibull_bins(validate.WEIBULL_K if k is None else k,
                                     scale=validate.WEIBULL_A if scale is None else scale, cut_in=cut_in,
                                     cut_out=cut_out, bin_width=bin_width)
-    speeds = tuple(float(v) for v in design_speeds)
     out.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
-    model = iea15mw()
-    _say(f"[1/3] QFT designs meeting the specification for 25 % less tower-base DEL at {_list(speeds)} m/s")
-    designs = qft.design_schedule(model, speeds)
+    _say(f"[1/3] QFT designs meeting the specification for {opts.target_reduction:g} % less tower-base DEL at "
+         f"{_list(speeds)} m/s")
+    designs = qft.design_schedule(model, speeds, opts.target_reduction)
     pitch = {v: ct.tf(d.pitch_controller) for v, d in zip(speeds, designs)}
     atd = {v: ct.tf(d.atd_controller) for v, d in zip(speeds, designs)}
     controllers = {"ROSCO": rosco_scheduled(model),

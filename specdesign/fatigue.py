@@ -1,6 +1,6 @@
 """Time-domain fatigue: ASTM E1049 rainflow counting, S-N curves, Palmgren-Miner, DEL.
 
-Conventions (see WORKBENCH.md): S-N curves are range-based, N(S) = (S_ref/S)^m with S the
+Conventions (the documentation's method page): S-N curves are range-based, N(S) = (S_ref/S)^m with S the
 cycle **range** (peak to valley, not the amplitude); half cycles count 0.5; the damage
 equivalent load uses the 1 Hz convention, DEL = (Σ n_i S_i^m / N_eq)^(1/m) with
 N_eq = duration · n_eq_rate (n_eq_rate = 1 Hz by default). Loads keep the units of the
@@ -24,6 +24,8 @@ from numpy.typing import ArrayLike
 from ._checks import as_real, as_signal, positive_scalar, representable
 
 __all__ = [
+    "TOWER_M",
+    "BLADE_M",
     "Cycles",
     "rainflow",
     "SNCurve",
@@ -34,6 +36,12 @@ __all__ = [
     "fit_variance_damage",
     "economic_cost",
 ]
+
+#: Wöhler (S-N) exponent of the welded-steel tower, N = (S_ref/S)^m with S the cycle range: the
+#: seed paper's m = 4, the default of every tower-load DEL and damage in the workbench.
+TOWER_M = 4.0
+#: Wöhler exponent of the glass-fibre composite blade root: the usual m = 10.
+BLADE_M = 10.0
 
 
 @dataclass(frozen=True)

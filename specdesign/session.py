@@ -29,14 +29,19 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 import control as ct
 import numpy as np
 
+from loopshaping.controller import Controller
+
 from . import spec as _spec_module
+from . import turbine
+from ._checks import distinct_keys, finite_system
+from .openfast import read_linearization
 
 __all__ = ["SCHEMA", "VERSION", "Session", "save_session", "load_session", "session_to_dict", "session_from_dict"]
 
@@ -110,8 +115,6 @@ class Session:
     notes: str = ""
 
     def __post_init__(self):
-        from loopshaping.controller import Controller
-
         _model_ref(self.model)
         speeds = tuple(self.wind_speeds) if np.ndim(self.wind_speeds) else (self.wind_speeds,)
         for v in speeds:
@@ -135,6 +138,10 @@ class Session:
             if not isinstance(c, (Controller, ct.LTI)):
                 raise TypeError(f"controllers[{k!r}] must be a loopshaping Controller or a python-control LTI, "
                                 f"got {type(c).__name__}")
+            if isinstance(c, ct.LTI):  # a Controller's elements refuse NaN themselves
+                finite_system(c, f"controllers[{k!r}]")
+        for k, s in self.specifications.items():
+            finite_system(s.baseline, f"specifications[{k!r}].baseline")
         for name in _TABLES:
             _json_exact(getattr(self, name), name)
         if not isinstance(self.notes, str):
@@ -212,8 +219,6 @@ class Session:
         ValueError
             If the session refers to a set of ``.lin`` files (read those with :meth:`linearization`).
         """
-        from . import turbine
-
         if self.model == "iea15mw":
             return turbine.iea15mw()
         if "fst" in self.model:
@@ -241,8 +246,6 @@ class Session:
         """
         if not isinstance(self.model, dict) or "lin_files" not in self.model:
             raise ValueError("the session's model is not a set of .lin files; use Session.turbine()")
-        from .openfast import read_linearization
-
         return read_linearization(self.model["lin_files"], **kwargs)
 
     def specification_name(self, name: str | None = None) -> str:
@@ -341,14 +344,33 @@ def _lti_to_dict(sys, where):
 
 def _lti_from_dict(d, where):
     if isinstance(d, dict) and set(d) == {"num", "den"}:
-        return ct.tf(np.asarray(d["num"], float), np.asarray(d["den"], float))
+        num, den = (_finite_list(d[k], f"{where}.{k}") for k in ("num", "den"))
+        if not np.any(den):
+            raise ValueError(f"{where}.den is all zeros: no transfer function has that denominator")
+        return ct.tf(num, den)
     if isinstance(d, dict) and set(d) == {"ss"} and isinstance(d["ss"], dict) and set(d["ss"]) == set("ABCD"):
         m = d["ss"]
-        n = len(m["A"])
+        n = len(m["A"]) if isinstance(m["A"], list) else -1
         shapes = {"A": (n, n), "B": (n, 1), "C": (1, n), "D": (1, 1)}
-        arrs = {k: np.asarray(m[k], float).reshape(shapes[k]) for k in "ABCD"}
-        return ct.ss(arrs["A"], arrs["B"], arrs["C"], arrs["D"])
+        arrs = {k: _finite_list(m[k], f"{where}.ss.{k}") for k in "ABCD"}
+        for k in "ABCD":
+            if arrs[k].size != max(shapes[k][0], 0) * shapes[k][1]:
+                raise ValueError(f"{where}.ss.{k} must have shape {shapes[k]} (A is {n}×{n}), got {arrs[k].size} values")
+        return ct.ss(*(arrs[k].reshape(shapes[k]) for k in "ABCD"))
     raise ValueError(f"{where} must be {{'num', 'den'}} or {{'ss': {{'A', 'B', 'C', 'D'}}}}, got {d!r:.120}")
+
+
+def _finite_list(value, where):
+    """A (nested) list of finite numbers as a float array; a NaN, an inf (json reads NaN and
+    Infinity), a bool or a string is refused naming ``where``."""
+    flat = np.ravel(np.asarray(value, dtype=object)) if isinstance(value, list) else None
+    if flat is None or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in flat):
+        raise ValueError(f"{where} must be a list of numbers, got {value!r:.80}")
+    a = np.asarray(value, float)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{where} holds NaN or inf ({value!r:.80}); a controller or specification needs finite "
+                         "coefficients")
+    return a
 
 
 def session_to_dict(session: Session) -> dict:
@@ -370,10 +392,6 @@ def session_to_dict(session: Session) -> dict:
     TypeError
         If ``session`` is not a :class:`Session`.
     """
-    from dataclasses import asdict
-
-    from loopshaping.controller import Controller
-
     if not isinstance(session, Session):
         raise TypeError(f"session must be a specdesign.session.Session, got {type(session).__name__}")
     specs = {}
@@ -407,8 +425,6 @@ def session_from_dict(data: dict) -> Session:
     ValueError
         For another schema, a newer or unknown version, unknown keys or an invalid entry (named).
     """
-    from loopshaping.controller import Controller
-
     if not isinstance(data, dict) or data.get("schema") != SCHEMA:
         raise ValueError(f"not a design session: the file must be a JSON object with \"schema\": \"{SCHEMA}\"")
     version = data.get("version")
@@ -498,8 +514,6 @@ def load_session(path: str | os.PathLike) -> Session:
         If it is not JSON, repeats a key, or is not a design session of a version this
         specdesign reads (the message names the file).
     """
-    from ._checks import distinct_keys
-
     path = Path(path)
     try:
         data = json.loads(path.read_text(encoding="utf-8"), object_pairs_hook=distinct_keys())

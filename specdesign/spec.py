@@ -17,15 +17,15 @@ Typical use:
 >>> w_myt = res.specification.tf()               # W_MyT(s)
 
 That is the paper's shaper (notches above 0.6 rad/s, no feasibility guarantee). The
-specification to hand to a design is ``shape_to_target(base, 25.0, quantity="del")``
-(``band="whole"``, the default for a DEL target): the whole band, certified over the plant
-cases, in ``res.certified`` (:func:`specdesign.feasibility.element_specification`).
+specification to hand to a design is ``feasibility.shape_whole_band(base, 25.0)`` (a DEL
+target): the whole band, certified over the plant cases, in ``res.certified``
+(:func:`specdesign.feasibility.shape_whole_band`, on this module's baseline).
 """
 from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -33,9 +33,14 @@ import control as ct
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import spectral
+from loopshaping import controller as lc
+from loopshaping.controller import Controller, Element
+
+from . import closedloop, spectral, turbine, wind
 from ._checks import as_omega, as_psd, positive_scalar
 from .closedloop import siso_response
+from .fatigue import TOWER_M
+from .rosco import rosco_baseline, rosco_gain_schedule
 
 if TYPE_CHECKING:
     from loopshaping.controller import Controller, Element
@@ -43,6 +48,7 @@ if TYPE_CHECKING:
     from .turbine import TurbineModel
 
 __all__ = [
+    "SLSQP_OPTIONS",
     "Notch",
     "Gain",
     "LeadLag",
@@ -64,6 +70,10 @@ __all__ = [
     "specification_pair",
     "from_element",
 ]
+
+#: SciPy SLSQP settings of the workbench's constrained fits (the notch shaper here, the QFT
+#: tuner's polish): at most 300 iterations, converged when the cost changes by less than 1e-10.
+SLSQP_OPTIONS = {"maxiter": 300, "ftol": 1e-10}
 
 
 # --------------------------------------------------------------------------------------
@@ -149,8 +159,6 @@ class Notch:
         tuple of loopshaping.controller.Element
             One ``notch(omega_n, zeta_zero, width)``.
         """
-        from loopshaping import controller as lc
-
         return (lc.notch(self.omega_n, self.zeta_zero, self.width),)
 
 
@@ -171,6 +179,11 @@ class Gain:
     """
 
     gain_db: float
+
+    def __post_init__(self):
+        # a NaN gain would make every response NaN (and a session saved with it unreadable)
+        if isinstance(self.gain_db, (bool, np.bool_, str, bytes)) or not np.isfinite(self.gain_db):
+            raise ValueError(f"Gain.gain_db={self.gain_db!r} must be a finite number of dB")
 
     def tf(self) -> ct.TransferFunction:
         """The gain as a static transfer function.
@@ -205,8 +218,6 @@ class Gain:
         tuple of loopshaping.controller.Element
             One ``gain(10^(gain_db/20))``.
         """
-        from loopshaping import controller as lc
-
         return (lc.gain(10 ** (self.gain_db / 20)),)
 
 
@@ -277,8 +288,6 @@ class LeadLag:
         tuple of loopshaping.controller.Element
             One ``lead_lag(omega_zero, omega_pole)``.
         """
-        from loopshaping import controller as lc
-
         return (lc.lead_lag(self.omega_zero, self.omega_pole),)
 
 
@@ -349,8 +358,6 @@ class LowPass:
         tuple of loopshaping.controller.Element
             A ``complex_pole`` (ζ < 1) or two ``real_pole`` at ω_c(ζ ± √(ζ² − 1)) (ζ ≥ 1).
         """
-        from loopshaping import controller as lc
-
         if self.zeta < 1:
             return (lc.complex_pole(self.omega_c, self.zeta),)
         r = math.sqrt(self.zeta ** 2 - 1)
@@ -390,8 +397,6 @@ def from_element(element: Element) -> Gain | LeadLag | Notch | LowPass:
     >>> from_element(lc.notch(1.0, 0.05, 0.2))       # ζ_z/ζ_p = 1/4: 12 dB deep
     Notch(omega_n=1.0, depth_db=12.041199826559248, width=0.2)
     """
-    from loopshaping.controller import Element
-
     if not isinstance(element, Element):
         raise TypeError(f"element must be a loopshaping.controller.Element, got {type(element).__name__}")
     k, p = element.kind, element.params
@@ -547,29 +552,7 @@ class Specification:
         loopshaping.controller.Controller
             The elements' product (-), without the baseline.
         """
-        from loopshaping.controller import Controller
-
         return Controller(tuple(x for e in self.elements for x in e.to_elements()))
-
-    def with_elements(self, elements: Iterable) -> "Specification":
-        """A copy with the shaping elements replaced.
-
-        Parameters
-        ----------
-        elements : iterable
-            The new shaping elements (:class:`Notch`, :class:`Gain`, ...).
-
-        Returns
-        -------
-        Specification
-            The new specification (this one is unchanged).
-
-        Raises
-        ------
-        TypeError
-            If an element is not a shaping element.
-        """
-        return replace(self, elements=tuple(elements))
 
 
 def _check_proper_stable(sys, name):
@@ -624,7 +607,7 @@ class Baseline:
         ``controller`` (None for ROSCO's) there.
     model : TurbineModel or LinearTurbine, optional
         The turbine the baseline was made on (:func:`baseline_analysis`), so that
-        ``shape_to_target(base, ..., band="whole")`` can certify a specification on its plant.
+        :func:`specdesign.feasibility.shape_whole_band` can certify a specification on its plant.
     """
 
     omega: np.ndarray
@@ -643,18 +626,12 @@ class Baseline:
     model: object = field(default=None, repr=False, compare=False)
 
     @property
-    def s_wind(self) -> np.ndarray:
-        """Deprecated name of :attr:`wind_psd` (one name for the wind PSD)."""
-        warnings.warn("Baseline.s_wind is deprecated, use Baseline.wind_psd", DeprecationWarning, stacklevel=2)
-        return self.wind_psd
-
-    @property
     def del_1hz(self) -> float:
         """DEL at 1 Hz of the baseline output, a range in the output's units (N·m for MyT)."""
         return float(self.damage_rate ** (1.0 / self.m))
 
 
-def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, wind_psd: ArrayLike, m: float = 4.0, *,
+def baseline_from_response(omega: ArrayLike, t_response: ArrayLike, wind_psd: ArrayLike, m: float = TOWER_M, *,
                            method: str = "dirlik", reduction: float = 0.01, system: ct.LTI | None = None,
                            output: str = "", wind_speed: float = float("nan")) -> Baseline:
     """Baseline from a closed-loop frequency response T(jω) and an input spectrum S_W(ω).
@@ -768,8 +745,6 @@ def baseline_controller(model, wind_speed: float) -> ct.LTI:
     own = getattr(model, "baseline_controller", None)
     if callable(own):
         return own(wind_speed)
-    from . import turbine
-
     return turbine.rosco_baseline(model, wind_speed)
 
 
@@ -798,13 +773,11 @@ def baseline_controllers(model, wind_speeds: Sequence[float]) -> list:
     """
     if callable(getattr(model, "baseline_controller", None)):
         return [model.baseline_controller(float(v)) for v in wind_speeds]
-    from .rosco import rosco_baseline, rosco_gain_schedule
-
     schedule = rosco_gain_schedule(model)  # once for every speed (the same fit each call would redo)
     return [rosco_baseline(model, float(v), schedule=schedule) for v in wind_speeds]
 
 
-def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tower_base_my", *, m: float = 4.0,
+def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tower_base_my", *, m: float = TOWER_M,
                       omega: ArrayLike | None = None, controller: ct.LTI | None = None, turbulence_class: str = "B",
                       method: str = "dirlik", reduction: float = 0.01) -> Baseline:
     """ΔD%(ω) of the baseline closed loop of ``model`` at ``wind_speed`` for ``output``.
@@ -856,8 +829,6 @@ def baseline_analysis(model: TurbineModel, wind_speed: float, output: str = "tow
     >>> print(f"{base.output}: DEL {base.del_1hz / 1e6:.1f} MN·m, ΣΔD% = {base.sensitivity.sum():.2f}")
     tower_base_my: DEL 32.2 MN·m, ΣΔD% = 2.00
     """
-    from . import closedloop, wind
-
     omega = default_omega() if omega is None else as_omega(omega, allow_zero=False)
     plant = model.linearize(wind_speed)
     c = baseline_controller(model, wind_speed) if controller is None else controller
@@ -977,12 +948,14 @@ class ShapingResult:
     message : str
         Human-readable outcome, saying why not when it failed.
     specification : Specification or None
-        Baseline × notches (``band="above"``) or × the whole-band elements (``band="whole"``);
-        None when no system is attached to the baseline.
+        Baseline × notches (:func:`shape_to_target`) or × the whole-band elements
+        (:func:`specdesign.feasibility.shape_whole_band`); None when no system is attached to
+        the baseline.
     certified : specdesign.feasibility.TargetSpecification or None
-        With ``band="whole"``: the certified pair (tower and generator-speed specifications,
-        the certificate, the plant cases) to hand to ``design_qft(model, v, spec=...)`` or to
-        edit and :func:`specdesign.feasibility.recertify`; None with ``band="above"``.
+        From :func:`specdesign.feasibility.shape_whole_band`: the certified pair (tower and
+        generator-speed specifications, the certificate, the plant cases) to hand to
+        ``design_qft(model, v, spec=...)`` or to edit and :func:`specdesign.feasibility.recertify`;
+        None from :func:`shape_to_target`.
     """
 
     notches: tuple
@@ -1009,93 +982,62 @@ def _notch_mag2(omega, params):
     return np.prod(np.abs(n) ** 2, axis=0)
 
 
-def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", band: str | None = None,
-                    keep_below: float = 0.6, n_notches: int | None = None, max_notches: int | None = None,
-                    max_depth_db: float = 30.0, width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5,
-                    **certify_options) -> ShapingResult:
-    """Shape a tower-load specification that promises a target reduction.
+def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", keep_below: float = 0.6,
+                    n_notches: int | None = None, max_notches: int = 3, max_depth_db: float = 30.0,
+                    width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5) -> ShapingResult:
+    """Shape a tower-load specification that promises a target reduction: notches above ``keep_below``.
 
-    Two shapers, one entry point; a DEL target (``quantity="del"``) gets the second by
-    default, a damage target the first:
+    The seed paper's shaping (used by the notch designs, notebooks 03-06 and their documented
+    numbers): notches where ΔD% is largest above ``keep_below``, no feasibility guarantee. The
+    problem solved (scipy SLSQP, exact Dirlik in the constraint): minimise the mean squared
+    log-magnitude change of the specification, Σ_k w_k (20 log10 |N(jω_k)|)², with w_k = 1
+    above ``keep_below`` and 100 below, subject to reduction ≥ target. Notch centres are
+    seeded at the largest ΔD% peaks above ``keep_below``.
 
-    ``band="above"`` (the seed paper's shaping, used by the notch designs, notebooks
-    03-06 and their documented numbers): notches where ΔD% is largest above ``keep_below``,
-    no feasibility guarantee. The problem solved (scipy SLSQP, exact Dirlik in the
-    constraint): minimise the mean squared log-magnitude change of the specification,
-    Σ_k w_k (20 log10 |N(jω_k)|)², with w_k = 1 above ``keep_below`` and 100 below, subject
-    to reduction ≥ target. Notch centres are seeded at the largest ΔD% peaks above
-    ``keep_below``.
-
-    ``band="whole"`` (issue 14's specification-driven design: use it when the specification
-    is to be handed to a design): the whole band where ΔD% pays, below the tower mode too,
-    with the generator-speed specification as the constraint that protects power regulation
-    and Bode's cost inside the specification, as ROSCO's map × a gain, a lag, a lead and
-    notches/bumps whose number and places are chosen with exact Dirlik in the constraint,
-    certified at every plant case: :func:`specdesign.feasibility.element_specification` on
-    the baseline's model and wind speed (the baseline must come from
-    :func:`baseline_analysis` of ``tower_base_my`` with ROSCO and the default wind). The
-    promise reported is that of the specification handed to the design; ``certified`` is the
-    pair to give ``design_qft(model, v, spec=res.certified)``, or to edit by hand
-    (``res.certified.tower.add(Notch(...))``) and re-check with
-    :func:`specdesign.feasibility.recertify`.
+    The specification to hand to a design, over the whole band and certified at every plant
+    case, is :func:`specdesign.feasibility.shape_whole_band`'s (same baseline, same result
+    record).
 
     Parameters
     ----------
     base : Baseline
-        From :func:`baseline_analysis` or :func:`baseline_from_response` (``band="above"``).
+        From :func:`baseline_analysis` or :func:`baseline_from_response`.
     target_reduction : float
         Requested reduction in percent (0 < target < 100) of ``quantity``.
     quantity : {"damage", "del"}
-        Whether the target is a reduction of damage (Eq. 10's quantity) or of DEL at 1 Hz
-        (``band="whole"`` certifies the DEL reduction equivalent to a damage target).
-    band : {"above", "whole"}, optional
-        Notches above ``keep_below``, or the certified whole-band specification. Default:
-        ``"whole"`` for ``quantity="del"``, ``"above"`` for ``quantity="damage"``.
+        Whether the target is a reduction of damage (Eq. 10's quantity) or of DEL at 1 Hz.
     keep_below : float
-        ``band="above"``: protected band upper edge, rad/s, the power-regulation band the
-        notches must leave alone (their effect below it is penalised heavily and the notch
-        centres stay above).
+        Protected band upper edge, rad/s, the power-regulation band the notches must leave
+        alone (their effect below it is penalised heavily and the notch centres stay above).
     n_notches : int, optional
-        ``band="above"``: fixed number of notches; by default 1, 2, ... up to ``max_notches``.
-    max_notches : int, optional
-        Most notches tried (default 3 with ``band="above"``, and most candidate centres
-        seeded; :data:`specdesign.feasibility.elements.MAX_NOTCHES` with ``band="whole"``).
+        Fixed number of notches; by default 1, 2, ... up to ``max_notches``.
+    max_notches : int
+        Most notches tried, and most candidate centres seeded.
     max_depth_db : float
-        ``band="above"``: deepest notch allowed, dB.
+        Deepest notch allowed, dB.
     width_range : (float, float)
-        ``band="above"``: bounds of the notch width ζ_p (-).
+        Bounds of the notch width ζ_p (-).
     tolerance : float
-        ``band="above"``: accepted shortfall, percentage points.
-    **certify_options
-        ``band="whole"``: passed to :func:`specdesign.feasibility.element_specification`
-        (``headroom_pp``, and the certificate's ``slack_db``, ``case_offsets``,
-        ``max_sensitivity``, ...).
+        Accepted shortfall, percentage points.
 
     Returns
     -------
     ShapingResult
-        The notches (with ``band="whole"`` the Notch elements among the others), the promise,
-        whether the target was reached, the specification (baseline × elements, when the
-        baseline has a system) and, with ``band="whole"``, the certified pair; its promise is
-        then evaluated on :data:`specdesign.feasibility.elements.FIT_OMEGA` (0.005-20 rad/s),
-        whatever the baseline's grid: the elements are free outside the baseline's band.
+        The notches, their promise, whether the target was reached and the specification
+        (baseline × notches, when the baseline has a system); ``certified`` is None.
 
     Raises
     ------
     TypeError
-        If ``base`` is not a :class:`Baseline`, or an option of the other band is given.
+        If ``base`` is not a :class:`Baseline`.
     ValueError
-        If ``quantity`` or ``band`` is unknown, ``target_reduction`` is not in (0, 100),
-        ``keep_below`` lies outside the grid, or no grid frequency lies above ``keep_below``;
-        with ``band="whole"``, if the baseline does not carry its model (or was not made on
-        ROSCO's tower-base map with the default wind), or when no certified element
-        specification reaches the target (the message says which constraint binds).
+        If ``quantity`` is unknown, ``target_reduction`` is not in (0, 100), ``keep_below``
+        lies outside the grid, or no grid frequency lies above ``keep_below``.
 
     Warns
     -----
     RuntimeWarning
-        ``band="above"``: when the target cannot be reached (the result then has
-        ``success=False`` and says why).
+        When the target cannot be reached (the result then has ``success=False`` and says why).
 
     Examples
     --------
@@ -1106,13 +1048,6 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
     'reached 15.00 % damage reduction (target 15.00 %) with 1 notch(es)'
     >>> print(f"{res.notches[0].omega_n:.2f} rad/s")
     1.02 rad/s
-
-    The certified whole-band specification for 25 % DEL, to hand to ``design_qft``:
-
-    >>> base = baseline_analysis(iea15mw(), 25.0)
-    >>> res = shape_to_target(base, 25.0, quantity="del")     # band="whole"  # doctest: +SKIP
-    >>> bool(res.promise.exact_del >= 25.0), res.certified.case_speeds      # doctest: +SKIP
-    (True, (24.0, 24.5, 25.0))
     """
     from scipy.optimize import minimize
 
@@ -1120,26 +1055,9 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
         raise TypeError(f"base must be a Baseline (see baseline_analysis), got {type(base).__name__}")
     if quantity not in ("damage", "del"):
         raise ValueError(f"quantity={quantity!r} must be 'damage' or 'del'")
-    if band is None:
-        band = "whole" if quantity == "del" else "above"
-    if band not in ("above", "whole"):
-        raise ValueError(f"band={band!r} must be 'above' (notches above keep_below) or 'whole' (the certified "
-                         "whole-band specification)")
     t = float(target_reduction)
     if not 0 < t < 100:
         raise ValueError(f"target_reduction={target_reduction!r} must be a percentage strictly between 0 and 100")
-    given = dict(keep_below=keep_below, n_notches=n_notches, max_depth_db=max_depth_db, width_range=width_range,
-                 tolerance=tolerance)
-    if band == "whole":
-        notch_only = sorted(k for k, x in given.items() if x != _ABOVE_DEFAULTS[k])
-        if notch_only:
-            raise TypeError(f"{notch_only} are options of band='above' (pass it for the paper's notches); band='whole', "
-                            "the default for a DEL target, chooses its elements itself (its options: max_notches and "
-                            "those of feasibility.element_specification)")
-        return _shape_whole(base, t, quantity, max_notches, certify_options)
-    if certify_options:
-        raise TypeError(f"{sorted(certify_options)} are options of band='whole' (feasibility.element_specification)")
-    max_notches = 3 if max_notches is None else max_notches
     omega = base.omega
     keep_below = float(keep_below)
     if not omega[0] <= keep_below < omega[-1]:
@@ -1188,7 +1106,7 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
         res = minimize(
             cost, x0, method="SLSQP", bounds=bounds,
             constraints=[{"type": "ineq", "fun": lambda x: damage_reduction(x) - target_damage}],
-            options={"maxiter": 300, "ftol": 1e-10},
+            options=dict(SLSQP_OPTIONS),
         )
         x = res.x
         if damage_reduction(x) >= target_damage - tolerance:
@@ -1212,37 +1130,6 @@ def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = 
         warnings.warn(message, RuntimeWarning, stacklevel=2)
     spec = Specification(base.system, notches, name=f"W_{base.output}") if base.system is not None else None
     return ShapingResult(notches, promise, t, quantity, bool(success), message, spec)
-
-
-#: The notch-shaper options of :func:`shape_to_target` at their defaults (refused with band="whole").
-_ABOVE_DEFAULTS = dict(keep_below=0.6, n_notches=None, max_depth_db=30.0, width_range=(0.05, 0.8), tolerance=0.5)
-
-
-def _shape_whole(base, t, quantity, max_notches, options):
-    """shape_to_target's band="whole": the certified element specification on the baseline's model."""
-    from . import feasibility
-
-    why = ["it carries no model (make it with baseline_analysis(model, v))" if base.model is None else "",
-           f"its output is {base.output!r}, not 'tower_base_my'" if base.output != "tower_base_my" else "",
-           "it was made with another controller than ROSCO's" if base.extras.get("controller") is not None else "",
-           f"its wind is turbulence class {base.extras.get('turbulence_class')!r}, not 'B'"
-           if base.extras.get("turbulence_class", "B") != "B" else "",
-           f"its damage method is {base.method!r}, not 'dirlik'" if base.method != "dirlik" else ""]
-    why = [w for w in why if w]
-    if why:
-        raise ValueError("band='whole' certifies a specification against ROSCO's tower-base map on the baseline's "
-                         f"model (baseline_analysis(model, v)); this baseline cannot be used: {'; '.join(why)}")
-    target_del = t if quantity == "del" else float(spectral.del_reduction(t, base.m))
-    if max_notches is not None:
-        options = {**options, "max_notches": max_notches}
-    ts = feasibility.element_specification(base.model, base.wind_speed, target_del, m=base.m, **options)
-    promise = ts.promise  # on the fit's wider grid, which sees the elements outside the baseline's
-    reached = promise.exact_del if quantity == "del" else promise.exact_damage
-    notches = tuple(e for e in ts.tower.elements if isinstance(e, Notch))
-    message = (f"certified {reached:.2f} % {quantity} reduction (target {t:.2f} %) over the whole band with "
-               f"{len(ts.tower.elements)} elements, the speed map relaxed by {ts.speed_relax_db:.2f} dB, at the "
-               f"plant cases {ts.case_speeds} m/s")
-    return ShapingResult(notches, promise, t, quantity, True, message, ts.tower, ts)
 
 
 def speed_specification(model: TurbineModel, wind_speed: float, *, margin_db: float = 0.0,
@@ -1272,8 +1159,6 @@ def speed_specification(model: TurbineModel, wind_speed: float, *, margin_db: fl
     >>> speed_specification(iea15mw(), 19.0, margin_db=3.0).elements
     (Gain(gain_db=3.0),)
     """
-    from . import closedloop
-
     plant = model.linearize(wind_speed)
     c = baseline_controller(model, wind_speed) if controller is None else controller
     cl = closedloop.closed_loop(plant, c)
@@ -1372,7 +1257,7 @@ def specification_pair(obj) -> tuple | None:
 
 def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
                           spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                          keep_below: float = 0.6, m: float = 4.0,
+                          keep_below: float = 0.6, m: float = TOWER_M,
                           omega: ArrayLike | None = None) -> DesignSpecifications:
     """The tower-load and generator-speed specifications that QFT and H∞ designs are given.
 
@@ -1437,12 +1322,3 @@ def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax
     tower = Specification(base.system, tuple(shaping.notches) + relax, name="W_tower_base_my")
     speed = speed_specification(model, v, margin_db=float(speed_relax_db))
     return DesignSpecifications(base, shaping, tower, speed)
-
-
-def __getattr__(name):
-    # spec.evaluate was renamed: loopshaping.qft.evaluate is a frequency response, this a promise
-    if name == "evaluate":
-        warnings.warn("specdesign.spec.evaluate is deprecated; use specdesign.spec.promise_of", DeprecationWarning,
-                      stacklevel=2)
-        return promise_of
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,7 +1,7 @@
 """Spectral fatigue: moments, damage rates (narrow-band, Dirlik, Tovo-Benasciutti, ...), DEL,
 and the damage sensitivity ΔD%(ω) of the seed paper's Eq. (7).
 
-Conventions (see WORKBENCH.md):
+Conventions (the workbench's, as in the documentation's method page):
 
 - ω in rad/s; PSDs one-sided per rad/s (∫₀^∞ S(ω) dω = variance), in load units² per rad/s.
 - Spectral moments m_n = ∫ ω^n S(ω) dω by the trapezoid rule on the given (possibly

@@ -7,7 +7,7 @@ All spectra are one-sided and per rad/s (∫₀^∞ S(ω) dω = variance, (m/s)�
 - :func:`rotor_effective_spectrum`: Kaimal times the rotor-disc average of the IEC exponential
   coherence, γ(f) = ∫₀^{2R} exp(−12 √((f r/U)² + (0.12 r/L_c)²)) p_R(r) dr, with p_R the
   density of the distance between two random points of the disc and L_c = 8.1·42 m.
-- :func:`synthesize`: Gaussian time series with a given one-sided PSD, reproducible per seed.
+- :func:`gaussian_series`: Gaussian time series with a given one-sided PSD, reproducible per seed.
 - :func:`wind_series`: the rotor-effective wind records the simulator runs on, one per
   (mean wind speed, seed), seeded by :func:`seed_for`.
 """
@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from ._checks import as_omega, positive_scalar
 
-__all__ = ["TURBULENCE_CLASSES", "kaimal_spectrum", "disc_coherence", "rotor_effective_spectrum", "synthesize", "seed_for",
+__all__ = ["TURBULENCE_CLASSES", "kaimal_spectrum", "disc_coherence", "rotor_effective_spectrum", "gaussian_series", "seed_for",
            "wind_series"]
 
 #: IEC 61400-1 ed. 3/4 reference turbulence intensities I_ref by turbulence class.
@@ -209,7 +209,7 @@ def _seeds(seeds):
     return out
 
 
-def synthesize(spectrum_or_callable: Callable | tuple, duration: float, dt: float, seeds: int | Sequence[int], *,
+def gaussian_series(spectrum_or_callable: Callable | tuple, duration: float, dt: float, seeds: int | Sequence[int], *,
                random_amplitude: bool = True) -> np.ndarray:
     """Zero-mean Gaussian series with a one-sided PSD, shape (n_seeds, n_samples).
 
@@ -251,7 +251,7 @@ def synthesize(spectrum_or_callable: Callable | tuple, duration: float, dt: floa
 
     Examples
     --------
-    >>> synthesize(lambda w: 1.0 / (1.0 + w**2), 60.0, 0.1, [1, 2]).shape
+    >>> gaussian_series(lambda w: 1.0 / (1.0 + w**2), 60.0, 0.1, [1, 2]).shape
     (2, 600)
     """
     duration = positive_scalar(duration, "duration")
@@ -306,7 +306,7 @@ def seed_for(wind_speed: float, seed: int) -> int:
     Returns
     -------
     int
-        The seed of :func:`synthesize` for that record.
+        The seed of :func:`gaussian_series` for that record.
 
     Examples
     --------
@@ -320,7 +320,7 @@ def wind_series(rotor_radius: float, wind_speeds: Sequence[float], seeds: Sequen
                 turbulence_class: str = "B") -> np.ndarray:
     """Rotor-effective wind records: the mean plus turbulence, one per (wind speed, seed).
 
-    Each record is its mean speed plus :func:`synthesize` of :func:`rotor_effective_spectrum`
+    Each record is its mean speed plus :func:`gaussian_series` of :func:`rotor_effective_spectrum`
     at that speed, seeded by :func:`seed_for`, so a record depends on (v, seed) only.
 
     Parameters
@@ -353,6 +353,6 @@ def wind_series(rotor_radius: float, wind_speeds: Sequence[float], seeds: Sequen
         def spec(om, v=v):
             return rotor_effective_spectrum(om, v, rotor_radius, turbulence_class=turbulence_class)
 
-        s = synthesize(spec, duration, dt, [seed_for(v, s) for s in seeds])
+        s = gaussian_series(spec, duration, dt, [seed_for(v, s) for s in seeds])
         out.append(v + np.asarray(s, dtype=float))
     return np.stack(out)

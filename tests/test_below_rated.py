@@ -180,8 +180,11 @@ def test_torque_law_gearbox_conversion(tmp_path):
     p.write_text(text)
     with pytest.warns(UserWarning, match="PS_Mode"):
         a, b = torque_law_from_discon(iea15mw_discon(), mode=1), torque_law_from_discon(p, mode=1)
-    with pytest.raises(ValueError, match="VS_ConstPower = 1 is not modelled"):
-        torque_law_from_discon(write_discon(p, tmp_path / "cp.IN", VS_ConstPower=1), mode=1)
+    with pytest.warns(UserWarning, match="PS_Mode"):
+        assert torque_law_from_discon(write_discon(p, tmp_path / "cp.IN", VS_ConstPower=1), mode=1).const_power
+    assert not b.const_power  # the IEA 15 MW's VS_ConstPower = 0
+    with pytest.raises(ValueError, match="VS_ConstPower = 2 must be 0"):
+        torque_law_from_discon(write_discon(p, tmp_path / "cp2.IN", VS_ConstPower=2), mode=1)
     assert b.min_speed == pytest.approx(a.min_speed / 50) and b.rated_torque == pytest.approx(a.rated_torque * 50)
     assert b.k_opt == pytest.approx(a.k_opt * 50**3) and b.kp == pytest.approx(a.kp * 50**2)
     with pytest.raises(ValueError, match="mode"):

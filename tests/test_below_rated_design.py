@@ -101,14 +101,14 @@ def test_unstable_certificate_near_rated_is_not_a_success(model):
     design must say so. Oracle: the roots of the controller's denominator (numpy)."""
     import warnings
 
-    from specdesign import qft
+    from specdesign import closedloop, qft
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         d = qft.design_qft(model, 11.0, 20.0)
     c = control.tf(d.pitch_controller)
     growth = np.roots(c.den[0][0]).real.max()
-    assert growth > qft.UNSTABLE_CONTROLLER_RATE
+    assert growth > closedloop.UNSTABLE_CONTROLLER_RATE
     assert not d.success and "controller itself is unstable" in d.message
 
 

@@ -71,3 +71,34 @@ def test_the_same_campaign_twice_on_the_client(client, setup):
     for _ in range(2):
         again = run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, executor=client, progress=False, **KW)
         assert_bitwise_equal(again, local)
+
+
+def _every_core_blas():
+    """Run on a worker: BLAS on every core (what it takes without dask's OPENBLAS_NUM_THREADS=1)."""
+    import os
+
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    threadpool_limits(limits=os.cpu_count(), user_api="blas")  # stays set: not used as a context
+    return max(lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas")
+
+
+def test_bitwise_whatever_blas_threads_the_workers_start_with(client, setup):
+    # dask starts workers with OPENBLAS/OMP/MKL_NUM_THREADS=1 (distributed.nanny.pre-spawn-environ);
+    # here the workers' BLAS is set to every core, as a local run has it by default. Every task
+    # runs BLAS on one thread itself (campaign_point), so neither the workers' thread count nor
+    # the client's changes a bit.
+    import os
+
+    from threadpoolctl import threadpool_limits
+
+    model, ctrls, local = setup
+    threads = client.run(_every_core_blas)
+    assert all(n == os.cpu_count() for n in threads.values()), threads
+    try:
+        on_cluster = run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, executor=client, progress=False, **KW)
+    finally:  # the module's other tests keep dask's default
+        client.run(lambda: __import__("threadpoolctl").threadpool_limits(limits=1, user_api="blas") and None)
+    assert_bitwise_equal(on_cluster, local)
+    with threadpool_limits(limits=2, user_api="blas"):  # the client with two BLAS threads asked for
+        assert_bitwise_equal(run_campaign(ctrls, SPEEDS, 2, model=model, keep_series=1, progress=False, **KW), local)

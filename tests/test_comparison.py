@@ -5,7 +5,7 @@ import pytest
 from specdesign import turbine
 from specdesign.fatigue import del_rainflow
 from specdesign.validate import INDICATORS, indicators, paired_change, run_campaign
-from specdesign.validate.metrics import BLADE_M
+from specdesign.fatigue import BLADE_M
 
 
 @pytest.fixture(scope="module")
@@ -63,14 +63,22 @@ def test_indicators_without_a_blade_channel_are_nan_and_bad_shapes_refused():
 
 
 def test_comparison_figure_labels(campaign):
+    from specdesign.plots.conventions import MIN_SEEDS_FOR_SE
     from specdesign.plots.validation import plot_comparison
 
     ch = {"ROSCO stiff": {k: campaign.change("ROSCO stiff", "ROSCO", k) for k in ("tower_del", "blade_del")}}
     ax = plot_comparison(ch)
-    assert [a.get_xlabel() for a in ax] == ["mean wind speed (m/s)"] * 2
-    assert "blade-root DEL" in ax[1].get_ylabel() and "(%)" in ax[1].get_ylabel()
-    assert [t.get_text() for t in ax[0].get_legend().get_texts()] == ["ROSCO stiff"]
+    assert [a.get_xlabel() for a in ax] == ["mean wind speed (m/s; controllers side by side)"] * 2
+    assert "blade-root DEL" in ax[1].get_ylabel() and "(%)" in ax[1].get_ylabel() and "negative: lower" in ax[1].get_ylabel()
+    n = ch["ROSCO stiff"]["tower_del"].n_seeds
+    # a standard error only from MIN_SEEDS_FOR_SE paired seeds on (the figure conventions)
+    want = "ROSCO stiff" if n >= MIN_SEEDS_FOR_SE else f"ROSCO stiff ({n} seeds: no SE)"
+    assert [t.get_text() for t in ax[0].get_legend().get_texts()] == [want]
     y = ax[1].lines[0].get_ydata()
     assert y[0] == pytest.approx(ch["ROSCO stiff"]["blade_del"].change[0])
+    # wind speeds are categories: one controller sits at the group positions 0, 1, ... labelled in m/s
+    speeds = ch["ROSCO stiff"]["tower_del"].wind_speeds
+    assert list(ax[0].lines[0].get_xdata()) == list(range(len(speeds)))
+    assert [t.get_text() for t in ax[0].get_xticklabels()] == [f"{v:g}" for v in speeds]
     with pytest.raises(ValueError, match="changes"):
         plot_comparison({})

@@ -12,7 +12,6 @@ import doctest
 import importlib
 import inspect
 import pkgutil
-import warnings
 
 import pytest
 
@@ -55,12 +54,10 @@ def _documented_names(modname):
 def test_public_names_have_numpydoc_docstrings(modname):
     validate = pytest.importorskip("numpydoc.validate").validate
     bad = {}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)  # deprecated properties document themselves
-        for qual in _documented_names(modname):
-            errs = sorted({c for c, _ in validate(qual)["errors"] if c in CODES})
-            if errs:
-                bad[qual] = errs
+    for qual in _documented_names(modname):
+        errs = sorted({c for c, _ in validate(qual)["errors"] if c in CODES})
+        if errs:
+            bad[qual] = errs
     assert not bad, bad
 
 

@@ -111,7 +111,7 @@ def test_the_youla_design_is_the_closed_loop_of_its_controller(model, design19):
     t = closedloop.t_tower_wind(plant, c, design19.omega)
     np.testing.assert_allclose(t, design19.t_tower, rtol=1e-6)
     np.testing.assert_allclose(closedloop.t_gen_speed_wind(plant, c, design19.omega), design19.t_speed, rtol=1e-6)
-    assert np.max(closedloop.closed_loop_poles(model, c, 19.0).real) < 0
+    assert np.max(closedloop.turbine_loop_poles(model, c, 19.0).real) < 0
     pred = validate.linear_prediction(model, c, 19.0).del_
     base = validate.linear_prediction(model, rosco_baseline(model, 19.0), 19.0).del_
     assert 100 * (1 - pred / base) == pytest.approx(design19.del_reduction, abs=0.5)

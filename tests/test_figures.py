@@ -244,7 +244,7 @@ FIGURES = {
     "turbine.plot_fatigue_origin": (_fatigue_origin, "(rad/s)", ["(dB", "per rad/s", "(%)"], ["T_MyT,w", "S_MyT", "ΔD%"]),
     "fatigue.plot_range_histogram": (_range_histogram, "[kN·m]", ["[1/kN·m]"], ["rainflow", "Dirlik"]),
     "fatigue.plot_sensitivity": (_sensitivity, "[rad/s]", ["[%]"], ["ΔD%(ω) [0]", "ΔD%(ω) [11]"]),
-    "spec.plot_specification": (_specification, "(rad/s)", ["(dB re 1 kN·m/(m/s))"], ["baseline", "specification"]),
+    "spec.plot_specification": (_specification, "(rad/s)", ["(dB re 1 N·m/(m/s))"], ["baseline", "specification"]),
     "spec.plot_frontier": (_frontier, "[dB]", ["[%]"], ["17 m/s achievable", "19 m/s upper bound"]),
 }
 
@@ -385,4 +385,60 @@ def test_fig10_as_notebook_06_draws_it_has_no_shared_style(campaign):
     ax.legend(fontsize="small")
     _check_figure(ax, "(m/s)", ["(%)"], ["rainflow, linearised model", "Volterra prediction", "notch specification's promise",
                                         "design target"])
+    plt.close("all")
+
+
+# ----------------------------------------------------------------------------- one set of conventions
+def test_transfer_function_figures_share_one_db_reference(design, model):
+    # the issue "Layers without cycles ... figures that say the truth": the tower transfer
+    # function was in dB re 1 kN·m/(m/s) in the specification figure and dB re 1 N·m/(m/s) in
+    # the design's Bode figure, 60 dB apart; both are SI now, and the same |T| reads the same
+    import matplotlib.pyplot as plt
+
+    from specdesign.plots.conventions import tf_magnitude_label
+    from specdesign.plots.qft import plot_design_bode
+    from specdesign.plots.spec import plot_specification
+    from specdesign.spec import baseline_analysis
+
+    base = baseline_analysis(model, 19.0)
+    ax = plot_specification(base)
+    assert ax.get_ylabel() == tf_magnitude_label("tower_base_my") == "magnitude (dB re 1 N·m/(m/s))"
+    y_spec = ax.get_lines()[0].get_ydata()
+    assert np.allclose(y_spec, 20 * np.log10(np.abs(base.t_response)))  # no display factor
+    fig = plot_design_bode(design, model)
+    assert "dB re 1 N·m/(m/s)" in fig.axes[1].get_ylabel()
+    plt.close("all")
+
+
+def test_spectra_show_the_band_of_the_loads(campaign):
+    # Fig. 8 drew up to the record's Nyquist frequency, where the Welch estimate rolls off to
+    # 1e-18 and squeezed the 0.1-2 rad/s band; now ω ≤ SPECTRA_MAX_OMEGA and the magnitude axis
+    # spans the drawn curves (a factor 3 margin each side)
+    import matplotlib.pyplot as plt
+
+    from specdesign.plots.validation import SPECTRA_MAX_OMEGA, plot_spectra
+
+    ax = plot_spectra(campaign, 19.0, "gen_speed")
+    xs = np.concatenate([ln.get_xdata() for ln in ax.get_lines()])
+    ys = np.concatenate([ln.get_ydata() for ln in ax.get_lines()])
+    assert xs.max() <= SPECTRA_MAX_OMEGA
+    lo, hi = ax.get_ylim()
+    assert lo == pytest.approx(ys[ys > 0].min() / 3) and hi == pytest.approx(ys.max() * 3)
+    plt.close("all")
+
+
+def test_fig10_reads_reductions_against_zero(campaign):
+    # fig10 cut its axis to 33.5-37 %: a 2 pp spread looked like a factor of two
+    import matplotlib.pyplot as plt
+
+    from specdesign import validate as va
+    from specdesign.plots.conventions import show_se
+    from specdesign.plots.validation import plot_reductions
+
+    acc = va.acceptance(campaign, "ATD", "ROSCO")
+    ax = plot_reductions(acc)
+    assert ax.get_ylim()[0] <= 0.0 <= ax.get_ylim()[1]
+    assert "(%), positive: lower" in ax.get_ylabel()
+    label = next(t for t in ax.get_legend_handles_labels()[1] if t.startswith("rainflow, nonlinear"))
+    assert ("±1 SE" in label) == show_se(acc.n_seeds)
     plt.close("all")

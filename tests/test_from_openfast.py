@@ -150,18 +150,17 @@ def test_simulate_synthesises_the_wind_for_the_models_rotor(nrel5mw):
 
 # ----------------------------------------------------------------------------- below rated
 def test_torque_law_of_the_discon_is_attached_and_trims_from_cut_in(cases, tmp_path):
-    # the NREL 5 MW's own DISCON.IN runs constant power above rated (VS_ConstPower = 1), which
-    # the workbench does not model: the model stays above rated only, and says so
-    with pytest.warns(UserWarning, match="VS_ConstPower.*above rated only"):
+    # the NREL 5 MW's own DISCON.IN runs constant power above rated (VS_ConstPower = 1): its law
+    # is attached with it; its peak shaving (PS_Mode = 1) is not modelled, and a warning says so
+    with pytest.warns(UserWarning, match="PS_Mode = 1: peak shaving"):
         plain = from_openfast(cases / "NREL-5MW/NREL-5MW.fst")
-    assert plain.torque_control is None
-    with pytest.raises(ValueError):
-        plain.trim(7.0)
+    assert plain.torque_control is not None and plain.torque_control.const_power
+    assert plain.trim(7.0).region == "2"
     # the same DISCON.IN with constant torque above rated and no peak shaving: its law
     # (VS_ControlMode 2, run as 3: TSR tracking on the measured rotor speed) is attached
     discon = write_discon(cases / "NREL-5MW/DISCON.IN", tmp_path / "DISCON.IN", VS_ConstPower=0, PS_Mode=0)
     m = from_openfast(cases / "NREL-5MW/NREL-5MW.fst", discon=discon)
-    assert m.torque_control is not None and m.torque_control.mode == 3
+    assert m.torque_control is not None and m.torque_control.mode == 3 and not m.torque_control.const_power
     # published (Jonkman et al. 2009): cut-in 3 m/s, rated 11.4 m/s, optimal TSR 7.55
     # (DISCON's VS_TSRopt 7.5); above rated the trim is the model without the law
     assert m.rated_wind_speed() == pytest.approx(11.4, abs=0.1)
@@ -176,4 +175,13 @@ def test_torque_law_of_the_discon_is_attached_and_trims_from_cut_in(cases, tmp_p
     assert regions[0] in ("1.5", "2") and regions[-1] == "3" and "2" in regions
     for v in (13.0, 19.0, 25.0):
         assert m.trim(v).pitch == plain.trim(v).pitch
-    assert m.linearize(7.0).nstates >= plain.linearize(19.0).nstates  # linearised below rated too
+    assert m.linearize(7.0).nstates >= m.linearize(19.0).nstates  # linearised below rated too
+    # above rated only the rotor-speed row differs: constant power adds −P/(η·Ω²)/J to ∂Ω̇/∂Ω
+    # (the torque column of B is −1/J: the rotor equation J·Ω̇ = Q − T)
+    a_cp, a_ct = plain.linearize(19.0).A, m.linearize(19.0).A
+    law, om = plain.torque_control, plain.trim(19.0).rotor_speed
+    dA = a_cp - a_ct
+    assert dA[0, 0] == pytest.approx(law.rated_power / law.generator_efficiency / om**2 / plain.drivetrain_inertia,
+                                     rel=1e-9)
+    dA[0, 0] = 0.0
+    assert np.all(dA == 0.0)

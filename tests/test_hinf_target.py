@@ -95,14 +95,10 @@ def test_bad_arguments_are_named(model, pair):
         hinf.refine_on_cases(model, pair, c, decay_rate=0.0)
     with pytest.raises(ValueError, match="target_reduction"):
         hinf.design_hinf(model, V, 150.0)
-    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match="not both"):
-        hinf.design_hinf(model, V, spec="qft", specs="rosco")
-
-
-def test_specs_is_a_deprecated_alias_of_spec(model):
-    # the old keyword still selects the specifications, with a warning naming the new one
-    with pytest.warns(DeprecationWarning, match="spec="), pytest.raises(ValueError, match="spec='hinf'"):
-        hinf.design_hinf(model, V, specs="hinf")
+    with pytest.raises(ValueError, match="spec='hinf'"):
+        hinf.design_hinf(model, V, spec="hinf")
+    with pytest.raises(TypeError, match="specs"):  # the former name of spec is gone
+        hinf.design_hinf(model, V, specs="qft")
 
 
 @pytest.fixture(scope="module")

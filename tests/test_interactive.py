@@ -138,6 +138,9 @@ def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
     sliders[1].value = round(12.0 + 0.04, 1)  # the echo of 12.0, from before the update
     sliders[2].value = round(start.width, 2)
     assert ex.notch == spec.Notch(1.05, 9.0, 0.2)
+    # and the sliders show what the figure draws, not the late echo (notebook 03 after Run All
+    # showed a 2.80 dB slider over a 12 dB notch, and the first touch jumped from there)
+    assert [s.value for s in sliders] == [1.05, 9.0, 0.2]
     sliders[1].value = 15.0  # a move again
     assert ex.notch == spec.Notch(1.05, 15.0, 0.2)
     plt.close("all")
@@ -177,4 +180,29 @@ def test_design_points_past_minus_360_degrees_stay_on_the_chart():
     lo, hi = d.figure.axes[0].get_xlim()
     loop_x = d._artists["loop"].get_xdata()
     assert np.all((loop_x[np.isfinite(loop_x)] >= lo) & (loop_x[np.isfinite(loop_x)] <= hi))
+    plt.close("all")
+
+
+def test_the_designer_views_cover_the_design_and_key_many_bound_colours():
+    # the issue "Layers without cycles ... widgets that tell the truth": the Designer's Nichols
+    # panel spanned −250 to +60 dB (the loop's roll-off ×100 above the band), its closed-loop
+    # panel 1e-4 to 1e3 rad/s, and 77 bound colours had no key
+    P = ct.tf([1.0], [1.0, 1.4, 1.0])
+    w = np.geomspace(0.05, 5.0, 24)
+    tmpl = qft.Template.from_systems([0.8 * P, P, 1.25 * P], w)
+    d = Designer(qft.bounds(tmpl, "stability", 1.3), tmpl, lc.Controller((lc.gain(2.0), lc.integrator())))
+    fig = d.draw()
+    ax_n, ax_b = fig.axes[0], fig.axes[1]
+    assert ax_b.get_xlim() == pytest.approx((w.min() / 3, w.max() * 3))
+    st = d.state()
+    band = (d.omega >= w.min() / 3) & (d.omega <= w.max() * 3)
+    lo, hi = ax_n.get_ylim()
+    # every loop magnitude in the band is in view, with the 10 dB margin, and no more than that
+    # beyond the bounds (the roll-off far above it is not what the view is sized for)
+    assert lo <= st.magnitude_db[band].min() - 10 + 1e-9 and hi >= st.magnitude_db[band].max() + 10 - 1e-9
+    assert lo > st.magnitude_db.min()
+    keys = [a for a in fig.axes if a.get_ylabel() == "bound frequency ω (rad/s)"]
+    assert len(keys) == 1  # 24 frequencies on a continuous colour map: a colour key says which is which
+    lo_k, hi_k = keys[0].get_ylim()
+    assert (lo_k, hi_k) == pytest.approx((w.min(), w.max()))
     plt.close("all")

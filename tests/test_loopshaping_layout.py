@@ -1,7 +1,5 @@
-"""Layout of loopshaping (issue 13): one home per concept, re-exports, deprecated names."""
+"""Layout of loopshaping (issue 13): one home per concept, re-exports; no deprecated names (issue 32)."""
 from __future__ import annotations
-
-import warnings
 
 import control as ct
 import numpy as np
@@ -63,65 +61,33 @@ def _template():
     return qft.Template.from_systems([1 / (s + 1), 2 / (s + 1)], [0.1, 1.0])
 
 
-def test_omegas_is_a_deprecated_alias_of_omega():
+def test_the_former_names_are_gone():
+    # renamed before the first release (issue 32): one name per meaning, no alias left behind
     t = _template()
-    with pytest.warns(DeprecationWarning, match="Template.omega"):
-        np.testing.assert_array_equal(t.omegas, t.omega)
-    with pytest.warns(DeprecationWarning, match="'omega'"):
-        t2 = qft.Template.from_systems([1 / (s + 1)], omegas=[0.1, 1.0])
-    np.testing.assert_array_equal(t2.omega, t.omega)
-    with pytest.warns(DeprecationWarning, match="'omega'"):
-        t3 = qft.Template(omegas=[0.1, 1.0], responses=t.responses)
-    np.testing.assert_array_equal(t3.responses, t.responses)
-    with pytest.raises(TypeError, match="both"):
-        qft.Template.from_systems([1 / (s + 1)], omega=[1.0], omegas=[1.0])
     b = qft.bounds(t, "sensitivity", 2.0)
-    with pytest.warns(DeprecationWarning, match="Bounds.omega"):
-        np.testing.assert_array_equal(b.omegas, b.omega)
-    with pytest.warns(DeprecationWarning, match="'omega'"):
+    G = Controller((gain(2.0), real_pole(10.0)))
+    w = np.logspace(-2, 2, 50)
+    res = lcheck.check(t, G, qft.Spec("sensitivity", 2.0), w)
+    for obj in (t, b, res):
+        assert not hasattr(obj, "omegas") and obj.omega.size > 0
+    assert not hasattr(lcheck, "closed_loop_poles")
+    with pytest.raises(TypeError, match="omegas"):
+        qft.Template.from_systems([1 / (s + 1)], omegas=[0.1, 1.0])
+    with pytest.raises(TypeError, match="omegas"):
         t.at(omegas=1.0)
+    with pytest.raises(TypeError, match="omega_dense"):
+        lcheck.check(t, G, qft.Spec("sensitivity", 2.0), omega_dense=w)
 
 
-def test_check_takes_plants_first_and_warns_on_the_former_order():
+def test_check_takes_the_plants_first():
+    # check(controller, plants, ...) was guessed and swapped; now the first argument is the plants
     t = _template()
     G = Controller((gain(2.0), real_pole(10.0)))
     spec = qft.Spec("sensitivity", 2.0)
     w = np.logspace(-2, 2, 50)
-    new = lcheck.check(t, G, spec, w)
-    with pytest.warns(DeprecationWarning, match=r"check\(plants, controller"):
-        old = lcheck.check(G, t, spec, w)
-    with pytest.warns(DeprecationWarning, match="'omega'"):
-        kw = lcheck.check(t, G, spec, omega_dense=w)
-    for r in (old, kw):
-        np.testing.assert_array_equal(r.margins_db, new.margins_db)
-        np.testing.assert_array_equal(r.max_pole_real, new.max_pole_real)
-    with pytest.warns(DeprecationWarning, match="CheckResult.omega"):
-        np.testing.assert_array_equal(new.omegas, new.omega)
-
-
-def test_closed_loop_poles_is_deprecated_for_feedback_poles():
-    P, G = 1 / (s * (s + 1)), 2 * (s + 3) / (s + 10)
-    want = lcheck.feedback_poles(P, G)
-    with pytest.warns(DeprecationWarning, match="feedback_poles"):
-        got = lcheck.closed_loop_poles(G, P)
-    np.testing.assert_array_equal(got, want)
-
-
-def test_internal_callers_use_no_deprecated_form():
-    t = _template()
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", DeprecationWarning)
-        b = qft.intersect(qft.bounds(t, "sensitivity", 2.0), qft.bounds(t, "stability", 1.3))
-        lcheck.check(t, Controller((gain(1.0),)), b, np.logspace(-2, 2, 50))
-        from loopshaping.nichols import loop_nichols
-
-        loop_nichols(1 / (s + 1), np.logspace(-1, 1, 5))
-
-
-def test_hf_omegas_and_omega_dense_keywords_are_deprecated():
-    from loopshaping import auto
-
-    with pytest.warns(DeprecationWarning, match="'hf_omega'"), pytest.raises(TypeError, match="Bounds"):
-        auto.shape("not bounds", hf_omegas=[100.0])
-    with pytest.warns(DeprecationWarning, match="'omega'"), pytest.raises(TypeError, match="Template"):
-        auto.refine("not a template", [], omega_dense=[1.0])
+    res = lcheck.check(t, G, spec, w)
+    # oracle: the feedback poles of each plant case with G, computed on their own
+    want = [np.max(lcheck.feedback_poles(p, G).real) for p in t.systems]
+    np.testing.assert_array_equal(res.max_pole_real, want)
+    with pytest.raises(TypeError):
+        lcheck.check(G, t, spec, w)

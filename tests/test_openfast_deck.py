@@ -98,8 +98,12 @@ def test_failed_run_names_case_seed_and_tail(tmp_path, library):
     assert err.value.case == case and "Aborting OpenFAST." in err.value.tail
     # a run that hangs is stopped at the timeout and reported the same way
     slow = OpenFASTInstall(_script(tmp_path / "slow", "echo started\nsleep 30"), None, "5.0.0")
-    with pytest.raises(OpenFASTRunError, match="did not finish in 0.5 s"):
+    with pytest.raises(OpenFASTRunError, match="did not finish in 0.5 s of wall time"):
         run_case(case, slow, timeout=0.5)
+    # a run that burns its CPU allowance (a busy loop: 1 s of CPU) is stopped by the CPU limit
+    busy = OpenFASTInstall(_script(tmp_path / "busy", "echo spinning\nwhile :; do :; done"), None, "5.0.0")
+    with pytest.raises(OpenFASTRunError, match="(?s)more than its 1 s of CPU time.*spinning"):
+        run_case(case, busy, cpu_limit=1.0, timeout=120.0)
 
 
 def test_deck_of_another_version_is_refused_before_running(tmp_path, library):

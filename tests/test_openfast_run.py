@@ -64,3 +64,27 @@ def test_rosco_runs_the_shipped_deck_at_19_mps(install, tmp_path):
     assert abs(np.mean(out.channels["GenSpeed"][late]) / ref - 1) < 0.05
     # pitched well away from fine pitch at 19 m/s (the reduced model trims at 0.27 rad)
     assert 0.15 < np.mean(pitch[late]) < 0.4
+
+
+def test_exported_design_runs_in_openfast(install, tmp_path):
+    """The workbench's 19 m/s ROSCO-form PI (the LTI baseline), exported as a DISCON library
+    (issue 27's export), runs unchanged in ServoDyn: finite outputs, pitch within the model's
+    limits, the generator held near rated speed."""
+    export = pytest.importorskip("specdesign.export")
+    from specdesign.turbine import iea15mw, rosco_baseline
+
+    model = iea15mw()
+    rec = export.export_discon(rosco_baseline(model, 19.0), tmp_path / "export", model=model, dt=0.01,
+                               torque="power", pitch_rate_limit=model.pitch_rate_limit, atd_highpass=0.05)
+    op = model.trim(19.0)
+    case = write_case(iea15mw_monopile(), tmp_path / "export19", tmax=30.0, wind_speed=19.0, library=rec.library,
+                      parameters=rec.parameters, controller_dt=rec.dt, dt_out=0.05, initial_pitch=op.pitch,
+                      initial_rotor_speed=op.rotor_speed)
+    out = run_case(case, install)
+    for name, x in out.channels.items():
+        assert np.all(np.isfinite(x)), name
+    pitch = out.channels["BldPitch1"]
+    assert np.all(pitch >= model.pitch_min - 1e-6) and np.all(pitch <= model.pitch_max + 1e-6)
+    late = out.time > 15.0
+    # the reduced model's rated speed on the rotor side (direct drive: the generator's)
+    assert abs(np.mean(out.channels["GenSpeed"][late]) / model.rated_rotor_speed - 1) < 0.05

@@ -1,7 +1,8 @@
 """One home per concept (issue 13) for ROSCO, the simulator, the turbine model and the wind.
 
-ROSCO lives in :mod:`specdesign.rosco`, re-exported by :mod:`specdesign.turbine` and
-:mod:`specdesign.simulate`; the simulator is the package :mod:`specdesign.simulate`; every public
+ROSCO is reached in :mod:`specdesign.rosco` (its baseline re-exported from
+:mod:`specdesign.turbine.baseline`, its torque law and DISCON.IN reader from
+:mod:`specdesign.controller`: the same objects); the simulator is the package :mod:`specdesign.simulate`; every public
 name importable before the split still is (the private ones are gone: no module uses another's).
 tests/test_architecture.py checks private names across modules and module sizes,
 tests/test_docstrings.py the documentation, for the whole package.
@@ -15,11 +16,12 @@ import pytest
 from specdesign import rosco, simulate, turbine, wind
 
 MODULES = [
-    "specdesign.rosco", "specdesign.wind",
-    "specdesign.simulate", "specdesign.simulate.core", "specdesign.simulate.checks",
-    "specdesign.simulate.schedule", "specdesign.simulate.controllers", "specdesign.simulate.kernels",
+    "specdesign.rosco", "specdesign.rosco.scheduled", "specdesign.wind",
+    "specdesign.controller", "specdesign.controller.scheduled", "specdesign.controller.lti",
+    "specdesign.controller.torque", "specdesign.controller.discon_file",
+    "specdesign.simulate", "specdesign.simulate.core", "specdesign.simulate.checks", "specdesign.simulate.kernels",
     "specdesign.turbine", "specdesign.turbine.model", "specdesign.turbine.operating",
-    "specdesign.turbine.kernel", "specdesign.turbine.tables",
+    "specdesign.turbine.kernel", "specdesign.turbine.tables", "specdesign.turbine.plant", "specdesign.turbine.baseline",
 ]
 
 #: Every public name of specdesign.simulate / specdesign.turbine before the split: still
@@ -63,14 +65,9 @@ def test_every_old_name_is_still_importable(module, names):
     assert set(mod.__all__) <= set(star)
 
 
-def test_discretize_is_renamed_tustin_matrices():
-    # simulate.discretize (the kernel's matrices) and loopshaping.hinf.discretize (a discrete
-    # LTI) shared a name; the simulator's is now tustin_matrices, the old name warns
+def test_tustin_matrices_are_python_controls_tustin_map():
     import control
 
-    with pytest.warns(DeprecationWarning, match="tustin_matrices"):
-        old = simulate.discretize
-    assert old is simulate.tustin_matrices
     c = control.tf([1.0, 0.2], [1.0, 1.0, 0.5])
     A, B, C, D = simulate.tustin_matrices(c, 0.05)
     d = control.c2d(control.ss(c), 0.05, method="tustin")  # python-control's own Tustin map

@@ -1,5 +1,5 @@
-"""Issue 14: ``spec.shape_to_target(base, target, quantity="del", band="whole")``, the user's entry to
-the certified whole-band specification (feasibility.element_specification on the baseline's model).
+"""Issue 14: ``feasibility.shape_whole_band(base, target)``, the user's entry to the certified
+whole-band specification (feasibility.element_specification on the baseline's model).
 
 The acceptance numbers are the issue's: promise ≥ 24.5 % recomputed independently (Dirlik DEL on
 |W|²S_W against ROSCO's |T|²S_W) within 0.5 pp; the certificate meets the pair at every plant case
@@ -39,23 +39,27 @@ def test_the_baseline_keeps_its_model_and_operating_point(model, base25):
 
 
 def test_bad_whole_band_requests_are_named(model, base25):
-    with pytest.raises(ValueError, match="band='middle' must be"):
-        spec.shape_to_target(base25, 25.0, band="middle")
+    with pytest.raises(ValueError, match="quantity='dell' must be"):
+        fz.shape_whole_band(base25, 25.0, quantity="dell")
+    with pytest.raises(ValueError, match="strictly between 0 and 100"):
+        fz.shape_whole_band(base25, 100.0)
+    with pytest.raises(TypeError, match="base must be a Baseline"):
+        fz.shape_whole_band(base25.omega, 25.0)
     # notch-shaper options have no meaning for the whole band, and the other way round
-    with pytest.raises(TypeError, match=r"\['keep_below'\] are options of band='above'"):
-        spec.shape_to_target(base25, 25.0, band="whole", keep_below=0.3)
-    with pytest.raises(TypeError, match=r"\['headroom_pp'\] are options of band='whole'"):
+    with pytest.raises(TypeError, match="keep_below"):
+        fz.shape_whole_band(base25, 25.0, keep_below=0.3)
+    with pytest.raises(TypeError, match="headroom_pp"):
         spec.shape_to_target(base25, 25.0, headroom_pp=(3.0,))
     # a baseline the certificate cannot be made against: each reason named
     bare = spec.baseline_from_response(base25.omega, base25.t_response, base25.wind_psd)
     with pytest.raises(ValueError, match="carries no model"):
-        spec.shape_to_target(bare, 25.0, quantity="del", band="whole")
+        fz.shape_whole_band(bare, 25.0)
     speed = spec.baseline_analysis(model, 25.0, "gen_speed")
     with pytest.raises(ValueError, match="output is 'gen_speed'"):
-        spec.shape_to_target(speed, 25.0, quantity="del", band="whole")
+        fz.shape_whole_band(speed, 25.0)
     other = spec.baseline_analysis(model, 25.0, controller=rosco_baseline(model, 24.0), turbulence_class="A")
     with pytest.raises(ValueError, match="another controller than ROSCO's; its wind is turbulence class 'A'"):
-        spec.shape_to_target(other, 25.0, quantity="del", band="whole")
+        fz.shape_whole_band(other, 25.0)
 
 
 def test_an_unreachable_whole_band_target_says_which_constraint_binds(base25):
@@ -63,14 +67,14 @@ def test_an_unreachable_whole_band_target_says_which_constraint_binds(base25):
     # specification_for_target's reason (the speed relaxation it would need and the best promise)
     with pytest.raises(ValueError, match=r"no element specification.*promises 70 % at 25 m/s.*"
                                          r"no pitch specification promises 73 %.*relaxed up to 12 dB \(best"):
-        spec.shape_to_target(base25, 70.0, quantity="del", band="whole", headroom_pp=(3.0,))
+        fz.shape_whole_band(base25, 70.0, headroom_pp=(3.0,))
 
 
 @pytest.fixture(scope="module")
 def whole25(base25):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy accuracy notes on some rungs
-        return spec.shape_to_target(base25, 25.0, quantity="del")  # band="whole" is the default for a DEL target
+        return fz.shape_whole_band(base25, 25.0)
 
 
 def _explicit_maps(model, v, controller, w):
@@ -140,7 +144,7 @@ def test_a_rounding_error_in_the_wind_speed_moves_neither_promise_nor_prediction
     v = 25.0 - 1e-9
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
-        near = spec.shape_to_target(spec.baseline_analysis(model, v), 25.0, quantity="del", band="whole").certified
+        near = fz.shape_whole_band(spec.baseline_analysis(model, v), 25.0).certified
     ts = whole25.certified
     assert abs(near.speed_relax_db - ts.speed_relax_db) <= 1e-3
     assert abs(near.promise.exact_del - ts.promise.exact_del) <= 1e-6

@@ -262,7 +262,7 @@ def _pi(model, v):
 def _gusty(v, n_seeds, amp, t_end, dt=0.05, seed=0):
     from specdesign import wind as wmod
 
-    w = wmod.synthesize(lambda om: wmod.rotor_effective_spectrum(om, v, 120.97), t_end + dt, dt, list(range(seed, seed + n_seeds)))
+    w = wmod.gaussian_series(lambda om: wmod.rotor_effective_spectrum(om, v, 120.97), t_end + dt, dt, list(range(seed, seed + n_seeds)))
     return (v + amp * np.asarray(w))[None]
 
 

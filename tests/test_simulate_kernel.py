@@ -9,7 +9,8 @@ import pytest
 
 from specdesign import closedloop, turbine
 from specdesign import simulate as sm
-from specdesign.simulate import core
+from specdesign.controller.scheduled import controller_bank
+from specdesign.simulate import checks, core
 from specdesign.simulate.checks import checked_loop
 from specdesign.turbine.kernel import HEADER_SIZE, bicubic
 
@@ -45,7 +46,7 @@ def test_identical_locals_run_once_is_bitwise_every_local_run(model, monkeypatch
 
 def _bank(c):
     """The padded bank arrays simulate builds (Ad, Bd, Cd, Dd, Rq, Ns)."""
-    _, mats, _, _ = sm.controllers.controller_bank(c, 0.02)
+    _, mats, _, _ = controller_bank(c, 0.02)
     K, nc = len(mats), max(1, max(m[0].shape[0] for m in mats))
     Ad, Bd, Cd, Dd = np.zeros((K, nc, nc)), np.zeros((K, nc, 2)), np.zeros((K, nc)), np.zeros((K, 2))
     Rq, Ns = np.zeros(K), np.zeros(K, dtype=np.int64)
@@ -82,7 +83,7 @@ def test_checked_loop_answers_once_per_plant_controller_speed_and_step(model, mo
         calls.append(a[2])
         return real(*a, **kw)
 
-    monkeypatch.setattr(closedloop, "unstable_poles", counted)
+    monkeypatch.setattr(checks, "unstable_poles", counted)  # the name checked_loop looks up
     assert checked_loop(plant, c, 19.0, 0.02).size == 0 == real(plant, c, 19.0).size
     assert checked_loop(plant, c, 19.0, 0.02).size == 0
     assert calls == [19.0]

@@ -108,7 +108,7 @@ def test_shape_to_target_19ms_15pct_damage(base19):
 
 
 def test_shape_to_target_on_del(base19):
-    res = spec.shape_to_target(base19, 4.0, quantity="del", band="above")  # the paper's notches on a DEL target
+    res = spec.shape_to_target(base19, 4.0, quantity="del")  # the paper's notches on a DEL target
     assert res.success
     assert abs(res.promise.exact_del - 4.0) <= 0.5
 

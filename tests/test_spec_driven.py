@@ -181,10 +181,16 @@ def test_the_figures_say_which_specification_the_design_meets(model, chain19):
     assert any(f"for the target (promises {ts.promise.exact_del:.1f} % DEL" in lab for lab in labels)
     assert any(f"ROSCO + {ts.speed_relax_db:.2f} dB" in lab for lab in labels)
     assert sum(lab.startswith("spec-driven") and "meets W_y" in lab for lab in labels) == 1
-    axes = Figure().subplots(1, 2)
-    plot_design_nichols(d, axes=axes)
-    assert "pitch-only" in axes[1].texts[0].get_text() and not axes[1].lines  # no ATD loop drawn
-    assert axes[0].lines  # the pitch loop and its bounds are
+    # a pitch-only design: one Nichols panel, titled without an ATD loop it does not have, with
+    # the critical point marked; two axes are refused (an empty panel said nothing)
+    fig = plot_design_nichols(d)
+    assert len(fig.axes) == 1 and "ATD" not in fig.axes[0].get_title()
+    labels = fig.axes[0].get_legend_handles_labels()[1]
+    assert "nominal loop L0" in labels and "critical point (−180°, 0 dB)" in labels
+    crit = next(ln for ln in fig.axes[0].lines if ln.get_label().startswith("critical"))
+    assert list(crit.get_xdata()) == [-180.0] and list(crit.get_ydata()) == [0.0]
+    with pytest.raises(ValueError, match="one axes per loop"):
+        plot_design_nichols(d, axes=Figure().subplots(1, 2))
 
 
 def test_a_hand_edited_specification_is_recertified(model, chain19):

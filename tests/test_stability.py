@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from specdesign import fatigue, simulate as sm, turbine, validate as va
-from specdesign.closedloop import ClosedLoopUnstableWarning
+from specdesign.closedloop import ClosedLoopUnstableWarning, turbine_loop_poles
 
 
 @pytest.fixture(scope="module")
@@ -31,12 +31,12 @@ def rosco(model):
 @pytest.mark.parametrize("factor", [-1.0, 100.0])
 def test_linear_prediction_of_a_destabilising_controller_raises(model, rosco, factor):
     bad = factor * rosco
-    poles = va.closed_loop_poles(model, bad, 19.0)
+    poles = turbine_loop_poles(model, bad, 19.0)
     assert np.max(poles.real) > 0  # independent: the interconnection's poles say unstable
     with pytest.raises(ValueError, match=r"destabilises the linearised turbine at 19 m/s .*poles"):
         va.linear_prediction(model, bad, 19.0)
     # ROSCO itself is stable and predicts a finite DEL
-    assert np.max(va.closed_loop_poles(model, rosco, 19.0).real) < 0
+    assert np.max(turbine_loop_poles(model, rosco, 19.0).real) < 0
     assert np.isfinite(va.linear_prediction(model, rosco, 19.0).del_)
 
 
@@ -45,7 +45,7 @@ def test_closed_loop_poles_match_the_interconnection(model, rosco):
     from specdesign import closedloop
 
     cl = closedloop.closed_loop(model.linearize(19.0), rosco, warn=False)
-    np.testing.assert_allclose(np.sort_complex(va.closed_loop_poles(model, rosco, 19.0)),
+    np.testing.assert_allclose(np.sort_complex(turbine_loop_poles(model, rosco, 19.0)),
                                np.sort_complex(cl.poles()), rtol=1e-7, atol=1e-9)
 
 
@@ -160,10 +160,10 @@ def test_blended_locals_with_integrators_are_stable_between_their_speeds(model):
     # simulator runs them (a parallel realisation would add a spurious pole at s = 0 and call
     # a stable loop unstable); the blend equals the explicit sum of the two responses.
     sc = sm.scheduled(model, {15.0: turbine.rosco_baseline(model, 15.0), 17.0: turbine.rosco_baseline(model, 17.0)})
-    poles = va.closed_loop_poles(model, sc, 16.0)
+    poles = turbine_loop_poles(model, sc, 16.0)
     assert np.max(poles.real) < 0
     assert np.isfinite(va.linear_prediction(model, sc, 16.0).del_)
-    assert np.max(va.closed_loop_poles(model, sm.rosco_scheduled(model), 16.3).real) < 0
+    assert np.max(turbine_loop_poles(model, sm.rosco_scheduled(model), 16.3).real) < 0
 
 
 # ----------------------------------------------------------------------------- hidden modes at s = 0
@@ -175,7 +175,7 @@ def test_an_integrating_atd_leaves_a_conserved_mode_at_zero_not_an_instability(m
     import control
 
     sc = sm.scheduled(model, {19.0: rosco}, {19.0: control.tf([0.05], [1.0, 0.0])}, name="ATD-I")
-    poles = va.closed_loop_poles(model, sc, 19.0)
+    poles = turbine_loop_poles(model, sc, 19.0)
     assert np.min(np.abs(poles)) < 1e-12  # the conserved mode is there
     assert np.max(poles.real[np.abs(poles) > 1e-9]) < -0.05  # every other mode decays
     from specdesign import closedloop
@@ -226,7 +226,7 @@ def test_a_step_the_sampled_loop_cannot_take_is_refused_with_its_limit(model):
     import re
 
     c = 2.0 * turbine.rosco_baseline(model, 13.0)
-    assert np.max(va.closed_loop_poles(model, c, 13.0).real) < 0
+    assert np.max(turbine_loop_poles(model, c, 13.0).real) < 0
     with pytest.raises(ValueError, match=r"dt=0.3 s is too large for controller .* at 13 m/s.*dt must be ≤ 0.2\d\d s") as err:
         sm.simulate(model, c, [13.0], seeds=[1], dt=0.3, record_dt=0.3, duration=60.0)
     limit = float(re.search(r"dt must be ≤ ([0-9.]+) s", str(err.value)).group(1))
@@ -333,7 +333,7 @@ def test_below_rated_the_pitch_loop_is_open(model, v):
     sched = sm.rosco_scheduled(model)
     G = model.linearize(v)
     for c in (sched, turbine.rosco_baseline(model, 19.0), 100.0 * turbine.rosco_baseline(model, 19.0)):
-        np.testing.assert_allclose(np.sort_complex(va.closed_loop_poles(model, c, v)),
+        np.testing.assert_allclose(np.sort_complex(turbine_loop_poles(model, c, v)),
                                    np.sort_complex(np.linalg.eigvals(np.asarray(G.A))), rtol=1e-10, atol=1e-12)
         cb, ca = local_response(model, c, v, 1j * np.array([0.1, 1.0]))
         assert not np.any(cb) and not np.any(ca)
@@ -342,4 +342,4 @@ def test_below_rated_the_pitch_loop_is_open(model, v):
     open_loop = np.array([G(1j * w)[k, 0] for w in omega])
     np.testing.assert_allclose(va.closed_loop_response(model, sched, v, omega, "tower_base_my"), open_loop, rtol=1e-9)
     # above rated nothing changes: the same controller closes the loop
-    assert va.closed_loop_poles(model, sched, 13.0).size > G.nstates
+    assert turbine_loop_poles(model, sched, 13.0).size > G.nstates

@@ -97,27 +97,27 @@ def test_bad_inputs_name_the_argument():
     with pytest.raises(ValueError, match="omega"):
         wind.kaimal_spectrum([1.0, 0.5], U)
     with pytest.raises(TypeError, match="seeds"):
-        wind.synthesize(lambda w: w, 10, 0.1, seeds=1.5)
+        wind.gaussian_series(lambda w: w, 10, 0.1, seeds=1.5)
     with pytest.raises(ValueError, match="duration"):
-        wind.synthesize(lambda w: w, -10, 0.1, seeds=1)
+        wind.gaussian_series(lambda w: w, -10, 0.1, seeds=1)
 
 
 def _spectrum(w):
     return wind.rotor_effective_spectrum(np.concatenate([[0.0], w]), U, R)[1:]
 
 
-def test_synthesize_reproducible_per_seed():
-    batch = wind.synthesize(_spectrum, 200, 0.25, seeds=[1, 3, 5])
-    alone = wind.synthesize(_spectrum, 200, 0.25, seeds=3)
+def test_gaussian_series_reproducible_per_seed():
+    batch = wind.gaussian_series(_spectrum, 200, 0.25, seeds=[1, 3, 5])
+    alone = wind.gaussian_series(_spectrum, 200, 0.25, seeds=3)
     assert batch.shape == (3, 800) and alone.shape == (1, 800)
     assert_allclose(batch[1], alone[0], rtol=0, atol=0)
     assert not np.allclose(batch[0], batch[1])
 
 
-def test_synthesize_variance_equals_discrete_integral():
+def test_gaussian_series_variance_equals_discrete_integral():
     duration, dt = 600.0, 0.2
     n = int(duration / dt)
-    x = wind.synthesize(_spectrum, duration, dt, seeds=[0, 1], random_amplitude=False)
+    x = wind.gaussian_series(_spectrum, duration, dt, seeds=[0, 1], random_amplitude=False)
     dw = 2 * np.pi / duration
     wk = dw * np.arange(1, (n - 1) // 2 + 1)
     assert_allclose(x.var(axis=1), np.sum(_spectrum(wk)) * dw, rtol=1e-10)
@@ -126,9 +126,9 @@ def test_synthesize_variance_equals_discrete_integral():
     assert_allclose(np.sum(_spectrum(wk)) * dw, np.trapezoid(_spectrum(omega), omega), rtol=1e-2)
 
 
-def test_synthesize_welch_matches_target():
+def test_gaussian_series_welch_matches_target():
     duration, dt = 1200.0, 0.25
-    x = wind.synthesize(_spectrum, duration, dt, seeds=range(16))
+    x = wind.gaussian_series(_spectrum, duration, dt, seeds=range(16))
     f, pxx = signal.welch(x, fs=1 / dt, nperseg=1200, axis=-1)  # one-sided per Hz
     s_est = pxx.mean(axis=0) / (2 * np.pi)  # per rad/s
     w = 2 * np.pi * f
@@ -142,9 +142,9 @@ def test_synthesize_welch_matches_target():
     assert abs(x.var(axis=1).mean() / var_target - 1) < 0.1
 
 
-def test_synthesize_accepts_tabulated_spectrum():
+def test_gaussian_series_accepts_tabulated_spectrum():
     omega = np.linspace(0, 20, 4001)
     table = wind.rotor_effective_spectrum(omega, U, R)
-    a = wind.synthesize((omega, table), 300, 0.1, seeds=7)
-    b = wind.synthesize(_spectrum, 300, 0.1, seeds=7)
+    a = wind.gaussian_series((omega, table), 300, 0.1, seeds=7)
+    b = wind.gaussian_series(_spectrum, 300, 0.1, seeds=7)
     assert_allclose(a, b, rtol=0, atol=1e-2 * np.abs(b).max())

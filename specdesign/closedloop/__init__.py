@@ -1,6 +1,6 @@
 """Closed-loop maps wind → output for a pitch controller and an optional tower-damping loop.
 
-Sign convention (WORKBENCH.md): the pitch command is
+Sign convention (the documentation's method page): the pitch command is
 
     β_cmd = −C_β·Ω_g − C_atd·z,
 
@@ -30,14 +30,48 @@ Every closed-loop construction of the workbench lives here, one module a concern
 from __future__ import annotations
 
 from .grid import case_speeds, lightly_damped, refine_grid, system_roots
-from .interconnect import (PLANT_INPUTS, check_stability, closed_loop, closed_loop_mimo, named_siso, partial_loop,
-                           require_signals)
-from .maps import (LOOP_OUTPUTS, LoopMaps, close_responses, closed_loop_del, closed_map, frequency_response,
-                   general_coefficients, general_form, loop_maps, output_psd, plant_responses, siso_response,
-                   t_gen_speed_wind, t_output_wind, t_tower_wind)
-from .stability import (ORIGIN_TOL, ClosedLoopUnstableWarning, closed_loop_matrices, closed_loop_poles,
-                        hidden_origin_poles, local_response, loop_parts, trim_weights, unstable_message,
-                        unstable_poles)
+from .interconnect import (
+                           PLANT_INPUTS,
+                           check_stability,
+                           closed_loop,
+                           closed_loop_mimo,
+                           named_siso,
+                           partial_loop,
+                           require_signals,
+)
+from .maps import (
+                           LOOP_OUTPUTS,
+                           LoopMaps,
+                           close_responses,
+                           closed_loop_del,
+                           closed_map,
+                           frequency_response,
+                           general_coefficients,
+                           general_form,
+                           loop_maps,
+                           output_psd,
+                           plant_responses,
+                           siso_response,
+                           t_gen_speed_wind,
+                           t_output_wind,
+                           t_tower_wind,
+)
+from .stability import (
+                           CERTIFICATE_MAX_SENSITIVITY,
+                           DESIGN_MAX_SENSITIVITY,
+                           MAX_SENSITIVITY,
+                           ORIGIN_TOL,
+                           UNSTABLE_CONTROLLER_RATE,
+                           ClosedLoopUnstableWarning,
+                           closed_loop_matrices,
+                           hidden_origin_poles,
+                           local_response,
+                           loop_parts,
+                           trim_weights,
+                           turbine_loop_poles,
+                           unstable_message,
+                           unstable_poles,
+)
 
 __all__ = [
     "ClosedLoopUnstableWarning",
@@ -65,7 +99,7 @@ __all__ = [
     "local_response",
     "trim_weights",
     "closed_loop_matrices",
-    "closed_loop_poles",
+    "turbine_loop_poles",
     "hidden_origin_poles",
     "unstable_poles",
     "unstable_message",
@@ -74,6 +108,10 @@ __all__ = [
     "refine_grid",
     "case_speeds",
     "ORIGIN_TOL",
+    "UNSTABLE_CONTROLLER_RATE",
+    "MAX_SENSITIVITY",
+    "DESIGN_MAX_SENSITIVITY",
+    "CERTIFICATE_MAX_SENSITIVITY",
     "PLANT_INPUTS",
     "LOOP_OUTPUTS",
 ]

@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from loopshaping.freqresp import as_siso
+
 from .stability import ClosedLoopUnstableWarning
 
 if TYPE_CHECKING:
@@ -59,8 +61,6 @@ def named_siso(sys: control.LTI | float, name: str, inp: str, out: str) -> contr
     (['gen_speed'], ['u_pitch'])
     """
     import control
-
-    from loopshaping.freqresp import as_siso
 
     ss = control.ss(as_siso(sys, name, proper=False))
     return control.ss(ss.A, ss.B, ss.C, ss.D, inputs=[inp], outputs=[out], name=name)

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import as_omega, as_psd, positive_scalar
+from ..spectral import del_spectral
 from .interconnect import PLANT_INPUTS, require_signals
 
 if TYPE_CHECKING:
@@ -410,8 +411,6 @@ def closed_loop_del(sys: control.LTI, omega: ArrayLike, wind_psd: ArrayLike, m: 
     >>> print(f"{closed_loop_del(cl, omega, s_w, 4.0) / 1e6:.1f} MN·m")
     32.2 MN·m
     """
-    from ..spectral import del_spectral
-
     m = positive_scalar(m, "m")
     w = as_omega(omega, "omega")
     return float(del_spectral(w, output_psd(sys, w, wind_psd, output, input), m, method))

@@ -10,19 +10,44 @@ linearisation, with the torque loop closed in it.
 """
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..controller.lti import as_lti, split_integrator
+from ..controller.scheduled import ScheduledController
+from ..turbine.plant import KernelPlant, turbine_plant
+
 if TYPE_CHECKING:
     import control
 
-    from ..simulate import KernelPlant, ScheduledController
     from ..turbine import TurbineModel
 
-__all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_loop_matrices", "closed_loop_poles",
-           "hidden_origin_poles", "unstable_poles", "unstable_message", "trim_weights", "ORIGIN_TOL"]
+__all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_loop_matrices", "turbine_loop_poles",
+           "hidden_origin_poles", "unstable_poles", "unstable_message", "trim_weights", "ORIGIN_TOL",
+           "UNSTABLE_CONTROLLER_RATE", "MAX_SENSITIVITY", "DESIGN_MAX_SENSITIVITY", "CERTIFICATE_MAX_SENSITIVITY"]
+
+
+#: Growth rate (1/s) above which a controller's own pole counts as unstable (a controller with
+#: one is refused by :func:`specdesign.qft.design_qft` and by the certificate's follow path:
+#: wherever the pitch saturates the loop opens and the mode grows): slower modes grow less
+#: than e-fold over a 10-minute record.
+UNSTABLE_CONTROLLER_RATE = 1e-3
+
+#: Peak M_s of the pitch loop's sensitivity |S| = |1/(1 + C·P_{Ω,β})| the feasibility checks and
+#: the convex design impose by default: 2 (6 dB), the usual robustness rule (it guarantees a gain
+#: margin of at least M_s/(M_s − 1) = 2 and a phase margin of at least 2·asin(1/(2·M_s)) = 29°).
+MAX_SENSITIVITY = 2.0
+#: Peak of |S| the designers require (both loops and the actuator): design_qft, its bounds check
+#: and design_hinf's plant-case check; below :data:`MAX_SENSITIVITY`, so a design keeps margin on
+#: the feasibility verdict.
+DESIGN_MAX_SENSITIVITY = 1.9
+#: Peak of |S| of the certificate (specification_for_target, CertificateSearch): below
+#: :data:`DESIGN_MAX_SENSITIVITY`, so that the plant cases and a reduced-order controller fitted
+#: to the certificate keep their margins in the design.
+CERTIFICATE_MAX_SENSITIVITY = 1.8
 
 
 class ClosedLoopUnstableWarning(UserWarning):
@@ -72,8 +97,6 @@ def loop_parts(model: TurbineModel | KernelPlant | None, controller: Any,
     TypeError
         If the controller is neither an LTI system, a Controller nor a ScheduledController.
     """
-    from ..simulate import turbine_plant
-
     plant = turbine_plant(model)  # one plant per model: the model and its plant share the cache
     key = (id(plant), id(controller), float(wind_speed))
     hit = _PARTS.get(key)
@@ -101,8 +124,6 @@ _PARTS_SIZE = 256
 def _loop_parts(plant, controller, wind_speed):
     """:func:`loop_parts` computed."""
     import control
-
-    from ..simulate import ScheduledController, as_lti
 
     if plant.linearize is None:
         raise ValueError(f"plant {plant.name!r} has no linearisation: its closed-loop poles are unknown")
@@ -208,10 +229,6 @@ def local_response(model: TurbineModel | KernelPlant | None, controller: Any, wi
     >>> np.round(np.abs(cb), 3), ca
     (array([0.448, 0.086]), array([0.+0.j, 0.+0.j]))
     """
-    import warnings
-
-    from ..simulate import ScheduledController, as_lti, turbine_plant
-
     s = np.asarray(s)
     plant = turbine_plant(model)
     if plant.rated_wind_speed is not None and wind_speed < plant.rated_wind_speed:
@@ -283,7 +300,7 @@ def closed_loop_matrices(model: TurbineModel | KernelPlant | None, controller: A
 ORIGIN_TOL = 1e-9
 
 
-def closed_loop_poles(model: TurbineModel | KernelPlant | None, controller: Any, wind_speed: float) -> np.ndarray:
+def turbine_loop_poles(model: TurbineModel | KernelPlant | None, controller: Any, wind_speed: float) -> np.ndarray:
     """Poles of the linearised turbine at ``wind_speed`` closed by ``controller``.
 
     The loop is β = −C_β·Ω_g − C_atd·ẋ_top.
@@ -315,11 +332,11 @@ def closed_loop_poles(model: TurbineModel | KernelPlant | None, controller: Any,
     Examples
     --------
     >>> import numpy as np
-    >>> from specdesign.closedloop import closed_loop_poles
+    >>> from specdesign.closedloop import turbine_loop_poles
     >>> from specdesign.rosco import rosco_baseline
     >>> from specdesign.turbine import iea15mw
     >>> model = iea15mw()
-    >>> p = closed_loop_poles(model, rosco_baseline(model, 19.0), 19.0)
+    >>> p = turbine_loop_poles(model, rosco_baseline(model, 19.0), 19.0)
     >>> p.size, bool(np.all(p.real < 0))
     (8, True)
     """
@@ -453,8 +470,6 @@ def unstable_message(controller: Any, wind_speed: float, poles: ArrayLike) -> st
 def _blend(weighted):
     """Σ w·C as one state-space system with a single integrator: Σ w·r/s + Σ w·C_r."""
     import control
-
-    from ..simulate import split_integrator
 
     r, rest = 0.0, control.ss([], [], [], [[0.0]])
     for wq, c in weighted:

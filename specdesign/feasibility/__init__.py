@@ -49,7 +49,10 @@ them with a Youla design made to meet them (the tower bound, |T_{MyT,w}| ≤ |W_
 Modules: :mod:`~specdesign.feasibility.conditions` (the necessary conditions, the frontier),
 :mod:`~specdesign.feasibility.achievable` (the convex Youla design),
 :mod:`~specdesign.feasibility.target` (the specification for a target),
-:mod:`~specdesign.feasibility.elements` (the same in shaping elements).
+:mod:`~specdesign.feasibility.elements` (the same in shaping elements),
+:mod:`~specdesign.feasibility.shaping` (:func:`shape_whole_band`: the same from a
+:func:`specdesign.spec.baseline_analysis` baseline, as :func:`specdesign.spec.shape_to_target`
+shapes the paper's notches).
 
 Units: ω in rad/s, magnitudes linear (dB only in messages), DEL reductions in %.
 """
@@ -57,8 +60,10 @@ from .achievable import YOULA_PAIRS, YOULA_REAL_POLES, AchievablePitch, YoulaPro
 from .conditions import (PitchChecker, PitchFeasibility, combine, pitch_checkers, pitch_feasibility, pitch_frontier,
                          sensitivity_disks)
 from .elements import element_specification
+from .shaping import shape_whole_band
 from .target import CertificateSearch, TargetSpecification, recertify, specification_for_target
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
            "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks",
-           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification", "CertificateSearch"]
+           "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification", "CertificateSearch",
+           "shape_whole_band"]

@@ -5,7 +5,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import spectral
 from .._checks import positive_scalar
+from ..closedloop import MAX_SENSITIVITY, frequency_response, siso_response
+from ..fatigue import TOWER_M
+from ..spectral import trapezoid_weights
 
 __all__ = ["SOLVER_OPTIONS", "YOULA_REAL_POLES", "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "YoulaProblem"]
 
@@ -104,8 +108,8 @@ class AchievablePitch:
         return control.minreal(control.feedback(y, control.tf(p), sign=+1), verbose=False)
 
 
-def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=2.0, max_pitch_rate_ratio=1.0,
-                     m=4.0, omega=None, base=None, integral_action=True) -> AchievablePitch:
+def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=MAX_SENSITIVITY, max_pitch_rate_ratio=1.0,
+                     m=TOWER_M, omega=None, base=None, integral_action=True) -> AchievablePitch:
     """The pitch design that minimises the predicted tower damage under a generator-speed specification.
 
     Every stabilising controller of the stable plant is C = Y/(1 − P_{Ω,β}Y) with Y stable,
@@ -189,14 +193,11 @@ class YoulaProblem:
         (:func:`specdesign.feasibility.element_specification`).
     """
 
-    def __init__(self, model, wind_speed, *, max_sensitivity=2.0, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
+    def __init__(self, model, wind_speed, *, max_sensitivity=MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
                  base=None, integral_action=True, tower_bound=False):
         import cvxpy as cp
 
         from .. import spec
-        from ..closedloop import frequency_response, siso_response
-        from ..spectral import trapezoid_weights
-
         kappa = positive_scalar(max_pitch_rate_ratio, "max_pitch_rate_ratio")
         self.ms = positive_scalar(max_sensitivity, "max_sensitivity")
         self.wind_speed = float(wind_speed)
@@ -278,8 +279,6 @@ class YoulaProblem:
             the relaxation then counts that relaxation as one with no design.
         """
         import cvxpy as cp
-
-        from .. import spectral
 
         g = float(speed_relax_db)
         if not (np.isfinite(g) and g >= 0):

@@ -6,14 +6,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._blas import on_one_blas_thread
-from .._checks import as_omega, positive_scalar
+from .._checks import as_omega, positive_scalar, real_scalar
+from ..closedloop import (
+    MAX_SENSITIVITY,
+    closed_map,
+    plant_responses,
+    refine_grid,
+    siso_response,
+)
+from ..fatigue import TOWER_M
+from ..spectral import trapezoid_weights
 from .achievable import YoulaProblem
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "pitch_frontier",
            "sensitivity_disks"]
 
 
-def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
+def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=MAX_SENSITIVITY):
     """The disks of the complex sensitivity S(jω) that each specification allows.
 
     Parameters
@@ -21,7 +30,7 @@ def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
     plant : control.LTI
         Named plant (inputs ``wind``, ``pitch_cmd``; outputs ``gen_speed``, ``tower_base_my``).
     omega : array_like
-        Frequencies, rad/s.
+        Frequencies, rad/s (all > 0).
     w_tower, w_speed : array_like
         |W_MyT(jω)| (N·m per m/s) and |W_Ω(jω)| ((rad/s) per (m/s)) on ``omega``; ``np.inf``
         for no constraint.
@@ -36,9 +45,7 @@ def sensitivity_disks(plant, omega, w_tower, w_speed, max_sensitivity=2.0):
         ``open_loop`` = P_{MyT,w} − K∞ (the factor of S in T_{MyT,w}) and ``k_inf`` = K∞,
         all arrays on ``omega``.
     """
-    from ..closedloop import plant_responses
-
-    w = as_omega(omega, "omega")
+    w = as_omega(omega, "omega", allow_zero=False)  # ω = 0: the disks' 1/|P| at DC is no frequency-domain bound
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
     R = plant_responses([plant], w, ("tower_base_my", "gen_speed"), method="batched")
     a, yb = R[("tower_base_my", "wind")][:, 0], R[("tower_base_my", "pitch_cmd")][:, 0]
@@ -74,8 +81,6 @@ def _poisson_kernel(z):
 def _poisson_weights(omega, z):
     """Weights q with q @ f = (1/π)∫ f(|ω|)·Re z/((Re z)² + (ω − Im z)²) dω over the grid
     (ω of both signs), trapezoid rule, for z = x + iy with x > 0."""
-    from ..spectral import trapezoid_weights
-
     kernel, _ = _poisson_kernel(z)
     return trapezoid_weights(omega) * kernel(omega)
 
@@ -155,7 +160,7 @@ def _bands(omega, mask):
 
 
 @on_one_blas_thread
-def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitivity=2.0, omega=None,
+def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitivity=MAX_SENSITIVITY, omega=None,
                       cases=None) -> PitchFeasibility:
     """Whether a tower-load and a generator-speed specification can be met by pitch control.
 
@@ -176,7 +181,7 @@ def pitch_feasibility(model, wind_speed, tower_spec, speed_spec, *, max_sensitiv
         condition, and the verdict holds for any controller acting through the pitch (an
         ATD loop included).
     omega : array_like, optional
-        Frequencies, rad/s (default :func:`specdesign.spec.default_omega`, refined around
+        Frequencies, rad/s, all > 0 (default :func:`specdesign.spec.default_omega`, refined around
         the right-half-plane zeros so the Poisson kernel is resolved).
     cases : sequence of float, optional
         Wind speeds (m/s) of the plant cases; default only ``wind_speed``.
@@ -264,7 +269,7 @@ class PitchChecker:
         return _verdict(self.omega, ~bad, binding, self.zeros, means, self.max_sensitivity)
 
 
-def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=None, cases=None) -> list:
+def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=MAX_SENSITIVITY, omega=None, cases=None) -> list:
     """One :class:`PitchChecker` per plant case, on one grid.
 
     Parameters
@@ -278,7 +283,7 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=
     max_sensitivity : float or None
         M_s (-), or None for none.
     omega : array_like, optional
-        Grid, rad/s (default :func:`specdesign.spec.default_omega` refined around the
+        Grid, rad/s, all > 0 (default :func:`specdesign.spec.default_omega` refined around the
         right-half-plane zeros of the nominal P_{Ω,β}).
     cases : sequence of float, optional
         Wind speeds (m/s) of the plant cases; default only ``wind_speed``.
@@ -289,13 +294,13 @@ def pitch_checkers(model, wind_speed, speed_spec, *, max_sensitivity=2.0, omega=
         Nominal case first when ``cases`` is None, else in the order given.
     """
     from .. import spec
-    from ..closedloop import closed_map, plant_responses, refine_grid, siso_response
-
-    v = float(wind_speed)
+    v = real_scalar(wind_speed, "wind_speed")
     ms = np.inf if max_sensitivity is None else positive_scalar(max_sensitivity, "max_sensitivity")
-    speeds = [v] if cases is None else [float(c) for c in cases]
+    speeds = [v] if cases is None else [real_scalar(c, f"cases[{i}]") for i, c in enumerate(cases)]
+    # the grid checked before any plant is linearised; ω must be > 0 (the Poisson kernel and the
+    # disks' radii divide by ω and by the plant's DC gain)
+    w = spec.default_omega() if omega is None else as_omega(omega, "omega", allow_zero=False)
     plants = [model.linearize(x) for x in speeds]
-    w = spec.default_omega() if omega is None else as_omega(omega, "omega")
     zeros0 = _rhp_zeros(plants[0])
     if omega is None and zeros0.size:
         w = refine_grid(w, zeros0, rel_width=0.2, rel_step=2e-4)
@@ -376,8 +381,6 @@ def _magnitude(spec_like, omega, name):
             raise ValueError(f"{name} returned values ≤ 0 or NaN; give |W(jω)| > 0 (linear, not dB) or W(jω) complex")
         out = np.abs(raw)
     else:
-        from ..closedloop import siso_response
-
         out = np.abs(siso_response(spec_like, omega, name))
     out = np.broadcast_to(np.asarray(out, float), omega.shape)
     if np.any(~(out > 0)):
@@ -386,8 +389,8 @@ def _magnitude(spec_like, omega, name):
 
 
 @on_one_blas_thread
-def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8.0), *, max_sensitivity=2.0,
-                   max_pitch_rate_ratio=1.0, m=4.0, omega=None) -> dict:
+def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8.0), *, max_sensitivity=MAX_SENSITIVITY,
+                   max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None) -> dict:
     """The largest tower-base DEL reduction a pitch controller can promise, per speed relaxation.
 
     For each relaxation g (dB) of the generator-speed specification W_Ω = 10^(g/20)·|T^ROSCO_{Ω,w}|:

@@ -36,17 +36,29 @@ promise(s + g) − :data:`REGULARISATION`·mean(e²) with g the log-sum-exp of r
 :data:`SMOOTHING_DB` (the least gain above r for a shape s), then settle the gain as above.
 This fallback is slower (a chain of non-convex fits per headroom) and its elements follow a
 certificate for a larger target, so it needs a more relaxed speed map.
-:func:`specdesign.spec.shape_to_target` with ``band="whole"`` is the user's entry point.
+:func:`specdesign.feasibility.shape_whole_band` is the user's entry point.
 
 Units: ω in rad/s, magnitudes in dB here, promises in % DEL.
 """
 from __future__ import annotations
 
+import inspect
 from dataclasses import replace
 
 import numpy as np
 
+from .. import spectral
 from .._blas import on_one_blas_thread
+from .._checks import del_target, margin_db, search_options
+from ..closedloop import (
+    UNSTABLE_CONTROLLER_RATE,
+    lightly_damped,
+    refine_grid,
+    siso_response,
+    system_roots,
+)
+from ..fatigue import TOWER_M
+from .target import DENSE_POINTS_PER_WIDTH, CertificateSearch, recertify
 
 __all__ = ["BELOW_WEIGHT", "ENVELOPES", "ENVELOPE_LOSS_PP", "FIT_OMEGA", "FOLLOW", "FOLLOW_GAIN_DB", "HEADROOM_PP",
            "MAX_ITERATIONS", "MAX_NOTCHES", "PROMISE_MARGIN_PP", "REGULARISATION", "SMOOTHING_DB",
@@ -142,8 +154,6 @@ class _Promise:
     one stacked damage evaluation) mapped back through the moment matrix."""
 
     def __init__(self, base):
-        from .. import spectral
-
         w = base.omega
         self.a = spectral.trapezoid_weights(w)[:, None] * w[:, None] ** np.asarray(_ORDERS)
         self.m, self.method, self.stats = base.m, base.method, spectral.SpectralStats
@@ -273,6 +283,8 @@ def _settle(promise, omega, x, n_notch, lift_db, aim):
         hi = 1.0
         while promise(e + hi, grad=False) > aim:
             hi *= 2
+            if hi > 80:  # bounded as _shift_to's search: 80 dB above any promise's reach
+                break
         dx = brentq(lambda g: promise(e + g, grad=False) - aim, 0.0, hi, xtol=1e-12, rtol=1e-14)
         x[0] += dx
         p = promise(e + dx, grad=False)
@@ -294,9 +306,6 @@ def _dense_ratio(cert, base):
     """20·log10(|W^cert|/|T^ROSCO|) on 2000 points over the baseline grid's span, refined around
     the lightly damped roots of both maps: the final check of the elements (between the fit's
     grid points a narrow dip of the certificate's ratio could rise above them)."""
-    from ..closedloop import lightly_damped, refine_grid, siso_response, system_roots
-    from .target import DENSE_POINTS_PER_WIDTH
-
     roots = np.concatenate([system_roots(cert.tower.baseline), system_roots(base.system)])
     w = refine_grid(np.geomspace(base.omega[0], base.omega[-1], 2000), lightly_damped(roots),
                     points_per_width=DENSE_POINTS_PER_WIDTH)
@@ -328,11 +337,9 @@ def _seeds(base, grid, r):
 
 def _unstable_pole(design, model):
     """The rightmost pole (1/s) of a certificate's controller when it is itself unstable (real
-    part above :data:`specdesign.qft.UNSTABLE_CONTROLLER_RATE`), else None: design_qft refuses
+    part above :data:`specdesign.closedloop.UNSTABLE_CONTROLLER_RATE`), else None: design_qft refuses
     such a controller (a saturated pitch opens the loop) and reduces its design from it."""
     import control as ct
-
-    from ..qft import UNSTABLE_CONTROLLER_RATE
 
     poles = np.asarray(ct.poles(design.controller(model)))
     if poles.size and poles.real.max() > UNSTABLE_CONTROLLER_RATE:
@@ -348,8 +355,6 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
     from scipy.ndimage import maximum_filter1d
 
     from .. import spec
-    from ..closedloop import siso_response
-
     cert = search.for_target(t + headroom_pp, **for_target)
     w = base.omega
     r = 20 * np.log10(np.abs(cert.tower.response(w)) / np.abs(siso_response(base.system, w)))
@@ -387,7 +392,7 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
 
 @on_one_blas_thread  # L-BFGS-B's small BLAS calls: 10× faster on one thread (specdesign._blas)
 def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_pp=HEADROOM_PP,
-                          max_notches=MAX_NOTCHES, m=4.0, omega=None, **target_options):
+                          max_notches=MAX_NOTCHES, m=TOWER_M, omega=None, **target_options):
     """A certified tower specification for ``target_reduction``, as ROSCO's map times shaping elements.
 
     See the module docstring for the problem solved.
@@ -444,21 +449,21 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     >>> [type(e).__name__ for e in ts.tower.elements]        # doctest: +SKIP
     ['Gain', 'LeadLag', 'LeadLag', 'Notch', 'Notch']
     """
-    import inspect
-
     from scipy.ndimage import maximum_filter1d
 
     from .. import spec
-    from .._checks import del_target
-    from ..closedloop import siso_response
-    from .target import CertificateSearch, recertify
-
     t = del_target(target_reduction)
     heads = np.atleast_1d(np.asarray(headroom_pp, float))
     if heads.ndim != 1 or heads.size == 0 or not np.all(np.isfinite(heads)) or np.any(heads <= 0):
         raise ValueError(f"headroom_pp={headroom_pp!r} must be positive percentage points")
-    if int(max_notches) != max_notches or max_notches < 0:
+    if isinstance(max_notches, (bool, np.bool_)) or int(max_notches) != max_notches or max_notches < 0:
         raise ValueError(f"max_notches={max_notches!r} must be a whole number ≥ 0")
+    # the certificate's options checked here, before the baseline and the search are built (a
+    # tolerance ≤ 0 would otherwise only stop the first bisection, forever)
+    margin_db(target_options.get("slack_db", 0.5), "slack_db")
+    margin_db(target_options.get("speed_slack_db", 0.2), "speed_slack_db")
+    search_options(target_options.get("tolerance_db", 0.05), target_options.get("max_relax_db", 12.0),
+                   target_options.get("speed_relax_db"))
     v = model.check_wind_speed(wind_speed)
     base = spec.baseline_analysis(model, v, m=m, omega=FIT_OMEGA if omega is None else omega)
     promise = _Promise(base)

@@ -1,11 +1,25 @@
 """A feasible specification pair for a DEL-reduction target (see :mod:`specdesign.feasibility`)."""
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._blas import on_one_blas_thread
+from .._checks import MAX_BISECTIONS, as_omega, del_target, margin_db, search_options
+from ..closedloop import (
+    CERTIFICATE_MAX_SENSITIVITY,
+    case_speeds,
+    closed_loop,
+    closed_map,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+    system_roots,
+)
+from ..fatigue import TOWER_M
 from .achievable import AchievablePitch, YoulaProblem
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
@@ -82,7 +96,12 @@ class TargetSpecification:
     case_speeds: tuple = ()
     robustness_db: float = 0.0
     speed_slack_db: float = 0.0
-    m: float = 4.0
+    m: float = TOWER_M
+
+    @property
+    def wind_speed(self) -> float:
+        """The operating point the pair was made and certified at, m/s (its certificate's)."""
+        return float(self.design.wind_speed)
 
     @property
     def template_offsets(self) -> tuple:
@@ -99,8 +118,8 @@ class TargetSpecification:
 
 @on_one_blas_thread
 def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
-                             max_sensitivity=1.8, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
-                             m=4.0, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
+                             max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
+                             m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
                              dense_omega=None) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
@@ -134,14 +153,15 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         A fixed relaxation of the certificate's speed constraint, dB: the slack is then the
         largest that keeps the promise ≥ ``target_reduction`` (bisection to ``tolerance_db``).
     max_sensitivity : float
-        M_s of the certificate (-); below design_qft's 1.9 so that the plant cases and a
-        reduced-order controller keep their margins.
+        M_s of the certificate (-); below :data:`~specdesign.closedloop.DESIGN_MAX_SENSITIVITY`
+        so that the plant cases and a reduced-order controller keep their margins.
     max_pitch_rate_ratio : float
         Pitch-rate SD allowance relative to ROSCO's (-).
     max_relax_db : float
         Largest speed relaxation tried, dB.
     tolerance_db : float
-        Bisection tolerance on the relaxation, dB.
+        Bisection tolerance on the relaxation, dB (> 0; the bisection stops after
+        :data:`specdesign._checks.MAX_BISECTIONS` halvings in any case).
     m : float
         Wöhler exponent (-).
     omega : array_like, optional
@@ -161,8 +181,10 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
     Raises
     ------
+    TypeError
+        For a bool or a string where a number is meant (``target_reduction=True`` is not 1 %).
     ValueError
-        For a target outside (0, 100), a negative slack, invalid offsets, or when even
+        For a target outside (0, 100), a negative slack, a tolerance ≤ 0, invalid offsets, or when even
         ``max_relax_db`` does not reach the target (the message gives the promise reached there).
 
     Examples
@@ -173,6 +195,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     True
     """
     _check_target(target_reduction, slack_db, speed_slack_db)  # at the door, before the plant cases are built
+    search_options(tolerance_db, max_relax_db, speed_relax_db)
     search = CertificateSearch(model, wind_speed, max_sensitivity=max_sensitivity,
                                max_pitch_rate_ratio=max_pitch_rate_ratio, m=m, omega=omega, case_offsets=case_offsets,
                                dense_omega=dense_omega)
@@ -182,15 +205,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
 
 def _check_target(target_reduction, slack_db, speed_slack_db):
     """(target %, slack dB, speed slack dB), checked."""
-    from .._checks import del_target
-
-    t = del_target(target_reduction)
-    slack, sslack = float(slack_db), float(speed_slack_db)
-    if not (np.isfinite(slack) and slack >= 0):
-        raise ValueError(f"slack_db={slack_db!r} must be a finite margin ≥ 0 dB")
-    if not (np.isfinite(sslack) and sslack >= 0):
-        raise ValueError(f"speed_slack_db={speed_slack_db!r} must be a finite margin ≥ 0 dB")
-    return t, slack, sslack
+    return del_target(target_reduction), margin_db(slack_db, "slack_db"), margin_db(speed_slack_db, "speed_slack_db")
 
 
 class CertificateSearch:
@@ -226,12 +241,9 @@ class CertificateSearch:
     True
     """
 
-    def __init__(self, model, wind_speed, *, max_sensitivity=1.8, max_pitch_rate_ratio=1.0, m=4.0, omega=None,
+    def __init__(self, model, wind_speed, *, max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
                  case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None):
         from .. import spec
-        from .._checks import as_omega
-        from ..closedloop import case_speeds
-
         self.model, self.m = model, float(m)
         self.wind_speed = v = model.check_wind_speed(wind_speed)
         self.case_speeds, _ = case_speeds(v, case_offsets, model.wind_range, name="case_offsets")
@@ -286,9 +298,9 @@ class CertificateSearch:
             As :func:`specification_for_target`.
         """
         t, slack, sslack = _check_target(target_reduction, slack_db, speed_slack_db)
+        tolerance_db, max_relax_db, g = search_options(tolerance_db, max_relax_db, speed_relax_db)
         model, v, speeds, base = self.model, self.wind_speed, self.case_speeds, self.base
         if speed_relax_db is not None:
-            g = float(speed_relax_db)
             design, best, rob = self._reached(g, 0.0)
             if design is None or rob is None:
                 raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {v:g} m/s over the plant "
@@ -297,7 +309,9 @@ class CertificateSearch:
                 raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s with the speed map relaxed by "
                                  f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs); relax it more")
             lo_s, hi_s = 0.0, 40.0
-            while hi_s - lo_s > tolerance_db:
+            for _ in range(MAX_BISECTIONS):  # bounded: a tolerance below float64's spacing is never reached
+                if hi_s - lo_s <= tolerance_db:
+                    break
                 mid = 0.5 * (lo_s + hi_s)
                 lo_s, hi_s = (mid, hi_s) if _slack_promise(design, base, mid + rob[0]) >= t else (lo_s, mid)
             return _target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t, self.m)
@@ -319,7 +333,9 @@ class CertificateSearch:
                              f"{slack:g} dB slack over the plant cases' needs); lower the target or the slack, or allow "
                              "more pitch activity")
         hi_g, best, best_rob = found
-        while hi_g - lo_g > tolerance_db:
+        for _ in range(MAX_BISECTIONS):
+            if hi_g - lo_g <= tolerance_db:
+                break
             mid = 0.5 * (lo_g + hi_g)
             d, red, rob = self._reached(mid, slack)
             if red >= t:
@@ -457,8 +473,6 @@ class _Cases:
 
     def _on(self, omega):
         """Plant responses and ROSCO's maps (|T_MyT|, |T_Ω|), each (n_omega, n_cases), on ``omega``."""
-        from ..closedloop import closed_map, plant_responses, siso_response
-
         R = plant_responses(self.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
         c = np.stack([siso_response(r, omega) for r in self.rosco], axis=1)
         return R, np.abs(closed_map(R, c, 0.0, "tower_base_my")), np.abs(closed_map(R, c, 0.0, "gen_speed"))
@@ -501,15 +515,11 @@ class _Cases:
         lightly damped roots of its nominal maps and of ``specs``' baselines (a narrow dip of W
         between grid points would hide a violation): (grid, responses, ROSCO's |T_MyT| and
         |T_Ω|, C(jω) as a column), or None if some case is unstable."""
-        import warnings
-
         from .. import spec
-        from ..closedloop import closed_loop, lightly_damped, refine_grid, siso_response, system_roots
-
         if self._unstable(controller):
             return None
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings():  # python-control's notes on the interconnection (unused signals)
+            warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             cl0 = closed_loop(self.plants[self.nom], controller, warn=False)
         roots = [system_roots(cl0["tower_base_my", "wind"]), system_roots(cl0["gen_speed", "wind"])]
         roots += [system_roots(x.baseline) for x in specs if isinstance(x, spec.Specification)]
@@ -523,8 +533,6 @@ class _Cases:
         The tower robustness is the largest excess of a case's |T_MyT|/|T^ROSCO_MyT| over the
         nominal case's; the speed relaxation the largest |T_Ω|/|T^ROSCO_Ω| (:meth:`_closed`'s grid).
         """
-        from ..closedloop import closed_map
-
         closed = self._closed(controller, omega)
         if closed is None:
             return None
@@ -546,8 +554,6 @@ class _Cases:
             the cases at each ω dB)} for "W_MyT" and "W_Ω", the grid, the nominal case's
             |T_MyT| and ROSCO's nominal |T_Ω| on it), or None if a case is unstable.
         """
-        from ..closedloop import closed_map
-
         closed = self._closed(controller, omega, (tower, speed))
         if closed is None:
             return None
@@ -572,8 +578,6 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     import control
 
     from .. import spec
-    from ..closedloop import closed_loop
-
     plant = model.linearize(float(wind_speed))
     # kept as a state space: the polynomial coefficients of a ~25th-order map carry no digits
     t_sys = control.minreal(closed_loop(plant, design.controller(model), warn=False)["tower_base_my", "wind"],
@@ -634,8 +638,6 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     >>> bool(looser.promise.exact_del < t.promise.exact_del)
     True
     """
-    from .._checks import as_omega
-
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a TargetSpecification, got {type(target).__name__}")
     tower = target.tower if tower is None else tower

@@ -31,11 +31,8 @@ Sign convention of the workbench: β = −C_β·Ω_g − C_atd·v_tt. SLICOT clo
 """
 from __future__ import annotations
 
-import warnings
-
-from ..closedloop import closed_loop_mimo, refine_grid
 from .cases import CHECK_OMEGA, CONTINUATION_DB, CaseCheck, check_pair, refine_on_cases
-from .design import DEFAULT_DECAY_RATE, QFT_SPEED_RELAX_DB, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
+from .design import DEFAULT_DECAY_RATE, TOWER_BAND, HinfDesign, design_hinf, qft_specifications
 from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, inverse_weight, siso_weight
 
@@ -47,7 +44,6 @@ __all__ = [
     "refine_on_cases",
     "GeneralizedPlant",
     "HinfDesign",
-    "QFT_SPEED_RELAX_DB",
     "design_hinf",
     "generalized_plant",
     "inverse_weight",
@@ -59,15 +55,3 @@ __all__ = [
     "DEFAULT_INTEGRAL_CORNER",
     "TOWER_BAND",
 ]
-
-_MOVED = {"closed_loop": ("closed_loop_mimo", closed_loop_mimo), "assessment_grid": ("refine_grid", refine_grid)}
-
-
-def __getattr__(name):
-    # names that moved to specdesign.closedloop (issue 13: one home per closed-loop construction)
-    if name in _MOVED:
-        new, obj = _MOVED[name]
-        warnings.warn(f"specdesign.hinf.{name} is deprecated; use specdesign.closedloop.{new}", DeprecationWarning,
-                      stacklevel=2)
-        return obj
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

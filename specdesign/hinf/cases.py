@@ -34,12 +34,14 @@ from scipy import linalg, optimize
 
 from .._blas import one_blas_thread
 from ..closedloop import (
+    DESIGN_MAX_SENSITIVITY,
     closed_map,
     lightly_damped,
     plant_responses,
     refine_grid,
     siso_response,
 )
+from ..feasibility import TargetSpecification
 from .modal import (
     modal_bounds,
     modal_matrices,
@@ -231,8 +233,6 @@ def _check(cases, k):
 
 
 def _require(target, controller):
-    from ..feasibility import TargetSpecification
-
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a feasibility.TargetSpecification, got {type(target).__name__}")
     if not isinstance(controller, ct.LTI):
@@ -323,7 +323,7 @@ class _Objective:
 
 
 def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float = 0.15, decay_rate: float = 0.02,
-                    max_sensitivity: float = 1.9, margins_db: tuple = CONTINUATION_DB, omega: ArrayLike | None = None,
+                    max_sensitivity: float = DESIGN_MAX_SENSITIVITY, margins_db: tuple = CONTINUATION_DB, omega: ArrayLike | None = None,
                     max_iterations: int = 5000) -> tuple[ct.StateSpace, CaseCheck]:
     """The multi-model H∞ step: adjust a pitch controller until it meets a certified pair at every case.
 

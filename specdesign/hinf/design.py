@@ -17,11 +17,16 @@ import control as ct
 import numpy as np
 from numpy.typing import ArrayLike
 
+from loopshaping import check, qft
 from loopshaping import hinf as lhinf
 
 from .._blas import one_blas_thread
+from .._checks import finite_system, spec_made_at
 from ..closedloop import closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
+from ..fatigue import TOWER_M
+from ..feasibility import TargetSpecification, specification_for_target
+from ..qft.design import SPEED_RELAX_DB
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
@@ -33,7 +38,7 @@ if TYPE_CHECKING:
     from ..spec import Specification
     from ..turbine import TurbineModel
 
-__all__ = ['HinfDesign', 'QFT_SPEED_RELAX_DB', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
+__all__ = ['HinfDesign', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
 
 #: α (1/s) of the α-shifted synthesis in :func:`design_hinf`.
 DEFAULT_DECAY_RATE = 0.02
@@ -176,8 +181,6 @@ def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
     """Re-check a SISO pitch controller with :mod:`loopshaping.check`: the tower spec in
     the general form |(A + B·C)/(1 + D·C)| ≤ |W_MyT| with A = P_{MyT,w},
     B = P_{MyT,w}P_{Ω,β} − P_{MyT,β}P_{Ω,w}, D = P_{Ω,β}; the speed spec with A = P_{Ω,w}, B = 0."""
-    from loopshaping import check, qft
-
     def resp(o, i):
         sub = plant[o, i]
         return lambda w: _response(sub, w).reshape(-1, 1)
@@ -215,7 +218,7 @@ def _is_design(obj) -> bool:
 
 def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
                        spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                       keep_below: float = 0.6, m: float = 4.0,
+                       keep_below: float = 0.6, m: float = TOWER_M,
                        omega: ArrayLike | None = None) -> tuple[Specification, Specification, Specification]:
     """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
 
@@ -283,9 +286,6 @@ def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db
     return d.tower, d.speed, d.shaping.specification
 
 
-#: Relaxations (dB) of the generator-speed spec tried in turn by ``design_hinf(spec="qft")``:
-#: the ladder of :func:`specdesign.qft.design_qft`.
-QFT_SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
 
 
 def design_hinf(
@@ -294,17 +294,16 @@ def design_hinf(
     target_reduction: float = 25.0,
     *,
     spec: str | Any = "target",
-    specs: str | Any | None = None,
     spec_reduction: float = 15.0,
     measurements: Sequence[str] | None = None,
     order: int = 8,
     w_tower: Specification | ct.LTI | None = None,
     w_speed: Specification | ct.LTI | None = None,
     w_pitch: ct.LTI | float | None = None,
-    speed_relax_db: float | Sequence[float] = QFT_SPEED_RELAX_DB,
+    speed_relax_db: float | Sequence[float] = SPEED_RELAX_DB,
     tower_relax_db: float = 6.0,
     tower_relax_omega: float = 1.3,
-    m: float = 4.0,
+    m: float = TOWER_M,
     omega: ArrayLike | None = None,
     suboptimality: float = 0.05,
     reduction_method: str = "balanced",
@@ -345,7 +344,7 @@ def design_hinf(
         ``"qft"``: those of ``specdesign.qft.design_qft(spec="notch")``
         (:func:`qft_specifications`): the notch spec relaxed by ``tower_relax_db`` above
         ≈ ``tower_relax_omega`` and ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``; given a
-        sequence (default :data:`QFT_SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
+        sequence (default :data:`specdesign.qft.SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
         in turn and the smallest whose reduced design meets both specs on the refined grid
         (speed everywhere, tower over the tower-mode band) is kept, as QFT does (this
         function's default before the certified pair).
@@ -353,8 +352,6 @@ def design_hinf(
         exactly the specs that design met. ``"rosco"``: the unrelaxed notch spec and ROSCO's
         T_{Ω,w} (its ζ = 0.01 dip at the tower mode is a spec no well-damped loop can follow,
         docs/hinf.md).
-    specs : optional
-        Deprecated alias of ``spec`` (DeprecationWarning); give one of the two.
     spec_reduction : float
         % of tower-base damage the automatic notch specification
         (:func:`specdesign.spec.shape_to_target`) must promise with ``spec="qft"`` or
@@ -414,13 +411,15 @@ def design_hinf(
     ------
     ValueError
         If ``spec`` is not "target", "qft", "rosco", a design record or a pair, or both
-        ``spec`` and ``specs`` are given; ``target_reduction`` is not in (0, 100) % with
+        ``spec`` and ``specs`` are given; ``spec`` is a record made at another wind speed
+        (a TargetSpecification, a QFTDesign, DesignSpecifications: the same check as
+        :func:`specdesign.qft.design_qft`'s); the plant at ``wind_speed`` has a NaN or inf entry; ``target_reduction`` is not in (0, 100) % with
         ``spec="target"``; ``speed_relax_db`` is not a
         relaxation ≥ 0 dB or a sequence of them; no notch specification reaches
         ``spec_reduction``; ``wind_speed`` is outside ``model.wind_range``; or a weight,
         the generalized plant, the synthesis or the reduction rejects its arguments
         (:func:`inverse_weight`, :func:`generalized_plant`, :func:`loopshaping.hinf.synthesize`,
-        :func:`loopshaping.hinf.reduce`).
+        :func:`loopshaping.hinf.reduce`); an ill-posed synthesis names the wind speed.
     RuntimeError
         If the reduced controller of the last relaxation tried does not stabilise the
         turbine (raise ``order``).
@@ -452,16 +451,13 @@ def design_hinf(
     True
     """
     from .. import spec as sp
-    from ..feasibility import TargetSpecification, specification_for_target
-
-    if specs is not None:
-        warnings.warn("design_hinf(specs=...) is deprecated; use spec=... (the name design_qft uses)",
-                      DeprecationWarning, stacklevel=2)
-        if not (isinstance(spec, str) and spec == "target"):
-            raise ValueError(f"give spec={spec!r} or the deprecated specs={specs!r}, not both")
-        spec = specs
     specs, made = spec, False
-    v = float(wind_speed)
+    v = model.check_wind_speed(wind_speed)
+    # a NaN plant: said here, naming the wind speed, before the specification search, the
+    # baseline analysis or SLICOT meet it ("SVD did not converge")
+    finite_system(model.linearize(v), f"the plant linearised at {v:g} m/s")
+    if not isinstance(specs, str):
+        spec_made_at(specs, v)  # the same check as design_qft's: a record's promise holds at its own speed only
     if isinstance(specs, str) and specs == "target":
         made = w_tower is None or w_speed is None
         try:
@@ -573,8 +569,11 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
             and not np.any(A_gp[:n_p, n_p:])):  # pragma: no cover - interconnect's state order
         raise RuntimeError("generalized plant does not start with the turbine's states, "
                            "followed by weights in series: the α-shift would be wrong")
-    res = lhinf.synthesize(gp.system, gp.n_meas, gp.n_ctrl, suboptimality=suboptimality,
-                           decay_rate=decay_rate, decay_states=np.arange(gp.system.nstates) < n_p)
+    try:
+        res = lhinf.synthesize(gp.system, gp.n_meas, gp.n_ctrl, suboptimality=suboptimality,
+                               decay_rate=decay_rate, decay_states=np.arange(gp.system.nstates) < n_p)
+    except ValueError as e:  # an ill-posed problem: say at which operating point
+        raise ValueError(f"H∞ design at {v:g} m/s: {e}") from e
     K_full = res.controller
     if gp.input_filter is not None:
         f = gp.input_filter

@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING
 import control as ct
 import numpy as np
 
+from loopshaping.freqresp import as_siso
+
 if TYPE_CHECKING:
     from ..spec import Specification
 
@@ -54,8 +56,6 @@ def siso_weight(sys: Specification | ct.LTI | float, name: str) -> ct.TransferFu
     >>> siso_weight(ct.ss(-1.0, 1.0, 1.0, 0.0), "w_pitch").den[0][0]
     array([1., 1.])
     """
-    from loopshaping.freqresp import as_siso
-
     from ..spec import Specification
 
     if isinstance(sys, Specification):

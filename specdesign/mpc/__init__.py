@@ -1,4 +1,4 @@
-"""Model predictive and learned pitch controllers (seed 000): a quadratic MPC, the
+"""Model predictive and learned pitch controllers (after Collet et al., fatigue-oriented economic MPC and behavioural cloning): a quadratic MPC, the
 fatigue-oriented economic MPC of the variance-damage surrogate (Eq. 4), and behavioural
 cloning of the long-horizon economic optimiser. The controllers are callables of
 :func:`specdesign.simulate.simulate` and :func:`specdesign.validate.run_campaign` (picklable,
@@ -13,7 +13,7 @@ Layout
   :func:`economic_open_loop`, :class:`EconomicMPC`.
 - :mod:`specdesign.mpc.cloning`: :func:`demonstrations`, :class:`CloningRegressor`,
   :class:`ClonedController`, :class:`OpenLoopPlayback`.
-- :mod:`specdesign.mpc.lpv`: the wind-scheduled LPV prediction model and observer (seed 002).
+- :mod:`specdesign.mpc.lpv`: the wind-scheduled LPV prediction model and observer (after Boutrous, Nejjari and Puig, health-aware LPV MPC).
 - :mod:`specdesign.mpc.health`: :class:`HealthMPC`, the health-aware MPC trading speed tracking
   against blade damage growth (docs/health_mpc.md); :mod:`specdesign.mpc.health_report`: its
   energy / damage trade-off.

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import positive_scalar
+from .._checks import bad_measurements, positive_scalar
 
 __all__ = ["DiscreteTurbine", "discretize_turbine", "kalman_gain", "operating_wind_speed", "prediction_matrices",
            "SampledController", "MEASURED", "MEASUREMENT_STD"]
@@ -408,6 +408,9 @@ class SampledController:
     def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
         """Subclass hook: command deviations (rad) of the runs at one operating point.
 
+        Each controller defines it (the QP's first move, the economic problem's first move, the
+        regressor's command within the actuator limits); they share this docstring.
+
         Parameters
         ----------
         pt : dict
@@ -421,6 +424,11 @@ class SampledController:
         -------
         numpy.ndarray
             (G,) new command deviations (rad).
+
+        Raises
+        ------
+        RuntimeError
+            If the controller's solver fails.
         """
         raise NotImplementedError
 
@@ -461,7 +469,7 @@ class SampledController:
             y0[v] = pts[v]["model"].y0[pts[v]["model"].rows(self.measured)]
         self.trace = [] if getattr(self, "_recording", False) else None
         self._run = {"every": every, "k": 0, "groups": groups, "points": pts, "beta0": beta0, "y0": y0,
-                     "xprior": np.zeros((pitch.size, n1)), "u": pitch - beta0, "cmd": pitch.copy()}
+                     "xprior": np.zeros((pitch.size, n1)), "u": pitch - beta0, "cmd": pitch.copy(), "warned": set()}
 
     def __call__(self, t: float, y: dict) -> np.ndarray:
         """Pitch command of every run at time ``t`` (the simulator's callable contract).
@@ -482,6 +490,13 @@ class SampledController:
         ------
         RuntimeError
             If called before :meth:`start`.
+
+        Warns
+        -----
+        RuntimeWarning
+            Once per signal, for a NaN or inf measurement: that run holds its last command and
+            its state estimate until the signal is finite again
+            (:func:`specdesign._checks.bad_measurements`, the convention of every controller).
         """
         run = getattr(self, "_run", None)
         if run is None:
@@ -491,8 +506,13 @@ class SampledController:
         run["k"] = k + 1
         if k % run["every"]:
             return run["cmd"]
+        # a run with a NaN/inf sample holds its command and its estimate (bad_measurements)
+        bad = bad_measurements(y, self.measured, t, run["warned"], self.name)
         ym = np.stack([np.asarray(y[n], float) for n in self.measured], axis=1)
         for v, idx in run["groups"].items():
+            idx = idx[~bad[idx]]
+            if not idx.size:
+                continue
             pt = run["points"][v]
             Aa, Ba, Ca, L = pt["kf"]
             xp = run["xprior"][idx]

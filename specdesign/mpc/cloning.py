@@ -1,4 +1,4 @@
-"""Behavioural cloning of the long-horizon economic optimiser (seed 000, Section 4).
+"""Behavioural cloning of the long-horizon economic optimiser (Collet et al., behavioural cloning of a fatigue-oriented economic MPC, Section 4).
 
 The expert is the economic problem of :func:`~specdesign.mpc.economic_problem` over a long
 horizon (default 20 s; the paper's 10-100 s), solved open loop from a given state: its first
@@ -31,10 +31,14 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from .._checks import positive_scalar
+from .._docs import docstring_of
+from ..simulate import SimulationDivergedError, simulate
 from .base import MEASURED, SampledController, discretize_turbine
 from .economic import economic_problem, solve_cone
+from .quadratic import QuadraticMPC
 
 __all__ = ["Demonstrations", "demonstrations", "CloningRegressor", "ClonedController", "OpenLoopPlayback", "clone",
            "UPREV"]
@@ -66,22 +70,6 @@ class Demonstrations:
     seeds: np.ndarray
     ts: float
     cpu_time: np.ndarray
-
-    def subset(self, seeds) -> Demonstrations:
-        """The rows of some seeds (a held-out split by wind record, not by sample).
-
-        Parameters
-        ----------
-        seeds : sequence of int
-            Seeds to keep.
-
-        Returns
-        -------
-        Demonstrations
-            The rows of those seeds.
-        """
-        keep = np.isin(self.seeds, np.asarray(seeds))
-        return Demonstrations(self.features[keep], self.targets[keep], self.seeds[keep], self.ts, self.cpu_time)
 
     def join(self, other: Demonstrations) -> Demonstrations:
         """These rows and ``other``'s (DAgger aggregates the rounds).
@@ -153,9 +141,6 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
         For ``every`` not a whole multiple of ``ts``, or a behaviour controller at another
         sample time.
     """
-    from ..simulate import SimulationDivergedError, simulate
-    from .quadratic import QuadraticMPC
-
     horizon, ts, every = positive_scalar(horizon, "horizon"), positive_scalar(ts, "ts"), positive_scalar(every, "every")
     stride = int(round(every / ts))
     if stride < 1 or abs(stride * ts - every) > 1e-9 * every:
@@ -200,8 +185,6 @@ _POOLS = []
 def _threadpools():
     """threadpoolctl's controller, built once (it scans the loaded libraries: milliseconds)."""
     if not _POOLS:
-        from threadpoolctl import ThreadpoolController  # a scikit-learn dependency
-
         _POOLS.append(ThreadpoolController())
     return _POOLS[0]
 
@@ -260,7 +243,7 @@ def clone(model, wind_speeds, seeds, terms, *, rounds: int = 2, ts: float = 0.2,
 
 
 class CloningRegressor:
-    """Linear regression plus gradient-boosted trees on its residual (seed 000, Eqs. 19-22).
+    """Linear regression plus gradient-boosted trees on its residual (Collet et al., Eqs. 19-22).
 
     Parameters
     ----------
@@ -441,23 +424,9 @@ class ClonedController(SampledController):
         self.saturated = 0
         super().start(dt, wind, pitch, torque)
 
+    @docstring_of(SampledController)
     def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
-        """The regressor's command for every run at one operating point, within the actuator limits.
-
-        Parameters
-        ----------
-        pt : dict
-            :meth:`point` of the operating point.
-        xhat : numpy.ndarray
-            (G, n+1) state and wind estimates.
-        uprev : numpy.ndarray
-            (G,) previous command deviations (rad).
-
-        Returns
-        -------
-        numpy.ndarray
-            (G,) command deviations (rad).
-        """
+        # the regressor's command for every run, within the actuator limits
         t0 = time.process_time()
         dm = pt["model"]
         X = np.column_stack([xhat, uprev, np.full(uprev.size, dm.wind_speed)])

@@ -1,4 +1,4 @@
-"""Fatigue-oriented economic MPC (seed 000): the variance-damage surrogate cost of Eq. (4),
+"""Fatigue-oriented economic MPC (after Collet et al.): the variance-damage surrogate cost of Eq. (4),
 
     J̃_fat(y) = Σ_i π_i e^{b_i} / L_ult,i^{m_i} · Var(y_i)^{a_i},
 
@@ -32,14 +32,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
-from ..fatigue import VarianceDamageFit, economic_cost, fit_variance_damage
+from .._docs import docstring_of
+from ..fatigue import (
+    BLADE_M,
+    TOWER_M,
+    VarianceDamageFit,
+    economic_cost,
+    fit_variance_damage,
+)
+from ..simulate import simulate
+from ..turbine import rosco_baseline
 from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine
 
 __all__ = ["solve_cone", "FatigueTerm", "fit_fatigue_terms", "surrogate_cost", "economic_problem",
            "economic_open_loop", "OpenLoopResult", "EconomicMPC", "WOHLER"]
 
-#: Wöhler exponents of the priced components: steel tower (4), glass-fibre blade root (10).
-WOHLER = {"tower_base_my": 4.0, "blade_root_my": 10.0}
+#: Wöhler exponents of the priced components: steel tower, glass-fibre blade root.
+WOHLER = {"tower_base_my": TOWER_M, "blade_root_my": BLADE_M}
 
 
 def solve_cone(problem) -> bool:
@@ -133,9 +142,6 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
         For an output the model does not have, one without a Wöhler exponent, or a window
         longer than ``duration``.
     """
-    from ..simulate import simulate
-    from ..turbine import rosco_baseline
-
     window = positive_scalar(window, "window")
     duration = positive_scalar(duration, "duration")
     if window > duration / 2:
@@ -277,7 +283,7 @@ def economic_problem(dm: DiscreteTurbine, terms, horizon: int, *, speed_weight: 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class OpenLoopResult:
-    """The long-horizon optimum on the linear model (the expert of seed 000).
+    """The long-horizon optimum on the linear model (the expert of Collet et al.'s behavioural cloning).
 
     Parameters
     ----------
@@ -313,7 +319,7 @@ class OpenLoopResult:
 def economic_open_loop(model, wind_speed: float, wind, wind_dt: float, terms, *, ts: float = 0.2,
                        speed_weight: float = 100.0, activity_weight: float = 1.0, dm: DiscreteTurbine | None = None,
                        problem: dict | None = None) -> OpenLoopResult:
-    """Minimise the economic cost over the whole wind record, open loop, wind known (seed 000 Eq. 14).
+    """Minimise the economic cost over the whole wind record, open loop, wind known (Collet et al., Eq. 14).
 
     Starts at the trim of ``wind_speed``; the wind is sampled at ``ts`` and held over each
     sample (zero-order hold, as the discrete model assumes).
@@ -443,28 +449,9 @@ class EconomicMPC(SampledController):
                                             rate_limit=float(self.model.pitch_rate_limit),
                                             pitch_limits=(float(self.model.pitch_min), float(self.model.pitch_max)))}
 
+    @docstring_of(SampledController)
     def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
-        """First move of the economic problem for every run at one operating point.
-
-        Parameters
-        ----------
-        pt : dict
-            :meth:`point` of the operating point.
-        xhat : numpy.ndarray
-            (G, n+1) state and wind estimates.
-        uprev : numpy.ndarray
-            (G,) previous command deviations (rad).
-
-        Returns
-        -------
-        numpy.ndarray
-            (G,) command deviations (rad).
-
-        Raises
-        ------
-        RuntimeError
-            If the solver fails.
-        """
+        # the first move of the economic problem of every run (RuntimeError if the solver fails)
         pb = pt["problem"]
         out = np.empty(uprev.size)
         for g in range(uprev.size):

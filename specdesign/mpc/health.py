@@ -1,4 +1,4 @@
-"""Health-aware LPV MPC of the pitch (seed 002), trading speed (power) tracking against the
+"""Health-aware LPV MPC of the pitch (after Boutrous, Nejjari and Puig, *Health-aware LPV model predictive control of wind turbines*), trading speed (power) tracking against the
 growth of the blades' accumulated fatigue damage.
 
 Seed 002 (Boutrous, Nejjari, Puig) augments an LPV turbine model with the accumulated
@@ -55,7 +55,9 @@ import time
 
 import numpy as np
 
-from .._checks import positive_scalar
+from .._checks import bad_measurements, positive_scalar
+from ..fatigue import SNCurve
+from ..fatigue_online import StreamingDamage
 from .base import MEASURED, SampledController
 from .lpv import LPVTurbine, lpv_observer, lpv_turbine
 
@@ -223,7 +225,7 @@ def health_scale(damage: float, t: float, m: float, prior: float) -> float:
 
 
 class HealthMPC(SampledController):
-    """Health-aware LPV MPC (seed 002), a callable controller for ``simulate`` and ``run_campaign``.
+    """Health-aware LPV MPC (after Boutrous et al.), a callable controller for ``simulate`` and ``run_campaign``.
 
     See the module docstring for the problem; the observer and sampling are those of
     :class:`specdesign.mpc.base.SampledController`. The generator torque stays at its trim.
@@ -242,7 +244,7 @@ class HealthMPC(SampledController):
     health_weight : float, default 0
         ψ, the weight of the blade moment's excursions about its mean (the damage-growth proxy).
     stress_weight : float, default 0
-        ψ_acc, seed 002's weight of the accumulated blade moment (derating).
+        ψ_acc, Boutrous et al.'s weight of the accumulated blade moment (derating).
     blade_m : float, default 10
         Wöhler exponent of the blade's online damage D(k).
     del_budget : float, optional
@@ -366,9 +368,6 @@ class HealthMPC(SampledController):
         torque : numpy.ndarray
             (R,) generator torque (N·m).
         """
-        from ..fatigue import SNCurve
-        from ..fatigue_online import StreamingDamage
-
         super().start(dt, wind, pitch, torque)
         sn = SNCurve(m=self.blade_m, s_ref=self.del_budget if self.del_budget is not None else 1e6)
         self._run["damage"] = [StreamingDamage(sn) for _ in range(np.asarray(pitch).size)]
@@ -413,6 +412,14 @@ class HealthMPC(SampledController):
         ------
         RuntimeError
             If called before :meth:`start`.
+
+        Warns
+        -----
+        RuntimeWarning
+            Once per signal, for a NaN or inf measurement (``blade_root_my``, ``gen_speed`` or
+            a measured output): that run holds its last command and its state (damage count,
+            mean moment, speed reference, estimate) until the signal is finite again
+            (:func:`specdesign._checks.bad_measurements`, the convention of every controller).
         """
         run = getattr(self, "_run", None)
         if run is None:
@@ -422,22 +429,31 @@ class HealthMPC(SampledController):
         run["k"] = k + 1
         if k % run["every"]:
             return run["cmd"]
+        # a run with a NaN/inf sample holds its command, damage count, mean moment, speed
+        # reference and estimate (bad_measurements: the convention of every controller)
+        signals = tuple(dict.fromkeys((*self.measured, "blade_root_my", "gen_speed")))
+        ok = ~bad_measurements(y, signals, t, run["warned"], self.name)
         moment = np.asarray(y["blade_root_my"], float)
         for r, sd in enumerate(run["damage"]):
-            sd.update(moment[r])
-        run["mean_moment"] += min(self.ts / self.mean_time, 1.0) * (moment - run["mean_moment"])
+            if ok[r]:
+                sd.update(moment[r])
+        run["mean_moment"] += np.where(ok, min(self.ts / self.mean_time, 1.0) * (moment - run["mean_moment"]), 0.0)
         if self.speed_integral_time is not None:
             rated = float(self.model.rated_rotor_speed)
             ref = run["speed_ref"] - self.ts / self.speed_integral_time * (np.asarray(y["gen_speed"], float) - rated)
             # anti-windup at 5 % above rated; with a derating term never above rated: it must not
             # undo the derating asked for
-            run["speed_ref"] = np.minimum(ref, rated if self.weights[4] > 0 else (1.0 + REF_MARGIN) * rated)
+            ref = np.minimum(ref, rated if self.weights[4] > 0 else (1.0 + REF_MARGIN) * rated)
+            run["speed_ref"] = np.where(ok, ref, run["speed_ref"])
         elapsed = k * run["dt"]
         ym = np.stack([np.asarray(y[n], float) for n in self.measured], axis=1)
         model = self.model
         step = float(model.pitch_rate_limit) * self.ts
         limits = (float(model.pitch_min), float(model.pitch_max))
         for v, idx in run["groups"].items():
+            idx = idx[ok[idx]]
+            if not idx.size:
+                continue
             pt = run["points"][v]
             Aa, Ba, Ca, L = pt["kf"]
             if self.lpv:  # the LPV observer, absolute (states, wind)

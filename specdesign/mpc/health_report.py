@@ -1,7 +1,7 @@
 """The trade-off of the health-aware MPC: energy against blade and tower fatigue as its weights vary.
 
 :func:`health_tradeoff` simulates :class:`specdesign.mpc.health.HealthMPC` for a sweep of the
-health weight ψ (blade-moment excursions) and of seed 002's accumulated-stress weight ψ_acc, on
+health weight ψ (blade-moment excursions) and of Boutrous, Nejjari and Puig's accumulated-stress weight ψ_acc, on
 the same wind (speeds × seeds, :func:`specdesign.simulate.simulate`), and returns one
 :class:`TradeoffPoint` per controller; :func:`plot_tradeoff` draws the curve. Aggregation over
 the runs: mean power over every run; DELs pooled by fatigue, DEL = (mean_runs DEL_r^m)^{1/m}
@@ -14,10 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["TradeoffPoint", "health_tradeoff", "plot_tradeoff", "BLADE_M", "TOWER_M"]
+from ..fatigue import BLADE_M, TOWER_M, del_rainflow
+from ..rosco import rosco_scheduled
+from ..simulate import simulate
+from .health import HealthMPC
 
-#: Wöhler exponents of the blade root (glass fibre) and the tower base (steel).
-BLADE_M, TOWER_M = 10.0, 4.0
+__all__ = ["TradeoffPoint", "health_tradeoff", "plot_tradeoff"]
+
 
 
 @dataclass(frozen=True)
@@ -56,8 +59,6 @@ class TradeoffPoint:
 
 
 def _pooled_del(x, m, duration):
-    from ..fatigue import del_rainflow
-
     dels = np.array([del_rainflow(s, m, duration) for s in x.reshape(-1, x.shape[-1])])
     return float(np.mean(dels**m) ** (1.0 / m))
 
@@ -87,7 +88,7 @@ def health_tradeoff(model, wind_speeds, seeds, *, health_weights=(0.0, 3.0, 10.0
     health_weights : sequence of float, optional
         ψ values (ψ_acc = 0); the first is the reference of the damage ratios.
     stress_weights : sequence of float, optional
-        ψ_acc values (ψ = 0): seed 002's derating term.
+        ψ_acc values (ψ = 0): Boutrous et al.'s derating term.
     duration, transient : float, optional
         Recorded and discarded time per run (s).
     baseline : bool, optional
@@ -100,10 +101,6 @@ def health_tradeoff(model, wind_speeds, seeds, *, health_weights=(0.0, 3.0, 10.0
     tuple of TradeoffPoint
         ROSCO (if asked), then the ψ sweep, then the ψ_acc sweep.
     """
-    from ..rosco import rosco_scheduled
-    from ..simulate import simulate
-    from .health import HealthMPC
-
     out = []
     run = dict(seeds=list(seeds), duration=duration, transient=transient)
     if baseline:
@@ -149,7 +146,7 @@ def plot_tradeoff(points, *, reference: str | None = None):
     fig = Figure(figsize=(9, 3.8), layout="constrained")
     axes = fig.subplots(1, 2)
     series = (("health weight ψ (excursions)", [p for p in mpc if p.stress_weight == 0], "o-"),
-              ("seed 002's ψ_acc (accumulated moment)", [p for p in mpc if p.stress_weight > 0 or p is ref], "s--"))
+              ("Boutrous et al.'s ψ_acc (accumulated moment)", [p for p in mpc if p.stress_weight > 0 or p is ref], "s--"))
     for ax, attr, m, title in ((axes[0], "blade_del", BLADE_M, "blade-root flapwise"),
                                (axes[1], "tower_del", TOWER_M, "tower-base fore-aft")):
         for name, pts, style in series:

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import positive_scalar
-from .base import discretize_turbine, prediction_matrices
+from .base import discretize_turbine, kalman_gain, prediction_matrices
 
 __all__ = ["LPVTurbine", "lpv_turbine", "LPVObserver", "lpv_observer", "PREDICTED"]
 
@@ -312,8 +312,6 @@ def lpv_observer(model, ts: float, measured, *, wind_speeds=None) -> LPVObserver
     ValueError
         As :func:`lpv_turbine`, or for an unknown measured output.
     """
-    from .base import kalman_gain
-
     ts = positive_scalar(ts, "ts")
     v = _check_speeds(model, wind_speeds)
     measured = tuple(measured)

@@ -1,5 +1,5 @@
 """Quadratic (tracking) MPC on the linearised turbine: the "finely tuned quadratic MPC" baseline
-of seed 000.
+of Collet et al.'s behavioural-cloning paper.
 
 At every sample k, from the Kalman estimate (x̂, d̂) of :mod:`specdesign.mpc.base` and the
 previous command u₋₁ (all deviations from the trim), solve over N steps::
@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 from .._checks import positive_scalar
+from .._docs import docstring_of
 from .base import MEASURED, DiscreteTurbine, SampledController, prediction_matrices
 
 __all__ = ["QuadraticMPC", "quadratic_qp", "OSQP_OPTIONS"]
@@ -281,23 +282,9 @@ class QuadraticMPC(SampledController):
             raise RuntimeError(f"{self.name}: the QP is {qp['problem'].status} (a start outside the rate limit?)")
         return np.asarray(qp["v"].value, float) * qp["step"]
 
+    @docstring_of(SampledController)
     def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
-        """First move of the QP of every run at one operating point.
-
-        Parameters
-        ----------
-        pt : dict
-            :meth:`point` of the operating point.
-        xhat : numpy.ndarray
-            (G, n+1) state and wind estimates.
-        uprev : numpy.ndarray
-            (G,) previous command deviations (rad).
-
-        Returns
-        -------
-        numpy.ndarray
-            (G,) command deviations (rad).
-        """
+        # the first move of the QP of every run at this operating point
         qp = pt["qp"]
         out = np.empty(uprev.size)
         dw = self._horizon_wind(pt.get("model"), xhat)

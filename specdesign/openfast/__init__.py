@@ -14,6 +14,8 @@
 """
 from __future__ import annotations
 
+import importlib
+
 _LAZY = {
     "read_linearization": ".lin",
     "LinearizationData": ".lin",
@@ -49,7 +51,5 @@ __all__ = list(_LAZY)
 
 def __getattr__(name):  # the adapters import openfast-io only when used
     if name in _LAZY:
-        import importlib
-
         return getattr(importlib.import_module(_LAZY[name], __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -12,6 +12,8 @@ import copy
 import io
 import math
 import os
+import resource
+import signal
 import subprocess
 import threading
 import time
@@ -186,7 +188,8 @@ def _read_deck(fst: str, mtime: float) -> dict:
 def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed: float,
                wind_file: str | os.PathLike | None = None, seed: int | None = None,
                library: str | os.PathLike | None = None, parameters: str | os.PathLike | None = None,
-               dt: float | None = None, dt_out: float | None = None, channels: Sequence[str] = CAMPAIGN_CHANNELS,
+               controller_dt: float | None = None, dt: float | None = None, dt_out: float | None = None,
+               channels: Sequence[str] | None = CAMPAIGN_CHANNELS,
                initial_pitch: float | None = None, initial_rotor_speed: float | None = None, hydro: bool = True,
                name: str | None = None) -> Case:
     """Write a case folder from a deck with openfast-io (its reader and its writer).
@@ -213,12 +216,16 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
     parameters : str or os.PathLike, optional
         The file the library reads at initialisation (``DLL_InFile``: a ROSCO ``DISCON.IN``
         or an exported design's ``.parameters``); default the deck's.
+    controller_dt : float, optional
+        The library's sample time (s), ServoDyn's ``DLL_DT`` (an exported design's ``.dt``; a
+        whole multiple of ``dt``); default the deck's (``"default"``: every time step).
     dt : float, optional
         Glue-code time step (s); default the deck's (0.005 s for the shipped deck).
     dt_out : float, optional
         Output spacing (s), a multiple of ``dt``; default ``dt``.
-    channels : sequence of str, default CAMPAIGN_CHANNELS
-        The only output channels written (OpenFAST names, e.g. ``"TwrBsMyt"``).
+    channels : sequence of str or None, default CAMPAIGN_CHANNELS
+        The only output channels written (OpenFAST names, e.g. ``"TwrBsMyt"``); None keeps
+        the deck's own list.
     initial_pitch : float, optional
         Initial blade pitch (rad); default the deck's. Starting near the trim shortens the
         transient to discard.
@@ -246,7 +253,7 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
     """
     if not isinstance(deck, Deck):
         raise TypeError(f"deck must be a specdesign.openfast.Deck, got {type(deck).__name__}")
-    for key, val in (("tmax", tmax), ("dt", dt), ("dt_out", dt_out)):
+    for key, val in (("tmax", tmax), ("dt", dt), ("dt_out", dt_out), ("controller_dt", controller_dt)):
         if val is not None and not (math.isfinite(val) and val > 0):
             raise ValueError(f"{key}={val!r} must be a positive number of seconds")
     if not (math.isfinite(wind_speed) and wind_speed >= 0):
@@ -282,6 +289,10 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
                                 "(e.g. specdesign.rosco.discon.rosco_library())")
     if parameters is not None:
         sd["DLL_InFile"] = str(_existing(parameters, "parameters"))
+    if controller_dt is not None:
+        if abs(controller_dt / step - round(controller_dt / step)) > 1e-9:
+            raise ValueError(f"controller_dt={controller_dt} s must be a whole multiple of the time step {step} s")
+        sd["DLL_DT"] = float(controller_dt)
     vt.pop("DISCON_in", None)  # the controller's file is the one named, not rewritten by openfast-io
     if initial_pitch is not None:
         for k in (1, 2, 3):
@@ -290,7 +301,8 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
         ed["RotSpeed"] = initial_rotor_speed * 30.0 / math.pi  # rad/s → rpm
     if not hydro:
         fst["CompSeaSt"], fst["CompHydro"] = 0, 0
-    _set_outputs(vt, channels)
+    if channels is not None:
+        _set_outputs(vt, channels)
     from openfast_io.FAST_writer import InputWriter_OpenFAST  # heavy, as in _read_deck
 
     writer = InputWriter_OpenFAST()
@@ -300,7 +312,7 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
     with _IO_LOCK, contextlib.redirect_stdout(io.StringIO()):
         writer.execute()
     return Case(name=name, folder=folder, deck=deck, tmax=float(tmax), wind_speed=float(wind_speed),
-                seed=None if seed is None else int(seed), channels=tuple(channels))
+                seed=None if seed is None else int(seed), channels=tuple(channels or ()))
 
 
 def _existing(path, key) -> Path:
@@ -330,8 +342,8 @@ def _set_outputs(vt: dict, channels) -> None:
             vt[mod]["BldNd_BladesOut"] = 0
 
 
-def run_case(case: Case, install: OpenFASTInstall | None = None, *, timeout: float | None = None,
-             channels: Sequence[str] | None = None, nice: int = 0) -> OpenFASTOutput:
+def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: float | None = None,
+             timeout: float | None = None, channels: Sequence[str] | None = None, nice: int = 0) -> OpenFASTOutput:
     """Run OpenFAST on a case in a subprocess and read its outputs.
 
     Parameters
@@ -340,11 +352,15 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, timeout: flo
         From :func:`write_case`.
     install : OpenFASTInstall, optional
         The executables; default :func:`specdesign.openfast.find_openfast`.
+    cpu_limit : float, optional
+        CPU-time limit of the OpenFAST process (s); default 10 × ``case.tmax`` + 120 s
+        (OpenFAST runs the shipped deck at about 1.3 s of CPU per simulated second). A CPU
+        limit, unlike a wall-clock one, does not fire on a busy machine: a run that exceeds it
+        is stuck (e.g. a diverging simulation cutting its step), not starved.
     timeout : float, optional
-        Wall-clock limit (s); default 10 × ``case.tmax`` + 120 s (OpenFAST runs the shipped
-        deck at about 1.3 s of CPU per simulated second).
+        Wall-clock limit (s); default none.
     channels : sequence of str, optional
-        Channels read; default the case's.
+        Channels read; default the case's (every channel when the case kept the deck's list).
     nice : int, default 0
         Niceness added to the OpenFAST process (POSIX), for runs in the background.
 
@@ -363,25 +379,35 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, timeout: flo
     """
     install = install or find_openfast(require_turbsim=False)
     check_deck_version(install, case.deck.version, case.deck.fst)
-    timeout = 10.0 * case.tmax + 120.0 if timeout is None else float(timeout)
+    cpu_limit = 10.0 * case.tmax + 120.0 if cpu_limit is None else float(cpu_limit)
     case.outb.unlink(missing_ok=True)
     t0 = time.monotonic()
-    pre = (lambda: os.nice(nice)) if nice else None
+
+    def limits():  # in the child, before OpenFAST starts
+        resource.setrlimit(resource.RLIMIT_CPU, (math.ceil(cpu_limit), math.ceil(cpu_limit) + 5))
+        if nice:
+            os.nice(nice)
+
+    # gfortran buffers a redirected stdout: unbuffered, the log keeps OpenFAST's last words
+    # even when the process is killed
+    env = dict(os.environ, GFORTRAN_UNBUFFERED_PRECONNECTED="y")
     with open(case.log, "w") as log:
         try:
             rc = subprocess.run([str(install.openfast), case.fst.name], cwd=case.folder, stdout=log,
                                 stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, timeout=timeout,
-                                preexec_fn=pre).returncode
+                                preexec_fn=limits, env=env).returncode
         except subprocess.TimeoutExpired:
             rc = None
     tail = _tail(case.log)
     if rc is None:
-        raise OpenFASTRunError(case, f"did not finish in {timeout:g} s", tail)
+        raise OpenFASTRunError(case, f"did not finish in {timeout:g} s of wall time", tail)
+    if rc in (-signal.SIGXCPU, -signal.SIGKILL) and time.monotonic() - t0 >= 0.9 * cpu_limit:
+        raise OpenFASTRunError(case, f"used more than its {cpu_limit:g} s of CPU time (cpu_limit)", tail)
     text = case.log.read_text(errors="replace")
     if rc != 0 or "Aborting OpenFAST" in text or not case.outb.is_file():
         raise OpenFASTRunError(case, f"failed (exit code {rc}, after {time.monotonic() - t0:.0f} s)", tail)
     try:
-        return read_outputs(case.outb, list(channels or case.channels))
+        return read_outputs(case.outb, list(channels or case.channels) or None)
     except ValueError as e:
         raise OpenFASTRunError(case, f"wrote outputs that cannot be read ({e})", tail) from None
 

@@ -33,6 +33,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import positive_scalar
+from .._docs import docstring_of
+from ..rosco import rosco_baseline, rosco_gain_schedule
+from ..simulate import KernelPlant
+from ..simulate.kernels import linear_outputs, linear_plant_params, linear_rhs
+from ..turbine import TurbineModel
+from .lin import read_lin_file, read_linearization
+from .signals import plant_from_linearization
 
 __all__ = ["LinearOperatingPoint", "RotorModelSchedule", "LinearTurbine", "rotor_speed_model"]
 
@@ -256,11 +263,6 @@ class LinearTurbine:
         return float(self.wind_speeds[0]), float(self.wind_speeds[-1])
 
     @property
-    def input_names(self) -> tuple:
-        """Names of the plant inputs."""
-        return tuple(self.plants[0].input_labels)
-
-    @property
     def output_names(self) -> tuple:
         """Names of the plant outputs."""
         return tuple(self.plants[0].output_labels)
@@ -270,24 +272,8 @@ class LinearTurbine:
         """Rotor-speed reference (rad/s): the operating points' rotor speed at the highest wind speed."""
         return float(self.operating_points[-1].rotor_speed)
 
+    @docstring_of(TurbineModel)
     def check_wind_speed(self, wind_speed: float) -> float:
-        """``wind_speed`` as a float, checked to be within the linearisations' speeds.
-
-        Parameters
-        ----------
-        wind_speed : float
-            Mean wind speed (m/s).
-
-        Returns
-        -------
-        float
-            The wind speed (m/s).
-
-        Raises
-        ------
-        ValueError
-            Outside ``wind_range`` (a LinearTurbine does not extrapolate).
-        """
         v = positive_scalar(wind_speed, "wind_speed")
         lo, hi = self.wind_range
         tol = _SAME_SPEED * hi
@@ -389,8 +375,6 @@ class LinearTurbine:
             Outside ``wind_range``, or a plant whose rotor model cannot be read
             (:func:`rotor_speed_model`).
         """
-        from ..rosco import rosco_baseline
-
         return rosco_baseline(self, wind_speed, schedule=self.schedule)
 
     def kernel_plant(self):
@@ -408,9 +392,6 @@ class LinearTurbine:
             The plant.
         """
         import control
-
-        from ..simulate import KernelPlant
-        from ..simulate.kernels import linear_outputs, linear_plant_params, linear_rhs
 
         def linearize(v):
             sys = self.linearize(v)
@@ -491,8 +472,6 @@ class LinearTurbine:
         LinearTurbine
             Plants ``model.linearize(v)``, operating points of ``model.trim(v)``.
         """
-        from ..rosco import rosco_gain_schedule
-
         vs = [float(v) for v in wind_speeds]
         sched = rosco_gain_schedule(model) if isinstance(schedule, str) and schedule == "rosco" else schedule
         ops = {v: LinearOperatingPoint(v, *(float(getattr(model.trim(v), k)) for k in ("rotor_speed", "pitch", "gen_torque")))
@@ -540,9 +519,6 @@ class LinearTurbine:
         >>> lt.wind_range, round(lt.rotor_radius, 1)
         ((19.0, 19.0), 119.5)
         """
-        from .lin import read_lin_file, read_linearization
-        from .signals import plant_from_linearization
-
         if isinstance(paths, (str, os.PathLike)):
             p = os.fspath(paths)
             files = sorted(glob.glob(p)) if glob.has_magic(p) else [p]

@@ -22,8 +22,9 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, field
+import struct
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -196,8 +197,6 @@ def _binary_size(path: Path) -> int:
     """The byte length an OpenFAST binary output must have by its own header (the layout
     openfast-io's ``load_binary_output`` reads: file ID 1 with packed time, 2 and 4 int16
     channels with scales, 3 float64 channels)."""
-    import struct
-
     with open(path, "rb") as f:
         head = f.read(2 + 2 + 4 + 4)
         if len(head) < 10:

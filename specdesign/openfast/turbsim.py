@@ -171,13 +171,16 @@ def turbsim_field(wind_speed: float, seed: int, *, length: float = 660.0, hub_he
 
 
 def _write_input(path: Path, wind_speed: float, s: dict) -> None:
-    """The TurbSim input file, written by openfast-io's TurbsimWriter."""
+    """The TurbSim input file, written by openfast-io's TurbsimWriter. Tower points below the
+    grid are written (``WrADTWR``): AeroDyn's tower nodes reach the transition piece at 15 m,
+    under the grid's bottom, and a monopile dipping by millimetres took the lowest one out of
+    the grid (InflowWind's fatal "G3D wind array boundaries violated")."""
     from openfast_io.turbsim_util import TurbsimWriter  # heavy: openfast-io imports ROSCO's toolbox; loaded when a field is made
 
     n = s["grid_points"]
     inputs = SimpleNamespace(
         Echo=False, RandSeed1=s["RandSeed1"], RandSeed2=s["RandSeed2"], WrBHHTP=False, WrFHHTP=False, WrADHH=False,
-        WrADFF=True, WrBLFF=False, WrADTWR=False, WrFMTFF=False, WrACT=False, Clockwise=True, ScaleIEC=0,
+        WrADFF=True, WrBLFF=False, WrADTWR=True, WrFMTFF=False, WrACT=False, Clockwise=True, ScaleIEC=0,
         NumGrid_Z=n, NumGrid_Y=n, TimeStep=s["time_step"], AnalysisTime=s["length"], UsableTime=s["length"],
         HubHt=s["hub_height"], GridHeight=s["grid_size"], GridWidth=s["grid_size"], VFlowAng=0.0, HFlowAng=0.0,
         TurbModel='"IECKAI"', UserFile='"unused"', IECstandard='"1-ED3"', IECturbc=f'"{s["turbulence_class"]}"',

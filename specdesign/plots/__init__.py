@@ -7,7 +7,9 @@ dB only in figures (and specifications); everything else is SI with ω in rad/s.
 - :mod:`specdesign.plots.fatigue`: rainflow histogram vs Dirlik, ΔD%(ω);
 - :mod:`specdesign.plots.spec`: specifications and the interactive notch explorer;
 - :mod:`specdesign.plots.qft`: QFT design Bode (Fig. 7) and Nichols charts (Figs. 5-6);
-- :mod:`specdesign.plots.validation`: spectra (Fig. 8), time series (Fig. 9), DEL reductions (Fig. 10).
+- :mod:`specdesign.plots.validation`: spectra (Fig. 8), time series (Fig. 9), DEL reductions (Fig. 10);
+- :mod:`specdesign.plots.conventions`: the units, dB references, signs and standard-error rule
+  every figure and table follows.
 
 The package itself defines no names: import the figures from their submodule.
 """

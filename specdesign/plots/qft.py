@@ -5,11 +5,19 @@ Magnitudes in dB, phases in degrees, ω in rad/s.
 """
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+from loopshaping import nichols
+from loopshaping import qft as lqft
+from loopshaping.freqresp import is_zero
+
+from .. import closedloop
+from ..turbine import iea15mw
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -58,8 +66,6 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
         The figure (two stacked axes, shared ω axis in rad/s): |T| in dB re 1 (rad/s)/(m/s)
         and re 1 N·m/(m/s).
     """
-    from .. import closedloop
-
     w = np.logspace(-2, 1, 800) if omega is None else np.asarray(omega, dtype=float)
     if axes is None:
         import matplotlib.pyplot as plt
@@ -68,8 +74,6 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
     else:
         fig = axes[0].figure
     if model is None:
-        from ..turbine import iea15mw
-
         model = iea15mw()
     cl_base = closedloop.closed_loop(model.linearize(design.wind_speed), design.baseline_controller, warn=False)
     opts = design.options
@@ -128,10 +132,6 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
 def _bounds_at(bounds, template, picks):
     """The same specs' bounds at the template frequencies nearest to ``picks`` (rad/s):
     a readable chart shows a handful of frequencies, not every design frequency."""
-    import warnings
-
-    from loopshaping import qft as lqft
-
     w = template.omega
     sub = np.unique([w[np.argmin(np.abs(w - p))] for p in picks])
     with warnings.catch_warnings():
@@ -141,11 +141,13 @@ def _bounds_at(bounds, template, picks):
 
 def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05, 0.1, 0.3, 0.6, 1.0, 1.5, 3.0),
                         axes: Sequence[Axes] | None = None) -> Figure:
-    """Nichols charts of both QFT loops with their bounds: the paper's Figs. 5-6 analogue.
+    """Nichols charts of the QFT loops with their bounds: the paper's Figs. 5-6 analogue.
 
-    Left: the pitch loop C_β·P'_{Ω,β} (ATD closed); right: the ATD loop C_atd·P''_{z,β}
-    (pitch loop closed); magnitude in dB vs phase in degrees, nominal plant case, with the
-    bounds at the design frequencies nearest to ``picks``.
+    The pitch loop C_β·P'_{Ω,β} (with the ATD loop closed, where the design has one) and, for
+    a design with active tower damping, the ATD loop C_atd·P''_{z,β} (pitch loop closed) beside
+    it; magnitude in dB vs phase in degrees, nominal plant case, the bounds at the design
+    frequencies nearest to ``picks`` and the critical point (−180°, 0 dB). A pitch-only design
+    gets one panel.
 
     Parameters
     ----------
@@ -154,36 +156,38 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
     picks : sequence of float
         Frequencies, rad/s, whose nearest template frequencies get their bounds drawn.
     axes : sequence of matplotlib.axes.Axes, optional
-        Two axes side by side (pitch loop, ATD loop); default a new figure.
+        One axes per loop drawn (two with ATD, one without); default a new figure.
 
     Returns
     -------
     matplotlib.figure.Figure
         The figure.
+
+    Raises
+    ------
+    ValueError
+        If ``axes`` holds another number of axes than the design has loops.
     """
     import matplotlib.pyplot as plt
 
-    from loopshaping import nichols
-    from loopshaping.freqresp import is_zero
-
+    with_atd = not is_zero(design.atd_controller)
+    loops = [(design.pitch_bounds, design.pitch_template, design.pitch_controller, (-60, 60),
+              "Pitch loop $C_\\beta P'_{\\Omega,\\beta}$" + (" (ATD closed)" if with_atd else ""))]
+    if with_atd:
+        loops.append((design.atd_bounds, design.atd_template, design.atd_controller, (-60, 40),
+                      "ATD loop $C_{atd} P''_{z,\\beta}$ (pitch loop closed)"))
     if axes is None:
-        fig, axes = plt.subplots(1, 2, figsize=(14, 5.5))
-    else:
-        fig = axes[0].figure
+        fig, axes = plt.subplots(1, len(loops), figsize=(7 * len(loops), 5.5), squeeze=False)
+        axes = axes[0]
+    axes = np.atleast_1d(np.asarray(axes, dtype=object))
+    if axes.size != len(loops):
+        raise ValueError(f"axes holds {axes.size} axes; this design has {len(loops)} loop(s) to draw "
+                         f"({'pitch and ATD' if with_atd else 'pitch only'}): give one axes per loop")
+    fig = axes[0].figure
     w = np.logspace(-3, 1.5, 3000)
-    for ax, bounds, template, c, ylim, title in (
-        (axes[0], design.pitch_bounds, design.pitch_template, design.pitch_controller, (-60, 60),
-         "Pitch loop $C_\\beta P'_{\\Omega,\\beta}$ (ATD closed)"),
-        (axes[1], design.atd_bounds, design.atd_template, design.atd_controller, (-60, 40),
-         "ATD loop $C_{atd} P''_{z,\\beta}$ (pitch loop closed)"),
-    ):
+    for ax, (bounds, template, c, ylim, title) in zip(axes, loops):
         plant = template.systems[template.nominal]
-        if is_zero(c):  # no loop here (a pitch-only design)
-            ax.text(0.5, 0.5, "no ATD loop: pitch-only design", ha="center", va="center", transform=ax.transAxes)
-            ax.set_xlabel("Open-loop phase [deg]")
-            ax.set_ylabel("Open-loop magnitude [dB]")
-        else:
-            nichols.draw(_bounds_at(bounds, template, picks), loop=c * plant, ax=ax, omega=w, ylim=ylim)
+        nichols.draw(_bounds_at(bounds, template, picks), loop=c * plant, ax=ax, omega=w, ylim=ylim)
         ax.set_title(f"{title}, {design.wind_speed:g} m/s")
     fig.tight_layout()
     return fig

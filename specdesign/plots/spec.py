@@ -1,6 +1,6 @@
 """Specification figures and the interactive notch explorer (results in, axes out).
 
-Magnitudes in dB (of the output per m/s, times a display ``scale``), ω in rad/s.
+Magnitudes in dB re 1 SI unit of the output per m/s (:mod:`specdesign.plots.conventions`), ω in rad/s.
 """
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..spec import Baseline, Notch, promise_of
+from .conventions import tf_magnitude_label
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -20,10 +21,11 @@ __all__ = ["plot_specification", "NotchExplorer", "plot_frontier"]
 
 
 def plot_specification(base: Baseline, specification: Specification | None = None, *, shaping: ArrayLike | None = None,
-                       ax: Axes | None = None, scale: float = 1e-3, unit: str = "kN·m/(m/s)") -> Axes:
+                       ax: Axes | None = None) -> Axes:
     """Bode magnitude of the baseline T_{y,w} and the specification W_y on the baseline grid.
 
-    Magnitudes in dB of ``scale`` × (output/wind), ω in rad/s on a log axis.
+    Magnitudes in dB re 1 SI unit of the output per m/s (for the tower-base moment, dB re
+    1 N·m/(m/s), as every transfer-function figure of the workbench), ω in rad/s on a log axis.
 
     Parameters
     ----------
@@ -36,10 +38,6 @@ def plot_specification(base: Baseline, specification: Specification | None = Non
         Ignored when ``specification`` is given.
     ax : matplotlib.axes.Axes, optional
         Axes to draw on (default a new pyplot figure).
-    scale : float
-        Display factor of the magnitudes (1e-3: N·m → kN·m).
-    unit : str
-        Unit of ``scale`` × output per m/s, for the axis label.
 
     Returns
     -------
@@ -61,14 +59,14 @@ def plot_specification(base: Baseline, specification: Specification | None = Non
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 3.5))
     w = base.omega
-    t_db = 20 * np.log10(np.abs(base.t_response) * scale)
+    t_db = 20 * np.log10(np.abs(base.t_response))
     ax.semilogx(w, t_db, label="baseline $|T_{y,w}|$")
     if specification is not None:
         shaping = specification.response(w) / base.t_response
     if shaping is not None:
         ax.semilogx(w, t_db + 20 * np.log10(np.abs(shaping)), "--", label="specification $|W_y|$")
     ax.set_xlabel("frequency ω (rad/s)")
-    ax.set_ylabel(f"magnitude (dB re 1 {unit})")
+    ax.set_ylabel(tf_magnitude_label(base.output or "tower_base_my"))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     return ax
@@ -89,8 +87,6 @@ class NotchExplorer:
         The baseline (:func:`specdesign.spec.baseline_analysis`).
     notch : specdesign.spec.Notch, optional
         Initial notch (default 6 dB deep, width 0.2, at 1.05 rad/s).
-    scale : float
-        Display factor of the magnitudes (1e-3: N·m → kN·m).
     checker : specdesign.feasibility.PitchChecker, optional
         With a generator-speed specification fixed (:func:`specdesign.feasibility.pitch_checkers`),
         every update also says, in the title, whether ROSCO's map × the notch can be met
@@ -124,7 +120,7 @@ class NotchExplorer:
     damage −28.4 %
     """
 
-    def __init__(self, base: Baseline, notch: Notch | None = None, *, scale: float = 1e-3, checker: Any = None,
+    def __init__(self, base: Baseline, notch: Notch | None = None, *, checker: Any = None,
                  bounds_checker: Any = None):
         import matplotlib.pyplot as plt
 
@@ -137,9 +133,9 @@ class NotchExplorer:
         # not shown by pyplot at the end of the cell: widget() shows it once, with the sliders
         with plt.ioff():
             self.fig, (self.ax_mag, self.ax_sens) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
-        plot_specification(base, shaping=self.notch.response(base.omega), ax=self.ax_mag, scale=scale)
+        plot_specification(base, shaping=self.notch.response(base.omega), ax=self.ax_mag)
         self.line = self.ax_mag.get_lines()[-1]
-        self._t_db = 20 * np.log10(np.abs(base.t_response) * scale)
+        self._t_db = 20 * np.log10(np.abs(base.t_response))
         self.ax_sens.semilogx(base.omega, base.sensitivity, color="C2", label="ΔD%(ω) per 1 % of $S_y$")
         self.marker = self.ax_sens.axvline(self.notch.omega_n, color="C1", ls=":", label="notch ω_n")
         self.ax_sens.set_xlabel("frequency ω (rad/s)")
@@ -151,6 +147,7 @@ class NotchExplorer:
         self._sliders, self._sent, self._quiet = None, {}, False  # the widget's sliders, once built
         if hasattr(self.fig.canvas, "header_visible"):  # ipympl: no "Figure n" label above the plot
             self.fig.canvas.header_visible = False
+            self.fig.canvas.toolbar_position = "right"  # beside the figure, not over its labels
         self.update(self.notch.omega_n, self.notch.depth_db, self.notch.width)
 
     def update(self, omega_n: float, depth_db: float, width: float, *, redraw: bool = True) -> Promise:
@@ -218,7 +215,7 @@ class NotchExplorer:
         return self.promise
 
     @classmethod
-    def from_session(cls, session: Any, name: str | None = None, *, scale: float = 1e-3, checker: Any = None) -> "NotchExplorer":
+    def from_session(cls, session: Any, name: str | None = None, *, checker: Any = None) -> "NotchExplorer":
         """An explorer starting from a saved design session's specification.
 
         The baseline is recomputed from the session's model at the specification's wind speed
@@ -230,8 +227,6 @@ class NotchExplorer:
             A session record, or the path of a session file (:func:`specdesign.session.load_session`).
         name : str, optional
             Which specification (default: the only one, or the first saved).
-        scale : float
-            Display factor of the magnitudes (1e-3: N·m → kN·m).
         checker : specdesign.feasibility.PitchChecker, optional
             As for the constructor.
 
@@ -254,7 +249,7 @@ class NotchExplorer:
         notches = [e for e in session.specifications[name].elements if isinstance(e, Notch)]
         if not notches:
             raise ValueError(f"specification {name!r} of the session has no notch for the explorer to move")
-        return cls(session.baseline(name), notches[0], scale=scale, checker=checker)
+        return cls(session.baseline(name), notches[0], checker=checker)
 
     def _show(self):
         from IPython.display import clear_output, display
@@ -299,8 +294,19 @@ class NotchExplorer:
             # The browser rounds each value set from Python to the slider's step and sends it
             # back, possibly after later cells have set others: within half a step of a value
             # Python set since the last move, it is such an echo, not a move.
-            dist = [abs(np.log10(new / v)) if name == "omega_n" else abs(new - v) for v in self._sent[name]]
-            if min(dist) < 0.5 * sliders[name].step:
+            gap = (lambda a, b: abs(np.log10(a / b))) if name == "omega_n" else (lambda a, b: abs(a - b))
+            if min(gap(new, v) for v in self._sent[name]) < 0.5 * sliders[name].step:
+                # an echo: not a move, but the slider now shows it; put back the value the figure
+                # draws (notebook 03 showed 2.80 dB over a 12 dB notch after Run All), unless the
+                # echo is that value rounded to the step (then it already says the same)
+                current = getattr(self.notch, name)
+                if gap(new, current) >= 0.5 * sliders[name].step:
+                    self._quiet = True
+                    try:
+                        sliders[name].value = current
+                        self._sent[name].append(sliders[name].value)
+                    finally:
+                        self._quiet = False
                 return
             self._sent[name] = [new]
             vals = dict(omega_n=self.notch.omega_n, depth_db=self.notch.depth_db, width=self.notch.width)

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..closedloop import LoopMaps
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
@@ -71,8 +73,6 @@ def plot_open_vs_baseline(maps: LoopMaps, axes: Sequence[Axes] | None = None, *,
     >>> plot_open_vs_baseline(maps).shape
     (3,)
     """
-    from ..closedloop import LoopMaps
-
     if not isinstance(maps, LoopMaps):
         raise TypeError(f"maps must be a LoopMaps from specdesign.closedloop.loop_maps, got {type(maps).__name__}")
     ax = _axes(axes, 3)

@@ -4,9 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from .conventions import SI_UNITS, TIME_SERIES, show_se
+
 __all__ = ["plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage", "plot_comparison"]
 
-_UNITS = {"gen_speed": ("Generator speed", "(rad/s)²/(rad/s)"), "tower_base_my": ("Tower-base fore-aft moment", "(N·m)²/(rad/s)")}
+_NAMES = {"gen_speed": "Generator speed", "tower_base_my": "Tower-base fore-aft moment", "blade_root_my": "Blade-root flapwise moment"}
+
+#: Upper end of the spectra drawn (rad/s): the band of the specifications and the design checks;
+#: above it the spectra only roll off (towards the record's Nyquist frequency) and would squeeze
+#: the band where the loads are.
+SPECTRA_MAX_OMEGA = 10.0
 
 
 def _axes(ax, **kw):
@@ -20,7 +27,8 @@ def _axes(ax, **kw):
 def plot_spectra(campaign, wind_speed: float, output: str = "tower_base_my", *, controllers=None, ax=None):
     """Fig. 8: seed-averaged Welch PSD (solid) and linear prediction |T|²S_W (dashed).
 
-    Log-log axes, ω in rad/s, PSD per rad/s.
+    Log-log axes, ω in rad/s up to :data:`SPECTRA_MAX_OMEGA`, PSD in SI units² per rad/s,
+    the magnitude axis spanning what the curves hold in that band.
 
     Parameters
     ----------
@@ -53,18 +61,25 @@ def plot_spectra(campaign, wind_speed: float, output: str = "tower_base_my", *, 
         raise ValueError(f"output={output!r} must be one of {sorted(campaign.welch)}")
     names = campaign.controllers if controllers is None else controllers
     w = campaign.omega
-    sel = w > 0
+    sel = (w > 0) & (w <= SPECTRA_MAX_OMEGA)
+    drawn = []
     for k, name in enumerate(names):
         c = campaign.index(name)
         color = f"C{k}"
         ax.loglog(w[sel], campaign.welch[output][c, i][sel], color=color, label=f"{name} simulation (Welch)")
+        drawn.append(campaign.welch[output][c, i][sel])
         pred = campaign.predicted_psd[output][c, i][sel]
         if np.any(np.isfinite(pred)):
             ax.loglog(w[sel], pred, color=color, ls="--", label=f"{name} linear |T|²S_W")
-    label, unit = _UNITS.get(output, (output, "SI²/(rad/s)"))
+            drawn.append(pred)
+    values = np.concatenate(drawn)
+    values = values[np.isfinite(values) & (values > 0)]
+    if values.size:  # the range the curves span in the band drawn, with a margin
+        ax.set_ylim(values.min() / 3.0, values.max() * 3.0)
+    unit = SI_UNITS.get(output)
     ax.set_xlabel("ω (rad/s)")
-    ax.set_ylabel(f"PSD {unit}")
-    ax.set_title(f"{label}, {campaign.wind_speeds[i]:g} m/s")
+    ax.set_ylabel(f"PSD ({unit})²/(rad/s)" if unit else "PSD (SI units)²/(rad/s)")
+    ax.set_title(f"{_NAMES.get(output, output)}, {campaign.wind_speeds[i]:g} m/s")
     ax.legend(fontsize="small")
     ax.grid(True, which="both", alpha=0.3)
     return ax
@@ -106,12 +121,9 @@ def plot_time_series(series, wind_speed: float, *, seed_index: int = 0, controll
     if axes.size != 4:
         raise ValueError(f"axes must hold 4 axes (speed, moment, power, pitch), got {axes.size}")
     names = list(series) if controllers is None else controllers
-    panels = [
-        ("gen_speed", 60 / (2 * np.pi), "Gen. speed (rpm)"),
-        ("tower_base_my", 1e-6, "Tower-base My (MN·m)"),
-        ("power", 1e-6, "Power (MW)"),
-        ("pitch", 180 / np.pi, "Pitch (deg)"),
-    ]
+    panels = [(key, *TIME_SERIES[key]) for key in ("gen_speed", "tower_base_my", "power", "pitch")]
+    titles = {"gen_speed": "Gen. speed", "tower_base_my": "Tower-base My", "power": "Power", "pitch": "Pitch"}
+    panels = [(key, scale, f"{titles[key]} ({unit})") for key, scale, unit in panels]
     for k, name in enumerate(names):
         r = series[name]
         i = int(np.argmin(np.abs(r.wind_speeds - float(wind_speed))))
@@ -173,12 +185,13 @@ def plot_reductions(acc, *, promised=None, target: float | None = None, ax=None)
         raise TypeError(f"promised must be a dict of wind speed (m/s) → DEL reduction (%), got {type(promised).__name__}")
     st = _REDUCTION_STYLES
     ax = _axes(ax)
+    se = show_se(acc.n_seeds)  # with fewer seeds the bars would claim a spread not estimated
     ax.plot(acc.wind_speeds, acc.predicted, **st["predicted"], label="linear prediction (Dirlik on |T|²S_W)")
-    ax.errorbar(acc.wind_speeds, acc.rainflow, yerr=acc.se, capsize=3, **st["rainflow"],
-                label=f"rainflow, nonlinear model ({acc.n_seeds} paired seeds, ±1 SE)")
+    ax.errorbar(acc.wind_speeds, acc.rainflow, yerr=acc.se if se else None, capsize=3, **st["rainflow"],
+                label=f"rainflow, nonlinear model ({acc.n_seeds} paired seeds{', ±1 SE' if se else ', too few for an SE'})")
     if np.all(np.isfinite(acc.rainflow_linear)):
-        ax.errorbar(acc.wind_speeds, acc.rainflow_linear, yerr=acc.se_spectral, capsize=3, **st["rainflow_linear"],
-                    label="rainflow, linearised model (same seeds, ±1 SE)")
+        ax.errorbar(acc.wind_speeds, acc.rainflow_linear, yerr=acc.se_spectral if se else None, capsize=3,
+                    **st["rainflow_linear"], label=f"rainflow, linearised model (same seeds{', ±1 SE' if se else ''})")
     if acc.volterra_order and np.all(np.isfinite(acc.volterra)):
         ax.plot(acc.wind_speeds, acc.volterra, **st["volterra"],
                 label=f"Volterra prediction, order {acc.volterra_order} (rainflow, same seeds)")
@@ -187,8 +200,12 @@ def plot_reductions(acc, *, promised=None, target: float | None = None, ax=None)
         ax.plot(v, [promised[k] for k in v], **st["promised"], label="specification's promise")
     if target is not None:
         ax.axhline(float(target), lw=0.8, **st["target"], label=f"design target ({float(target):g} %)")
+    # reductions are read against zero (no reduction): an axis cut just around the curves
+    # would make a 2 pp spread look like a factor of two
+    top = max(ax.get_ylim()[1], 0.0)
+    ax.set_ylim(min(ax.get_ylim()[0], 0.0), top)
     ax.set_xlabel("mean wind speed (m/s)")
-    ax.set_ylabel("tower-base DEL reduction (%)")
+    ax.set_ylabel("tower-base DEL reduction (%), positive: lower than the baseline")
     ax.legend(fontsize="small")
     ax.grid(True, alpha=0.3)
     return ax
@@ -236,7 +253,7 @@ def plot_lifetime_damage(life, channel: str = "tower_base_my", *, ax=None):
                label=label)
     ax.set_xlabel("wind-speed bin centre (m/s)")
     ax.set_ylabel(f"share of {life.baseline}'s damage over the simulated bins (%)")
-    title = f"{_UNITS.get(channel, (channel,))[0]}, m = {life.m:g}"
+    title = f"{_NAMES.get(channel, channel)}, m = {life.m:g}"
     if life.missing_speeds.size:
         title += (f"\nbins not simulated: {', '.join(f'{x:g}' for x in life.missing_speeds.tolist())} m/s "
                   f"(p = {float(life.missing_probability.sum()):.3g})")
@@ -249,12 +266,17 @@ def plot_lifetime_damage(life, channel: str = "tower_base_my", *, ax=None):
 def plot_comparison(changes, indicators=("tower_del", "blade_del"), *, axes=None):
     """DEL change vs the baseline per controller and wind speed, with standard-error bars.
 
+    The wind speeds are categories on the horizontal axis (one group per speed, labelled in
+    m/s), the controllers side by side within a group: a controller's position in its group
+    is not a wind speed. Standard-error bars only from
+    :data:`~specdesign.plots.conventions.MIN_SEEDS_FOR_SE` paired seeds on.
+
     Parameters
     ----------
     changes : mapping
         Controller name → {indicator → :class:`~specdesign.validate.PairedChange`} (the
-        changes of ``benchmarks/comparison.py``); each change's ``wind_speeds`` (m/s) place
-        its points, so a controller run on fewer speeds shows fewer points.
+        changes of ``benchmarks/comparison.py``); each change's ``wind_speeds`` (m/s) name
+        its groups, so a controller run on fewer speeds shows fewer points.
     indicators : sequence of str, default ("tower_del", "blade_del")
         One panel per indicator (:data:`~specdesign.validate.INDICATORS`).
     axes : sequence of matplotlib.axes.Axes, optional
@@ -277,7 +299,7 @@ def plot_comparison(changes, indicators=("tower_del", "blade_del"), *, axes=None
     >>> ch = {"A": {"tower_del": paired_change([[9.0, 10.0]], [[10.0, 11.0]], wind_speeds=[19.0])}}
     >>> ax = plot_comparison(ch, ("tower_del",))
     >>> ax[0].get_ylabel()
-    'tower-base DEL change vs baseline (%)'
+    'tower-base DEL change vs baseline (%), negative: lower'
     """
     names = list(changes)
     if not names:
@@ -294,14 +316,20 @@ def plot_comparison(changes, indicators=("tower_del", "blade_del"), *, axes=None
     labels = {"tower_del": "tower-base DEL", "blade_del": "blade-root DEL", "gen_speed_sd": "generator-speed SD",
               "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD"}
     width = 0.8 / len(names)
+    speeds = np.unique(np.concatenate([np.asarray(changes[n][ind].wind_speeds, dtype=float)
+                                       for n in names for ind in inds]))
     for ax, ind in zip(axes, inds):
         for i, n in enumerate(names):
             ch = changes[n][ind]
-            x = np.asarray(ch.wind_speeds, dtype=float) + (i - (len(names) - 1) / 2) * width
-            ax.errorbar(x, ch.change, yerr=ch.se, fmt="o", capsize=3, label=n)
+            group = np.searchsorted(speeds, np.asarray(ch.wind_speeds, dtype=float))
+            x = group + (i - (len(names) - 1) / 2) * width
+            se = show_se(ch.n_seeds)
+            ax.errorbar(x, ch.change, yerr=ch.se if se else None, fmt="o", capsize=3,
+                        label=n if se else f"{n} ({ch.n_seeds} seeds: no SE)")
         ax.axhline(0.0, color="0.5", lw=0.8)
-        ax.set_xlabel("mean wind speed (m/s)")
-        ax.set_ylabel(f"{labels.get(ind, ind)} change vs baseline (%)")
+        ax.set_xticks(np.arange(speeds.size), [f"{v:g}" for v in speeds])
+        ax.set_xlabel("mean wind speed (m/s; controllers side by side)")
+        ax.set_ylabel(f"{labels.get(ind, ind)} change vs baseline (%), negative: lower")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize="small")
     return axes

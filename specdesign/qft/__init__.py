@@ -1,8 +1,9 @@
 """QFT design of the pitch controller C_β and an active tower damping (ATD) controller.
 
-Modules: :mod:`~specdesign.qft.design` (the design at one operating point and over a schedule,
-:class:`QFTDesign`), :mod:`~specdesign.qft.structure` (the fixed controller structures and their
-parameter vector), :mod:`~specdesign.qft.tuner` (objective, constraints, the tuner); the loop
+Modules: :mod:`~specdesign.qft.design` (the design at one operating point and over a schedule),
+:mod:`~specdesign.qft.result` (its record, :class:`QFTDesign`), :mod:`~specdesign.qft.structure`
+(the fixed controller structures and their parameter vector), :mod:`~specdesign.qft.tuner`
+(objective, constraints, the tuner); the loop
 algebra they use (general form, sequential closure) is :mod:`specdesign.closedloop`'s.
 
 The seed paper's Sect. 4 on the embedded turbine model, as a deterministic automatic
@@ -11,7 +12,7 @@ specification pair for a DEL target (:func:`specdesign.feasibility.specification
 then its certificate reduced to the lowest order that meets the pair at every plant case
 (:mod:`~specdesign.qft.certificate`), checked as below. ``design_qft(spec="notch")`` is the
 fixed-structure design of the sections below (notch specification, DEL target, tuner).
-Sign convention (WORKBENCH.md, :mod:`specdesign.closedloop`):
+Sign convention (:mod:`specdesign.closedloop`):
 
     β_cmd = −C_β·Ω_g − C_atd·z,    z = tower-top fore-aft velocity (m/s),
 
@@ -30,7 +31,7 @@ every wind map in QFT's general form |(A + B·G)/(C + D·G)| with, per plant cas
     A = P'_{y,w},  B = P'_{y,w}P'_{n,β} − P'_{y,β}P'_{n,w},  C = 1,  D = P'_{n,β}
 
 (B = 0 when y = n). For the pitch controller (G = C_β, n = Ω_g, ATD closed) and y = MyT this
-is WORKBENCH.md's tower-load form with the primed plant; for the ATD (G = C_atd, n = z,
+is the tower-load form of :mod:`specdesign.closedloop` with the primed plant; for the ATD (G = C_atd, n = z,
 pitch loop closed) the roles swap. :func:`specdesign.closedloop.general_form` computes A..D; the tests check
 (A + B·G)/(C + D·G) against ``control.interconnect`` to 1e-9.
 
@@ -79,8 +80,8 @@ from __future__ import annotations
 
 from ..closedloop import general_form, partial_loop
 from .checks import fine_pitch_lift
-from .design import (DEFAULT_DESIGN_OMEGA, UNSTABLE_CONTROLLER_RATE, QFTDesign, check_design_speed, design_qft, design_schedule, design_table,
-                     format_table)
+from .design import SPEED_RELAX_DB, check_design_speed, design_qft, design_schedule, design_table, format_table
+from .result import DEFAULT_DESIGN_OMEGA, QFTDesign
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 
 __all__ = [
@@ -93,18 +94,9 @@ __all__ = [
     "design_table",
     "format_table",
     "DEFAULT_DESIGN_OMEGA",
-    "UNSTABLE_CONTROLLER_RATE",
+    "SPEED_RELAX_DB",
     "fine_pitch_lift",
     "TorqueDesign",
     "design_torque",
     "torque_general_form",
 ]
-
-
-def __getattr__(name):
-    if name == "DEFAULT_DESIGN_OMEGAS":  # renamed: one name for frequency grids, omega
-        import warnings
-
-        warnings.warn("DEFAULT_DESIGN_OMEGAS is deprecated, use DEFAULT_DESIGN_OMEGA", DeprecationWarning, stacklevel=2)
-        return DEFAULT_DESIGN_OMEGA
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -15,11 +15,22 @@ Units: ω in rad/s, magnitudes linear (N·m per m/s for the tower weight).
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..closedloop import case_speeds, closed_map, general_coefficients, plant_responses, siso_response
+from loopshaping import qft as lqft
+
+from ..closedloop import (
+    DESIGN_MAX_SENSITIVITY,
+    case_speeds,
+    closed_map,
+    general_coefficients,
+    plant_responses,
+    siso_response,
+)
+from .result import DEFAULT_DESIGN_OMEGA
 
 __all__ = ["BoundsVerdict", "BoundsChecker", "bounds_checker"]
 
@@ -97,10 +108,6 @@ class BoundsChecker:
         ValueError
             If an array of the wrong length is given.
         """
-        import warnings
-
-        from loopshaping import qft as lqft
-
         w = self.template.omega
         vals = (np.asarray(tower_spec.response(w)) if hasattr(tower_spec, "response")
                 else np.asarray(tower_spec, complex))
@@ -116,7 +123,7 @@ class BoundsChecker:
         return BoundsVerdict(w.copy(), empty, not bool(empty.any()))
 
 
-def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
+def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=DESIGN_MAX_SENSITIVITY,
                    template_offsets=(-1.0, -0.5, 0.5, 1.0), design_omega=None) -> BoundsChecker:
     """Precompute the pitch loop's QFT problem at ``wind_speed`` for live tower-spec checks.
 
@@ -133,7 +140,7 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     template_offsets : sequence of float
         Wind-speed offsets of the plant cases, m/s (clipped to ``model.wind_range``).
     design_omega : array_like, optional
-        Design frequencies, rad/s (default :data:`specdesign.qft.design.DEFAULT_DESIGN_OMEGA`).
+        Design frequencies, rad/s (default :data:`specdesign.qft.result.DEFAULT_DESIGN_OMEGA`).
 
     Returns
     -------
@@ -155,13 +162,8 @@ def bounds_checker(model, wind_speed, speed_spec=None, *, max_sensitivity=1.9,
     >>> checker.check(design_specifications(model, 19.0).tower).feasible
     True
     """
-    import warnings
-
-    from loopshaping import qft as lqft
-
     from .. import spec as sp
     from ..spec import baseline_controllers
-    from .design import DEFAULT_DESIGN_OMEGA
 
     if not max_sensitivity > 1:
         raise ValueError(f"max_sensitivity={max_sensitivity!r} must be > 1 (|1/(1+L)| bound)")

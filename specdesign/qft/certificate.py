@@ -7,7 +7,7 @@ shape of such a specification (a ≥ 25 % promise asks for T_{MyT,w} reduced ove
 wind band); the certificate can. :func:`design_from_certificate` balances-and-truncates it
 to the lowest order (from ``min_order`` up) whose loop meets every specification on the
 dense grid over every plant case, then runs the same checks and records the same
-:class:`~specdesign.qft.design.QFTDesign` as the fixed-structure design (exact bounds at the
+:class:`~specdesign.qft.result.QFTDesign` as the fixed-structure design (exact bounds at the
 design frequencies, dense checks of both loops, stability of every case). No ATD (pitch
 only), no tuning, no DEL penalty: the specification carries the target.
 
@@ -21,13 +21,26 @@ from typing import Any
 import control as ct
 import numpy as np
 
-from ..closedloop import closed_loop, closed_map, lightly_damped, refine_grid, siso_response
+from loopshaping import qft as lqft
+
+from ..closedloop import (
+    DESIGN_MAX_SENSITIVITY,
+    closed_loop,
+    closed_map,
+    lightly_damped,
+    plant_responses,
+    refine_grid,
+    siso_response,
+)
+from ..feasibility import TargetSpecification
 from .checks import spec_ratio, spec_roots
+from .result import DEFAULT_DESIGN_OMEGA, assemble_design
+from .tuner import TuningProblem
 
 __all__ = ["design_from_certificate"]
 
 
-def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_decay: float = 0.02,
+def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MAX_SENSITIVITY, min_decay: float = 0.02,
                             min_order: int = 4, design_omega=None, dense_omega=None) -> Any:
     """QFT design at a target specification's operating point from its certificate.
 
@@ -45,14 +58,14 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
         Lowest controller order tried (states, ≥ 1).
     design_omega : array_like, optional
         QFT design frequencies, rad/s (default
-        :data:`specdesign.qft.design.DEFAULT_DESIGN_OMEGA` plus the specification's sharp features).
+        :data:`specdesign.qft.result.DEFAULT_DESIGN_OMEGA` plus the specification's sharp features).
     dense_omega : array_like, optional
         Grid of the final check, rad/s (default 600 points, 0.005-20 rad/s, refined around the
         lightly damped roots of the specification).
 
     Returns
     -------
-    specdesign.qft.design.QFTDesign
+    specdesign.qft.result.QFTDesign
         The design (``atd_controller`` zero; ``parameters`` holds the order), ``success`` when
         every check passes; ``promise`` is the specification's and ``target_reduction`` its
         exact DEL promise.
@@ -64,12 +77,7 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
     ValueError
         If ``max_sensitivity`` ≤ 1, ``min_decay`` ≤ 0 or ``min_order`` < 1.
     """
-    from loopshaping import qft as lqft
-
     from .. import spec as sp
-    from ..feasibility import TargetSpecification
-    from .design import DEFAULT_DESIGN_OMEGA, assemble_design
-    from .tuner import TuningProblem
 
     if not isinstance(target, TargetSpecification):
         raise TypeError(f"target must be a feasibility.TargetSpecification, got {type(target).__name__}")
@@ -114,16 +122,14 @@ def design_from_certificate(model, target, *, max_sensitivity: float = 1.9, min_
 def _lowest_order(prob, full, omega, min_order, ms, min_decay):
     """The lowest-order balanced truncation of ``full`` that meets every specification on ``omega``
     at every plant case, is stable with decay ≥ ``min_decay`` and keeps |S| ≤ ``ms``; else ``full``."""
-    from ..closedloop import plant_responses
-
     R = plant_responses(prob.plants, omega, ("gen_speed", "tower_base_my", "tower_top_vel"), method="batched")
     w_speed, w_tower = prob.weights(omega)
     ob = R[("gen_speed", "pitch_cmd")]
     for n in range(min_order, full.nstates + 1):
         if n < full.nstates:
             try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
+                with warnings.catch_warnings():  # python-control's and SLICOT's notes on the reduction
+                    warnings.filterwarnings("ignore", category=UserWarning, module=r"(control|slycot)\.")
                     cand = ct.balred(full, n, method="truncate")
             except (ValueError, np.linalg.LinAlgError, ct.ControlArgument):
                 continue
@@ -134,8 +140,8 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay):
                 or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > w_speed)
                 or np.any(np.abs(1 / (1 + c * ob)) > ms)):
             continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
+            warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
         if decay >= min_decay:
             return cand, n

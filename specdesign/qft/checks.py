@@ -5,9 +5,21 @@ target specification's certificate (:mod:`specdesign.qft.certificate`). Units: Ï
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from ..closedloop import close_responses, general_coefficients, partial_loop, plant_responses, siso_response
+from loopshaping import qft as lqft
+from loopshaping.check import check as lcheck
+
+from .._checks import positive_scalar
+from ..closedloop import (
+    close_responses,
+    general_coefficients,
+    partial_loop,
+    plant_responses,
+    siso_response,
+)
 
 __all__ = ["loop_checks", "bounds_met", "spec_ratio", "spec_roots", "fine_pitch_lift"]
 
@@ -39,9 +51,6 @@ def loop_checks(prob, cb, ca, wdense):
         :class:`loopshaping.check.CheckResult` of each loop, its
         :class:`loopshaping.templates.Template` and its list of :class:`loopshaping.qft.Spec`.
     """
-    from loopshaping import qft as lqft
-    from loopshaping.check import check as lcheck
-
     plants, nom = prob.plants, prob.nom
 
     def data(omega):
@@ -161,16 +170,14 @@ def spec_roots(spec_like) -> np.ndarray:
     numpy.ndarray
         Finite complex roots, 1/s.
     """
-    import warnings
-
     import control
 
     from ..spec import Specification
 
     if not isinstance(spec_like, Specification):
         return np.zeros(0, complex)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings():  # python-control's notes on the conversion to state space
+        warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
         b = control.ss(spec_like.baseline)
         out = [np.asarray(b.poles(), complex), np.asarray(b.zeros(), complex)]
     for e in spec_like.elements:
@@ -223,8 +230,6 @@ def fine_pitch_lift(controller, deficit: float, duration: float = 60.0, n: int =
     True
     """
     import control
-
-    from .._checks import positive_scalar
 
     deficit = positive_scalar(deficit, "deficit")
     duration = positive_scalar(duration, "duration")

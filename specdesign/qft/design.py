@@ -6,279 +6,44 @@ phase margins in degrees, decay rates in 1/s; β = −C_β·Ω_g − C_atd·ẋ_
 """
 from __future__ import annotations
 
+import inspect
 import warnings
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import control as ct
 import numpy as np
+from tqdm.auto import tqdm
 
-from .._checks import del_target, positive_scalar
-from ..closedloop import (case_speeds, check_stability, closed_loop, lightly_damped, plant_responses, refine_grid,
-                          siso_response)
-from .checks import bounds_met, loop_checks, spec_ratio, spec_roots
+from loopshaping import qft as lqft
+
+from .. import turbine
+from .._checks import del_target, positive_scalar, spec_made_at
+from ..closedloop import (
+    DESIGN_MAX_SENSITIVITY,
+    case_speeds,
+    closed_loop,
+    lightly_damped,
+    refine_grid,
+)
+from ..feasibility import TargetSpecification, specification_for_target
+from .certificate import design_from_certificate
+from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
+from .result import DEFAULT_DESIGN_OMEGA, QFTDesign, assemble_design
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
 
 if TYPE_CHECKING:
-    from loopshaping.bounds import Bounds
-    from loopshaping.check import CheckResult
-    from loopshaping.templates import Template
 
-    from ..spec import Baseline, Promise, ShapingResult, Specification
     from ..turbine import TurbineModel
 
-__all__ = ["QFTDesign", "design_qft", "assemble_design", "design_schedule", "design_table", "format_table",
-           "DEFAULT_DESIGN_OMEGA", "check_design_speed", "UNSTABLE_CONTROLLER_RATE"]
+__all__ = ["design_qft", "design_schedule", "design_table", "format_table", "SPEED_RELAX_DB", "check_design_speed"]
 
 
-#: Default QFT design frequencies, rad/s: the wind band, the tower mode (~1.06 rad/s) and
-#: the actuator band.
-DEFAULT_DESIGN_OMEGA = np.unique(np.r_[0.005, 0.007, np.logspace(-2, 1, 37), 0.9, 0.95, 1.0, 1.03, 1.05, 1.07, 1.1, 1.15, 1.2])
-
-
-#: Growth rate (1/s) above which a controller pole counts as unstable in :func:`design_qft`'s
-#: checks: slower modes grow less than e-fold over a 10-minute record.
-UNSTABLE_CONTROLLER_RATE = 1e-3
-
-
-# ----------------------------------------------------------------------------- result
-@dataclass(frozen=True, eq=False)
-class QFTDesign:
-    """One operating point's QFT design (frozen), made by :func:`design_qft`.
-
-    All changes are designed vs ROSCO (ATD off), in %, positive = increase; reductions are
-    positive = less. The controllers are in the workbench sign β_cmd = −C_β·Ω_g − C_atd·ẋ_top.
-
-    Parameters
-    ----------
-    wind_speed : float
-        Operating point, m/s.
-    pitch_controller : control.TransferFunction
-        C_β, generator speed (rad/s) → pitch command (rad).
-    atd_controller : control.TransferFunction
-        C_atd, tower-top fore-aft velocity ẋ_top (m/s) → pitch command (rad).
-    baseline_controller : control.TransferFunction
-        ROSCO's PI (with its speed filter) at the same speed, rad/s → rad.
-    template_speeds : tuple of float
-        Wind speeds of the plant cases, m/s; nominal at ``wind_speed``.
-    design_omega : numpy.ndarray
-        QFT design frequencies, rad/s (the final set, refinements included).
-    dense_omega : numpy.ndarray
-        Grid of the dense check, rad/s.
-    tower_spec : specdesign.spec.Specification
-        The (relaxed) tower-load specification W_MyT, N·m per m/s.
-    speed_spec : specdesign.spec.Specification
-        The generator-speed specification W_Ω (ROSCO's T_{Ω,w} relaxed by the
-        ``speed_relax_db`` that worked), rad/s per m/s.
-    shaping : specdesign.spec.ShapingResult
-        The notches of :func:`specdesign.spec.shape_to_target` and the unrelaxed notch
-        specification's promise (``shaping.promise``, what the paper's Table 3 lists).
-    promise : specdesign.spec.Promise
-        Promise of the (relaxed) tower specification, %.
-    pitch_template : loopshaping.qft.Template
-        Template of P'_{Ω,β} (ATD closed) on ``design_omega``.
-    atd_template : loopshaping.qft.Template
-        Template of P''_{z,β} (pitch loop closed) on ``design_omega``.
-    pitch_bounds : loopshaping.qft.Bounds
-        Bounds on L0 = C_β·P'_{Ω,β} (ATD closed), exact for the final controllers.
-    atd_bounds : loopshaping.qft.Bounds
-        Bounds on L0 = C_atd·P''_{z,β} (pitch loop closed).
-    pitch_check : loopshaping.check.CheckResult
-        Dense check of the pitch loop on ``dense_omega``, every case.
-    atd_check : loopshaping.check.CheckResult
-        Dense check of the ATD loop on ``dense_omega``, every case.
-    closed_loop : control.StateSpace
-        Nominal plant with both loops closed (:func:`specdesign.closedloop.closed_loop`).
-    baseline : specdesign.spec.Baseline
-        ROSCO's nominal loop as seen by the tower-base moment (T_{MyT,w}, S_W, ΔD%).
-    bounds_met : bool
-        Every bound met at every design frequency (nominal loop, exact).
-    all_stable : bool
-        The full interconnection is stable for every plant case.
-    del_reduction : float
-        Predicted tower-base DEL reduction (1 Hz, m = 4), Dirlik on |T|²S_W, nominal case, %.
-    damage_reduction : float
-        Predicted tower-base damage reduction, same method, %.
-    gen_speed_sd_change : float
-        Change of the generator-speed standard deviation, %.
-    pitch_sd_change : float
-        Change of the pitch standard deviation, %.
-    pitch_rate_sd_change : float
-        Change of the pitch-rate standard deviation, %.
-    pitch_rate_sd : float
-        Pitch-rate standard deviation of the design, rad/s (linear, nominal case).
-    gain_margin_db : float
-        Gain margin of the nominal pitch loop C_β·P'_{Ω,β} (ATD closed), dB.
-    phase_margin_deg : float
-        Phase margin of the same loop, degrees.
-    atd_gain_margin_db : float
-        Gain margin of the nominal ATD loop C_atd·P''_{z,β} (pitch loop closed), dB.
-    atd_phase_margin_deg : float
-        Phase margin of the same loop, degrees.
-    actuator_peak_sensitivity : float
-        Maximum over ω and cases of |1/(1 + C_β P_{Ω,β} + C_atd P_{z,β})| (-).
-    target_reduction : float
-        The requested tower-base DEL reduction, %.
-    success : bool
-        Every specification met: target (within 0.5 pp), bounds, dense checks, stability of
-        every closed loop and of the controller itself (no pole growing faster than
-        :data:`UNSTABLE_CONTROLLER_RATE`: a saturated pitch opens the loop).
-    message : str
-        ``"all specifications met"`` or what failed.
-    parameters : dict of str to float
-        The tuned parameters (:func:`specdesign.qft.structure.from_vector`).
-    options : dict
-        The options the design was made with (``spec_reduction``, ``template_offsets``,
-        ``speed_relax_db``, ``tower_relax_db``, ``tower_relax_omega``, ``max_sensitivity``,
-        ``min_decay``) and ``refine_rounds``.
-
-    Examples
-    --------
-    >>> from specdesign import turbine
-    >>> from specdesign.qft import design_qft
-    >>> d = design_qft(turbine.iea15mw(), 19.0)  # doctest: +SKIP
-    >>> d.success, d.n_states, d.is_proper  # doctest: +SKIP
-    (True, 6, True)
-    """
-
-    wind_speed: float
-    pitch_controller: ct.TransferFunction
-    atd_controller: ct.TransferFunction
-    baseline_controller: ct.TransferFunction
-    template_speeds: tuple[float, ...]
-    design_omega: np.ndarray
-    dense_omega: np.ndarray
-    tower_spec: Specification
-    speed_spec: Specification
-    shaping: ShapingResult
-    promise: Promise
-    pitch_template: Template
-    atd_template: Template
-    pitch_bounds: Bounds
-    atd_bounds: Bounds
-    pitch_check: CheckResult
-    atd_check: CheckResult
-    closed_loop: ct.StateSpace
-    baseline: Baseline
-    bounds_met: bool
-    all_stable: bool
-    del_reduction: float
-    damage_reduction: float
-    gen_speed_sd_change: float
-    pitch_sd_change: float
-    pitch_rate_sd_change: float
-    pitch_rate_sd: float
-    gain_margin_db: float
-    phase_margin_deg: float
-    atd_gain_margin_db: float
-    atd_phase_margin_deg: float
-    actuator_peak_sensitivity: float
-    target_reduction: float
-    success: bool
-    message: str
-    parameters: dict[str, float] = field(default_factory=dict)
-    options: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def design_omegas(self) -> np.ndarray:
-        """Deprecated name of :attr:`design_omega`.
-
-        Warns
-        -----
-        DeprecationWarning
-            Always: use :attr:`design_omega`.
-        """
-        warnings.warn("QFTDesign.design_omegas is deprecated, use QFTDesign.design_omega", DeprecationWarning, stacklevel=2)
-        return self.design_omega
-
-    @property
-    def dense_omegas(self) -> np.ndarray:
-        """Deprecated name of :attr:`dense_omega`.
-
-        Warns
-        -----
-        DeprecationWarning
-            Always: use :attr:`dense_omega`.
-        """
-        warnings.warn("QFTDesign.dense_omegas is deprecated, use QFTDesign.dense_omega", DeprecationWarning, stacklevel=2)
-        return self.dense_omega
-
-    @property
-    def n_states(self) -> int:
-        """Total controller order (pitch + ATD states)."""
-        return int(ct.ss(self.pitch_controller).nstates + ct.ss(self.atd_controller).nstates)
-
-    @property
-    def is_proper(self) -> bool:
-        """Both controllers are proper (numerator degree ≤ denominator degree)."""
-
-        def proper(tf):
-            return len(np.trim_zeros(tf.num[0][0], "f")) <= len(np.trim_zeros(tf.den[0][0], "f"))
-
-        return proper(self.pitch_controller) and proper(self.atd_controller)
-
-    def row(self) -> dict[str, Any]:
-        """One row of :func:`design_table`.
-
-        Returns
-        -------
-        dict
-            ``wind_speed`` (m/s); the promises of the notch and of the relaxed specification
-            (``notch_promise_del_pct``, ``notch_promise_damage_pct``, ``promised_del_pct``,
-            ``promised_damage_pct``) and the predicted reductions (``predicted_del_pct``,
-            ``predicted_damage_pct``), %; the SD changes (``*_sd_change_pct``), %; the margins
-            (``gain_margin_db``, ``phase_margin_deg``, ``atd_gain_margin_db``,
-            ``atd_phase_margin_deg``); ``bounds_met``, ``dense_check_passed``, ``all_stable``
-            (bool) and ``n_states``.
-        """
-        return {
-            "wind_speed": self.wind_speed,
-            "notch_promise_del_pct": self.shaping.promise.exact_del,
-            "notch_promise_damage_pct": self.shaping.promise.exact_damage,
-            "promised_del_pct": self.promise.exact_del,
-            "promised_damage_pct": self.promise.exact_damage,
-            "predicted_del_pct": self.del_reduction,
-            "predicted_damage_pct": self.damage_reduction,
-            "gen_speed_sd_change_pct": self.gen_speed_sd_change,
-            "pitch_sd_change_pct": self.pitch_sd_change,
-            "pitch_rate_sd_change_pct": self.pitch_rate_sd_change,
-            "gain_margin_db": self.gain_margin_db,
-            "phase_margin_deg": self.phase_margin_deg,
-            "atd_gain_margin_db": self.atd_gain_margin_db,
-            "atd_phase_margin_deg": self.atd_phase_margin_deg,
-            "bounds_met": self.bounds_met,
-            "dense_check_passed": bool(self.pitch_check.passed and self.atd_check.passed),
-            "all_stable": self.all_stable,
-            "n_states": self.n_states,
-        }
-
-    def summary(self) -> str:
-        """One-paragraph summary: reductions, SD changes, margins, checks and the message.
-
-        Returns
-        -------
-        str
-            The summary (reductions and changes in %, margins in dB and degrees).
-        """
-        r = self.row()
-        if self.options.get("structure") == "certificate":
-            return (f"QFT design at {self.wind_speed:g} m/s meeting the target specification: tower DEL reduced "
-                    f"{r['predicted_del_pct']:.1f} % (the specification promises {r['promised_del_pct']:.1f} %), "
-                    f"{r['n_states']}-state pitch controller, no ATD; gen-speed SD {r['gen_speed_sd_change_pct']:+.1f} %, "
-                    f"pitch SD {r['pitch_sd_change_pct']:+.1f} %, pitch-rate SD {r['pitch_rate_sd_change_pct']:+.1f} %; "
-                    f"pitch loop GM {r['gain_margin_db']:.1f} dB PM {r['phase_margin_deg']:.1f}°; bounds met: "
-                    f"{self.bounds_met}, dense check: {r['dense_check_passed']}, all {len(self.template_speeds)} cases "
-                    f"stable: {self.all_stable}; {self.message}")
-        return (f"QFT design at {self.wind_speed:g} m/s: tower DEL reduced {r['predicted_del_pct']:.1f} % "
-                f"(notch spec promises {r['notch_promise_del_pct']:.1f} %, relaxed spec {r['promised_del_pct']:.1f} %), "
-                f"gen-speed SD {r['gen_speed_sd_change_pct']:+.1f} %, "
-                f"pitch SD {r['pitch_sd_change_pct']:+.1f} %, pitch-rate SD {r['pitch_rate_sd_change_pct']:+.1f} %; "
-                f"pitch loop GM {r['gain_margin_db']:.1f} dB PM {r['phase_margin_deg']:.1f}°, ATD loop GM "
-                f"{r['atd_gain_margin_db']:.1f} dB PM {r['atd_phase_margin_deg']:.1f}°; bounds met: {self.bounds_met}, "
-                f"dense check: {r['dense_check_passed']}, all {len(self.template_speeds)} cases stable: {self.all_stable}; "
-                f"{self.message}")
+#: Relaxations (dB) of the generator-speed spec the notch design (``spec="notch"``) tries in turn,
+#: smallest first: ROSCO's T_{Ω,w} dips at the tower mode where a well-damped loop cannot follow
+#: it, and 3 dB is the least that the IEA 15 MW designs met; design_hinf(spec="qft") uses the same.
+SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
 
 
 def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01)):
@@ -288,8 +53,8 @@ def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01
     if not enabled:
         return np.zeros(0)
     out = []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
+        warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
         for P, c in zip(prob.plants, prob.rosco):
             cl = closed_loop(P, c, warn=False)
             for y in ("gen_speed", "tower_base_my"):
@@ -326,7 +91,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         reduction the tuner must reach. Not used with a given specification.
     speed_relax_db : float or sequence of float, optional
         Only with ``spec="notch"``: relaxation of the generator-speed spec in dB (≥ 0), or an
-        increasing sequence tried in turn (default 3, 4.5, 6, 8 dB): the design with the
+        increasing sequence tried in turn (default :data:`SPEED_RELAX_DB`): the design with the
         smallest relaxation that meets every spec is returned (else the last attempt, with a
         warning). With a specification-driven design the certificate sets it.
     spec : "target", "notch", TargetSpecification or (tower, speed)
@@ -367,7 +132,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         tower_relax_db, tower_relax_omega : float, default 6.0 dB, 1.3 rad/s
             The tower spec is relaxed by this many dB above about this frequency (rad/s),
             where ΔD% is negligible (0 dB to disable).
-        max_sensitivity : float, default 1.9
+        max_sensitivity : float, default :data:`~specdesign.closedloop.DESIGN_MAX_SENSITIVITY`
             Bound on |1/(1+L)| for both loops and at the actuator (> 1).
         min_decay : float, default 0.02
             Required closed-loop decay rate, 1/s (poles left of −min_decay).
@@ -390,8 +155,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     TypeError
         If ``model`` is not a :class:`specdesign.turbine.TurbineModel`, an option is unknown
         (or belongs to the other design: ``speed_relax_db`` and the tuner's options need
-        ``spec="notch"`` or ``structure="fixed"``), or both a deprecated and a current keyword (``design_omegas=``/``design_omega=``,
-        ``dense_omegas=``/``dense_omega=``) are given.
+        ``spec="notch"`` or ``structure="fixed"``).
     ValueError
         If ``wind_speed`` is outside ``model.wind_range``; ``target_reduction`` is not
         strictly between 0 and 100 %; no certified specification reaches it ("infeasible
@@ -406,8 +170,6 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     RuntimeWarning
         When no relaxation of ``speed_relax_db`` gives a design that meets every
         specification (the last attempt is returned, ``success`` False).
-    DeprecationWarning
-        For the old keywords ``design_omegas=`` and ``dense_omegas=``.
 
     Examples
     --------
@@ -417,21 +179,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     >>> print(d.summary())  # doctest: +SKIP
     >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
     """
-    for old_name in ("design_omegas", "dense_omegas"):  # renamed: one name for frequency grids, omega
-        if old_name in kwargs:
-            new_name = old_name[:-1]
-            warnings.warn(f"design_qft({old_name}=...) is deprecated, use {new_name}=", DeprecationWarning, stacklevel=2)
-            if new_name in kwargs:
-                raise TypeError(f"design_qft got both {old_name}= and {new_name}=")
-            kwargs[new_name] = kwargs.pop(old_name)
-    import inspect
-
     options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
     unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
     if unknown:  # named here, not as a TypeError of an internal function
         raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
-    from .. import turbine
-
     if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
         raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
                         f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
@@ -446,19 +197,15 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
                         "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
                         "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
     if speed_relax_db is None:
-        speed_relax_db = (3.0, 4.5, 6.0, 8.0)
+        speed_relax_db = SPEED_RELAX_DB
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
     if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
     if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
-    from ..feasibility import TargetSpecification
-
     if structure not in (None, "certificate", "fixed"):
         raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
     if isinstance(spec, str) and spec == "target":
-        from ..feasibility import specification_for_target
-
         # the plant cases the pair is certified on are the ones the design must meet it on
         offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
         spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction,
@@ -469,8 +216,6 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         raise ValueError("structure='certificate' needs spec='target' or a feasibility.TargetSpecification (it carries "
                          "the certificate)")
     if isinstance(spec, TargetSpecification) and structure != "fixed":
-        from .certificate import design_from_certificate
-
         allowed = {"max_sensitivity", "min_decay", "design_omega", "dense_omega"}
         if "template_offsets" in kwargs:
             raise TypeError("design_qft(spec=TargetSpecification) meets the pair on the plant cases it was certified on "
@@ -479,10 +224,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         if set(kwargs) - allowed:
             raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
                             f"got {sorted(set(kwargs) - allowed)}")
-        if model.check_wind_speed(wind_speed) != spec.design.wind_speed:
-            raise ValueError(f"spec was made at {spec.design.wind_speed:g} m/s, not at wind_speed={wind_speed!r}")
+        spec_made_at(spec, model.check_wind_speed(wind_speed))
         return design_from_certificate(model, spec, **kwargs)
     if spec is not None:
+        spec_made_at(spec, model.check_wind_speed(wind_speed))
         return _design_single(model, wind_speed, None, speed_relax_db=float(ladder[0]), given=_given_spec(spec), **kwargs)
     design = None
     for relax in ladder:
@@ -560,10 +305,8 @@ def _given_spec(spec):
 def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec_reduction=15.0,
                    template_offsets=(-1.0, -0.5, 0.5, 1.0),
                    design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
-                   max_sensitivity=1.9, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
+                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
-    from loopshaping import qft as lqft
-
     from .. import spec as sp
 
     v = model.check_wind_speed(wind_speed)  # the model's type is checked by design_qft
@@ -643,107 +386,6 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
                            checks=(pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs))
 
 
-def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_spec, speed_spec, shaping, promise,
-                    parameters, options, checks=None) -> QFTDesign:
-    """Check a pair of controllers against a tuning problem's specifications and record the design.
-
-    The exact bounds at the design frequencies, the dense checks of both loops over every
-    plant case, closed-loop stability of every case, and the nominal performance.
-
-    Parameters
-    ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine (kept for the record's provenance).
-    prob : specdesign.qft.tuner.TuningProblem
-        Plant cases, weights, design frequencies, ``max_sensitivity``.
-    cb, ca : control.LTI
-        Pitch controller C_β (rad per rad/s) and ATD controller C_atd (rad per m/s).
-    wdense : numpy.ndarray
-        Grid of the dense check, rad/s.
-    t : float
-        The DEL reduction the design must reach, % (0.5 pp tolerance).
-    performance : tuple of float
-        (DEL reduction %, damage reduction %, σ ratios of gen speed, pitch, pitch rate) nominal.
-    base : specdesign.spec.Baseline
-        ROSCO's baseline at the nominal speed.
-    tower_spec, speed_spec : object
-        The specifications met (recorded).
-    shaping : specdesign.spec.ShapingResult
-        The shaping the tower specification came from (recorded).
-    promise : specdesign.spec.Promise
-        The promise of the tower specification (recorded).
-    parameters : dict
-        Controller parameters (recorded).
-    options : dict
-        Options of the design (recorded).
-    checks : tuple, optional
-        :func:`specdesign.qft.checks.loop_checks`'s result for these controllers, if computed.
-
-    Returns
-    -------
-    QFTDesign
-        The design; ``success`` False with a message (and a RuntimeWarning) when a check fails.
-    """
-    from loopshaping import qft as lqft
-
-    v, nom, speeds = prob.v, prob.nom, prob.speeds
-    if checks is None:
-        checks = loop_checks(prob, cb, ca, wdense)
-    pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = checks
-    # exact bounds on the final design frequencies, for the Nichols charts and the bound check
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", lqft.BoundsWarning)
-        pitch_bounds = lqft.intersect(*[lqft.bounds(pitch_t, s_) for s_ in pitch_specs])
-        atd_bounds = lqft.intersect(*[lqft.bounds(atd_t, s_) for s_ in atd_specs])
-    met = bounds_met(pitch_bounds, cb, pitch_t, prob.wd) and bounds_met(atd_bounds, ca, atd_t, prob.wd)
-
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        stable = [check_stability(closed_loop(P, cb, ca, warn=False), tol=0.0) for P in prob.plants]
-        cl = closed_loop(prob.plants[nom], cb, ca, warn=False)
-    all_stable = bool(np.all(stable))
-    red, dred, gs, ps, rate = performance
-    Rdense = plant_responses(prob.plants, wdense, ("gen_speed", "tower_top_vel"), method=prob.response_method)
-    cdn, kdn = siso_response(cb, wdense)[:, None], siso_response(ca, wdense)[:, None]
-    peak_in = float(np.max(1 / np.abs(1 + cdn * Rdense[("gen_speed", "pitch_cmd")] + kdn * Rdense[("tower_top_vel", "pitch_cmd")])))
-    nomp = pitch_t.nominal
-    problems = []
-    if red < t - 0.5:
-        problems.append(f"DEL reduction {red:.1f} % below the target {t:g} %")
-    if not met:
-        problems.append("a bound is violated at a design frequency")
-    if not pitch_check.passed:
-        problems.append("dense check of the pitch loop failed: " + pitch_check.summary().replace("\n", "; "))
-    if not atd_check.passed:
-        problems.append("dense check of the ATD loop failed: " + atd_check.summary().replace("\n", "; "))
-    if not all_stable:
-        problems.append(f"unstable closed loops at {[speeds[i] for i, s_ in enumerate(stable) if not s_]} m/s")
-    rhp = np.concatenate([ct.poles(cb), ct.poles(ca)])
-    rhp = rhp[rhp.real > UNSTABLE_CONTROLLER_RATE]
-    if rhp.size:
-        problems.append(f"the controller itself is unstable (poles {np.array2string(rhp, precision=4)} 1/s): wherever the "
-                        "pitch saturates (at fine pitch in the lulls near rated, at its rate limit) the loop opens and "
-                        "these modes grow (docs/below_rated.md)")
-    success = not problems
-    message = "all specifications met" if success else "; ".join(problems)
-    if not success:
-        warnings.warn(f"design_qft at {v:g} m/s: {message}", RuntimeWarning, stacklevel=3)
-    return QFTDesign(
-        wind_speed=v, pitch_controller=cb, atd_controller=ca, baseline_controller=prob.rosco[nom],
-        template_speeds=speeds, design_omega=prob.wd.copy(), dense_omega=wdense, tower_spec=tower_spec,
-        speed_spec=speed_spec, shaping=shaping, promise=promise, pitch_template=pitch_t, atd_template=atd_t,
-        pitch_bounds=pitch_bounds, atd_bounds=atd_bounds, pitch_check=pitch_check, atd_check=atd_check, closed_loop=cl,
-        baseline=base, bounds_met=bool(met), all_stable=all_stable, del_reduction=float(red),
-        damage_reduction=float(dred), gen_speed_sd_change=100 * (gs - 1), pitch_sd_change=100 * (ps - 1),
-        pitch_rate_sd_change=100 * (rate - 1), pitch_rate_sd=float(rate * prob.sd0["pitch_rate"]),
-        gain_margin_db=float(pitch_check.gain_margin_db[nomp]), phase_margin_deg=float(pitch_check.phase_margin_deg[nomp]),
-        atd_gain_margin_db=float(atd_check.gain_margin_db[nomp]), atd_phase_margin_deg=float(atd_check.phase_margin_deg[nomp]),
-        actuator_peak_sensitivity=peak_in, target_reduction=t, success=success, message=message, parameters=parameters,
-        options=options,
-    )
-
-
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
                     target_reduction: float | Sequence[float] = 25.0, *, specification: str = "target",
                     progress: bool = True, **kwargs: Any) -> tuple[QFTDesign, ...]:
@@ -775,11 +417,12 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     Raises
     ------
     ValueError
-        If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` does not
-        broadcast to it, ``specification`` is unknown, or :func:`design_qft` (or, with
+        If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` is not one
+        DEL reduction in (0, 100) % or one per wind speed (every one checked before the first
+        design), ``specification`` is unknown, or :func:`design_qft` (or, with
         ``"target"``, :func:`specdesign.feasibility.specification_for_target`) raises.
     TypeError
-        As :func:`design_qft`.
+        As :func:`design_qft`; for a bool or a string as a target.
 
     Warns
     -----
@@ -799,12 +442,17 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     vs = np.atleast_1d(np.asarray(wind_speeds, float))
     if vs.ndim != 1 or vs.size == 0:
         raise ValueError("wind_speeds must be a non-empty 1-D sequence of wind speeds in m/s")
-    targets = np.broadcast_to(np.asarray(target_reduction, float), vs.shape)
     if specification not in ("notch", "target"):
         raise ValueError(f"specification={specification!r} must be 'notch' or 'target'")
     for v in vs:  # before any design: a speed below the design range is refused with its reason
         check_design_speed(model, float(v))
-    from tqdm.auto import tqdm
+    # every target too (a bool or a string is no target), before the first design
+    per_speed = np.ndim(target_reduction) != 0
+    if per_speed and np.shape(target_reduction) != vs.shape:
+        raise ValueError(f"target_reduction has {np.size(target_reduction)} values for {vs.size} wind speeds; give "
+                         "one number or one per wind speed")
+    targets = np.array([del_target(x, f"target_reduction[{i}]" if per_speed else "target_reduction") for i, x in
+                        enumerate(target_reduction if per_speed else [target_reduction] * vs.size)])
 
     out = []
     for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
@@ -816,8 +464,6 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
 
 def _warn_held_design(model, design):
     """Warn when a schedule's lowest design, held below rated, would lift the pitch off fine pitch."""
-    from .checks import fine_pitch_lift
-
     law = getattr(model, "torque_control", None)
     if law is None:
         return
@@ -898,10 +544,3 @@ def format_table(rows: Iterable[dict[str, Any]]) -> str:
             f"| {r['atd_phase_margin_deg']:.1f} | {'yes' if r['bounds_met'] else 'NO'} | {'pass' if r['dense_check_passed'] else 'FAIL'} "
             f"| {'yes' if r['all_stable'] else 'NO'} | {r['n_states']} |")
     return "\n".join(lines)
-
-
-def __getattr__(name):
-    if name == "DEFAULT_DESIGN_OMEGAS":  # renamed: one name for frequency grids, omega
-        warnings.warn("DEFAULT_DESIGN_OMEGAS is deprecated, use DEFAULT_DESIGN_OMEGA", DeprecationWarning, stacklevel=2)
-        return DEFAULT_DESIGN_OMEGA
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

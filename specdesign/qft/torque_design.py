@@ -33,6 +33,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
+from ..fatigue import TOWER_M
 from ..spec import baseline_analysis
 from ..spectral import del_spectral
 
@@ -213,7 +214,7 @@ def _check(model, wind_speed, target_reduction, max_power_loss_pct, m):
 
 
 def design_torque(model, wind_speed: float, target_reduction: float = 15.0, max_power_loss_pct: float = 1.0, *,
-                  m: float = 4.0, turbulence_class: str = "B", omega=None) -> TorqueDesign:
+                  m: float = TOWER_M, turbulence_class: str = "B", omega=None) -> TorqueDesign:
     """The smallest added torque-loop stiffness that cuts the tower-base DEL by ``target_reduction`` %.
 
     The gain is the first crossing of the target on a log grid of 81 gains, 0.01-100 times the

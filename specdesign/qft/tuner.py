@@ -19,7 +19,9 @@ import control as ct
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import spectral
 from ..closedloop import closed_map, plant_responses, siso_response
+from ..spec import SLSQP_OPTIONS
 from .structure import controller_polys, vector_bounds
 
 if TYPE_CHECKING:
@@ -132,8 +134,6 @@ class TuningProblem:
             self.pss.append((np.asarray(p.A), np.asarray(p.B), np.asarray(p.C)))
         c0 = siso_response(self.rosco[nominal], self.wf)[:, None]
         T0 = {y: self._t(self.Rf, c0, 0.0, y)[:, nominal] for y in ("tower_base_my", "gen_speed", "pitch")}
-        from .. import spectral
-
         self.d0 = float(spectral.damage_rate(self.wf, np.abs(T0["tower_base_my"]) ** 2 * self.S, base.m, method=base.method))
         self.sd0 = {"gen_speed": self._sd(T0["gen_speed"]), "pitch": self._sd(T0["pitch"]),
                     "pitch_rate": self._sd(T0["pitch"] * 1j * self.wf)}
@@ -290,8 +290,6 @@ class TuningProblem:
         tuple of float
             As :meth:`performance`.
         """
-        from .. import spectral
-
         tm = self._t(self.Rf, c, k, "tower_base_my")[:, self.nom]
         tp = self._t(self.Rf, c, k, "pitch")[:, self.nom]
         to = self._t(self.Rf, c, k, "gen_speed")[:, self.nom]
@@ -453,7 +451,7 @@ def tune(prob: TuningProblem, x0: ArrayLike, target: float | None, min_decay: fl
             try:
                 r = minimize(prob.objective, start, method="SLSQP", bounds=box,
                              constraints=[{"type": "ineq", "fun": prob.constraints, "args": (target, min_decay)}],
-                             options={"maxiter": 300, "ftol": 1e-10})
+                             options=dict(SLSQP_OPTIONS))
             except (ValueError, np.linalg.LinAlgError, FloatingPointError):
                 return None
         return np.clip(r.x, lo, hi) if np.all(np.isfinite(r.x)) else None

@@ -1,36 +1,32 @@
 """ROSCO in one place: its pitch PI gain schedule, the baseline controller, its scheduled form,
-schedules read from DISCON.IN files and the compiled ROSCO controller itself.
+schedules read from DISCON.IN files, its torque law and the compiled ROSCO controller itself.
 
-- :mod:`specdesign.rosco.baseline`: the NREL ROSCO controller of the IEA 15 MW as the
-  workbench reproduces it from the reduced model (:func:`rosco_gain_schedule`,
-  :func:`speed_filter`, :func:`rosco_baseline`, :func:`rosco_scheduled`).
-- :mod:`specdesign.rosco.discon_file`: a DISCON.IN file read as the schedule
-  :func:`rosco_scheduled` runs (:func:`from_discon`, :class:`DisconSchedule`).
-- :mod:`specdesign.rosco.torque`: ROSCO's generator-torque controller below rated
-  (:class:`TorqueLaw`, :func:`torque_law`, :func:`torque_law_from_discon`, its steady state
-  :func:`steady_state` and linearisation :func:`close_torque_loop`, the compiled
-  :func:`torque_step` the simulator runs).
+- :mod:`specdesign.rosco.scheduled`: :func:`rosco_scheduled`, the baseline with ROSCO's gain
+  scheduling as the simulator runs it, and :func:`iea15mw_discon`, the shipped DISCON.IN.
 - :mod:`specdesign.rosco.discon`: ROSCO's compiled DISCON library (from the ``rosco``
   package, optional extra ``specdesign[rosco]``) as a controller of
   :func:`specdesign.simulate.simulate` (:class:`Discon`).
 
-This package does not import :mod:`specdesign.simulate` at load time (it imports
-:mod:`specdesign.turbine`, which :mod:`specdesign.simulate` imports too), so both
-:mod:`specdesign.turbine` and :mod:`specdesign.simulate` re-export names of it.
+Re-exported here, the same objects, from the layers ROSCO stands on:
+
+- :mod:`specdesign.turbine.baseline`: the NREL ROSCO controller of the IEA 15 MW as the
+  workbench reproduces it from the reduced model (:func:`rosco_gain_schedule`,
+  :func:`speed_filter`, :func:`rosco_baseline`); the turbine's public contract
+  (``specdesign.turbine.rosco_baseline``), so it lives with the model.
+- :mod:`specdesign.controller.discon_file`: a DISCON.IN file read as the schedule
+  :func:`rosco_scheduled` runs (:func:`from_discon`, :class:`DisconSchedule`).
+- :mod:`specdesign.controller.torque`: ROSCO's generator-torque controller below rated
+  (:class:`TorqueLaw`, :func:`torque_law`, :func:`torque_law_from_discon`, its steady state
+  :func:`steady_state` and linearisation :func:`close_torque_loop`, the compiled
+  :func:`torque_step` the simulator runs), which the turbine model closes in its trim.
+
+Layers: :mod:`specdesign.controller` < :mod:`specdesign.turbine` < this package; it never
+imports :mod:`specdesign.simulate` or :mod:`specdesign.closedloop`.
 """
 from __future__ import annotations
 
-from .baseline import (
-    RoscoSchedule,
-    first_order_rotor_model,
-    rosco_baseline,
-    rosco_gain_schedule,
-    rosco_scheduled,
-    speed_filter,
-)
-from .discon import Discon, DisconError, rosco_library, rosco_test_cases
-from .discon_file import DisconEntry, DisconSchedule, from_discon, iea15mw_discon, read_discon, write_discon
-from .torque import (
+from ..controller.discon_file import DisconEntry, DisconSchedule, from_discon, read_discon, write_discon
+from ..controller.torque import (
     TORQUE_MODES,
     TORQUE_REGIONS,
     TorqueLaw,
@@ -40,6 +36,9 @@ from .torque import (
     torque_law_from_discon,
     torque_step,
 )
+from ..turbine.baseline import RoscoSchedule, first_order_rotor_model, rosco_baseline, rosco_gain_schedule, speed_filter
+from .discon import Discon, DisconError, rosco_library, rosco_test_cases
+from .scheduled import TowerDamper, iea15mw_discon, rosco_scheduled, tower_mode_damping, tune_tower_damper
 
 __all__ = [
     "RoscoSchedule",
@@ -48,6 +47,9 @@ __all__ = [
     "speed_filter",
     "rosco_baseline",
     "rosco_scheduled",
+    "TowerDamper",
+    "tune_tower_damper",
+    "tower_mode_damping",
     "DisconEntry",
     "DisconSchedule",
     "iea15mw_discon",

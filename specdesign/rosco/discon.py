@@ -29,6 +29,8 @@ command (HSS N·m, N times that on the rotor shaft, which the plant takes).
 from __future__ import annotations
 
 import ctypes
+import importlib.metadata
+import os
 import re
 import shutil
 import tempfile
@@ -37,7 +39,8 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from .discon_file import read_discon
+from .._checks import bad_measurements
+from ..controller.discon_file import read_discon
 
 __all__ = ["SWAP_SIZE", "DisconError", "rosco_library", "rosco_test_cases", "Discon"]
 
@@ -77,8 +80,6 @@ class DisconError(RuntimeError):
 
 
 def _rosco_file(rel: str) -> Path:
-    import importlib.metadata
-
     try:
         dist = importlib.metadata.distribution("rosco")
     except importlib.metadata.PackageNotFoundError:
@@ -125,6 +126,25 @@ def rosco_test_cases() -> Path:
     return _rosco_file("Examples/Test_Cases")
 
 
+#: First word of a parameter file of :func:`specdesign.export.export_discon` (its own format, not ROSCO's).
+_EXPORTED = "specdesign-discon"
+
+
+def _exported_gearbox_ratio(path: Path) -> float | None:
+    """The ``gearbox_ratio`` of an exported controller's parameter file, None for a ROSCO DISCON.IN."""
+    with open(path, errors="replace") as f:
+        if f.read(len(_EXPORTED)) != _EXPORTED:
+            return None
+        for line in f:
+            words = line.partition("#")[0].split()
+            if words[:1] == ["gearbox_ratio"] and len(words) == 2:
+                try:
+                    return float(words[1])
+                except ValueError:
+                    break
+    raise ValueError(f"{path}: no numeric gearbox_ratio: write the file with specdesign.export.export_discon")
+
+
 def _refused_parameter(msg: str) -> str | None:
     """The DISCON.IN key a ROSCO error message names, if any."""
     m = re.search(r"\bfor ([A-Za-z][A-Za-z0-9_]*)", msg) or re.search(r"\b([A-Z][A-Za-z0-9]*_[A-Za-z0-9_]+)\b(?!.*:)", msg)
@@ -154,6 +174,35 @@ def _run_copy(discon_in: Path, folder: Path) -> Path:
     return out
 
 
+#: The files ROSCO opens, by the DISCON.IN key naming each and the mode key that makes it read
+#: it (ReadSetParameters.f90, ROSCO 2.9): ReadCpFile opens PerfFileName with STATUS='old' and
+#: no IOSTAT when WE_Mode > 0, so a missing table ends the whole process (gfortran's runtime
+#: error), taking the caller's interpreter with it.
+_OPENED_FILES = (("PerfFileName", "WE_Mode"), ("OL_Filename", "OL_Mode"), ("DLL_FileName", "Ext_Mode"))
+
+
+def _check_opened_files(discon_in: Path, entries: dict) -> None:
+    """Raise FileNotFoundError, naming the DISCON.IN, the line and the key, for a file ROSCO
+    will open that is missing or unreadable (checked before the library is loaded: ROSCO's
+    Fortran runtime would stop the process instead)."""
+    for key, mode in _OPENED_FILES:
+        e, m = entries.get(key), entries.get(mode)
+        try:
+            used = m is not None and int(float(m.values[0])) > 0
+        except (ValueError, IndexError):
+            raise ValueError(f"{discon_in}: line {m.line}: {mode} = {' '.join(m.values)!r} is not a whole number") from None
+        if not used:
+            continue
+        if e is None or not e.values or not e.values[0].strip('"'):
+            raise ValueError(f"{discon_in}: {mode} > 0 makes ROSCO read {key}, which is missing or empty")
+        name = e.values[0].strip('"')
+        path = Path(name) if Path(name).is_absolute() else discon_in.parent / name  # ROSCO: from the file's folder
+        if not path.is_file() or not os.access(path, os.R_OK):
+            why = "does not exist" if not path.exists() else "is not a readable file"
+            raise FileNotFoundError(f"{discon_in}: line {e.line}: {key} = {e.values[0]}: {path} {why}; ROSCO "
+                                    f"({mode} = {m.values[0]}) would stop the Python process opening it")
+
+
 class Discon:
     """ROSCO's compiled controller (its DISCON library) as a controller of :func:`specdesign.simulate.simulate`.
 
@@ -163,10 +212,15 @@ class Discon:
     and ``Echo`` set to 0 (no debug files) and its relative file names made absolute; ROSCO
     prints its banner and a status line every 10 s of simulated time on the process's stdout.
 
+    An exported controller runs the same way: ``Discon(rec.parameters, library=rec.library)``
+    for a record of :func:`specdesign.export.export_discon`; its parameter file (first word
+    ``specdesign-discon``) is read as it is, its ``gearbox_ratio`` converting the speeds.
+
     Parameters
     ----------
     discon_in : str or pathlib.Path
-        The DISCON.IN file, written for the library's ROSCO version.
+        The DISCON.IN file, written for the library's ROSCO version, or the parameter file of
+        an exported controller.
     library : str or pathlib.Path, optional
         The compiled controller (default :func:`rosco_library`, the ``rosco`` package's).
     name : str, optional
@@ -175,11 +229,17 @@ class Discon:
     Raises
     ------
     FileNotFoundError
-        If ``discon_in`` or ``library`` does not exist.
+        If ``discon_in`` or ``library`` does not exist, or a file ROSCO will open does not
+        (``PerfFileName`` with ``WE_Mode`` > 0, ``OL_Filename`` with ``OL_Mode`` > 0,
+        ``DLL_FileName`` with ``Ext_Mode`` > 0; relative names from the DISCON.IN's folder):
+        ROSCO's Fortran runtime would end the Python process on a missing performance table,
+        so every such file is checked before the library is loaded, and the message names the
+        DISCON.IN, the line and the key.
     ModuleNotFoundError
         Without ``library``, if the ``rosco`` package is not installed.
     ValueError
-        If ``discon_in`` lacks ``WE_GearboxRatio`` or has a non-positive one, or uses
+        If an exported controller's file has no numeric ``gearbox_ratio``; if ``discon_in``
+        lacks ``WE_GearboxRatio`` or has a non-positive one, or uses
         ``WE_Mode = 0`` (ROSCO would read a hub-height wind the simulator does not give).
 
     Notes
@@ -205,10 +265,22 @@ class Discon:
 
     def __init__(self, discon_in: str | Path, library: str | Path | None = None, *, name: str = "ROSCO DISCON"):
         self.discon_in = Path(discon_in)
-        entries, self.file_version = read_discon(self.discon_in)
+        if not self.discon_in.is_file():
+            raise FileNotFoundError(f"discon_in={str(self.discon_in)!r} does not exist")
+        # an exported controller's parameter file (specdesign.export): its library reads it as it is
+        exported = _exported_gearbox_ratio(self.discon_in)
+        self.exported = exported is not None
         self.library = Path(library) if library is not None else rosco_library()
         if not self.library.is_file():
             raise FileNotFoundError(f"library={str(self.library)!r} does not exist")
+        self.__name__ = str(name)
+        self._tmp = None
+        self._runs = 0
+        if self.exported:
+            self.gearbox_ratio, self.file_version = exported, _EXPORTED
+            return
+        entries, self.file_version = read_discon(self.discon_in)
+        _check_opened_files(self.discon_in, entries)  # before the library is loaded (it can end the process)
         e = entries.get("WE_GearboxRatio")
         try:
             ratio = float(e.values[0]) if e is not None else float("nan")
@@ -222,14 +294,11 @@ class Discon:
             raise ValueError(f"{self.discon_in}: line {we.line}: WE_Mode = 0 reads the measured hub-height wind, which "
                              "the simulator does not give the controller; use WE_Mode = 1 or 2 (ROSCO's estimators)")
         self.gearbox_ratio = ratio
-        self.__name__ = str(name)
-        self._tmp = None
-        self._runs = 0
 
     def __getstate__(self):
         # the loaded library copies stay with this process: a pickled Discon (a campaign's
         # task on another worker) carries its files and starts fresh copies there
-        keep = ("discon_in", "file_version", "library", "gearbox_ratio", "__name__")
+        keep = ("discon_in", "exported", "file_version", "library", "gearbox_ratio", "__name__")
         return {**{k: self.__dict__[k] for k in keep}, "_tmp": None, "_runs": 0}
 
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
@@ -250,7 +319,7 @@ class Discon:
         R = int(np.size(wind))
         self._tmp = tempfile.TemporaryDirectory(prefix="specdesign_discon_")
         folder = Path(self._tmp.name)
-        infile = _run_copy(self.discon_in, folder)
+        infile = self.discon_in.resolve() if self.exported else _run_copy(self.discon_in, folder)
         # loading the original first resolves the copies' dependencies (its RPATH points next to it)
         ctypes.CDLL(str(self.library))
         self._fns = []
@@ -293,16 +362,19 @@ class Discon:
     def _message(self, r: int) -> str:
         return bytes(self._msg[r]).split(b"\0", 1)[0].decode(errors="replace").strip()
 
-    def _call_all(self, status: int) -> None:
+    def _call_all(self, status: int, skip=None) -> None:
         sw = self._swap
         sw[:, 0] = status
         fns, infile = self._fns, self._infile
         for r, (a, f, o, m) in enumerate(self._args):
-            fns[r](a, f, infile, o, m)
+            if skip is None or not skip[r]:  # a skipped run (a bad sample) keeps ROSCO's state and command
+                fns[r](a, f, infile, o, m)
         self._flush()
         if self._fail.min() < 0:
             r = int(np.flatnonzero(self._fail < 0)[0])
             msg = self._message(r)
+            if status == 0 and self.exported:
+                raise ValueError(f"the exported controller ({self.library.name}) refused its parameter file: {msg}")
             if status == 0:
                 key = _refused_parameter(msg)
                 what = f"parameter {key}" if key else "its input"
@@ -335,17 +407,37 @@ class Discon:
         RuntimeError
             If :meth:`start` was not called.
         ValueError
-            If ROSCO refuses the DISCON.IN at its initialisation (the parameter is named).
+            If ROSCO refuses the DISCON.IN at its initialisation (the parameter is named), or
+            a measurement is NaN or inf at the first call (ROSCO initialises on it).
         DisconError
             If ROSCO stops a run later.
+
+        Warns
+        -----
+        RuntimeWarning
+            Once per signal, for a NaN or inf measurement after the first call: ROSCO is not
+            called for that run at that step, which holds its last commands (and ROSCO its
+            state) until the signal is finite again (:func:`specdesign._checks.bad_measurements`,
+            the convention of every controller).
         """
         if not self._runs:
             raise RuntimeError("Discon.start(dt, wind, pitch, torque) must run first (simulate calls it)")
-        omega = np.ascontiguousarray(y["gen_speed"], dtype=float)
+        signals = ("gen_speed", "pitch", "power", "tower_top_acc")
+        if self._step == 0:
+            self._warned = set()
+            bad = [n for n in signals if not np.all(np.isfinite(np.asarray(y[n], float)))]
+            if bad:  # ROSCO initialises on this sample: no command to hold yet
+                raise ValueError(f"{self.__name__}: measurement {bad[0]!r} is not finite at the first call (t = "
+                                 f"{float(t):g} s): ROSCO initialises on it, and there is no command to hold yet")
+        bad = bad_measurements(y, signals, float(t), self._warned, self.__name__)
+        keep = self._swap[bad].copy() if bad.any() else None
+        omega = np.ascontiguousarray(np.where(bad, 0.0, y["gen_speed"]), dtype=float)  # the azimuth holds too
         _fill_swap(self._swap, float(t), omega, np.ascontiguousarray(y["pitch"], dtype=float),
                    np.ascontiguousarray(y["power"], dtype=float), np.ascontiguousarray(y["tower_top_acc"], dtype=float),
                    self.gearbox_ratio)
-        self._call_all(0 if self._step == 0 else 1)
+        if keep is not None:
+            self._swap[bad] = keep
+        self._call_all(0 if self._step == 0 else 1, skip=bad if keep is not None else None)
         self._step += 1
         pitch, torque = np.empty(self._runs), np.empty(self._runs)
         _read_swap(self._swap, omega, self._dt, self.gearbox_ratio, pitch, torque)

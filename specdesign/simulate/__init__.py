@@ -46,7 +46,12 @@ dict of the model outputs, each an array over all runs, returning the absolute p
 command in rad for all runs, or a tuple of it and the generator torque in N·m on the rotor
 shaft, which the controller then commands; a ``start(dt, wind, pitch, torque)`` method, if it
 has one, is called once before the first step; use it for MPC or other time-domain
-controllers, and for ROSCO's compiled controller, :class:`specdesign.rosco.Discon`).
+controllers, and for ROSCO's compiled controller, :class:`specdesign.rosco.Discon`). A
+callable must return finite commands; a NaN or inf measurement is handled alike by every
+controller of the package (:func:`specdesign._checks.bad_measurements`): the run holds its
+last command and its state until the signal is finite again, with one RuntimeWarning per
+signal naming it, the time and the run. A callable that returns a non-finite command anyway
+is stopped with a ValueError naming the time and the measurements that were not finite.
 
 Generator torque (``simulate(..., torque_control=...)``): above rated the torque is held at
 the trim's (rated) torque, as ever. Below rated the compiled loop runs ROSCO's torque
@@ -62,8 +67,11 @@ runs as above: below rated its error is negative and its command sits at the min
 (ROSCO's form clamps its integrator there, an LTI controller's integrator is clamped or
 frozen, see :func:`simulate`), so the pitch is held at fine pitch as ROSCO holds it.
 ``torque_control="auto"`` (default) runs the law in the runs whose wind speed is below rated
-and holds the trim torque in the others (bit for bit the results before the law existed);
-``"rosco"`` runs it in every run (region 3 is then rated torque, with the transitions);
+and holds the trim torque in the others (bit for bit the results before the law existed),
+except a law with constant power above rated (``VS_ConstPower = 1``, e.g. the NREL 5 MW's
+DISCON.IN), which runs in every run as the linearisation has it;
+``"rosco"`` runs it in every run (region 3 is then rated torque, or rated power
+P/(η·Ω_f) with ``VS_ConstPower = 1``, with the transitions);
 a ``TorqueLaw`` runs that law in every run; ``None`` holds the trim torque everywhere.
 The pitch loop's stability check (:func:`warn_unstable`) covers the speeds at or above rated
 only: below rated the pitch loop is open.
@@ -76,26 +84,29 @@ and its torque input is held at the trim.
 
 Layout
 ------
-- :mod:`specdesign.simulate.core`: :func:`simulate`, :class:`KernelPlant`, :func:`turbine_plant`,
-  :class:`SimulationResult`, :class:`SimulationDivergedError`.
+- :mod:`specdesign.simulate.core`: :func:`simulate`, :class:`SimulationResult`,
+  :class:`SimulationDivergedError`.
 - :mod:`specdesign.simulate.checks`: the step checks (:func:`check_step`,
   :func:`check_loop_step`, :func:`sampled_loop_radius`).
-- :mod:`specdesign.simulate.schedule`: :class:`ScheduledController`, :func:`scheduled`.
-- :mod:`specdesign.simulate.controllers`: controller preparation (:func:`as_lti`,
-  :func:`tustin_matrices`, :func:`split_integrator`, :func:`split_slow`, the discrete bank).
 - :mod:`specdesign.simulate.kernels`: the numba kernels (the compiled loop, the linear plant).
-- :func:`rosco_scheduled` lives in :mod:`specdesign.rosco`, :func:`wind_series` and
-  :func:`seed_for` in :mod:`specdesign.wind`; both are re-exported here.
+- Re-exported here, the same objects, from the layers the simulator stands on:
+  :class:`ScheduledController` (:mod:`specdesign.controller.scheduled`), the controller
+  preparation :func:`as_lti`, :func:`tustin_matrices`, :func:`split_integrator`,
+  :func:`split_slow` (:mod:`specdesign.controller.lti`), the plant :class:`KernelPlant`,
+  :func:`turbine_plant` and :func:`scheduled` (:mod:`specdesign.turbine.plant`),
+  :func:`rosco_scheduled` (:mod:`specdesign.rosco`), :func:`wind_series` and :func:`seed_for`
+  (:mod:`specdesign.wind`).
 """
 from __future__ import annotations
 
+from ..controller.lti import SLOW_OMEGA, as_lti, is_lti_like, split_integrator, split_slow, tustin_matrices
+from ..controller.scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from ..rosco import rosco_scheduled
+from ..turbine.plant import KernelPlant, scheduled, turbine_plant
 from ..wind import seed_for, wind_series
 from .checks import MAX_STEP_EIGENVALUE, check_loop_step, check_step, sampled_loop_radius, warn_unstable
-from .controllers import SLOW_OMEGA, as_lti, is_lti_like, split_integrator, split_slow, tustin_matrices
-from .core import WIND_MEAN_TOLERANCE, KernelPlant, SimulationDivergedError, SimulationResult, simulate, turbine_plant
+from .core import WIND_MEAN_TOLERANCE, SimulationDivergedError, SimulationResult, simulate
 from .kernels import linear_plant_params
-from .schedule import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController, scheduled
 
 __all__ = [
     "SimulationDivergedError",
@@ -124,12 +135,3 @@ __all__ = [
     "FORMS",
     "warn_unstable",
 ]
-
-def __getattr__(name):
-    if name == "discretize":  # renamed: loopshaping.hinf.discretize returns a discrete LTI, this the kernel's matrices
-        import warnings
-
-        warnings.warn("specdesign.simulate.discretize is deprecated, use specdesign.simulate.tustin_matrices",
-                      DeprecationWarning, stacklevel=2)
-        return tustin_matrices
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

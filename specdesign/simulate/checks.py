@@ -5,14 +5,24 @@ unstable, is refused before any run (:func:`specdesign.simulate.simulate` applie
 from __future__ import annotations
 
 import math
+import warnings
 import weakref
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..closedloop import (
+    ClosedLoopUnstableWarning,
+    closed_loop_matrices,
+    hidden_origin_poles,
+    loop_parts,
+    unstable_message,
+    unstable_poles,
+)
+
 if TYPE_CHECKING:  # pragma: no cover
-    from .core import KernelPlant
+    from ..turbine.plant import KernelPlant
 
 __all__ = ["MAX_STEP_EIGENVALUE", "check_step", "sampled_loop_radius", "check_loop_step", "checked_loop",
            "warn_unstable"]
@@ -106,8 +116,6 @@ def sampled_loop_radius(plant: KernelPlant, controller: object, wind_speed: floa
     >>> bool(sampled_loop_radius(m, rosco_baseline(m, 19.0), 19.0, 0.02) < 1.0)
     True
     """
-    from ..closedloop import closed_loop_matrices, hidden_origin_poles, loop_parts
-
     if parts is None:
         parts = loop_parts(plant, controller, wind_speed)
     G, rows, K = parts
@@ -175,8 +183,6 @@ def check_loop_step(plant: KernelPlant, controller: object, wind_speed: float, d
     ValueError
         If the sampled loop is unstable at ``dt``.
     """
-    from ..closedloop import loop_parts
-
     v = wind_speed
 
     if parts is None:
@@ -241,8 +247,6 @@ def checked_loop(plant: KernelPlant, controller: object, wind_speed: float, dt: 
     >>> checked_loop(turbine_plant(m), rosco_baseline(m, 19.0), 19.0, 0.02).size
     0
     """
-    from ..closedloop import loop_parts, unstable_poles
-
     key = (id(controller), float(wind_speed), float(dt))
     known = _LOOPS.setdefault(plant, {})
     hit = known.get(key)
@@ -291,10 +295,6 @@ def warn_unstable(plant: KernelPlant, controller: object, wind_speeds: Sequence[
     """
     if plant.linearize is None:
         return
-    import warnings
-
-    from ..closedloop import ClosedLoopUnstableWarning, unstable_message
-
     for v in wind_speeds:
         bad = checked_loop(plant, controller, v, dt)
         if bad.size:

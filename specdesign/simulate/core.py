@@ -1,11 +1,12 @@
-"""The simulator's Python API: :func:`simulate`, its plant (:class:`KernelPlant`,
-:func:`turbine_plant`) and result (:class:`SimulationResult`). The step checks it applies are
-in :mod:`specdesign.simulate.checks`.
+"""The simulator's Python API: :func:`simulate` and its result (:class:`SimulationResult`). Its
+plant is :class:`specdesign.turbine.plant.KernelPlant`; the step checks it applies are in
+:mod:`specdesign.simulate.checks`.
 
 See :mod:`specdesign.simulate` for the conventions (signs, scheduling, anti-windup).
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -13,11 +14,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
+from ..controller.lti import is_lti_like
+from ..controller.scheduled import ScheduledController, controller_bank, schedule_filter_coefficients
+from ..controller.torque import TORQUE_PARAMS, TorqueLaw
+from ..turbine import iea15mw
+from ..turbine.plant import KernelPlant, turbine_plant
 from ..wind import wind_series
 from .checks import check_step, warn_unstable
-from .controllers import controller_bank, is_lti_like
 from .kernels import NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs, run_callable
-from .schedule import ScheduledController, schedule_filter_coefficients
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
@@ -25,8 +29,6 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "WIND_MEAN_TOLERANCE",
     "SimulationDivergedError",
-    "KernelPlant",
-    "turbine_plant",
     "SimulationResult",
     "simulate",
 ]
@@ -35,6 +37,8 @@ __all__ = [
 #: entry: half an IEC 2 m/s bin. The trim, the linearisation and the scheduling all use
 #: ``wind_speeds``, so a record from another bin would be simulated about the wrong point.
 WIND_MEAN_TOLERANCE = 1.0
+#: python-control's automatic system names ("sys[4]"): not the user's, so not used as a label.
+_AUTO_NAME = re.compile(r"sys\[\d+\]")
 
 
 class SimulationDivergedError(RuntimeError):
@@ -43,156 +47,6 @@ class SimulationDivergedError(RuntimeError):
     Raised by :func:`simulate` for a non-finite state, or an output beyond
     :attr:`KernelPlant.output_limits`; the message names the wind speed, seed and time.
     """
-
-
-# ----------------------------------------------------------------------------- plant
-@dataclass(frozen=True, eq=False)  # array fields: compare by identity
-class KernelPlant:
-    """A plant given by a compiled kernel pair, as :mod:`specdesign.turbine` defines it.
-
-    Parameters
-    ----------
-    rhs : numba dispatcher
-        ``@njit`` ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` (SI units).
-    outputs : numba dispatcher
-        ``@njit`` ``outputs(x, wind, pitch_cmd, gen_torque, p, y)`` (SI units).
-    params : numpy.ndarray
-        Flat float64 parameter array ``p``.
-    output_names : tuple of str
-        Names of ``y`` in order; must contain ``gen_speed`` (rad/s), ``tower_top_vel`` (m/s)
-        and ``pitch`` (rad).
-    trim : callable
-        ``trim(wind_speed) -> (x0, pitch0 rad, gen_torque N·m)``, the steady operating point.
-    rated_speed : float
-        Generator-speed reference Ω_rated (rad/s).
-    linearize : callable, optional
-        ``linearize(wind_speed) -> control.StateSpace`` with inputs (wind, pitch_cmd,
-        gen_torque) and outputs ``output_names``, deviations from trim.
-    name : str, optional
-        Label of the plant.
-    pitch_limits : tuple of float, optional
-        (min, max) pitch command (rad): every controller's command is saturated there, with
-        anti-windup (see :func:`simulate`).
-    output_limits : dict, optional
-        Output name → largest physically possible |y| (SI); a run whose output leaves it, or
-        turns non-finite, has diverged and :func:`simulate` raises.
-    torque_law : specdesign.rosco.TorqueLaw, optional
-        The generator-torque controller below rated (``torque_control`` of :func:`simulate`);
-        the plant then needs outputs ``power`` (W) and ``pitch`` (rad).
-    rated_wind_speed : float, optional
-        Wind speed (m/s) below which ``torque_control="auto"`` runs ``torque_law``.
-    """
-
-    rhs: object
-    outputs: object
-    params: np.ndarray = field(repr=False)
-    output_names: tuple
-    trim: object = field(repr=False)
-    rated_speed: float
-    linearize: object = field(default=None, repr=False)
-    name: str = "plant"
-    pitch_limits: tuple | None = None
-    output_limits: dict = field(default_factory=dict)
-    torque_law: object = None
-    rated_wind_speed: float | None = None
-
-    def index(self, name: str) -> int:
-        """Position of output ``name`` in ``output_names``.
-
-        Parameters
-        ----------
-        name : str
-            An output name.
-
-        Returns
-        -------
-        int
-            Its index in ``y``.
-
-        Raises
-        ------
-        ValueError
-            If the plant has no such output.
-        """
-        if name not in self.output_names:
-            raise ValueError(f"output {name!r} not among the plant outputs {self.output_names}")
-        return self.output_names.index(name)
-
-
-def turbine_plant(model: TurbineModel | KernelPlant | None = None) -> KernelPlant:
-    """Wrap a :class:`specdesign.turbine.TurbineModel` as a KernelPlant.
-
-    The plant's pitch limits are the model's; its output limits (divergence) twice the rated
-    generator speed and the tower-base moment of 10 m of tower-top deflection.
-
-    Parameters
-    ----------
-    model : TurbineModel or KernelPlant, optional
-        The model (default :func:`specdesign.turbine.iea15mw`); a KernelPlant is returned as is.
-
-    Returns
-    -------
-    KernelPlant
-        The plant on the turbine's compiled kernel.
-
-    Examples
-    --------
-    >>> turbine_plant().output_names[0]
-    'gen_speed'
-    """
-    from .. import turbine
-
-    if model is None:
-        model = turbine.iea15mw()
-    if isinstance(model, KernelPlant):
-        return model
-    hit = _PLANTS.get(id(model))
-    if hit is not None and hit[0] is model:
-        return hit[1]
-    trims = {}
-
-    def trim(v):
-        # a campaign asks for the same trims many times (checks, prediction, simulation): each
-        # solved once per plant; the state returned as a copy, so no caller shares it
-        v = float(v)
-        if v not in trims:
-            op = model.trim(v)
-            trims[v] = (np.array(op.x, dtype=float), float(op.pitch), float(op.gen_torque))
-        x, pitch, torque = trims[v]
-        return x.copy(), pitch, torque
-
-    plant = KernelPlant(
-        rhs=turbine.rhs,
-        outputs=turbine.outputs,
-        params=np.ascontiguousarray(model.kernel_params(), dtype=float),
-        output_names=tuple(turbine.OUTPUT_NAMES),
-        trim=trim,
-        rated_speed=float(model.rated_rotor_speed),
-        linearize=model.linearize,
-        name=model.name,
-        pitch_limits=(float(model.pitch_min), float(model.pitch_max)),
-        # divergence: twice the rated speed is far past any overspeed trip; a tower-base moment
-        # of 10 m of tower-top deflection is far past the tower's strength
-        output_limits={"gen_speed": 2.0 * float(model.rated_rotor_speed),
-                       "tower_base_my": 10.0 * float(model.tower_base_moment_per_m)},
-        torque_law=getattr(model, "torque_control", None),
-        rated_wind_speed=None if getattr(model, "torque_control", None) is None else float(model.rated_wind_speed()),
-    )
-    if len(_PLANTS) >= _PLANTS_SIZE:
-        try:  # another thread (a threaded dask worker) may have changed it meanwhile: drop any entry
-            _PLANTS.pop(next(iter(_PLANTS)), None)
-        except (RuntimeError, StopIteration):
-            pass
-    # the model is held with its plant, so its id cannot be reused while the entry lives
-    _PLANTS[id(model)] = (model, plant)
-    return plant
-
-
-# id(model) → (model, plant): one plant per model (and its trims, and the loop checks keyed on
-# it, :func:`specdesign.closedloop.loop_parts`) for the models in use, oldest dropped first
-_PLANTS: dict = {}
-_PLANTS_SIZE = 16
-
 
 
 # ----------------------------------------------------------------------------- results
@@ -289,9 +143,10 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, optional
         Generator torque of the compiled loop (see :mod:`specdesign.simulate`): "auto" runs
         the plant's torque law (the model's ``torque_control``) in the runs below rated and
-        holds the trim torque above; "rosco" runs it in every run; a TorqueLaw runs that one
-        in every run; None holds the trim torque everywhere. Ignored with ``linear=True``
-        (the linearisation closes the law below rated) and for a callable controller (it
+        holds the trim torque above (a constant-power law runs in every run); "rosco" runs it
+        in every run; a TorqueLaw runs that one in every run; None holds the trim torque
+        everywhere. Ignored with ``linear=True`` (the linearisation closes the law below
+        rated, and above rated a constant-power one) and for a callable controller (it
         commands the torque itself, or holds the trim torque).
 
     Returns
@@ -370,9 +225,7 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         wind_dt = record_dt if wind_dt is None else positive_scalar(wind_dt, "wind_dt")
         radius = wind_rotor_radius if wind_rotor_radius is not None else model_radius
         if radius is None:
-            from .. import turbine
-
-            radius = turbine.iea15mw().rotor_radius
+            radius = iea15mw().rotor_radius
         wind = wind_series(radius, vs, seeds, total + wind_dt, wind_dt, turbulence_class)
     else:
         wind = np.asarray(wind, dtype=float)
@@ -444,7 +297,10 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
                       plant.output_names, lim_idx, lim_val, status)
         _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
     else:
-        label = getattr(controller, "name", "controller")
+        label = getattr(controller, "name", None)
+        if label is None or _AUTO_NAME.fullmatch(str(label)):
+            # python-control names an unnamed system "sys[4]": a name the user never gave
+            label = "controller"
         # below rated the pitch loop is open (its PI sits at the minimum pitch): not checked there
         warn_unstable(plant, controller, vs[above], dt)
         sched_pitch, mats, fw, pi = controller_bank(controller, dt)
@@ -501,8 +357,6 @@ def _same_locals(Ad, Bd, Cd, Dd, Rq, Ns):
 def _torque_params(plant, torque_control, vs, S, linear):
     """(R, TORQUE_PARAMS) torque-law parameters per run (mode 0: torque held) and the mask of
     wind speeds where the pitch loop is active (not below rated under the torque law)."""
-    from ..rosco.torque import TORQUE_PARAMS, TorqueLaw
-
     rated = plant.rated_wind_speed
     above = np.ones(vs.size, dtype=bool) if rated is None else vs >= rated
     on = np.zeros(vs.size, dtype=bool)
@@ -514,8 +368,8 @@ def _torque_params(plant, torque_control, vs, S, linear):
             raise ValueError("torque_control='rosco' needs a plant with a torque law (a TurbineModel with "
                              "torque_control, e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw instead")
         on[:] = True
-    elif torque_control == "auto":
-        on = ~above if law is not None else on
+    elif torque_control == "auto":  # a constant-power law (VS_ConstPower = 1) acts above rated too
+        on = (~above | law.const_power) if law is not None else on
     elif torque_control is not None:
         raise ValueError(f"torque_control={torque_control!r} must be 'auto', 'rosco', None or a specdesign.rosco.TorqueLaw")
     if linear:

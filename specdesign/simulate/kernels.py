@@ -3,7 +3,7 @@
 One ``@njit`` loop integrates a batch of runs in parallel (``prange`` over runs): per run, fixed-step
 RK4 of the plant kernel pair with the wind linearly interpolated between its samples, the pitch
 command and generator torque held over a step, and the discrete controller bank of
-:mod:`specdesign.simulate.controllers` (output-blended locals, each with its integrator run
+:mod:`specdesign.controller.scheduled` (output-blended locals, each with its integrator run
 apart and clamped or conditionally integrated, and ROSCO's gain-scheduled PI) scheduled on the
 filtered pitch command. See :mod:`specdesign.simulate` for the conventions.
 
@@ -17,6 +17,7 @@ by :func:`specdesign.simulate.simulate`; nothing is meant to be called directly 
 from __future__ import annotations
 
 import math
+import types
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
@@ -27,7 +28,7 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:  # pragma: no cover
     import control
 
-from ..rosco.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
+from ..controller.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
 from ..turbine import aero_loads as _turbine_aero
 from ..turbine import mechanics as _turbine_mechanics
 from ..turbine import outputs as _turbine_outputs
@@ -489,8 +490,6 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
         :data:`KIND_LINEAR`, or :data:`KIND_USER` for a rebound user pair) and the batch loop, the one-step
         function and the outputs function of the callable path (:func:`run_callable`).
     """
-    import types
-
     if rhs is linear_rhs:
         return KIND_LINEAR, _run_batch, _step_all, _outputs_all
     if rhs is _turbine_rhs and outfn is _turbine_outputs:
@@ -519,6 +518,15 @@ def compiled_for(rhs: Callable, outfn: Callable) -> tuple:
         g["_run_one"] = copy(_run_one)
         _REBOUND[key] = (KIND_USER, copy(_run_batch, parallel=True), copy(_step_all), copy(_outputs_all))
     return _REBOUND[key]
+
+
+def _bad_inputs(given, t):
+    """The measurements handed to the controller (``given``, as it left them) that were not
+    finite at time ``t``, for the message of a non-finite command (a controller that passes a
+    NaN sample through names nothing itself)."""
+    bad = [(n, np.flatnonzero(~np.isfinite(np.asarray(v, dtype=float)))) for n, v in given.items()]
+    bad = [f"{n} (run {int(r[0])})" for n, r in bad if r.size]
+    return f" at t = {t:g} s; its measurements held NaN or inf in {', '.join(bad)}" if bad else f" at t = {t:g} s"
 
 
 def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: int, P: np.ndarray, X0: np.ndarray,
@@ -602,7 +610,8 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
                 over = np.argmax(np.abs(y[r][:, lim_idx]) > lim_val, axis=1)
                 status[r] = 64 * k + np.where(nonfinite, NONFINITE, over)
                 return
-        cmd = fn(t, {n: y[:, i].copy() for i, n in enumerate(names)})
+        given = {n: y[:, i].copy() for i, n in enumerate(names)}
+        cmd = fn(t, given)
         if isinstance(cmd, tuple):
             if len(cmd) != 2:
                 raise ValueError(f"controller callable must return pitch_cmd or (pitch_cmd, gen_torque), got {len(cmd)} items")
@@ -610,10 +619,11 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
             # a sum is finite iff every term is (barring overflow past 1e308): cheaper per step
             if torque.shape != (R,) or not math.isfinite(torque.sum()):
                 raise ValueError(f"controller callable must return a finite generator torque (N·m) of shape ({R},), "
-                                 f"got {torque.shape}")
+                                 f"got {torque.shape}" + _bad_inputs(given, t))
         cmd = np.asarray(cmd, dtype=float)
         if cmd.shape != (R,) or not math.isfinite(cmd.sum()):
-            raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}")
+            raise ValueError(f"controller callable must return a finite pitch command (rad) of shape ({R},), got {cmd.shape}"
+                             + _bad_inputs(given, t))
         if k % rec_every == 0:
             Y[:, :ny, j] = y
             Y[:, ny, j] = bcmd  # the command held during the previous step, as in the compiled loop

@@ -4,7 +4,7 @@ The model: rigid-drivetrain rotor (aerodynamic torque from Cp(λ, β), thrust fr
 first tower fore-aft mode driven by thrust with the rotor seeing the relative wind U − ẋ_top,
 a 2nd-order pitch actuator with rate and position limits, and a generator torque that is an
 input (constant, ``rated_generator_torque``, above rated; below rated set by ROSCO's torque law,
-the model's ``torque_control``, :mod:`specdesign.rosco.torque`, closed in :meth:`TurbineModel.trim`
+the model's ``torque_control``, :mod:`specdesign.controller.torque`, closed in :meth:`TurbineModel.trim`
 and :meth:`TurbineModel.linearize` from cut-in to cut-out). Figures come from the shipped
 ``specdesign/data/iea15mw`` (IEA Wind Task 37 and NREL ROSCO, Apache-2.0; see NOTICE.md).
 
@@ -19,11 +19,20 @@ Layout
   kernel interface".
 - :mod:`specdesign.turbine.tables`: the shipped data and the bicubic rotor-table coefficients.
 - :mod:`specdesign.turbine.openfast_deck`: :func:`from_openfast`, a model from an OpenFAST deck.
-- ROSCO (:func:`rosco_baseline`, :func:`rosco_gain_schedule`, :class:`RoscoSchedule`,
-  :func:`speed_filter`) lives in :mod:`specdesign.rosco` and is re-exported here.
+- :mod:`specdesign.turbine.plant`: the model as the compiled loops run it
+  (:class:`~specdesign.turbine.plant.KernelPlant`, :func:`~specdesign.turbine.plant.turbine_plant`,
+  :func:`~specdesign.turbine.plant.scheduled`; re-exported by :mod:`specdesign.simulate`).
+- :mod:`specdesign.turbine.baseline`: ROSCO's pitch PI from the model (:func:`rosco_baseline`,
+  :func:`rosco_gain_schedule`, :class:`RoscoSchedule`, :func:`speed_filter`), re-exported by
+  :mod:`specdesign.rosco`.
+
+Layers: this package stands on :mod:`specdesign.controller` (the torque law, the DISCON.IN
+reader); :mod:`specdesign.rosco`, :mod:`specdesign.closedloop` and :mod:`specdesign.simulate`
+stand on it.
 """
 from __future__ import annotations
 
+from .baseline import RoscoSchedule, rosco_baseline, rosco_gain_schedule, speed_filter
 from .kernel import (
     INPUT_NAMES,
     OUTPUT_NAMES,
@@ -78,20 +87,3 @@ __all__ = [
     "rosco_gain_schedule",
     "speed_filter",
 ]
-
-#: Names that live in :mod:`specdesign.rosco` and stay importable from here (public contract:
-#: ``specdesign.turbine.rosco_baseline``). Resolved on first access: :mod:`specdesign.rosco`
-#: imports this package, so importing it here at load time would be circular.
-_ROSCO_NAMES = ("RoscoSchedule", "rosco_gain_schedule", "speed_filter", "rosco_baseline")
-
-
-def __getattr__(name):
-    if name in _ROSCO_NAMES:
-        from .. import rosco
-
-        return getattr(rosco, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_ROSCO_NAMES))

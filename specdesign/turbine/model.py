@@ -4,7 +4,7 @@ The model: rigid-drivetrain rotor (aerodynamic torque from Cp(λ, β), thrust fr
 first tower fore-aft mode driven by thrust with the rotor seeing the relative wind U − ẋ_top,
 a 2nd-order pitch actuator with rate and position limits, and a generator torque that is an
 input (constant, ``rated_generator_torque``, above rated; below rated set by ROSCO's torque law,
-the model's ``torque_control``, :mod:`specdesign.rosco.torque`, closed in :meth:`TurbineModel.trim`
+the model's ``torque_control``, :mod:`specdesign.controller.torque`, closed in :meth:`TurbineModel.trim`
 and :meth:`TurbineModel.linearize` from cut-in to cut-out). Figures come from the shipped
 ``specdesign/data/iea15mw`` (IEA Wind Task 37 and NREL ROSCO, Apache-2.0; see NOTICE.md).
 
@@ -15,6 +15,7 @@ The state, input and output vectors and the compiled kernel are those of
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass, field, fields
 from functools import cached_property
@@ -24,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
+from ..controller.torque import TRIM_TOL, close_torque_loop, steady_state, torque_law
 
 if TYPE_CHECKING:  # pragma: no cover
     import control
@@ -290,6 +292,9 @@ class TurbineModel:
     def check_wind_speed(self, wind_speed: float) -> float:
         """``wind_speed`` as a float, checked to be within ``wind_range``.
 
+        Every model the design loop takes has it (:class:`specdesign.openfast.LinearTurbine`
+        shares this docstring).
+
         Parameters
         ----------
         wind_speed : float
@@ -303,7 +308,8 @@ class TurbineModel:
         Raises
         ------
         ValueError
-            Outside the above-rated range where the model is valid.
+            Outside ``wind_range``: for a TurbineModel the above-rated range where it is valid,
+            for a LinearTurbine its linearisations' speeds (it interpolates, never extrapolates).
         """
         v = positive_scalar(wind_speed, "wind_speed")
         lo, hi = self.wind_range
@@ -441,7 +447,7 @@ class TurbineModel:
         k = int(np.argmax(vals <= 0))
         if vals[k] > 0:
             raise ValueError(f"no pitch within the table balances the torque at wind_speed={v!r} m/s")
-        beta = brentq(surplus, grid[k - 1], grid[k], xtol=1e-14, rtol=1e-14)
+        beta = brentq(surplus, grid[k - 1], grid[k], xtol=TRIM_TOL, rtol=TRIM_TOL)
         tsr = omega * self.rotor_radius / v
         cp, ct = (float(c) for c in self.rotor_coefficients(tsr, beta))
         area = np.pi * self.rotor_radius**2
@@ -464,8 +470,6 @@ class TurbineModel:
         )
 
     def _trim_below(self, v):
-        from ..rosco.torque import steady_state
-
         omega, torque, beta, region = steady_state(self, self.torque_control, v)
         tsr = omega * self.rotor_radius / v
         cp, ct = (float(c) for c in self.rotor_coefficients(tsr, beta))
@@ -541,7 +545,9 @@ class TurbineModel:
         Below rated (a model with ``torque_control``) the torque loop is closed
         (:func:`specdesign.rosco.close_torque_loop`): the law's dT/dΩ enters A (region 2:
         2KΩ; regions 1.5 and 2.5: the transition PI, its integral an extra state
-        ``torque_pi``), and ``gen_torque`` is a torque added to the law's. The pitch loop is
+        ``torque_pi``), and ``gen_torque`` is a torque added to the law's. Above rated a law
+        with constant power (``VS_ConstPower = 1``) enters A the same way (dT/dΩ = −P/(η·Ω²));
+        one with constant torque leaves the torque an input. The pitch loop is
         open there: ROSCO's pitch PI sits at its minimum below rated.
 
         Parameters
@@ -576,9 +582,7 @@ class TurbineModel:
         op = self.trim(wind_speed)
         A, B, C, D = self.jacobians(op)
         inputs, states = list(INPUT_NAMES), list(STATE_NAMES)
-        if op.region != "3":
-            from ..rosco.torque import close_torque_loop
-
+        if self.torque_control is not None:  # above rated it matters only for constant power
             A, B, C, D, extra = close_torque_loop(A, B, C, D, self.torque_control, op.rotor_speed, op.region)
             states += extra
         if load_inputs:
@@ -689,10 +693,6 @@ def iea15mw() -> TurbineModel:
     >>> iea15mw().name
     'IEA-15-240-RWT'
     """
-    import dataclasses
-
-    from ..rosco.torque import torque_law
-
     par = json.loads(read_text("parameters.json"))
     tsr, pitch_deg, cp, ct = read_rotor_table()
     model = TurbineModel(

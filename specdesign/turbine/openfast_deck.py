@@ -38,11 +38,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from .._checks import positive_scalar
+from ..controller.discon_file import from_discon, read_discon
+from ..controller.torque import torque_law_from_discon
 from .model import TurbineModel
 
 __all__ = ["GRAVITY", "read_openfast_file", "read_cp_table", "from_openfast"]
@@ -93,7 +96,9 @@ class _File:
     def has(self, key):
         return key in self.entries
 
-    def number(self, key, positive=False, nonnegative=False):
+    def number(self, key, positive=False, nonnegative=False, *, integer=False, below=None, at_most=None):
+        """The value of ``key``, checked as OpenFAST checks it (``below``: |v| < below;
+        ``at_most``: v ≤ at_most; ``integer``: a whole number, as Fortran reads an INTEGER)."""
         if key not in self.entries:
             raise ValueError(f"{self.path}: key {key!r} is missing")
         tok, n = self.entries[key]
@@ -104,6 +109,12 @@ class _File:
         if not math.isfinite(v) or (positive and not v > 0) or (nonnegative and not v >= 0):
             need = "positive" if positive else "non-negative" if nonnegative else "finite"
             raise ValueError(f"{self.path}: line {n}: {key} = {tok} must be {need}")
+        if integer and v != int(v):
+            raise ValueError(f"{self.path}: line {n}: {key} = {tok} must be a whole number (OpenFAST reads an integer)")
+        if below is not None and not abs(v) < below:
+            raise ValueError(f"{self.path}: line {n}: {key} = {tok} must lie in (-{below:g}, {below:g}) (OpenFAST's range)")
+        if at_most is not None and not v <= at_most:
+            raise ValueError(f"{self.path}: line {n}: {key} = {tok} must be at most {at_most:g} (OpenFAST's range)")
         return v
 
     def file(self, key):
@@ -113,9 +124,11 @@ class _File:
         p = Path(name)
         return p if p.is_absolute() else self.path.parent / p
 
-    def table(self, after, columns, rows):
+    def table(self, after, columns, rows, *, positive=(), fraction=None):
         """``rows`` rows of the numeric table under the section line containing ``after``
-        (two header lines), the named ``columns`` of its header."""
+        (two header lines), the named ``columns`` of its header. Columns in ``positive`` must
+        be > 0 in every row, and the column ``fraction`` must rise strictly from 0 to 1, as
+        ElastoDyn requires (ValidateBladeData, ValidateTowerData): the error names the line."""
         for i, line in enumerate(self.lines):
             if after in line.upper():
                 header = self.lines[i + 1].split()
@@ -134,6 +147,23 @@ class _File:
                         raise ValueError(f"{self.path}: line {n}: row {k + 1} has {len(data[-1])} values, "
                                          f"the header {len(header)}")
                 a = np.array(data)
+                if not np.all(np.isfinite(a)):
+                    k = int(np.argmin(np.all(np.isfinite(a), axis=1)))
+                    raise ValueError(f"{self.path}: line {i + 4 + k}: row {k + 1} of the {after.lower()} table holds "
+                                     "NaN or inf")
+                for c in positive:
+                    col = a[:, header.index(c)]
+                    if np.any(col <= 0):
+                        k = int(np.argmax(col <= 0))
+                        raise ValueError(f"{self.path}: line {i + 4 + k}: {c}({k + 1}) = {col[k]:g} must be greater "
+                                         "than zero (as ElastoDyn requires)")
+                if fraction is not None:
+                    col = a[:, header.index(fraction)]
+                    bad = [k for k in range(1, rows) if not col[k] > col[k - 1]]
+                    if col[0] != 0.0 or col[-1] != 1.0 or bad:
+                        k = 0 if col[0] != 0.0 else bad[0] if bad else rows - 1
+                        raise ValueError(f"{self.path}: line {i + 4 + k}: {fraction}({k + 1}) = {col[k]:g}: {fraction} "
+                                         "must rise strictly from 0 to 1 (as ElastoDyn requires)")
                 return [a[:, header.index(c)] for c in columns]
         raise ValueError(f"{self.path}: no section {after!r}")
 
@@ -199,14 +229,16 @@ def read_cp_table(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray,
 
 def _tower(ed: _File, lumped: list, j_tilt: float):
     twr = _File(ed.file("TwrFile"))
-    n = int(twr.number("NTwInpSt", positive=True))
-    frac, mu, ei = twr.table("DISTRIBUTED TOWER PROPERTIES", ("HtFract", "TMassDen", "TwFAStif"), n)
-    if frac[0] != 0.0 or frac[-1] != 1.0 or np.any(np.diff(frac) <= 0):
-        raise ValueError(f"{twr.path}: HtFract must rise strictly from 0 to 1")
+    n = int(twr.number("NTwInpSt", positive=True, integer=True))
+    if n < 2:
+        raise ValueError(f"{twr.path}: line {twr.entries['NTwInpSt'][1]}: NTwInpSt = {n}: the tower needs at least 2 "
+                         "stations (0 and 1)")
+    frac, mu, ei = twr.table("DISTRIBUTED TOWER PROPERTIES", ("HtFract", "TMassDen", "TwFAStif"), n,
+                             positive=("TMassDen", "TwFAStif"), fraction="HtFract")
     c = np.array([twr.number(f"TwFAM1Sh({i})") for i in range(2, 7)])
     if abs(c.sum() - 1.0) > 1e-3:
         raise ValueError(f"{twr.path}: TwFAM1Sh(2..6) sum to {c.sum():.5g}, not 1 (the mode at the tower top)")
-    length = ed.number("TowerHt") - ed.number("TowerBsHt")
+    length = ed.number("TowerHt", positive=True) - ed.number("TowerBsHt")
     if not length > 0:
         raise ValueError(f"{ed.path}: TowerHt - TowerBsHt = {length} m must be positive")
     mu = mu * twr.number("AdjTwMa", positive=True)
@@ -226,7 +258,7 @@ def _tower(ed: _File, lumped: list, j_tilt: float):
     stiff = np.trapezoid(ei_x * ddphi**2, h) - GRAVITY * np.trapezoid((top_mass + above) * dphi**2, h)
     if not stiff > 0:
         raise ValueError(f"{twr.path}: the first fore-aft mode has no positive stiffness with gravity ({stiff:.4g} N/m)")
-    return mass, stiff, twr.number("TwrFADmp(1)", nonnegative=True) / 100.0, ei_x[0] * ddphi[0]
+    return mass, stiff, twr.number("TwrFADmp(1)", nonnegative=True, at_most=100.0) / 100.0, ei_x[0] * ddphi[0]
 
 
 def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
@@ -264,7 +296,11 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     FileNotFoundError
         If a file of the deck does not exist.
     ValueError
-        Naming the file, line and key, for a missing, non-numeric or inconsistent value
+        Naming the file, line and key, for a value outside what OpenFAST itself accepts
+        (ElastoDyn: |PreCone| < 90°, HubRad < TipRad, TowerHt > 0, masses, inertias and
+        Twr2Shft ≥ 0, whole station counts, BMassDen/TMassDen/TwFAStif > 0, BlFract and
+        HtFract rising from 0 to 1, TwrFADmp in 0-100 %; ROSCO: PA_CornerFreq, PA_Damping > 0),
+        for a missing, non-numeric or inconsistent value
         (e.g. ServoDyn's ``GenEff`` against DISCON's ``VS_GenEff``, the gear ratio of
         ElastoDyn and DISCON, a mode shape that does not end at 1), a rotor table the
         compiled model cannot use (a non-uniform grid), or a deck with a flexible substructure
@@ -275,8 +311,6 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     >>> from specdesign.rosco import rosco_test_cases
     >>> m = from_openfast(rosco_test_cases() / "NREL-5MW/NREL-5MW.fst")  # doctest: +SKIP
     """
-    from ..rosco.discon_file import from_discon, read_discon
-
     fst = _File(fst_path)
     if fst.has("CompSub") and fst.number("CompSub") != 0:
         raise ValueError(f"{fst.path}: line {fst.entries['CompSub'][1]}: CompSub = {fst.entries['CompSub'][0]}: the "
@@ -301,26 +335,33 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     tsr, pitch, cp, ct = read_cp_table(cp_table)
     # rotor: blades (distributed mass), hub, generator through the gearbox
     tip, hub = ed.number("TipRad", positive=True), ed.number("HubRad", nonnegative=True)
+    if not hub < tip:
+        raise ValueError(f"{ed.path}: line {ed.entries['HubRad'][1]}: HubRad = {hub:g} m must be less than TipRad = "
+                         f"{tip:g} m (as ElastoDyn requires)")
     blade = _File(ed.file("BldFile1" if ed.has("BldFile1") and not ed.has("BldFile(1)") else "BldFile(1)"))
-    nb = int(blade.number("NBlInpSt", positive=True))
-    frac, mden = blade.table("DISTRIBUTED BLADE PROPERTIES", ("BlFract", "BMassDen"), nb)
+    nb = int(blade.number("NBlInpSt", positive=True, integer=True))
+    if nb < 2:
+        raise ValueError(f"{blade.path}: line {blade.entries['NBlInpSt'][1]}: NBlInpSt = {nb}: the blade's mass "
+                         "integral needs at least 2 stations (0 and 1)")
+    frac, mden = blade.table("DISTRIBUTED BLADE PROPERTIES", ("BlFract", "BMassDen"), nb, positive=("BMassDen",),
+                             fraction="BlFract")
     r = hub + frac * (tip - hub)
     mden = mden * blade.number("AdjBlMs", positive=True)
-    cone = math.radians(ed.number("PreCone(1)"))
+    cone = math.radians(ed.number("PreCone(1)", below=90.0))  # ElastoDyn: |PreCone| < 90°
     m_blade = np.trapezoid(mden, r)
     rotor = 3 * np.trapezoid(mden * (r * math.cos(cone)) ** 2, r) + ed.number("HubIner", nonnegative=True)
     if rotor_inertia is not None:
         rotor = positive_scalar(rotor_inertia, "rotor_inertia (kg·m², about the shaft, hub included)")
     inertia = rotor + gb**2 * ed.number("GenIner", nonnegative=True)
     lumped = [(ed.number("NacMass", nonnegative=True), ed.number("NacCMzn")),
-              (ed.number("HubMass", nonnegative=True) + 3 * m_blade, ed.number("Twr2Shft")),
+              (ed.number("HubMass", nonnegative=True) + 3 * m_blade, ed.number("Twr2Shft", nonnegative=True)),
               (ed.number("YawBrMass", nonnegative=True), 0.0)]
     mass, stiff, zeta, my_per_m = _tower(ed, lumped, rotor / 2)
     if fst.has("AirDens"):
         rho = fst.number("AirDens", positive=True)
     else:
         rho = _File(fst.file("AeroFile")).number("AirDens", positive=True)
-    pa = [float(entries[k].values[0]) if k in entries else v for k, v in (("PA_CornerFreq", 3.14), ("PA_Damping", 0.707))]
+    pa = [_discon_positive(discon, entries, k, v) for k, v in (("PA_CornerFreq", 3.14), ("PA_Damping", 0.707))]
     try:
         model = _model(fst_path, rho, tip, inertia, mass, stiff, zeta, my_per_m, pa, ds, gb, tsr, pitch, cp, ct)
         # from the first 0.1 m/s above rated: ROSCO's schedule starts just above rated
@@ -330,13 +371,27 @@ def from_openfast(fst_path: str | Path, cp_table: str | Path | None = None,
     return _with_torque_law(model, discon, entries)
 
 
+def _discon_positive(discon, entries, key, default):
+    """DISCON's ``key`` (default when absent) as a number > 0, else a ValueError naming the file,
+    line and key: ROSCO refuses a negative actuator corner or damping ("must be greater than
+    0"), and the model's second-order actuator has no pole to place at 0 (a pole at +0.707 1/s
+    with PA_CornerFreq = -1)."""
+    e = entries.get(key)
+    if e is None:
+        return default
+    try:
+        v = float(e.values[0])
+    except (ValueError, IndexError):
+        raise ValueError(f"{discon}: line {e.line}: {key} = {' '.join(e.values)!r} is not a number") from None
+    if not (math.isfinite(v) and v > 0):
+        raise ValueError(f"{discon}: line {e.line}: {key} = {e.values[0]} must be greater than 0 (ROSCO's pitch "
+                         "actuator: a corner frequency in rad/s, a damping ratio)")
+    return v
+
+
 def _with_torque_law(model, discon, entries):
     """The model with ROSCO's torque law of its DISCON.IN attached (trim and linearize from
     cut-in), or unchanged with a warning when the workbench does not run that DISCON's law."""
-    import warnings
-
-    from ..rosco.torque import torque_law_from_discon
-
     e = entries.get("VS_ControlMode")
     try:
         # mode 2 tracks the TSR from ROSCO's wind-speed estimator (not modelled): its power-based

@@ -40,13 +40,13 @@ figures) live in :mod:`specdesign.cli`; this package imports neither matplotlib 
 """
 from __future__ import annotations
 
-from ..closedloop import closed_loop_poles  # noqa: F401  (reachable here as before; not part of __all__)
 from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
-from .campaign import Campaign, check_campaign_step, check_plant_step, concat_campaigns, run_campaign, seeds_from
+from .campaign import check_campaign_step, check_plant_step, concat_campaigns, run_campaign
+from .campaign_record import Campaign
 from .lifetime_del import DEL_CHANNELS, LifetimeDEL, WindClimate, lifetime, weibull_bins, wind_climate
 from .metrics import INDICATORS, Indicators, indicators
 from .prediction import LinearPrediction, closed_loop_response, linear_prediction, loop_plant, prediction_grid
-from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, weibull_weights,
+from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, seeds_from, weibull_weights,
                     welch_psd)
 from .surrogate import (CONDITIONS, DelData, GPSurrogate, LookupTable, SurrogateComparison, SurrogatePrediction,
                         compare_surrogates, del_data, fit_gp, fit_lut)
@@ -74,18 +74,3 @@ __all__ = [
     # lifetime
     "DEL_CHANNELS", "WindClimate", "weibull_bins", "wind_climate", "LifetimeDEL", "lifetime",
 ]
-
-#: names that moved to :mod:`specdesign.cli` (campaign files are the command line's business)
-_MOVED_TO_CLI = ("ConfigError", "read_config", "load_controller", "run_config")
-
-
-def __getattr__(name):
-    if name in _MOVED_TO_CLI:
-        import warnings
-
-        warnings.warn(f"specdesign.validate.{name} moved to specdesign.cli.{name}; import it from there",
-                      DeprecationWarning, stacklevel=2)
-        from .. import cli
-
-        return getattr(cli, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -5,18 +5,17 @@ load numba.
 """
 from __future__ import annotations
 
+from .. import turbine
+from ..simulate import ScheduledController, is_lti_like
+
 
 def has_linear_form(c) -> bool:
     """True for controllers with a frequency response (LTI-like or scheduled), False for callables."""
-    from ..simulate import ScheduledController, is_lti_like
-
     return isinstance(c, ScheduledController) or is_lti_like(c)
 
 
 def rotor_radius(model):
     """The model's rotor radius (m); the embedded IEA 15 MW's for a model without one."""
     if model is None or not hasattr(model, "rotor_radius"):
-        from .. import turbine
-
         return turbine.iea15mw().rotor_radius
     return model.rotor_radius

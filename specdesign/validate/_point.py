@@ -7,7 +7,17 @@ import warnings
 
 import numpy as np
 
-from ..closedloop import unstable_message, unstable_poles
+from .. import wind as wmod
+from .._blas import on_one_blas_thread
+from ..closedloop import ClosedLoopUnstableWarning, unstable_message, unstable_poles
+from ..simulate import (
+    SimulationDivergedError,
+    SimulationResult,
+    simulate,
+    turbine_plant,
+    wind_series,
+)
+from ..simulate.checks import checked_loop
 from ._loop import has_linear_form, rotor_radius
 from .metrics import INDICATORS, indicators
 from .prediction import closed_loop_response, linear_prediction, prediction_grid
@@ -33,6 +43,10 @@ def _nan_point(out, omega, n_seeds, linear_twin, volterra):
         out["ppsd"][k].append(np.full(omega.size, np.nan))
 
 
+# BLAS on one thread in every task, wherever it runs: a campaign's results must not depend on
+# the thread count of the process running it (a dask worker's differs from the client's, and a
+# threaded BLAS reduction may sum in another order)
+@on_one_blas_thread
 def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
                     turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0, torque_control="auto"):
     """One wind speed, every controller, the same seeds: indicators, per-seed spectra, predictions.
@@ -43,11 +57,6 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
     for the compiled controllers; a callable one commands the torque itself (or holds the
     trim torque), so it runs with "auto" unless None is asked.
     """
-    from .. import wind as wmod
-    from ..closedloop import ClosedLoopUnstableWarning
-    from ..simulate import SimulationDivergedError, SimulationResult, simulate, turbine_plant, wind_series
-    from ..simulate.checks import checked_loop
-
     n_keep = len(seeds) if keep_series is True else int(keep_series)
     radius = rotor_radius(model)
     wdt = record_dt
@@ -72,8 +81,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
                 r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
                              record_dt=record_dt, transient=transient, torque_control=tc)
             except SimulationDivergedError as err:
-                warnings.warn(f"{err}; campaign results of {name!r} at {v:g} m/s are NaN", ClosedLoopUnstableWarning,
-                              stacklevel=3)
+                warnings.warn(f"controller {name!r}: {err}; campaign results of {name!r} at {v:g} m/s are NaN",
+                              ClosedLoopUnstableWarning, stacklevel=3)
                 bad = np.array([np.nan])
         out["unstable"].append(bool(bad.size))
         if r is None:
@@ -90,8 +99,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
                                   record_dt=record_dt, transient=transient, linear=True)
                     lin = indicators(rl.outputs, rl.dt, m).as_dict()
                 except SimulationDivergedError as err:  # keep the nonlinear results: only the twin is NaN
-                    warnings.warn(f"{err}; the linear twin of {name!r} at {v:g} m/s is NaN", ClosedLoopUnstableWarning,
-                                  stacklevel=3)
+                    warnings.warn(f"controller {name!r}: {err}; the linear twin of {name!r} at {v:g} m/s is NaN",
+                                  ClosedLoopUnstableWarning, stacklevel=3)
             for k, val in lin.items():
                 out["linear"].setdefault(k, []).append(val[0])
         if volterra:

@@ -3,176 +3,33 @@ indicators, Welch spectra, linear and Volterra predictions, with the up-front ch
 refuse a bad step before the first simulation."""
 from __future__ import annotations
 
+import concurrent.futures as cf
 import dataclasses
+import queue
 import sys
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
+from tqdm.auto import tqdm
 
+from .. import turbine
+from .._blas import on_one_blas_thread
 from .._checks import positive_scalar
+from ..controller.torque import TorqueLaw
+from ..fatigue import TOWER_M
+from ..simulate import SimulationResult, check_step, turbine_plant
+from ..simulate.checks import checked_loop
 from ._loop import has_linear_form
+from .campaign_record import Campaign
 from ._point import SPECTRA, campaign_point
 from .metrics import INDICATORS
-from .stats import PairedChange, paired_change
+from .openfast_campaign import run_openfast_campaign
+from .stats import PairedChange, paired_change, seeds_from
+from .store import CampaignStore, fingerprint
 
-__all__ = ["Campaign", "run_campaign", "concat_campaigns", "seeds_from", "check_plant_step", "check_campaign_step"]
-
-
-def seeds_from(seeds) -> np.ndarray:
-    """The seeds of a campaign, in a campaign file and in :func:`run_campaign` alike.
-
-    Parameters
-    ----------
-    seeds : int or sequence of int
-        An integer n means the n seeds 0, 1, …, n − 1; a sequence lists distinct integer seeds.
-
-    Returns
-    -------
-    numpy.ndarray
-        (S,) int64 seeds.
-
-    Raises
-    ------
-    ValueError
-        An integer below 1, an empty sequence, a non-integer or repeated seed.
-
-    Examples
-    --------
-    >>> seeds_from(3).tolist(), seeds_from([7, 2]).tolist()
-    ([0, 1, 2], [7, 2])
-    """
-    if isinstance(seeds, (int, np.integer)) and not isinstance(seeds, bool):
-        if seeds < 1:
-            raise ValueError(f"seeds={seeds!r}: an integer n means the seeds 0..n−1 and must be ≥ 1")
-        return np.arange(int(seeds), dtype=np.int64)
-    items = list(np.atleast_1d(np.asarray(seeds, dtype=object)))
-    if not items or not all(isinstance(s, (int, np.integer)) and not isinstance(s, bool) for s in items):
-        raise ValueError(f"seeds must be an integer n (the seeds 0..n−1) or a non-empty list of integers, got {seeds!r}")
-    out = np.asarray(items, dtype=np.int64)
-    if len(set(out.tolist())) != out.size:
-        raise ValueError(f"seeds must be distinct, got {out.tolist()}")
-    return out
-
-
-@dataclass(frozen=True, eq=False)  # array fields: compare by identity
-class Campaign:
-    """Results of controllers × wind speeds × seeds (paired: every controller saw the same seeds).
-
-    Parameters
-    ----------
-    controllers : tuple of str
-        Controller names, in order (C).
-    wind_speeds : numpy.ndarray
-        (W,) wind speeds (m/s).
-    seeds : numpy.ndarray
-        (S,) seeds.
-    duration : float
-        Record length (s).
-    dt : float
-        Sample spacing of the records (s).
-    m : float
-        Wöhler exponent of the DEL.
-    values : dict
-        Indicator → (C, W, S) per-run values (units: :class:`~specdesign.validate.Indicators`).
-    predicted_del : numpy.ndarray
-        (C, W) linear prediction of the tower-base DEL (Dirlik on |T|²S_W, N·m); NaN for
-        controllers without a linear form (callables).
-    omega : numpy.ndarray
-        (nω,) Welch grid (rad/s).
-    welch : dict
-        Output → (C, W, nω) seed-averaged Welch PSD (SI² per rad/s).
-    predicted_psd : dict
-        Output → (C, W, nω) |T|²S_W on the same grid.
-    series : dict, optional
-        Controller → :class:`~specdesign.simulate.SimulationResult` (W, k, n) of the first k
-        seeds kept (``keep_series``), else {}.
-    linear_values : dict, optional
-        Like ``values``, from the same seeds run through the *linearised* model
-        (``run_campaign(linear_twin=True)``; NaN for controllers without a linear form), else
-        {}. It splits the prediction error into the spectral method's part and the plant's
-        nonlinearity (:func:`~specdesign.validate.acceptance`).
-    volterra_values : dict, optional
-        Like ``values``, from the Volterra series of order ``volterra_order``
-        (:func:`~specdesign.validate.volterra_response`) on the same wind
-        (``run_campaign(volterra=k)``; NaN for controllers without a linear form), else {}: a
-        prediction that includes the aerodynamic nonlinearity, still made from the linear loop.
-    volterra_order : int, default 0
-        Order of ``volterra_values`` (0: none).
-    unstable : numpy.ndarray, optional
-        (C, W) bool: the controller destabilises the linearised loop or its simulation
-        diverged at that wind speed; its values and predictions there are NaN (with a warning
-        when the campaign ran), and the tables print "unstable". Default: all False.
-
-    See Also
-    --------
-    run_campaign : Runs one.
-    concat_campaigns : Joins campaigns over different wind speeds.
-    """
-
-    controllers: tuple
-    wind_speeds: np.ndarray
-    seeds: np.ndarray
-    duration: float
-    dt: float
-    m: float
-    values: dict = field(repr=False)
-    predicted_del: np.ndarray = field(repr=False)
-    omega: np.ndarray = field(repr=False)
-    welch: dict = field(repr=False)
-    predicted_psd: dict = field(repr=False)
-    series: dict = field(default_factory=dict, repr=False)
-    linear_values: dict = field(default_factory=dict, repr=False)
-    volterra_values: dict = field(default_factory=dict, repr=False)
-    volterra_order: int = 0
-    unstable: np.ndarray | None = field(default=None, repr=False)
-
-    def __post_init__(self):
-        if self.unstable is None:
-            object.__setattr__(self, "unstable", np.zeros((len(self.controllers), np.size(self.wind_speeds)), bool))
-
-    def index(self, controller: str) -> int:
-        """Position of a controller in :attr:`controllers`.
-
-        Parameters
-        ----------
-        controller : str
-            Its name.
-
-        Returns
-        -------
-        int
-            Index along the first axis of the arrays.
-
-        Raises
-        ------
-        ValueError
-            A name that is not in the campaign.
-        """
-        if controller not in self.controllers:
-            raise ValueError(f"controller {controller!r} not in the campaign {self.controllers}")
-        return self.controllers.index(controller)
-
-    def change(self, designed: str, baseline: str, indicator: str = "tower_del", **kw) -> PairedChange:
-        """:func:`~specdesign.validate.paired_change` of ``indicator`` between two controllers.
-
-        Parameters
-        ----------
-        designed, baseline : str
-            Controller names.
-        indicator : str, default "tower_del"
-            The indicator compared.
-        **kw
-            ``method``, ``n_boot``, ``seed`` of :func:`~specdesign.validate.paired_change`.
-
-        Returns
-        -------
-        PairedChange
-            Change (%) and SE (pp) per wind speed.
-        """
-        i, j = self.index(designed), self.index(baseline)
-        return paired_change(self.values[indicator][i], self.values[indicator][j], indicator, m=self.m,
-                             wind_speeds=self.wind_speeds, **kw)
+__all__ = ["run_campaign", "concat_campaigns", "check_plant_step", "check_campaign_step"]
 
 
 def check_plant_step(model, wind_speeds, dt: float) -> None:
@@ -193,8 +50,6 @@ def check_plant_step(model, wind_speeds, dt: float) -> None:
         ``dt`` is too large for the fastest mode of the linearised plant at some wind speed
         (the message gives the largest step it allows).
     """
-    from ..simulate import check_step, turbine_plant
-
     check_step(turbine_plant(model), np.asarray(wind_speeds, float), dt)
 
 
@@ -222,9 +77,6 @@ def check_campaign_step(model, controllers: Mapping, wind_speeds, dt: float) -> 
         ``dt`` is not positive, too large for the plant (:func:`check_plant_step`), or one at
         which a controller's sampled loop is unstable (naming the controller).
     """
-    from ..simulate import check_step, turbine_plant
-    from ..simulate.checks import checked_loop
-
     dt = positive_scalar(dt, "dt")
     plant = turbine_plant(model)
     if plant.linearize is None:
@@ -240,8 +92,9 @@ def check_campaign_step(model, controllers: Mapping, wind_speeds, dt: float) -> 
                 raise ValueError(f"campaign controller {name!r}: {err}") from None
 
 
+@on_one_blas_thread  # the tasks' own limit (campaign_point) nests in it: two local threads never undo it
 def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, duration: float = 600.0, dt: float = 0.02,
-                 record_dt: float = 0.1, transient: float = 60.0, m: float = 4.0, predict: bool = True,
+                 record_dt: float = 0.1, transient: float = 60.0, m: float = TOWER_M, predict: bool = True,
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
                  volterra: int = 0, executor=None, progress: bool | None = None,
                  nperseg: int | None = None, store=None, torque_control="auto", plant=None,
@@ -312,8 +165,10 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         runs already there and simulates only the missing ones: an interrupted campaign
         resumes, and one given more seeds, speeds or controllers runs only those. The
         result is bitwise that of an uninterrupted run. A store holding other settings,
-        another model or another controller under the same name is refused. With an
-        OpenFAST ``plant``: the campaign folder (a folder per run, resumable).
+        another model or another controller under the same name is refused; a stored cell
+        that fails verification (unreadable, another cell's coordinates, its checksum) is
+        recomputed with a RuntimeWarning naming its file. With an OpenFAST ``plant``: the
+        campaign folder (a folder per run, resumable).
     torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, default "auto"
         Generator torque of the simulations (:func:`specdesign.simulate.simulate`): "auto"
         runs the model's torque law below rated and holds the trim torque above; "rosco"
@@ -330,7 +185,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         is the deck's; the predictions are NaN.
     openfast : dict, optional
         With ``plant``: further options of ``run_openfast_campaign`` (``processes``,
-        ``grid_points``, ``hydro``, ``timeout``, ``nice``, ``install``, ``dt``).
+        ``grid_points``, ``hydro``, ``cpu_limit``, ``timeout``, ``nice``, ``install``, ``dt``).
 
     Returns
     -------
@@ -350,15 +205,14 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     if not isinstance(controllers, dict) or not controllers:
         raise TypeError("controllers must be a non-empty dict {name: controller}")
     if plant is not None:
-        from .openfast_campaign import run_openfast_campaign  # openfast-io and the executables: only when asked
-
+        if linear_twin or volterra or executor is not None:
+            raise ValueError("linear_twin, volterra and executor are options of the reduced model's campaign, not of "
+                             "an OpenFAST plant (its processes: openfast={'processes': n})")
         return run_openfast_campaign(controllers, wind_speeds, seeds, deck=plant, duration=duration, transient=transient,
                                      record_dt=record_dt, m=m, turbulence_class=turbulence_class,
                                      keep_series=keep_series, nperseg=nperseg, progress=progress, folder=store,
                                      **dict(openfast or {}))
     if model is None:
-        from .. import turbine
-
         model = turbine.iea15mw()
     vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
     seeds = seeds_from(seeds)
@@ -376,16 +230,12 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                 "linear_twin": bool(linear_twin),
                 "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg),
                 "torque_control": _torque_setting(torque_control)}
-    from ..simulate import turbine_plant
-
     if torque_control == "rosco" and turbine_plant(model).torque_law is None:
         raise ValueError("torque_control='rosco' needs a model with a torque law (a TurbineModel with torque_control, "
                          "e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw or torque_control='auto'")
     wanted = [(float(v), int(s), n) for v in vs for s in seeds for n in names]
     records, st = {}, None
     if store is not None:
-        from .store import CampaignStore, fingerprint
-
         st = CampaignStore(store, settings, fingerprint(model), {n: fingerprint(c) for n, c in controllers.items()})
         records = st.load(wanted)
     kept = set(seeds[:n_keep].tolist())
@@ -404,8 +254,6 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         for todo, group in groups.items():
             tasks.append((float(v), np.asarray(todo, dtype=np.int64), tuple(group)))
     show = (sys.stderr.isatty()) if progress is None else bool(progress)
-    from tqdm.auto import tqdm
-
     bar = tqdm(total=sum(t[1].size * len(t[2]) for t in tasks), desc="validation", unit="run", disable=not show)
 
     def args(task):
@@ -441,8 +289,6 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                 t = todo.pop(0)
                 finish(t, campaign_point(*args(t)))
             if len(todo) > 1 and _overlap(controllers):
-                import concurrent.futures as cf
-
                 with cf.ThreadPoolExecutor(2) as pool:
                     collect(pool, todo)
             else:
@@ -462,8 +308,6 @@ def _overlap(controllers) -> bool:
     the order. Only for controllers with a linear form (a callable may keep state between the
     steps of a run: two runs at once would share it) and under a numba threading layer that
     takes calls from two threads at once (OpenMP, TBB; not the workqueue)."""
-    import numba
-
     try:
         layer = numba.threading_layer()
     except ValueError:  # no parallel kernel has run in this process
@@ -473,11 +317,7 @@ def _overlap(controllers) -> bool:
 
 def _torque_setting(torque_control):
     """``torque_control`` as a JSON-serialisable store setting (a law by its fingerprint), checked up front."""
-    from ..rosco.torque import TorqueLaw
-
     if isinstance(torque_control, TorqueLaw):
-        from .store import fingerprint
-
         return "law:" + fingerprint(torque_control)
     if torque_control is None or (isinstance(torque_control, str) and torque_control in ("auto", "rosco")):
         return torque_control
@@ -487,9 +327,6 @@ def _torque_setting(torque_control):
 def _as_completed(futures):
     """Futures in the order they finish: concurrent.futures ones, or any with ``add_done_callback``
     (a dask.distributed Client's own futures)."""
-    import concurrent.futures as cf
-    import queue
-
     if all(isinstance(f, cf.Future) for f in futures):
         yield from cf.as_completed(futures)
         return
@@ -538,8 +375,6 @@ def _assemble(records, names, vs, seeds, settings) -> Campaign:
     series = {}
     n_keep = len(seeds) if settings["keep_series"] is True else settings["keep_series"]
     if n_keep:
-        from ..simulate import SimulationResult
-
         for ci, name in enumerate(names):
             kept = [[c["series"] for c in row[:n_keep]] for row in cell[ci]]
             ok = next((r for row in kept for r in row if r is not None), None)

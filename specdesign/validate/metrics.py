@@ -8,14 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import positive_scalar
+from ..fatigue import BLADE_M, TOWER_M, del_rainflow
 
-__all__ = ["BLADE_M", "INDICATORS", "Indicators", "indicators"]
+__all__ = ["INDICATORS", "Indicators", "indicators"]
 
 #: Names of the indicators, in the order of :meth:`Indicators.as_dict` and of the output files.
 INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "blade_del")
-
-#: Wöhler exponent of the blade-root DEL (composite blade root, the usual m = 10).
-BLADE_M = 10.0
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
@@ -68,7 +66,7 @@ class Indicators:
         return {k: getattr(self, k) for k in INDICATORS}
 
 
-def indicators(series: Mapping, dt: float, m: float = 4.0) -> Indicators:
+def indicators(series: Mapping, dt: float, m: float = TOWER_M) -> Indicators:
     """Compute the indicators of every run in ``series``.
 
     Parameters
@@ -104,8 +102,6 @@ def indicators(series: Mapping, dt: float, m: float = 4.0) -> Indicators:
     >>> float(indicators(s, 0.1).mean_power)
     15000000.0
     """
-    from ..fatigue import del_rainflow
-
     dt = positive_scalar(dt, "dt")
     m = positive_scalar(m, "m")
     get = series.__getitem__

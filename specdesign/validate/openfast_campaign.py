@@ -19,15 +19,20 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
 
+from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
 from ..openfast.series import series_from_openfast
 from ..openfast.turbsim import TURBSIM_GRID, turbsim_field
+from ..rosco.discon import rosco_library
+from ..simulate import SimulationResult
+from ..turbine import iea15mw
 from ._point import SPECTRA
-from .campaign import Campaign, seeds_from
+from .campaign_record import Campaign
 from .metrics import INDICATORS, indicators
-from .stats import welch_psd
+from .stats import seeds_from, welch_psd
 
 __all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES"]
 
@@ -46,10 +51,14 @@ class DisconController:
         The compiled ``DISCON`` library.
     parameters : pathlib.Path
         The file it reads at initialisation (ServoDyn's ``DLL_InFile``).
+    dt : float or None
+        Its sample time (s), ServoDyn's ``DLL_DT`` (an exported design's ``dt``); None: the
+        deck's (ROSCO is called every time step).
     """
 
     library: Path
     parameters: Path
+    dt: float | None = None
 
 
 def as_discon(controller) -> DisconController:
@@ -77,7 +86,6 @@ def as_discon(controller) -> DisconController:
         The library or parameter file does not exist.
     """
     if isinstance(controller, (str, Path)):
-        from ..rosco.discon import rosco_library  # the rosco package is optional
 
         lib, par = rosco_library(), Path(controller)
     elif hasattr(controller, "library") and hasattr(controller, "parameters"):
@@ -91,7 +99,8 @@ def as_discon(controller) -> DisconController:
     for key, p in (("library", lib), ("parameters", par)):
         if not p.is_file():
             raise FileNotFoundError(f"controller {key} {p} does not exist")
-    return DisconController(lib.resolve(), par.resolve())
+    dt = getattr(controller, "dt", None)
+    return DisconController(lib.resolve(), par.resolve(), None if dt is None else float(dt))
 
 
 def _sha(path: Path) -> str:
@@ -99,12 +108,13 @@ def _sha(path: Path) -> str:
 
 
 def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Deck, duration: float = 600.0,
-                          transient: float = 60.0, dt: float | None = None, record_dt: float = 0.05, m: float = 4.0,
+                          transient: float = 60.0, dt: float | None = None, record_dt: float = 0.05, m: float = TOWER_M,
                           folder=None, processes: int | None = None, progress: bool | None = None,
                           turbulence_class: str = "B", grid_points: int = TURBSIM_GRID["points"],
                           grid_size: float = TURBSIM_GRID["size"], hydro: bool = True, keep_series: bool | int = False,
                           nperseg: int | None = None, install: OpenFASTInstall | None = None,
-                          timeout: float | None = None, nice: int = 0, initial_conditions: bool = True) -> Campaign:
+                          cpu_limit: float | None = None, timeout: float | None = None, nice: int = 0,
+                          initial_conditions: bool = True) -> Campaign:
     """Run every controller at every wind speed and seed in OpenFAST with TurbSim winds.
 
     Every run is a folder ``<folder>/<controller>/<speed>mps_seed<seed>/`` holding the case
@@ -157,8 +167,10 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         Welch segment length (:func:`~specdesign.validate.welch_psd`).
     install : OpenFASTInstall, optional
         The executables; default :func:`specdesign.openfast.find_openfast`.
-    timeout : float, optional
-        Wall-clock limit per OpenFAST run (s); default :func:`specdesign.openfast.run_case`'s.
+    cpu_limit, timeout : float, optional
+        CPU-time and wall-clock limits per OpenFAST run (s); defaults those of
+        :func:`specdesign.openfast.run_case` (10 s of CPU per simulated second + 120 s; no
+        wall-clock limit).
     nice : int, default 0
         Niceness added to the OpenFAST processes.
     initial_conditions : bool, default True
@@ -217,7 +229,6 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         else:
             todo.append((run, meta))
     show = sys.stderr.isatty() if progress is None else bool(progress)
-    from tqdm.auto import tqdm
 
     bar = tqdm(total=len(runs), initial=len(results), desc="OpenFAST", unit="run", disable=not show)
     failures = {}
@@ -230,10 +241,10 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         c = discon[name]
         init = trim(v) if trim is not None else (None, None)
         case = write_case(deck, _run_folder(root, run), tmax=transient + duration, wind_speed=v, wind_file=wind.path,
-                          seed=s, library=c.library, parameters=c.parameters, dt=dt, dt_out=record_dt,
+                          seed=s, library=c.library, parameters=c.parameters, controller_dt=c.dt, dt=dt, dt_out=record_dt,
                           channels=CAMPAIGN_CHANNELS, initial_pitch=init[0], initial_rotor_speed=init[1],
                           hydro=hydro, name=f"{_slug(name)}_{v:g}mps_seed{s}")
-        out = run_case(case, install, timeout=timeout, nice=nice)
+        out = run_case(case, install, cpu_limit=cpu_limit, timeout=timeout, nice=nice)
         return _post(case, out, settings, meta, keep=s in kept, wind=wind)
 
     try:
@@ -273,7 +284,6 @@ def _trim(deck: Deck):
     IEA-15-240-RWT deck; None for another deck (its own initial conditions are kept)."""
     if not deck.name.startswith("IEA-15-240-RWT"):
         return None
-    from ..turbine import iea15mw  # heavy (builds the reduced model); only when used
 
     model = iea15mw()
 
@@ -295,13 +305,13 @@ def _run_folder(root: Path, run) -> Path:
 
 def _meta(run, c: DisconController, settings) -> dict:
     name, v, s = run
-    return {"controller": name, "wind_speed": v, "seed": s, "library_sha": _sha(c.library),
+    return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt, "library_sha": _sha(c.library),
             "parameters_sha": _sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
             "settings": settings}
 
 
 def _same(a: dict, b: dict) -> bool:
-    keys = ("controller", "wind_speed", "seed", "library_sha", "parameters_sha")
+    keys = ("controller", "wind_speed", "seed", "controller_dt", "library_sha", "parameters_sha")
     return all(a.get(k) == b.get(k) for k in keys) and a.get("settings") == b.get("settings")
 
 
@@ -378,7 +388,6 @@ def _assemble(results, names, vs, seeds, settings, n_keep) -> Campaign:
                     welch[k][ci, wi] = np.mean(acc[k], axis=0)
     series = {}
     if n_keep and keep:
-        from ..simulate import SimulationResult
 
         for name, outs in keep.items():
             series[name] = SimulationResult(time=np.arange(n) * dt, wind_speeds=vs, seeds=seeds[:n_keep],

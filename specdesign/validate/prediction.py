@@ -6,9 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import spectral, wind
 from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind, unstable_message, unstable_poles
 from ..closedloop.maps import state_space_response
+from ..fatigue import TOWER_M
+from ..simulate import turbine_plant
 from ._loop import rotor_radius
 
 __all__ = ["loop_plant", "closed_loop_response", "prediction_grid", "LinearPrediction", "linear_prediction"]
@@ -30,8 +33,6 @@ def loop_plant(model):
     KernelPlant
         The plant.
     """
-    from ..simulate import turbine_plant
-
     own = getattr(model, "kernel_plant", None)
     return own() if callable(own) else turbine_plant(model)
 
@@ -127,7 +128,7 @@ def prediction_grid(duration: float = 600.0, omega_max: float = 30.0, n: int = 3
     return np.geomspace(2 * np.pi / positive_scalar(duration, "duration"), positive_scalar(omega_max, "omega_max"), int(n))
 
 
-def linear_prediction(model, controller, wind_speed: float, *, output: str = "tower_base_my", m: float = 4.0,
+def linear_prediction(model, controller, wind_speed: float, *, output: str = "tower_base_my", m: float = TOWER_M,
                       omega=None, turbulence_class: str = "B", method: str = "dirlik") -> LinearPrediction:
     """|T_{y,w}|²·S_W and its DEL by a spectral method (Dirlik by default) at one wind speed.
 
@@ -162,8 +163,6 @@ def linear_prediction(model, controller, wind_speed: float, *, output: str = "to
         The controller destabilises the loop (naming it and the unstable poles): |T|²S_W of
         an unstable loop is finite but describes no response.
     """
-    from .. import spectral, wind
-
     bad = unstable_poles(loop_plant(model), controller, wind_speed)
     if bad.size:
         raise ValueError(unstable_message(controller, wind_speed, bad) + "; a linear prediction of an unstable loop is meaningless")

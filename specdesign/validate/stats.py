@@ -16,12 +16,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from .._checks import positive_scalar
-from .metrics import BLADE_M, INDICATORS
+from ..fatigue import BLADE_M, TOWER_M
+from .metrics import INDICATORS
 
 __all__ = ["WEIBULL_K", "WEIBULL_A", "weibull_weights", "welch_psd", "pool", "resampled_se", "PairedChange",
-           "paired_change"]
+           "paired_change", "seeds_from"]
 
 #: Weibull shape of the paper's wind climate (Table 2's mean).
 WEIBULL_K = 2.2
@@ -111,7 +113,6 @@ def welch_psd(x, dt: float, nperseg: int | None = None, axis: int = -1) -> tuple
     >>> bool(abs(np.trapezoid(p, w) - x.var()) < 0.05)
     True
     """
-    from numpy.lib.stride_tricks import sliding_window_view
     from scipy.signal import get_window
 
     x = np.moveaxis(np.asarray(x, dtype=float), axis, -1)
@@ -155,7 +156,7 @@ def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
     -------
     numpy.ndarray
         ``tower_del``: (mean DEL^m)^{1/m} (the DEL of the summed damage), ``blade_del``
-        the same with m = :data:`~specdesign.validate.metrics.BLADE_M`; ``mean_power``:
+        the same with m = :data:`~specdesign.fatigue.BLADE_M`; ``mean_power``:
         the mean; a standard deviation: √(mean of the variances).
 
     Examples
@@ -250,7 +251,7 @@ class PairedChange:
     n_seeds: int
 
 
-def paired_change(designed, baseline, indicator: str = "tower_del", *, m: float = 4.0, wind_speeds=None,
+def paired_change(designed, baseline, indicator: str = "tower_del", *, m: float = TOWER_M, wind_speeds=None,
                   method: str = "jackknife", n_boot: int = 2000, seed: int = 0) -> PairedChange:
     """Paired-seed relative change of an indicator, with jackknife (default) or bootstrap SE.
 
@@ -305,3 +306,39 @@ def paired_change(designed, baseline, indicator: str = "tower_del", *, m: float 
     est = theta(a, b)
     se = resampled_se(lambda idx: theta(a[:, idx], b[:, idx]), S, W, method, n_boot, seed)
     return PairedChange(indicator=indicator, wind_speeds=vs, change=est, se=se, method=method, n_seeds=S)
+
+
+def seeds_from(seeds) -> np.ndarray:
+    """The seeds of a campaign, in a campaign file and in :func:`run_campaign` alike.
+
+    Parameters
+    ----------
+    seeds : int or sequence of int
+        An integer n means the n seeds 0, 1, …, n − 1; a sequence lists distinct integer seeds.
+
+    Returns
+    -------
+    numpy.ndarray
+        (S,) int64 seeds.
+
+    Raises
+    ------
+    ValueError
+        An integer below 1, an empty sequence, a non-integer or repeated seed.
+
+    Examples
+    --------
+    >>> seeds_from(3).tolist(), seeds_from([7, 2]).tolist()
+    ([0, 1, 2], [7, 2])
+    """
+    if isinstance(seeds, (int, np.integer)) and not isinstance(seeds, bool):
+        if seeds < 1:
+            raise ValueError(f"seeds={seeds!r}: an integer n means the seeds 0..n−1 and must be ≥ 1")
+        return np.arange(int(seeds), dtype=np.int64)
+    items = list(np.atleast_1d(np.asarray(seeds, dtype=object)))
+    if not items or not all(isinstance(s, (int, np.integer)) and not isinstance(s, bool) for s in items):
+        raise ValueError(f"seeds must be an integer n (the seeds 0..n−1) or a non-empty list of integers, got {seeds!r}")
+    out = np.asarray(items, dtype=np.int64)
+    if len(set(out.tolist())) != out.size:
+        raise ValueError(f"seeds must be distinct, got {out.tolist()}")
+    return out

@@ -32,7 +32,17 @@ A cell file holds the scalar indicators (``tower_del``, ... ; ``linear_*`` and
 per-seed Welch spectra ``welch_<output>(omega)``, the linear prediction
 ``predicted_psd_<output>(omega)`` of its (wind speed, controller), and with ``keep_series``
 the records ``series_<output>(time)``; the scalar variables ``wind_speed`` and ``seed`` and
-the global attribute ``controller`` name the cell.
+the global attribute ``controller`` name the cell, and the global attribute ``checksum`` (SHA-256
+of the controller's name and every variable's name, shape and float64 bytes) seals it.
+
+On resume every stored cell is verified before it is used: it must read, carry the
+coordinates its file name promises (a file copied or renamed under another seed's name is
+caught) and match its checksum. A cell that fails is said (one RuntimeWarning naming the
+file and why) and recomputed, its file replaced. Opening a store writes nothing unless the
+campaign adds to it (a new store, or new controllers in the manifest), so a finished store
+in a read-only folder is read as it is; temporary files a killed writer left behind
+(``.<name>.<pid>.tmp`` of a process no longer running) are removed when the store is next
+opened for writing.
 """
 from __future__ import annotations
 
@@ -41,6 +51,8 @@ import hashlib
 import json
 import os
 import pickle
+import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -49,8 +61,14 @@ from .metrics import INDICATORS
 
 __all__ = ["CampaignStore", "fingerprint"]
 
-#: version of the layout above; a store of another version is refused
-FORMAT = 2
+#: version of the layout above; a store of another version is refused (3: per-cell checksums)
+FORMAT = 3
+#: A temporary file of :func:`_atomic_write`: ``.<name>.<pid>.tmp``.
+_TMP = re.compile(r"^\..+\.(\d+)\.tmp$")
+
+
+class CellError(ValueError):
+    """A stored cell that cannot be used (unreadable, another cell's data, a checksum mismatch)."""
 
 
 def fingerprint(obj) -> str:
@@ -117,11 +135,20 @@ class CampaignStore:
         self.path = Path(path)
         if self.path.exists() and not self.path.is_dir():
             raise ValueError(f"store={str(path)!r} is a file; give a directory (it is created if missing)")
-        (self.path / "cells").mkdir(parents=True, exist_ok=True)
+        if not (self.path / "cells").is_dir():
+            (self.path / "cells").mkdir(parents=True, exist_ok=True)
+        _remove_stale_tmp(self.path)
         manifest = {"format": FORMAT, "settings": settings, "model": model, "controllers": dict(controllers)}
         mpath = self.path / "manifest.json"
+        old = None
         if mpath.exists():
-            old = json.loads(mpath.read_text())
+            try:
+                old = json.loads(mpath.read_text())
+                if not isinstance(old, dict) or not isinstance(old.get("controllers"), dict):
+                    raise ValueError("not a JSON object with 'controllers'")
+            except (ValueError, UnicodeDecodeError) as e:
+                raise ValueError(f"{mpath}: not a readable campaign manifest ({e}); it may have been truncated: "
+                                 "remove the store's folder to start afresh, or give another store path") from None
             for key in ("format", "settings", "model"):
                 if old.get(key) != manifest[key]:
                     raise ValueError(f"store {str(path)!r} holds a campaign with another {key} ({old.get(key)!r}, now "
@@ -131,7 +158,8 @@ class CampaignStore:
                     raise ValueError(f"store {str(path)!r}: controller {name!r} differs from the one stored under that "
                                      "name; rename it or give another store path")
             manifest["controllers"] = {**old["controllers"], **controllers}
-        _atomic_write(mpath, lambda p: p.write_text(json.dumps(manifest, indent=1, sort_keys=True)))
+        if manifest != old:  # never rewritten on a read: a finished store in a read-only folder opens
+            _atomic_write(mpath, lambda p: p.write_text(json.dumps(manifest, indent=1, sort_keys=True)))
         self._rows = {}
 
     @staticmethod
@@ -167,13 +195,24 @@ class CampaignStore:
         -------
         dict
             (v, seed, controller) → cell record (the form :meth:`~specdesign.validate.store.CampaignStore.write` takes) for every
-            wanted cell that is stored; missing ones are absent.
+            wanted cell that is stored and verified; missing ones are absent, and so are
+            those that fail verification (the caller recomputes them).
+
+        Warns
+        -----
+        RuntimeWarning
+            For each stored cell that fails verification (truncated or unreadable, another
+            cell's coordinates, a checksum mismatch): the file and the reason.
         """
         out = {}
         for cell in cells:
             f = self.path / "cells" / self.cell_file(*cell)
             if f.exists():
-                out[cell] = _read_cell(f)
+                try:
+                    out[cell] = _read_cell(f, cell)
+                except CellError as e:
+                    warnings.warn(f"campaign store: {f}: {e}; the cell is recomputed", RuntimeWarning, stacklevel=2)
+                    continue
                 self._rows[cell] = _index_row(cell, f.name, out[cell])
         return out
 
@@ -210,41 +249,95 @@ def _index_row(cell, name, rec):
             *(float(rec["values"][k]) for k in INDICATORS)]
 
 
+def _remove_stale_tmp(path: Path) -> None:
+    """Remove the temporary files of writers no longer running (a killed campaign's); a live
+    process's are left alone, and a folder that cannot be written is left as it is."""
+    for folder in (path, path / "cells"):
+        try:
+            names = [p for p in folder.iterdir() if _TMP.match(p.name)]
+        except OSError:
+            continue
+        for p in names:
+            pid = int(_TMP.match(p.name).group(1))
+            try:
+                os.kill(pid, 0)  # signal 0: does the process exist (no signal is sent)
+                continue  # still running: its file
+            except ProcessLookupError:
+                pass
+            except (PermissionError, OverflowError):  # another user's live process, or no such pid
+                continue
+            try:
+                p.unlink()
+            except OSError:
+                pass
+
+
+def _checksum(controller: str, var: dict) -> str:
+    """SHA-256 of a cell: the controller's name and every variable's name, shape and float64 bytes."""
+    h = hashlib.sha256(str(controller).encode())
+    for k in sorted(var):
+        a = np.ascontiguousarray(var[k], dtype="<f8")
+        h.update(f"\0{k}\0{a.shape}\0".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
 def _write_cell(path, cell, rec):
     from scipy.io import netcdf_file
 
     v, seed, controller = cell
+    # (type, dimension, value) of every variable, in file order; the checksum is over these
+    var = {"wind_speed": ("d", (), float(v)), "seed": ("i", (), int(seed)), "omega": ("d", ("omega",), rec["omega"])}
+    scalars = {"predicted_del": rec["pred"]}
+    for group, prefix in (("values", ""), ("linear", "linear_"), ("volterra", "volterra_")):
+        scalars.update({prefix + k: x for k, x in rec[group].items()})
+    var.update({k: ("d", (), float(x)) for k, x in scalars.items()})
+    var["unstable"] = ("b", (), int(rec["unstable"]))
+    for k in rec["welch"]:
+        var[f"welch_{k}"] = ("d", ("omega",), rec["welch"][k])
+        var[f"predicted_psd_{k}"] = ("d", ("omega",), rec["ppsd"][k])
+    s = rec["series"]
+    if s is not None:
+        var["series_dt"] = ("d", (), float(s["dt"]))
+        var["series_sim_dt"] = ("d", (), float(s["sim_dt"]))
+        var["series_time"] = ("d", ("time",), s["time"])
+        var.update({f"series_{k}": ("d", ("time",), x) for k, x in s["outputs"].items()})
     with netcdf_file(path, "w", version=2) as f:
         # numbers as variables, not attributes: scipy writes a float attribute as float32
         f.controller = str(controller)
-        f.createVariable("wind_speed", "d", ())[...] = float(v)
-        f.createVariable("seed", "i", ())[...] = int(seed)
+        f.checksum = _checksum(controller, {k: np.asarray(x, dtype=float) for k, (_, _, x) in var.items()})
         f.createDimension("omega", rec["omega"].size)
-        f.createVariable("omega", "d", ("omega",))[:] = rec["omega"]
-        scalars = {"predicted_del": rec["pred"]}
-        for group, prefix in (("values", ""), ("linear", "linear_"), ("volterra", "volterra_")):
-            scalars.update({prefix + k: x for k, x in rec[group].items()})
-        for k, x in scalars.items():
-            f.createVariable(k, "d", ())[...] = float(x)
-        f.createVariable("unstable", "b", ())[...] = int(rec["unstable"])
-        for k in rec["welch"]:
-            f.createVariable(f"welch_{k}", "d", ("omega",))[:] = rec["welch"][k]
-            f.createVariable(f"predicted_psd_{k}", "d", ("omega",))[:] = rec["ppsd"][k]
-        s = rec["series"]
         if s is not None:
-            f.createVariable("series_dt", "d", ())[...] = float(s["dt"])
-            f.createVariable("series_sim_dt", "d", ())[...] = float(s["sim_dt"])
             f.createDimension("time", s["time"].size)
-            f.createVariable("series_time", "d", ("time",))[:] = s["time"]
-            for k, x in s["outputs"].items():
-                f.createVariable(f"series_{k}", "d", ("time",))[:] = x
+        for k, (typ, dims, x) in var.items():
+            f.createVariable(k, typ, dims)[...] = x
 
 
-def _read_cell(path):
+def _read_cell(path, cell=None):
+    """The record of a cell file, verified: it reads, carries ``cell``'s coordinates (when
+    given) and its checksum; CellError otherwise."""
     from scipy.io import netcdf_file
 
-    with netcdf_file(path, "r", mmap=False) as f:
-        var = {k: np.array(x.data, dtype=float) for k, x in f.variables.items()}
+    try:
+        with netcdf_file(path, "r", mmap=False) as f:
+            var = {k: np.array(x.data, dtype=float) for k, x in f.variables.items()}
+            controller = f.controller.decode() if isinstance(f.controller, bytes) else str(f.controller)
+            stored = getattr(f, "checksum", b"")
+    except Exception as e:  # a truncated file fails in scipy's reader with whatever it met: ValueError, OSError, ...
+        raise CellError(f"unreadable ({type(e).__name__}: {e})") from None
+    stored = stored.decode() if isinstance(stored, bytes) else str(stored)
+    if cell is not None:
+        v, seed, name = cell
+        here = (float(var.get("wind_speed", np.nan)), float(var.get("seed", np.nan)), controller)
+        if here != (float(v), float(seed), name):
+            raise CellError(f"holds the cell (wind speed {here[0]!r} m/s, seed {here[1]:g}, controller {here[2]!r}), not "
+                            f"the one its name stands for ({float(v)!r} m/s, seed {int(seed)}, {name!r})")
+    if stored != _checksum(controller, var):
+        raise CellError("its data do not match its checksum (changed after it was written)" if stored else
+                        "it has no checksum")
+    for k in ("omega", "predicted_del", "unstable"):
+        if k not in var:
+            raise CellError(f"lacks the variable {k!r}")
     rec = {"values": {}, "linear": {}, "volterra": {}, "welch": {}, "ppsd": {}, "omega": var["omega"],
            "pred": float(var["predicted_del"]), "unstable": bool(var["unstable"]), "series": None}
     for k, x in var.items():

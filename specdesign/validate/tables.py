@@ -11,8 +11,18 @@ from pathlib import Path
 
 import numpy as np
 
-from .campaign import Campaign
-from .stats import WEIBULL_A, WEIBULL_K, paired_change, pool, resampled_se, weibull_weights
+from ..fatigue import TOWER_M
+from .campaign_record import Campaign
+from .lifetime_del import lifetime
+from .prediction import linear_prediction
+from .stats import (
+    WEIBULL_A,
+    WEIBULL_K,
+    paired_change,
+    pool,
+    resampled_se,
+    weibull_weights,
+)
 
 __all__ = ["Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance"]
 
@@ -172,8 +182,6 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
     w = weibull_weights(campaign.wind_speeds, k, scale)
     life = None
     if climate is not None:
-        from .lifetime_del import lifetime
-
         life = lifetime(campaign, climate, controllers=(baseline, designed), m=campaign.m)
     rows = []
     for ind in ("gen_speed_sd", "mean_power", "tower_del", "pitch_sd", "pitch_rate_sd"):
@@ -183,7 +191,8 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
         if life is not None:
             row += (_lifetime_cell(campaign, designed, baseline, ind, life),)
         rows.append((_LABELS[ind], row))
-    note = (f"Relative change 100·(X_{designed}/X_{baseline} − 1) over {campaign.seeds.size} paired seeds of "
+    note = (f"Relative change 100·(X_{designed}/X_{baseline} − 1), negative: lower than {baseline} (Table 3 gives "
+            f"the DEL's as a reduction, positive), over {campaign.seeds.size} paired seeds of "
             f"{campaign.duration:g} s; DEL with m = {campaign.m:g}, 1 Hz. Mean: weighted by the Weibull pdf "
             f"(k = {k}, A = {scale} m/s) at the operating points, normalised.")
     marks = _unstable_marks(campaign, designed, baseline)
@@ -440,8 +449,9 @@ def table3(campaign: Campaign, designed: str, baseline: str, *, promised: Mappin
     return Table(
         title=f"Table 3: tower-base fatigue (DEL) reduction, {designed} vs {baseline}",
         columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
-        note=f"{acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with m = {campaign.m:g} at 1 Hz; "
-             "linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
+        note=f"Reduction 100·(1 − DEL_{designed}/DEL_{baseline}), positive: lower than {baseline} (Table 2 gives "
+             f"it as a change, negative); {acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with "
+             f"m = {campaign.m:g} at 1 Hz; linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
         row_fmt=tuple(pp),
         marks=_unstable_marks(campaign, designed, baseline),
     )
@@ -456,7 +466,7 @@ def _at(controller, v, what):
     return controller
 
 
-def linear_table3(model, designed, wind_speeds, *, baseline=None, promised: Mapping | None = None, m: float = 4.0,
+def linear_table3(model, designed, wind_speeds, *, baseline=None, promised: Mapping | None = None, m: float = TOWER_M,
                   turbulence_class: str = "B", name: str = "designed") -> Table:
     """The linear rows of the paper's Table 3, without simulation: promised and predicted DEL reduction.
 
@@ -505,8 +515,6 @@ def linear_table3(model, designed, wind_speeds, *, baseline=None, promised: Mapp
     0.0
     """
     from ..spec import baseline_controller
-    from .prediction import linear_prediction
-
     vs = [float(v) for v in np.atleast_1d(np.asarray(wind_speeds, float))]
     pred = []
     for v in vs:

@@ -9,8 +9,11 @@ import numpy as np
 
 from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind
+from ..fatigue import TOWER_M, del_rainflow
+from ..simulate import wind_series
+from ..turbine import OUTPUT_NAMES
 from ._loop import has_linear_form, rotor_radius
-from .stats import pool
+from .stats import pool, seeds_from
 
 __all__ = ["volterra_response", "VolterraPrediction", "volterra_prediction"]
 
@@ -29,7 +32,7 @@ def volterra_response(model, controller, wind_speed: float, wind, dt: float, *, 
     the ``aero_torque`` and ``thrust`` inputs) to ½ z₁ᵀ H z₁, the quadratic loads along the
     linear trajectory z₁. Term 3 is its response to z₁ᵀ H z₂ + D³[z₁, z₁, z₁]/6, z₂ the
     second-order trajectory. Each product is formed in the time domain and filtered by FFT,
-    so ``wind`` must be periodic over its record (as :func:`specdesign.wind.synthesize`
+    so ``wind`` must be periodic over its record (as :func:`specdesign.wind.gaussian_series`
     makes it); no time stepping. With the aerodynamic nonlinearity of class-B turbulence the
     series to third order matches the tower-base DEL of the nonlinear simulation within a few
     tenths of a percent (docs/nonlinearity.md, section (i)).
@@ -65,8 +68,6 @@ def volterra_response(model, controller, wind_speed: float, wind, dt: float, *, 
         An order outside 1-3, an unknown output, a non-finite or too short wind record, or a
         non-positive ``dt``.
     """
-    from ..turbine import OUTPUT_NAMES
-
     if not hasattr(model, "aero_expansion"):
         raise TypeError(f"model must be a turbine.TurbineModel (with aero_expansion), got {type(model).__name__}")
     if order not in (1, 2, 3):
@@ -152,7 +153,7 @@ class VolterraPrediction:
 
 
 def volterra_prediction(model, controller, wind_speed: float, *, seeds=range(1000, 1200), duration: float = 600.0,
-                        dt: float = 0.1, order: int = 3, m: float = 4.0, output: str = "tower_base_my",
+                        dt: float = 0.1, order: int = 3, m: float = TOWER_M, output: str = "tower_base_my",
                         turbulence_class: str = "B", chunk: int = 50) -> VolterraPrediction:
     """DEL of ``output`` predicted by the Volterra series over synthetic periodic wind records.
 
@@ -201,10 +202,6 @@ def volterra_prediction(model, controller, wind_speed: float, *, seeds=range(100
     TypeError
         See :func:`volterra_response`.
     """
-    from ..fatigue import del_rainflow
-    from ..simulate import wind_series
-    from .campaign import seeds_from  # the campaign's meaning of seeds (an int n → 0..n−1)
-
     seeds = seeds_from(seeds)
     duration, dt, m = positive_scalar(duration, "duration"), positive_scalar(dt, "dt"), positive_scalar(m, "m")
     dels, sq = [], []

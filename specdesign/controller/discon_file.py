@@ -16,30 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["DisconEntry", "DisconSchedule", "iea15mw_discon", "read_discon", "from_discon", "write_discon"]
-
-
-def iea15mw_discon() -> Path:
-    """Path of the shipped DISCON.IN of the IEA 15 MW monopile (ROSCO 2.9.4 tuning).
-
-    Its ``PerfFileName`` points outside the package: it reads as a schedule
-    (:func:`from_discon`) but the compiled ROSCO cannot run it as it is.
-
-    Returns
-    -------
-    pathlib.Path
-        ``specdesign/data/iea15mw/IEA-15-240-RWT-Monopile_DISCON.IN``.
-
-    Examples
-    --------
-    >>> iea15mw_discon().name
-    'IEA-15-240-RWT-Monopile_DISCON.IN'
-    """
-    from importlib import resources
-
-    from ..turbine.tables import DATA_DIR
-
-    return Path(str(resources.files("specdesign").joinpath(f"{DATA_DIR}/IEA-15-240-RWT-Monopile_DISCON.IN")))
+__all__ = ["DisconEntry", "DisconSchedule", "read_discon", "from_discon", "write_discon"]
 
 
 @dataclass(frozen=True)
@@ -88,6 +65,7 @@ def read_discon(path: str | Path) -> tuple[dict, str | None]:
 
     Examples
     --------
+    >>> from specdesign.rosco import iea15mw_discon
     >>> entries, version = read_discon(iea15mw_discon())
     >>> version, entries["PC_GS_n"].values
     ('2.9.4', ('30',))
@@ -169,6 +147,16 @@ class DisconSchedule:
         ``VS_RefSpd`` (HSS rad/s).
     rotor_radius : float
         ``WE_BladeRadius`` (m).
+    td_mode : int, optional
+        ``TD_Mode``: 0 no tower damper (default), 1 ROSCO's fore-aft damper (pitch +=
+        ``FA_KI`` × ∫ high-passed tower-top fore-aft acceleration, saturated at ``FA_IntSat``).
+    fa_ki : float, optional
+        ``FA_KI`` (rad·s/m): the damper's integral gain on acceleration, i.e. its gain on
+        tower-top velocity.
+    fa_hpf_corner : float, optional
+        ``FA_HPFCornerFreq`` (rad/s): corner of the first-order high-pass on the acceleration.
+    fa_int_sat : float, optional
+        ``FA_IntSat`` (rad): saturation of the damper's pitch contribution.
     """
 
     path: str
@@ -194,6 +182,10 @@ class DisconSchedule:
     generator_efficiency: float
     rated_generator_speed: float
     rotor_radius: float
+    td_mode: int = 0
+    fa_ki: float = 0.0
+    fa_hpf_corner: float = 0.0
+    fa_int_sat: float = 0.0
 
     def gains(self, pitch: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(K_p, K_i) at ``pitch`` as ROSCO interpolates them: linear, held at the table ends.
@@ -212,6 +204,7 @@ class DisconSchedule:
 
         Examples
         --------
+        >>> from specdesign.rosco import iea15mw_discon
         >>> s = from_discon(iea15mw_discon())
         >>> bool(s.gains(s.pitch[0])[0] == s.kp[0])
         True
@@ -264,6 +257,7 @@ def from_discon(path: str | Path) -> DisconSchedule:
 
     Examples
     --------
+    >>> from specdesign.rosco import iea15mw_discon
     >>> s = from_discon(iea15mw_discon())
     >>> s.pitch.size, round(s.filter_corner, 4), s.reference_speed
     (30, 1.0081, 0.79168)
@@ -299,6 +293,18 @@ def from_discon(path: str | Path) -> DisconSchedule:
     if vals["VS_GenEff"] > 100:
         raise ValueError(f"{p}: line {entries['VS_GenEff'].line}: VS_GenEff = {vals['VS_GenEff']} is a percentage "
                          "(at most 100)")
+    # ROSCO's tower damper (Controllers.f90, ForeAftDamping): read only when it is on, as
+    # ROSCO itself skips FA_* with TD_Mode = 0 (ReadSetParameters.f90).
+    td_mode = num("TD_Mode", integer=True) if "TD_Mode" in entries else 0
+    if td_mode not in (0, 1):
+        raise ValueError(f"{p}: line {entries['TD_Mode'].line}: TD_Mode = {td_mode} must be 0 or 1")
+    tower = {}
+    if td_mode == 1:
+        tower = {"fa_ki": num("FA_KI"), "fa_hpf_corner": num("FA_HPFCornerFreq"), "fa_int_sat": num("FA_IntSat")}
+        for k, f in (("FA_KI", "fa_ki"), ("FA_HPFCornerFreq", "fa_hpf_corner"), ("FA_IntSat", "fa_int_sat")):
+            if not tower[f] > 0:
+                raise ValueError(f"{p}: line {entries[k].line}: {k} = {tower[f]!r} must be positive with TD_Mode = 1 "
+                                 "(set TD_Mode = 0 to switch the tower damper off)")
     return DisconSchedule(
         path=p, version=version, pitch=angles, kp=kp, ki=ki, filter_type=ftype,
         filter_corner=vals["F_LPFCornerFreq"], filter_damping=vals["F_LPFDamping"],
@@ -308,7 +314,7 @@ def from_discon(path: str | Path) -> DisconSchedule:
         vs_control_mode=num("VS_ControlMode", integer=True), vs_const_power=num("VS_ConstPower", integer=True),
         rated_torque=vals["VS_RtTq"], max_torque=vals["VS_MaxTq"], rated_power=vals["VS_RtPwr"],
         generator_efficiency=vals["VS_GenEff"] / 100.0, rated_generator_speed=vals["VS_RefSpd"],
-        rotor_radius=vals["WE_BladeRadius"],
+        rotor_radius=vals["WE_BladeRadius"], td_mode=td_mode, **tower,
     )
 
 
@@ -340,6 +346,7 @@ def write_discon(source: str | Path, target: str | Path, **values) -> Path:
     Examples
     --------
     >>> import tempfile
+    >>> from specdesign.rosco import iea15mw_discon
     >>> out = write_discon(iea15mw_discon(), Path(tempfile.mkdtemp()) / "DISCON.IN", PS_Mode=0)
     >>> read_discon(out)[0]["PS_Mode"].values
     ('0',)

@@ -13,6 +13,10 @@ generator speed low-passed by the filter the pitch controller uses (``F_LPFType`
   reference speed (P/η/K)^{1/3} or (T/K)^{1/2}, low-passed at ``F_VSRefSpdCornerFreq`` and held
   between ``VS_MinOMSpd`` and ``VS_RefSpd``; its output is limited to [``VS_MinTq``, ``VS_RtTq``].
   In steady state both track T = K·Ω² between the two speeds.
+* ``VS_ConstPower = 1`` (``const_power``): above rated (state 5 of ROSCO's state machine) the
+  torque holds the rated power, P_rated/(η·Ω_f) on the filtered speed Ω_f, instead of the
+  rated torque, and every mode's torque ceiling is min(P_rated/(η·Ω_f), ``VS_MaxTq``) instead of
+  ``VS_RtTq`` (``VariableSpeedControl`` of ``Controllers.f90``).
 * ``VS_ControlMode = 2`` tracks the TSR from ROSCO's wind-speed estimator (an extended Kalman
   filter of the rotor) which the workbench does not model: :func:`torque_law_from_discon`
   refuses it unless told to read the file's gains as mode 3 (``mode=3``).
@@ -21,10 +25,12 @@ Setpoint smoothing (``SS_Mode = 1``) shifts the references apart so the two loop
 fight near rated: ΔΩ = Ω_pc·[(β − β_min)/0.524·``SS_VSGain`` − (P_rated − P)/P_rated·``SS_PCGain``],
 low-passed at ``F_SSCornerFreq``; a positive shift lowers the torque reference, a negative one
 raises the pitch controller's. Torque is then limited to [``VS_MinTq``, min(``VS_MaxTq``,
-``VS_RtTq``)] and to the rate ``VS_MaxRat``. PIs are ROSCO's: forward Euler integrator
+``VS_RtTq``)] (with constant power min(``VS_MaxTq``, P_rated/(η·Ω_f))) and to the rate
+``VS_MaxRat``. PIs are ROSCO's: forward Euler integrator
 saturated at the output limits. Filters are ROSCO's Tustin forms, reset to their input on
-the first call. Peak shaving (``PS_Mode``, a minimum pitch from the estimated wind) is not
-modelled: the pitch limit is the model's.
+the first call. Peak shaving (``PS_Mode``, a minimum pitch ``PS_BldPitchMin`` interpolated at
+the wind speed estimated by ROSCO's extended Kalman filter) is not modelled, the estimator being
+outside the workbench: the pitch limit is the model's, and :func:`torque_law_from_discon` warns.
 
 All quantities here are on the rotor (low-speed) shaft in SI: a DISCON.IN's generator-side
 speeds are divided by its gearbox ratio N, torques multiplied by it (K by N³, PI gains by N²).
@@ -32,6 +38,7 @@ speeds are divided by its gearbox ratio N, torques multiplied by it (K by N³, P
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -44,7 +51,7 @@ from .discon_file import read_discon
 if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
 
-__all__ = ["TORQUE_MODES", "TORQUE_PARAMS", "TORQUE_STATES", "TORQUE_REGIONS", "TorqueLaw", "torque_law",
+__all__ = ["TORQUE_MODES", "TORQUE_PARAMS", "TORQUE_STATES", "TORQUE_REGIONS", "TRIM_TOL", "TorqueLaw", "torque_law",
            "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step"]
 
 #: Regions of a trim (:attr:`specdesign.turbine.OperatingPoint.region`): "1.5" minimum speed held
@@ -58,18 +65,22 @@ TORQUE_MODES = (1, 3, 4)
 # Layout of the flat parameter array of torque_step (TorqueLaw.params()).
 (T_MODE, T_K, T_KP, T_KI, T_MIN_SPEED, T_VS_REF, T_PC_REF, T_RATED_TQ, T_MAX_TQ, T_AR_SAT, T_MIN_TQ, T_MAX_RATE,
  T_RATED_POWER, T_GEN_EFF, T_FILT_TYPE, T_FILT_CORNER, T_FILT_DAMP, T_REF_CORNER, T_SS_MODE, T_SS_VS, T_SS_PC,
- T_SS_CORNER, T_PC_SWITCH, T_PITCH_MIN) = range(24)
+ T_SS_CORNER, T_PC_SWITCH, T_PITCH_MIN, T_CONST_POWER) = range(25)
 #: Length of :meth:`TorqueLaw.params`.
-TORQUE_PARAMS = 24
+TORQUE_PARAMS = 25
 # Layout of the state array of torque_step.
 (S_WF, S_WF2, S_U1, S_U2, S_REF, S_REF_U, S_SSF, S_SS_U, S_IAR, S_IBR, S_AR, S_BR, S_STATE, S_TQ, S_PLAST) = range(15)
 #: Length of the state array of :func:`torque_step`.
 TORQUE_STATES = 16
+#: brentq's ``xtol`` and ``rtol`` for a trim's rotor speed (rad/s) and pitch (rad), here and in
+#: :meth:`specdesign.turbine.TurbineModel.trim`: a few ulps of values near 1, so a trim is
+#: converged to what float64 holds.
+TRIM_TOL = 1e-14
 
 
 @dataclass(frozen=True)
 class TorqueLaw:
-    """ROSCO's generator-torque controller, on the rotor shaft (see :mod:`specdesign.rosco.torque`).
+    """ROSCO's generator-torque controller, on the rotor shaft (see :mod:`specdesign.controller.torque`).
 
     Parameters
     ----------
@@ -120,6 +131,9 @@ class TorqueLaw:
         ``PC_Switch`` (rad): region 3 from the minimum pitch plus this.
     fine_pitch : float, optional
         ``PC_FinePit`` (rad), the pitch below rated.
+    const_power : bool, optional
+        ``VS_ConstPower``: above rated hold the rated power (torque P_rated/(η·Ω_f), N·m, capped
+        at ``max_torque``) instead of the rated torque.
     name : str, optional
         Label.
     """
@@ -148,6 +162,7 @@ class TorqueLaw:
     ss_corner: float = 0.6283
     pitch_switch: float = 0.01745
     fine_pitch: float = 0.0
+    const_power: bool = False
     name: str = "ROSCO torque"
 
     def __post_init__(self):
@@ -168,11 +183,6 @@ class TorqueLaw:
         """ROSCO's ``VS_MinOMTq`` = K·Ω_min², the torque at the start of region 2 (N·m)."""
         return self.k_opt * self.min_speed**2
 
-    @property
-    def max_speed_torque(self) -> float:
-        """ROSCO's ``VS_MaxOMTq`` = K·Ω_ref², the torque at the end of region 2 (N·m)."""
-        return self.k_opt * self.reference_speed**2
-
     def params(self) -> np.ndarray:
         """Flat float64 parameter array of :func:`torque_step`.
 
@@ -184,35 +194,13 @@ class TorqueLaw:
         p = np.zeros(TORQUE_PARAMS)
         p[[T_MODE, T_K, T_KP, T_KI, T_MIN_SPEED, T_VS_REF, T_PC_REF, T_RATED_TQ, T_MAX_TQ, T_AR_SAT, T_MIN_TQ,
            T_MAX_RATE, T_RATED_POWER, T_GEN_EFF, T_FILT_TYPE, T_FILT_CORNER, T_FILT_DAMP, T_REF_CORNER, T_SS_MODE,
-           T_SS_VS, T_SS_PC, T_SS_CORNER, T_PC_SWITCH, T_PITCH_MIN]] = [
+           T_SS_VS, T_SS_PC, T_SS_CORNER, T_PC_SWITCH, T_PITCH_MIN, T_CONST_POWER]] = [
             self.mode, self.k_opt, self.kp, self.ki, self.min_speed, self.reference_speed, self.pitch_reference_speed,
             self.rated_torque, self.max_torque, self.transition_torque, self.min_torque, self.max_rate,
             self.rated_power, self.generator_efficiency, self.filter_type, self.filter_corner, self.filter_damping,
             self.reference_corner, float(self.setpoint_smoothing), self.ss_vs_gain, self.ss_pc_gain, self.ss_corner,
-            self.pitch_switch, self.fine_pitch]
+            self.pitch_switch, self.fine_pitch, float(self.const_power)]
         return p
-
-    def steady_torque(self, omega: float) -> float:
-        """The torque this law holds in steady state at rotor speed ``omega`` in region 2.
-
-        Parameters
-        ----------
-        omega : float
-            Rotor speed (rad/s).
-
-        Returns
-        -------
-        float
-            K·Ω² (N·m).
-
-        Examples
-        --------
-        >>> from specdesign.turbine import iea15mw
-        >>> law = iea15mw().torque_control
-        >>> bool(law.steady_torque(law.reference_speed) == law.max_speed_torque)
-        True
-        """
-        return self.k_opt * float(omega) ** 2
 
 
 def torque_law(model: TurbineModel, *, mode: int = 1, omega_vs: float = 0.12, zeta_vs: float = 0.85,
@@ -307,20 +295,21 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
     ------
     ValueError
         For a missing or non-numeric key (file, line and key named), a mode outside
-        :data:`TORQUE_MODES` (mode 2: pass ``mode=3``), or ``VS_ConstPower``, ``VS_FBP`` or
-        ``PRC_Mode`` not 0 (laws the workbench does not run).
+        :data:`TORQUE_MODES` (mode 2: pass ``mode=3``), ``VS_ConstPower`` not 0 or 1, or
+        ``VS_FBP`` or ``PRC_Mode`` not 0 (laws the workbench does not run).
 
     Warns
     -----
     UserWarning
-        For ``PS_Mode`` not 0: peak shaving is not modelled (the pitch limit is the model's).
+        For ``PS_Mode`` not 0, naming the file, line and key: peak shaving is not modelled (the
+        pitch limit is the model's).
 
     Examples
     --------
     >>> import warnings
     >>> from specdesign.rosco import iea15mw_discon
     >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore")  # its PS_Mode = 1
+    ...     warnings.simplefilter("ignore", UserWarning)  # its PS_Mode = 1: peak shaving not modelled
     ...     law = torque_law_from_discon(iea15mw_discon(), mode=1)
     >>> law.mode, round(law.min_speed, 4)
     (1, 0.5236)
@@ -338,15 +327,21 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
         raise ValueError(f"{p}: line {line}: VS_ControlMode = {use} is not run by the workbench (modes {TORQUE_MODES}); "
                          "mode 2 tracks the TSR from ROSCO's wind-speed estimator, which is not modelled: pass mode=3 "
                          "to run the file's PI on the power-based reference")
-    for key in ("VS_ConstPower", "VS_FBP", "PRC_Mode"):  # they change the law itself: not run here
+    for key in ("VS_FBP", "PRC_Mode"):  # they change the law itself: not run here
         if key in entries and int(f(key)) != 0:
             raise ValueError(f"{p}: line {entries[key].line}: {key} = {int(f(key))} is not modelled (the workbench "
-                             "runs constant torque above rated, variable pitch, no power-reference tracking); set it to 0")
+                             "runs variable pitch, no power-reference tracking); set it to 0")
+    const_power = int(f("VS_ConstPower", 0.0))
+    if const_power not in (0, 1):
+        raise ValueError(f"{p}: line {entries['VS_ConstPower'].line}: VS_ConstPower = {const_power} must be 0 "
+                         "(constant torque above rated) or 1 (constant power)")
     if "PS_Mode" in entries and int(f("PS_Mode")) != 0:
-        import warnings
-
-        warnings.warn(f"{p}: PS_Mode = {int(f('PS_Mode'))}: peak shaving (a minimum pitch from ROSCO's wind-speed "
-                      "estimate) is not modelled; the pitch limit is the model's", UserWarning, stacklevel=2)
+        warnings.warn(f"{p}: line {entries['PS_Mode'].line}: PS_Mode = {int(f('PS_Mode'))}: peak shaving (ROSCO's "
+                      "minimum pitch PS_BldPitchMin at its wind-speed estimate WE_Vw_F, an extended Kalman filter the "
+                      "workbench does not model) is not modelled; the pitch limit is the model's. Where the pitch "
+                      "dips to that table it matters (the NREL 5 MW's deck: 6 % in tower DEL at 19 m/s, "
+                      "docs/turbines.md); compare with the compiled DISCON on write_discon(path, out, PS_Mode=0)",
+                      UserWarning, stacklevel=2)
     n = f("WE_GearboxRatio")
     if not n > 0:
         raise ValueError(f"{p}: line {entries['WE_GearboxRatio'].line}: WE_GearboxRatio must be positive")
@@ -359,7 +354,7 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
         filter_damping=f("F_LPFDamping"), reference_corner=f("F_VSRefSpdCornerFreq", 0.0),
         setpoint_smoothing=bool(int(f("SS_Mode"))), ss_vs_gain=f("SS_VSGain"), ss_pc_gain=f("SS_PCGain"),
         ss_corner=f("F_SSCornerFreq"), pitch_switch=f("PC_Switch"), fine_pitch=f("PC_FinePit"),
-        name=f"ROSCO torque ({Path(p).name})",
+        const_power=bool(const_power), name=f"ROSCO torque ({Path(p).name})",
     )
 
 
@@ -372,7 +367,9 @@ def steady_state(model: TurbineModel, law: TorqueLaw, wind_speed: float) -> tupl
     (2.5) until the torque reaches ``transition_torque``, and then the speed floats where
     Q(Ω) equals that torque (2.5s). K·Ω² is capped at min(``rated_torque``, ``max_torque``):
     if it reaches the cap below ``reference_speed`` (the IEA 15 MW's ROSCO tuning does, at
-    0.72 rad/s) region 2.5 never engages and the speed floats at that torque (2.5s). Modes 3 and 4 track the same curve in steady state.
+    0.72 rad/s) region 2.5 never engages and the speed floats at that torque (2.5s). With
+    constant power (``const_power``) the cap is min(``max_torque``, P/(η·Ω)) instead. Modes 3 and
+    4 track the same curve in steady state.
 
     Parameters
     ----------
@@ -421,18 +418,31 @@ def steady_state(model: TurbineModel, law: TorqueLaw, wind_speed: float) -> tupl
         return lo, t, beta, "1.5"
     # K·Ω² is capped at the torque limit: where it reaches it before the reference speed (the
     # IEA 15 MW's tuning does), the torque saturates there and the speed floats up to rated
-    cap = min(law.rated_torque, law.max_torque)
-    top = min(hi, math.sqrt(cap / law.k_opt))
+    # (with constant power the limit is min(VS_MaxTq, P/(η·Ω)), a function of the speed)
+    p_eta = law.rated_power / law.generator_efficiency
+
+    def ceiling(om):
+        return min(law.max_torque, p_eta / om) if law.const_power else min(law.rated_torque, law.max_torque)
+
+    if law.const_power:  # K·Ω² meets P/(η·Ω) at Ω³ = P/(η·K)
+        top = min(hi, math.sqrt(law.max_torque / law.k_opt), (p_eta / law.k_opt) ** (1.0 / 3.0))
+    else:
+        top = min(hi, math.sqrt(ceiling(hi) / law.k_opt))
     if g(top) < 0:
-        om = brentq(g, lo, top, xtol=1e-14, rtol=1e-14)
+        om = brentq(g, lo, top, xtol=TRIM_TOL, rtol=TRIM_TOL)
         return float(om), law.k_opt * float(om) ** 2, beta, "2"
+    limit = ceiling
     if top == hi:
         t = q(hi)
-        cap = min(cap, law.transition_torque)
-        if t <= cap:
+
+        def limit(om):
+            return min(ceiling(om), law.transition_torque)
+
+        if t <= limit(hi):
             return hi, t, beta, "2.5"
-    om = brentq(lambda w: q(w) - cap, top, max(float(model.rated_rotor_speed), hi) * 1.5, xtol=1e-14, rtol=1e-14)
-    return float(om), cap, beta, "2.5s"
+    om = brentq(lambda w: q(w) - limit(w), top, max(float(model.rated_rotor_speed), hi) * 1.5, xtol=TRIM_TOL,
+                rtol=TRIM_TOL)
+    return float(om), limit(float(om)), beta, "2.5s"
 
 
 def close_torque_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, law: TorqueLaw, omega: float,
@@ -442,7 +452,9 @@ def close_torque_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray
     The law's dT/dΩ enters A through the torque column b_T of B: region 2, T = K·Ω², gives
     A + b_T·2KΩ·e₀ᵀ (modes 3 and 4 as the curve they track in steady state); regions 1.5 and
     2.5, the PI on a constant reference, add its integral z as a state: δT = −k_p·δΩ + z,
-    ż = −k_i·δΩ; region 2.5s (PI saturated) and 3 leave the torque constant. The speed
+    ż = −k_i·δΩ; region 2.5s (PI saturated) leaves the torque constant, and so does region 3
+    unless the law holds constant power (``const_power``): T = P/(η·Ω) gives
+    A − b_T·P/(η·Ω²)·e₀ᵀ. The speed
     filter (corner 1 rad/s, well above the torque loop's 0.1-0.2 rad/s), the torque rate limit
     and setpoint smoothing (inactive in steady state below rated) are left out.
 
@@ -470,6 +482,9 @@ def close_torque_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray
     bt, dtq = B[:, 2:3], D[:, 2:3]
     if region == "2":
         s = 2.0 * law.k_opt * omega
+        return A + s * bt @ e0, B, C + s * dtq @ e0, D, []
+    if region == "3" and law.const_power:
+        s = -law.rated_power / (law.generator_efficiency * omega**2)
         return A + s * bt @ e0, B, C + s * dtq @ e0, D, []
     if region in ("1.5", "2.5"):
         Aa = np.block([[A - law.kp * bt @ e0, bt], [-law.ki * e0, np.zeros((1, 1))]])
@@ -508,7 +523,7 @@ def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):
 @njit(cache=True)
 def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitch: float, dt: float,
                 first: bool) -> tuple[float, float]:
-    """One step of ROSCO's torque controller (compiled; :mod:`specdesign.rosco.torque`).
+    """One step of ROSCO's torque controller (compiled; :mod:`specdesign.controller.torque`).
 
     Parameters
     ----------
@@ -598,6 +613,10 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
              - (tq[T_RATED_POWER] - st[S_PLAST]) / tq[T_RATED_POWER] * tq[T_SS_PC]) * tq[T_PC_REF]
         st[S_SSF] = _lpf1(st, S_SSF, S_SS_U, d, tq[T_SS_CORNER], dt, first)
     last = st[S_TQ]
+    # VS_ConstPower: the rated power on the filtered speed above rated, and as every mode's ceiling
+    const_power = tq[T_CONST_POWER] != 0.0
+    power_torque = tq[T_RATED_POWER] / tq[T_GEN_EFF] / wf
+    ceiling = min(power_torque, tq[T_MAX_TQ]) if const_power else tq[T_RATED_TQ]
     if mode == 1:
         ar = _pi(err, tq[T_KP], tq[T_KI], max_om, tq[T_AR_SAT], dt, max_om, st, S_IAR, first)
         br = _pi(err_br, tq[T_KP], tq[T_KI], tq[T_MIN_TQ], min_om, dt, min_om, st, S_IBR, first)
@@ -610,12 +629,12 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         elif state == 3:
             t = ar
         elif state == 4:
-            t = tq[T_RATED_TQ]
+            t = power_torque if const_power else tq[T_RATED_TQ]
         else:  # ROSCO's error state leaves the torque as it was
             t = last
     else:
-        t = _pi(err, tq[T_KP], tq[T_KI], tq[T_MIN_TQ], tq[T_RATED_TQ], dt, last, st, S_IAR, first)
-    t = min(max(t, tq[T_MIN_TQ]), min(tq[T_MAX_TQ], tq[T_RATED_TQ]))
+        t = _pi(err, tq[T_KP], tq[T_KI], tq[T_MIN_TQ], ceiling, dt, last, st, S_IAR, first)
+    t = min(max(t, tq[T_MIN_TQ]), min(tq[T_MAX_TQ], ceiling))
     if not first:
         r = tq[T_MAX_RATE] * dt
         t = min(max(t, last - r), last + r)

@@ -10,6 +10,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from loopshaping.freqresp import as_siso
+
 from .._checks import positive_scalar
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -22,7 +24,6 @@ __all__ = [
     "split_integrator",
     "SLOW_OMEGA",
     "split_slow",
-    "controller_bank",
 ]
 
 
@@ -67,8 +68,6 @@ def as_lti(c: object, name: str) -> control.LTI:
         If it is not SISO, or is discrete-time.
     """
     import control
-
-    from loopshaping.freqresp import as_siso
 
     if hasattr(c, "tf") and callable(c.tf) and not isinstance(c, control.LTI):
         c = c.tf()
@@ -223,93 +222,3 @@ def split_slow(controller: object, omega: float = SLOW_OMEGA) -> tuple[control.S
     slow = control.ss(T[:k, :k], Bt[:k], Ct[:, :k], np.zeros_like(D))
     fast = control.ss(T[k:, k:], Bt[k:], Ct[:, k:], D) if k < n else control.ss([], [], [], D)
     return slow, fast
-
-
-_BANKS: dict = {}
-
-
-def controller_bank(controller: object, dt: float) -> tuple:
-    """Discrete arrays of one controller (K local 2-input controllers) and its filter corner.
-
-    Memoised per (controller object, dt): a campaign simulates the same controllers at
-    every wind speed, and discretising a 15-point ROSCO schedule costs more than a run.
-
-    Parameters
-    ----------
-    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
-        The controller (an LTI is one local controller at scheduling pitch 0).
-    dt : float
-        Simulation step (s).
-
-    Returns
-    -------
-    tuple
-        ``(schedule_pitch, mats, filter_omega, pi)``: the (K,) scheduling pitches (rad); per
-        local controller ``(A, B, C, D, r, ns)`` of its output-blended part, discrete at ``dt``
-        (inputs speed error and negated tower-top velocity; ``r`` the pitch controller's
-        integrator gain, run apart, see :func:`split_integrator`; its first ``ns`` states the
-        modes of the rest under :data:`SLOW_OMEGA`, :func:`split_slow`); the scheduling filter
-        corner (rad/s); and the scheduled-PI arrays ``(kp, ki, Af, Bf, Cf, Df, limits)`` of
-        ``form="gains"`` or None (limits (2,) in rad, ±inf for none).
-
-    Raises
-    ------
-    TypeError, ValueError
-        For a controller that is not a continuous SISO LTI or a ScheduledController, or an
-        improper one.
-    """
-    key = (id(controller), float(dt))
-    hit = _BANKS.get(key)
-    if hit is not None and hit[0] is controller:
-        return hit[1]
-    out = _make_bank(controller, dt)
-    if len(_BANKS) > 64:
-        _BANKS.clear()
-    _BANKS[key] = (controller, out)
-    return out
-
-
-def _make_bank(controller, dt):
-    """(schedule_pitch, per-local (A, B, C, D, r, ns) of the output-blended part (r: the
-    pitch controller's integrator gain, run apart, see :func:`split_integrator`; its first ns
-    states: the modes of the rest under SLOW_OMEGA, :func:`split_slow`), filter corner,
-    scheduled-PI arrays (kp, ki, Af, Bf, Cf, Df, limits) or None; limits (2,) in rad, ±inf
-    for none).
-
-    In ``form="gains"`` the local pitch controllers are not in the blended bank (only the ATD
-    locals are); the PI runs as one filter, one integrator and interpolated gains."""
-    from .schedule import ScheduledController
-
-    if not isinstance(controller, ScheduledController):
-        controller = ScheduledController(np.zeros(1), (as_lti(controller, "controller"),), None, name="controller")
-    gains = controller.form == "gains"
-    none = (np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1))
-    done = {}  # id → (system, its Tustin matrices): a schedule often holds one ATD at every local
-
-    def tustin(c):
-        hit = done.get(id(c))
-        if hit is None:
-            hit = done[id(c)] = (c, tustin_matrices(c, dt))  # the system held: its id stays its own
-        return hit[1]
-
-    mats = []
-    for k in range(controller.schedule_pitch.size):
-        cb, ca = controller.local(k)
-        r, rest = (0.0, None) if gains else split_integrator(cb)
-        slow, rest = (None, rest) if gains or r == 0.0 else split_slow(rest)
-        As, Bs, Cs, Ds = none if slow is None else tustin_matrices(slow, dt)  # states first: the kernel's ns
-        Ab, Bb, Cb, Db = none if gains else tustin_matrices(rest, dt)
-        Aa, Ba, Ca, Da = none if ca is None else tustin(ca)
-        ns, nb, na = As.shape[0], Ab.shape[0], Aa.shape[0]
-        nt = ns + nb + na
-        A = np.zeros((nt, nt))
-        A[:ns, :ns], A[ns:ns + nb, ns:ns + nb], A[ns + nb:, ns + nb:] = As, Ab, Aa
-        B = np.zeros((nt, 2))
-        B[:ns, 0], B[ns:ns + nb, 0], B[ns + nb:, 1] = Bs, Bb, Ba
-        mats.append((A, B, np.concatenate([Cs, Cb, Ca]), np.array([(Ds[0] if ns else 0.0) + Db[0], Da[0]]), r, ns))
-    pi = None
-    if gains:
-        Af, Bf, Cf, Df = tustin_matrices(controller.error_filter, dt)
-        lim = (-np.inf, np.inf) if controller.pitch_limits is None else controller.pitch_limits
-        pi = (controller.kp, controller.ki, Af, Bf, Cf, Df, np.array(lim, dtype=float))
-    return controller.schedule_pitch, mats, controller.filter_omega, pi

@@ -1,7 +1,8 @@
 """Gain-scheduled controllers: local controllers scheduled on the filtered pitch command.
 
 :class:`ScheduledController` in its two forms (output blending of designed locals, ROSCO's
-gain-scheduled PI) and :func:`scheduled`, which builds one from controllers designed per wind
+gain-scheduled PI) and :func:`controller_bank`, its discrete arrays for the compiled loop.
+:func:`specdesign.turbine.plant.scheduled` builds one from controllers designed per wind
 speed. See :mod:`specdesign.simulate` for how the simulator runs them and
 :func:`specdesign.rosco.rosco_scheduled` for ROSCO's.
 """
@@ -15,9 +16,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
-from .controllers import as_lti
+from .lti import as_lti, split_integrator, split_slow, tustin_matrices
 
-__all__ = ["SCHEDULE_FILTER_OMEGA", "FORMS", "ScheduledController", "scheduled", "schedule_filter_coefficients"]
+__all__ = ["SCHEDULE_FILTER_OMEGA", "FORMS", "ScheduledController", "schedule_filter_coefficients", "controller_bank"]
 
 #: Default low-pass corner of the scheduling pitch filter (rad/s): slow enough that the
 #: scheduling variable follows the mean operating point rather than the turbulence
@@ -214,65 +215,6 @@ class ScheduledController:
                    filter_damping=filter_damping)
 
 
-def scheduled(model: object, pitch: dict, atd: dict | None = None, *, filter_omega: float = SCHEDULE_FILTER_OMEGA,
-              name: str = "designed") -> ScheduledController:
-    """Build an output-blended ScheduledController from controllers designed per wind speed.
-
-    Each controller is scheduled at the trim pitch of its wind speed.
-
-    Parameters
-    ----------
-    model : TurbineModel or KernelPlant
-        The plant whose trim gives each wind speed's scheduling pitch.
-    pitch : dict
-        Wind speed (m/s) → pitch controller C_β (LTI or ``loopshaping`` Controller).
-    atd : dict or None, optional
-        Wind speed (m/s) → ATD controller, same keys, or None.
-    filter_omega : float, optional
-        Corner of the scheduling filter (rad/s).
-    name : str, optional
-        Label used in tables and figures.
-
-    Returns
-    -------
-    ScheduledController
-        The controller in ``form="output"``.
-
-    Raises
-    ------
-    TypeError
-        If ``pitch`` is not a non-empty dict.
-    ValueError
-        If ``atd`` has other wind speeds than ``pitch``, or a wind speed is outside the model's range.
-
-    Examples
-    --------
-    >>> from specdesign.turbine import iea15mw, rosco_baseline
-    >>> m = iea15mw()
-    >>> sc = scheduled(m, {15.0: rosco_baseline(m, 15.0), 21.0: rosco_baseline(m, 21.0)})
-    >>> sc.schedule_pitch.size
-    2
-    """
-    if not isinstance(pitch, dict) or not pitch:
-        raise TypeError("pitch must be a non-empty dict {wind_speed_m_s: controller}")
-    if atd is not None and set(atd) != set(pitch):
-        raise ValueError(f"atd must have the same wind speeds as pitch: {sorted(pitch)} vs {sorted(atd)}")
-    from .core import turbine_plant
-
-    plant = turbine_plant(model)
-    vs = sorted(pitch)
-    b = np.array([plant.trim(v)[1] for v in vs])
-    order = np.argsort(b)
-    vs = [vs[i] for i in order]
-    return ScheduledController(
-        schedule_pitch=b[order],
-        pitch=tuple(as_lti(pitch[v], f"pitch[{v}]") for v in vs),
-        atd=None if atd is None else tuple(as_lti(atd[v], f"atd[{v}]") for v in vs),
-        filter_omega=filter_omega,
-        name=name,
-    )
-
-
 def schedule_filter_coefficients(omega: float, damping: float | None, dt: float) -> np.ndarray:
     """Coefficients of the discrete scheduling filter the simulator runs on the pitch command.
 
@@ -312,3 +254,91 @@ def schedule_filter_coefficients(omega: float, damping: float | None, dt: float)
     wt2 = (w * dt) ** 2
     a0 = wt2 + 4.0 + 4.0 * z * w * dt
     return np.array([wt2, 2.0 * wt2, wt2, 2.0 * wt2 - 8.0, wt2 + 4.0 - 4.0 * z * w * dt]) / a0
+
+
+_BANKS: dict = {}
+
+
+def controller_bank(controller: object, dt: float) -> tuple:
+    """Discrete arrays of one controller (K local 2-input controllers) and its filter corner.
+
+    Memoised per (controller object, dt): a campaign simulates the same controllers at
+    every wind speed, and discretising a 15-point ROSCO schedule costs more than a run.
+
+    Parameters
+    ----------
+    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
+        The controller (an LTI is one local controller at scheduling pitch 0).
+    dt : float
+        Simulation step (s).
+
+    Returns
+    -------
+    tuple
+        ``(schedule_pitch, mats, filter_omega, pi)``: the (K,) scheduling pitches (rad); per
+        local controller ``(A, B, C, D, r, ns)`` of its output-blended part, discrete at ``dt``
+        (inputs speed error and negated tower-top velocity; ``r`` the pitch controller's
+        integrator gain, run apart, see :func:`split_integrator`; its first ``ns`` states the
+        modes of the rest under :data:`~specdesign.controller.lti.SLOW_OMEGA`, :func:`split_slow`); the scheduling filter
+        corner (rad/s); and the scheduled-PI arrays ``(kp, ki, Af, Bf, Cf, Df, limits)`` of
+        ``form="gains"`` or None (limits (2,) in rad, ±inf for none).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a controller that is not a continuous SISO LTI or a ScheduledController, or an
+        improper one.
+    """
+    key = (id(controller), float(dt))
+    hit = _BANKS.get(key)
+    if hit is not None and hit[0] is controller:
+        return hit[1]
+    out = _make_bank(controller, dt)
+    if len(_BANKS) > 64:
+        _BANKS.clear()
+    _BANKS[key] = (controller, out)
+    return out
+
+
+def _make_bank(controller, dt):
+    """(schedule_pitch, per-local (A, B, C, D, r, ns) of the output-blended part (r: the
+    pitch controller's integrator gain, run apart, see :func:`split_integrator`; its first ns
+    states: the modes of the rest under SLOW_OMEGA, :func:`split_slow`), filter corner,
+    scheduled-PI arrays (kp, ki, Af, Bf, Cf, Df, limits) or None; limits (2,) in rad, ±inf
+    for none).
+
+    In ``form="gains"`` the local pitch controllers are not in the blended bank (only the ATD
+    locals are); the PI runs as one filter, one integrator and interpolated gains."""
+    if not isinstance(controller, ScheduledController):
+        controller = ScheduledController(np.zeros(1), (as_lti(controller, "controller"),), None, name="controller")
+    gains = controller.form == "gains"
+    none = (np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1))
+    done = {}  # id → (system, its Tustin matrices): a schedule often holds one ATD at every local
+
+    def tustin(c):
+        hit = done.get(id(c))
+        if hit is None:
+            hit = done[id(c)] = (c, tustin_matrices(c, dt))  # the system held: its id stays its own
+        return hit[1]
+
+    mats = []
+    for k in range(controller.schedule_pitch.size):
+        cb, ca = controller.local(k)
+        r, rest = (0.0, None) if gains else split_integrator(cb)
+        slow, rest = (None, rest) if gains or r == 0.0 else split_slow(rest)
+        As, Bs, Cs, Ds = none if slow is None else tustin_matrices(slow, dt)  # states first: the kernel's ns
+        Ab, Bb, Cb, Db = none if gains else tustin_matrices(rest, dt)
+        Aa, Ba, Ca, Da = none if ca is None else tustin(ca)
+        ns, nb, na = As.shape[0], Ab.shape[0], Aa.shape[0]
+        nt = ns + nb + na
+        A = np.zeros((nt, nt))
+        A[:ns, :ns], A[ns:ns + nb, ns:ns + nb], A[ns + nb:, ns + nb:] = As, Ab, Aa
+        B = np.zeros((nt, 2))
+        B[:ns, 0], B[ns:ns + nb, 0], B[ns + nb:, 1] = Bs, Bb, Ba
+        mats.append((A, B, np.concatenate([Cs, Cb, Ca]), np.array([(Ds[0] if ns else 0.0) + Db[0], Da[0]]), r, ns))
+    pi = None
+    if gains:
+        Af, Bf, Cf, Df = tustin_matrices(controller.error_filter, dt)
+        lim = (-np.inf, np.inf) if controller.pitch_limits is None else controller.pitch_limits
+        pi = (controller.kp, controller.ki, Af, Bf, Cf, Df, np.array(lim, dtype=float))
+    return controller.schedule_pitch, mats, controller.filter_omega, pi

@@ -1,0 +1,147 @@
+"""OpenFAST campaigns with fake OpenFAST and TurbSim executables (Python scripts writing a
+binary .outb of known signals): the Campaign record, the transient cut and SI units checked
+against indicators computed directly on the same signals, a failed run reported with its case,
+seed and OpenFAST's tail while the rest is kept, resuming without rerunning, refusing a folder
+of another campaign, and the dispatch from run_campaign(plant=Deck)."""
+import math
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+pytest.importorskip("openfast_io")
+
+from specdesign.openfast import OpenFASTInstall, iea15mw_monopile
+from specdesign.validate import indicators, run_campaign
+from specdesign.validate.openfast_campaign import run_openfast_campaign
+
+# The fake OpenFAST: reads TMax and DT_Out from the .fst, the seed from the wind file's name,
+# and writes the campaign's 9 channels (OpenFAST's units) as a binary .outb (file ID 3). It
+# fails like OpenFAST when the controller's parameter file says FAIL. Each call is counted.
+_FAKE_OPENFAST = textwrap.dedent('''\
+    #!{python}
+    import math, re, struct, sys
+    from pathlib import Path
+    import numpy as np
+    fst = Path(sys.argv[1]); root = fst.stem
+    with open("{calls}", "a") as f:
+        f.write(root + "\\n")
+    def keys(p):
+        out = {{}}
+        for line in Path(p).read_text().splitlines():
+            t = line.split()
+            if len(t) > 1:
+                out.setdefault(t[1], t[0].strip('"'))
+        return out
+    k = keys(fst)
+    sd, ifw = keys(k["ServoFile"]), keys(k["InflowFile"])
+    if "FAIL" in Path(sd["DLL_InFile"]).read_text():
+        print("ROSCO:ReadControlParameterFileSub:Invalid parameter file")
+        print("Aborting OpenFAST.")
+        sys.exit(1)
+    seed = int(re.search(r"seed(\\d+)", ifw["FileName_BTS"]).group(1))
+    gain = float(Path(sd["DLL_InFile"]).read_text().split()[0])
+    dt, tmax = float(k["DT_Out"]), float(k["TMax"])
+    t = np.arange(int(round(tmax / dt)) + 1) * dt
+    w = 1.0 + 0.1 * seed
+    ch = {{"Wind1VelX": ("(m/s)", 19 + np.sin(w * t)), "BldPitch1": ("(deg)", 15 + gain * np.sin(0.3 * w * t)),
+          "RotSpeed": ("(rpm)", 7.56 + 0.1 * np.sin(w * t)), "GenSpeed": ("(rpm)", 7.56 + 0.2 * np.sin(1.3 * w * t)),
+          "GenTq": ("(kN-m)", 2e4 + 0 * t), "GenPwr": ("(kW)", 1.5e4 + 50 * np.sin(t)),
+          "TwrBsMyt": ("(kN-m)", 1e5 + gain * 2e4 * np.sin(1.1 * w * t) + 5e3 * np.sin(2.4 * t)),
+          "RootMyb1": ("(kN-m)", 3e4 + 8e3 * np.sin(0.8 * t + seed)), "YawBrTAxp": ("(m/s^2)", 0.1 * np.sin(t))}}
+    names = ["Time"] + list(ch); units = ["(s)"] + [u for u, _ in ch.values()]
+    data = np.column_stack([a for _, a in ch.values()])
+    b = struct.pack("h", 3) + struct.pack("i", data.shape[1]) + struct.pack("i", t.size)
+    b += struct.pack("d", t[0]) + struct.pack("d", dt)
+    b += struct.pack("i", 4) + b"fake"
+    b += b"".join(n.ljust(10).encode() for n in names) + b"".join(u.ljust(10).encode() for u in units)
+    b += data.astype("<f8").tobytes()
+    Path(root + ".outb").write_bytes(b)
+    print("OpenFAST terminated normally.")
+''')
+
+
+@pytest.fixture
+def fake(tmp_path, monkeypatch):
+    calls = tmp_path / "calls.txt"
+    calls.write_text("")
+    exe = tmp_path / "openfast"
+    exe.write_text(_FAKE_OPENFAST.format(python=sys.executable, calls=calls))
+    exe.chmod(0o755)
+    ts = tmp_path / "turbsim"
+    ts.write_text('#!/bin/sh\nroot="${1%.inp}"\necho bts > "$root.bts"\n')
+    ts.chmod(0o755)
+    monkeypatch.setenv("SPECDESIGN_TURBSIM_CACHE", str(tmp_path / "winds"))
+    lib = tmp_path / "libfake.so"
+    lib.write_bytes(b"\x7fELF")
+    return OpenFASTInstall(exe, ts, "5.0.0"), calls, lib
+
+
+class Exported:
+    """What an export returns: a library and a parameter file (here the fake's gain)."""
+
+    def __init__(self, library, parameters):
+        self.library, self.parameters = library, parameters
+
+
+def _controller(tmp_path, lib, name, text):
+    p = tmp_path / f"{name}.in"
+    p.write_text(text)
+    return Exported(lib, p)
+
+
+def test_campaign_in_fake_openfast(tmp_path, fake):
+    inst, calls, lib = fake
+    ctrls = {"A": _controller(tmp_path, lib, "a", "1.0"), "B": _controller(tmp_path, lib, "b", "0.5")}
+    kw = dict(deck=iea15mw_monopile(), duration=40.0, transient=10.0, record_dt=0.05, install=inst, processes=2,
+              folder=tmp_path / "camp", initial_conditions=False, keep_series=1)
+    camp = run_openfast_campaign(ctrls, [19.0], [0, 2], **kw)
+    assert camp.controllers == ("A", "B") and camp.values["tower_del"].shape == (2, 1, 2)
+    assert not camp.unstable.any() and np.isnan(camp.predicted_del).all()
+    # the same indicators computed directly on the fake's signals after the 10 s transient, in SI
+    t = 10.0 + np.arange(800) * 0.05
+    for ci, gain in enumerate((1.0, 0.5)):
+        for si, seed in enumerate((0, 2)):
+            w = 1.0 + 0.1 * seed
+            series = {"tower_base_my": 1e3 * (1e5 + gain * 2e4 * np.sin(1.1 * w * t) + 5e3 * np.sin(2.4 * t)),
+                      "gen_speed": (7.56 + 0.2 * np.sin(1.3 * w * t)) * math.pi / 30,
+                      "pitch": np.radians(15 + gain * np.sin(0.3 * w * t)), "power": 1e3 * (1.5e4 + 50 * np.sin(t)),
+                      "blade_root_my": 1e3 * (3e4 + 8e3 * np.sin(0.8 * t + seed))}
+            want = indicators({k: a[None] for k, a in series.items()}, 0.05, 4.0).as_dict()
+            for k, v in want.items():
+                assert_allclose(camp.values[k][ci, 0, si], v[0], rtol=1e-9, err_msg=f"{k} {ci} {seed}")
+    assert camp.series["A"].outputs["tower_base_my"].shape == (1, 1, 800)
+    n_calls = len(calls.read_text().split())
+    assert n_calls == 4
+    # resumed: nothing runs again, the same numbers
+    again = run_openfast_campaign(ctrls, [19.0], [0, 2], **kw)
+    assert len(calls.read_text().split()) == n_calls
+    assert_allclose(again.values["tower_del"], camp.values["tower_del"], rtol=0)
+    # another controller under a stored name is refused
+    with pytest.raises(ValueError, match="other settings or another controller under the name 'A'"):
+        run_openfast_campaign({"A": ctrls["B"]}, [19.0], [0], **kw)
+
+
+def test_failed_run_is_reported_and_the_rest_kept(tmp_path, fake):
+    inst, calls, lib = fake
+    ctrls = {"good": _controller(tmp_path, lib, "good", "1.0"), "bad": _controller(tmp_path, lib, "bad", "FAIL")}
+    with pytest.warns(RuntimeWarning, match=r"(?s)2 of 4 OpenFAST runs failed.*seed 1.*Aborting OpenFAST"):
+        camp = run_openfast_campaign(ctrls, [19.0], 2, deck=iea15mw_monopile(), duration=20.0, transient=5.0,
+                                     install=inst, folder=tmp_path / "c", initial_conditions=False)
+    assert camp.unstable.tolist() == [[False], [True]]
+    assert np.isfinite(camp.values["tower_del"][0]).all() and np.isnan(camp.values["tower_del"][1]).all()
+    assert "Invalid parameter file" in (tmp_path / "c" / "failures.txt").read_text()
+
+
+def test_run_campaign_dispatches_to_openfast(tmp_path, fake):
+    inst, calls, lib = fake
+    camp = run_campaign({"A": _controller(tmp_path, lib, "a", "1.0")}, [19.0], [3], plant=iea15mw_monopile(),
+                        duration=20.0, transient=5.0, store=tmp_path / "s",
+                        openfast={"install": inst, "initial_conditions": False})
+    assert camp.values["tower_del"].shape == (1, 1, 1) and np.isfinite(camp.values["tower_del"]).all()
+    assert (tmp_path / "s" / "A" / "19mps_seed3" / "run.json").is_file()
+    with pytest.raises(TypeError, match="export_discon"):
+        run_campaign({"lti": object()}, [19.0], [3], plant=iea15mw_monopile(), openfast={"install": inst})
