@@ -142,7 +142,8 @@ print('OpenFAST terminated normally.')""")
     cache = tmp_path / "cache"
     lt = linearize_deck(deck, [19.0], n_azimuths=1, openfast=fake, cache=cache, progress=False)
     assert isinstance(lt, LinearTurbine) and lt.wind_range == (19.0, 19.0)
-    assert set(lt.input_names) >= {"wind", "pitch_cmd"} and "tower_base_my" in lt.output_names
+    plant = lt.linearize(19.0)
+    assert set(plant.input_labels) >= {"wind", "pitch_cmd"} and "tower_base_my" in plant.output_labels
     again = linearize_deck(deck, [19.0], n_azimuths=1, openfast=fake, cache=cache, progress=False)
     assert runs.read_text() == "x"  # the second call was served from the cache
     np.testing.assert_array_equal(again.linearize(19.0).A, lt.linearize(19.0).A)

@@ -88,7 +88,7 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import positive_scalar
-from ..rosco.discon_file import from_discon, read_discon
+from ..controller.discon_file import from_discon, read_discon
 from ..turbine.openfast_deck import read_cp_table
 from .deck import _IO_LOCK, Case, Deck, OpenFASTRunError, _tail, run_case
 from .deck import _read_deck as _read_deck_cached
