@@ -335,6 +335,14 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
         sd[f"{kind}files"] = []
         vt[kind] = []
 
+    # openfast-io resolves the deck's "unused"/"none" file names to absolute paths: back to the
+    # bare word, so that a case (and its digest) does not depend on where the deck lies
+    for module in vt.values():
+        if isinstance(module, dict):
+            for key, value in module.items():
+                if isinstance(value, str) and os.path.isabs(value) and os.path.basename(value).lower() in ("unused", "none"):
+                    module[key] = os.path.basename(value)
+
     out = vt["outlist"]
     for module, channels in out.items():
         for ch in channels:
@@ -409,9 +417,14 @@ def write_linearization_case(fst_path, wind_speed: float, folder, *, fst_vt: dic
     return LinearizationCase(v, out, out / f"{_CASE}.fst", speed, torque, pitch)
 
 
+#: Files of a case that OpenFAST does not read in a linearisation (pitch control off, simple
+#: generator law: no controller library), left out of the case's digest.
+_UNREAD = ("_DISCON.IN", "_Cp_Ct_Cq.txt")
+
+
 def _digest(folder: Path, version: str) -> str:
     h = hashlib.sha256(version.encode())
-    for f in sorted(p for p in folder.rglob("*") if p.is_file()):
+    for f in sorted(p for p in folder.rglob("*") if p.is_file() and not p.name.endswith(_UNREAD)):
         h.update(str(f.relative_to(folder)).encode())
         h.update(f.read_bytes())
     return h.hexdigest()[:16]
