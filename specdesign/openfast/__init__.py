@@ -9,6 +9,8 @@
   into a cache; :class:`OpenFASTInstall`)
 - :class:`Deck`, :func:`iea15mw_monopile` (the shipped v5.0 deck), :func:`write_case`,
   :func:`run_case` (case folders written with openfast-io and run in a subprocess)
+- :func:`linearize_deck` (a deck → OpenFAST trim-and-linearise runs at several wind speeds →
+  :class:`LinearTurbine`; :func:`write_linearization_case` writes one case)
 """
 from __future__ import annotations
 
@@ -39,6 +41,9 @@ _LAZY = {
     "write_case": ".deck",
     "run_case": ".deck",
     "CAMPAIGN_CHANNELS": ".deck",
+    "linearize_deck": ".linearize",
+    "write_linearization_case": ".linearize",
+    "LinearizationCase": ".linearize",
 }
 
 __all__ = list(_LAZY)

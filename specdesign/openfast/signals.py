@@ -26,7 +26,9 @@ __all__ = ["DEFAULT_SIGNALS", "REQUIRED_SIGNALS", "INPUT_SIGNALS", "AZIMUTH_STAT
 
 #: Workbench signal → OpenFAST description (substring) or alternatives, tried in order.
 #: Inputs: ``wind`` the InflowWind horizontal (hub-height, uniform) wind speed, the
-#: rotor-effective wind of the workbench; ``pitch_cmd`` ElastoDyn's collective blade-pitch
+#: rotor-effective wind of the workbench (OpenFAST v5 files also list AeroDyn's own copy of
+#: it, "AD Extended input: horizontal wind speed", which InflowWind's drives: InflowWind's
+#: is taken first); ``pitch_cmd`` ElastoDyn's collective blade-pitch
 #: command; ``gen_torque`` ElastoDyn's generator torque. Outputs: ``gen_speed`` (GenSpeed),
 #: ``tower_base_my`` (TwrBsMyt, the tower-base fore-aft moment), ``tower_top_acc`` (the
 #: nacelle IMU fore-aft acceleration NcIMUTAxs, else YawBrTAxp), ``tower_top_vel`` (the time
@@ -34,7 +36,7 @@ __all__ = ["DEFAULT_SIGNALS", "REQUIRED_SIGNALS", "INPUT_SIGNALS", "AZIMUTH_STAT
 #: tower base, so on a floating turbine without the platform's motion), ``pitch``
 #: (BldPitch1) and ``power`` (GenPwr).
 DEFAULT_SIGNALS = {
-    "wind": ("horizontal wind speed",),
+    "wind": ("IfW Extended input: horizontal wind speed", "horizontal wind speed"),
     "pitch_cmd": ("collective blade-pitch command",),
     "gen_torque": ("ED Generator torque",),
     "gen_speed": ("GenSpeed",),
