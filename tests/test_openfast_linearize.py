@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import stat
 import sys
 import time
@@ -163,19 +162,8 @@ shutil.copy({str(outb)!r}, pathlib.Path(sys.argv[1]).stem + '.outb')""")
         linearize_deck(deck, [19.0, 19.0], openfast=fake, cache=cache)
 
 
-def _openfast_or_skip():
-    from specdesign.openfast import find_openfast
-
-    try:
-        return find_openfast(require_turbsim=False)
-    except FileNotFoundError as exc:
-        if os.environ.get("SPECDESIGN_REQUIRE_OPENFAST"):
-            raise
-        pytest.skip(f"no OpenFAST: {exc}")
-
-
 @pytest.mark.slow
-def test_openfast_linearisation_at_19_mps(deck, tmp_path):
+def test_openfast_linearisation_at_19_mps(deck, tmp_path, openfast):
     """One speed, one azimuth: OpenFAST's plant has the rotor and the tower of the references.
 
     Reference figures: rotor_linearization_reference.json (OpenFAST linearisations of the
@@ -186,7 +174,7 @@ def test_openfast_linearisation_at_19_mps(deck, tmp_path):
     simulated time (~1 min of CPU); the one linearisation takes ~4.5 min of CPU, most of it
     in the LU solve of OpenFAST's glue system on the reference BLAS (docs/openfast_linearization.md).
     """
-    install = _openfast_or_skip()
+    install = openfast  # tests/conftest.py: found, or built in CI; skipped or failed without one
     t0 = time.perf_counter()
     lt = linearize_deck(deck, [19.0], n_azimuths=1, openfast=install, cache=tmp_path, progress=False)
     print(f"end-to-end linearisation at 19 m/s: {time.perf_counter() - t0:.0f} s")
