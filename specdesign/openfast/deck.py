@@ -168,19 +168,19 @@ class OpenFASTRunError(RuntimeError):
 
 # openfast-io's reader and writer print through sys.stdout, which is swapped to silence them:
 # one at a time, so that threads writing cases at once (a campaign) never leave it swapped
-_IO_LOCK = threading.Lock()
+IO_LOCK = threading.Lock()
 _DECK_LOCK = threading.Lock()
 
 
 @lru_cache(maxsize=8)
-def _read_deck(fst: str, mtime: float) -> dict:
+def read_deck_cached(fst: str, mtime: float) -> dict:
     """openfast-io's variable tree of a deck (cached per file and modification time)."""
     from openfast_io.FAST_reader import InputReader_OpenFAST  # heavy: openfast-io imports ROSCO's toolbox; loaded when a case is written
 
     reader = InputReader_OpenFAST()
     reader.FAST_InputFile = os.path.basename(fst)
     reader.FAST_directory = os.path.dirname(fst)
-    with _IO_LOCK, contextlib.redirect_stdout(io.StringIO()):  # ROSCO's DISCON reader prints what it loads
+    with IO_LOCK, contextlib.redirect_stdout(io.StringIO()):  # ROSCO's DISCON reader prints what it loads
         reader.execute()
     return reader.fst_vt
 
@@ -259,7 +259,7 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
     if not (math.isfinite(wind_speed) and wind_speed >= 0):
         raise ValueError(f"wind_speed={wind_speed!r} must be a non-negative speed in m/s")
     with _DECK_LOCK:  # one read of a deck, however many threads ask for it at once
-        vt = copy.deepcopy(_read_deck(str(deck.fst), deck.fst.stat().st_mtime))
+        vt = copy.deepcopy(read_deck_cached(str(deck.fst), deck.fst.stat().st_mtime))
     folder = Path(folder).expanduser().resolve()
     name = name or folder.name
     fst, sd, ifw, ed = vt["Fst"], vt["ServoDyn"], vt["InflowWind"], vt["ElastoDyn"]
@@ -303,13 +303,13 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
         fst["CompSeaSt"], fst["CompHydro"] = 0, 0
     if channels is not None:
         _set_outputs(vt, channels)
-    from openfast_io.FAST_writer import InputWriter_OpenFAST  # heavy, as in _read_deck
+    from openfast_io.FAST_writer import InputWriter_OpenFAST  # heavy, as in read_deck_cached
 
     writer = InputWriter_OpenFAST()
     writer.fst_vt = vt
     writer.FAST_runDirectory = str(folder)
     writer.FAST_namingOut = name
-    with _IO_LOCK, contextlib.redirect_stdout(io.StringIO()):
+    with IO_LOCK, contextlib.redirect_stdout(io.StringIO()):
         writer.execute()
     return Case(name=name, folder=folder, deck=deck, tmax=float(tmax), wind_speed=float(wind_speed),
                 seed=None if seed is None else int(seed), channels=tuple(channels or ()))
@@ -398,7 +398,7 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
                                 preexec_fn=limits, env=env).returncode
         except subprocess.TimeoutExpired:
             rc = None
-    tail = _tail(case.log)
+    tail = log_tail(case.log)
     if rc is None:
         raise OpenFASTRunError(case, f"did not finish in {timeout:g} s of wall time", tail)
     if rc in (-signal.SIGXCPU, -signal.SIGKILL) and time.monotonic() - t0 >= 0.9 * cpu_limit:
@@ -412,6 +412,7 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
         raise OpenFASTRunError(case, f"wrote outputs that cannot be read ({e})", tail) from None
 
 
-def _tail(log: Path, n: int = 12) -> str:
+def log_tail(log: Path, n: int = 12) -> str:
+    """The last ``n`` non-blank lines of an OpenFAST log, for error messages."""
     lines = [ln.rstrip() for ln in log.read_text(errors="replace").splitlines() if ln.strip()]
     return "\n".join(lines[-n:])

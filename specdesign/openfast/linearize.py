@@ -90,8 +90,7 @@ import numpy as np
 from .._checks import positive_scalar
 from ..controller.discon_file import from_discon, read_discon
 from ..turbine.openfast_deck import read_cp_table
-from .deck import _IO_LOCK, Case, Deck, OpenFASTRunError, _tail, run_case
-from .deck import _read_deck as _read_deck_cached
+from .deck import IO_LOCK, Case, Deck, OpenFASTRunError, log_tail, read_deck_cached, run_case
 from .install import OpenFASTInstall, find_openfast, openfast_version
 from .linear_turbine import LinearTurbine
 
@@ -127,7 +126,13 @@ _CASE = "lin"  # file root of every case: <folder>/lin.fst, lin.1.lin, ...
 
 
 def default_lin_cache() -> Path:
-    """Where :func:`linearize_deck` keeps results: ``$SPECDESIGN_LIN_CACHE`` or ``~/.cache/specdesign/linearizations``."""
+    """Where :func:`linearize_deck` keeps results: ``$SPECDESIGN_LIN_CACHE`` or ``~/.cache/specdesign/linearizations``.
+
+    Returns
+    -------
+    pathlib.Path
+        The cache folder (not created here).
+    """
     env = os.environ.get("SPECDESIGN_LIN_CACHE")
     return Path(env) if env else Path.home() / ".cache" / "specdesign" / "linearizations"
 
@@ -172,7 +177,7 @@ def _read_deck(fst_path) -> dict:
     """openfast-io's dictionary of a deck (``fst_vt``; cached, not to be modified), errors naming the deck."""
     fst = _as_deck(fst_path).fst
     try:
-        return _read_deck_cached(str(fst), fst.stat().st_mtime)
+        return read_deck_cached(str(fst), fst.stat().st_mtime)
     except (ValueError, IndexError, KeyError) as exc:
         raise ValueError(f"openfast-io cannot read the deck {str(fst)!r} ({type(exc).__name__}: {exc}); it must be in "
                          "the format of the openfast-io installed (OpenFAST v5.0 for openfast-io 5.0)") from exc
@@ -412,7 +417,7 @@ def write_linearization_case(fst_path, wind_speed: float, folder, *, fst_vt: dic
     writer.fst_vt = case
     writer.FAST_runDirectory = str(out)
     writer.FAST_namingOut = _CASE
-    with _IO_LOCK, contextlib.redirect_stdout(io.StringIO()):  # openfast-io and ROSCO's writer print what they write
+    with IO_LOCK, contextlib.redirect_stdout(io.StringIO()):  # openfast-io and ROSCO's writer print what they write
         writer.execute()
     return LinearizationCase(v, out, out / f"{_CASE}.fst", speed, torque, pitch)
 
@@ -451,7 +456,7 @@ def _run_case(install: OpenFASTInstall, deck: Deck, case: LinearizationCase, tma
     run_case(run, install, timeout=timeout, nice=nice)
     lins = _lin_files(case.folder)
     if not lins:
-        raise OpenFASTRunError(run, "wrote no .lin files", _tail(run.log))
+        raise OpenFASTRunError(run, "wrote no .lin files", log_tail(run.log))
     return lins, time.perf_counter() - t0, _FORCED in run.log.read_text(errors="replace")
 
 
