@@ -95,21 +95,24 @@ def test_pitch_design_below_the_design_range_is_refused_with_its_reason(model, v
 
 @pytest.mark.slow
 def test_unstable_certificate_near_rated_is_not_a_success(model):
-    """At 11 m/s the certificate for 20 % (the Youla design, C = Y/(1 − P·Y)) has a pole pair
+    """At 11 m/s the certificate for 20 % (the Youla design, C = Y/(1 − P·Y)) had a pole pair
     at +0.146 ± 2.38j 1/s (benchmarks/below_rated_design.py); in the lulls the pitch sits at
-    fine pitch, the loop opens and that pair grows (the 9-15 m/s campaign diverges): the
-    design must say so. Oracle: the roots of the controller's denominator (numpy)."""
+    fine pitch, the loop opens and that pair grows (the 9-15 m/s campaign diverges). The
+    certificate search now counts a certificate that is itself unstable as no design
+    (feasibility.target's UNSTABLE_POLE_TOL), so the target is refused before any design, with
+    the speed, the target and the best stable promise named (the stable certificates promise
+    a few per cent there), and never returned as a success."""
+    import re
     import warnings
 
-    from specdesign import closedloop, qft
+    from specdesign import qft
 
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        d = qft.design_qft(model, 11.0, 20.0)
-    c = control.tf(d.pitch_controller)
-    growth = np.roots(c.den[0][0]).real.max()
-    assert growth > closedloop.UNSTABLE_CONTROLLER_RATE
-    assert not d.success and "controller itself is unstable" in d.message
+        warnings.simplefilter("ignore", UserWarning)
+        with pytest.raises(ValueError, match="no pitch specification promises 20 % at 11 m/s") as err:
+            qft.design_qft(model, 11.0, 20.0)
+    best = float(re.search(r"best ([0-9.]+) %", str(err.value)).group(1))
+    assert 0.0 < best < 20.0
 
 
 # ----------------------------------------------------------------------------- a design held below rated
