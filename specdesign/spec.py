@@ -719,7 +719,7 @@ def record_window(omega: ArrayLike, record_length: float = RECORD_LENGTH) -> np.
     sin x / x. Slow wind (periods beyond T) moves the 10-minute mean, which the Weibull
     distribution of mean speeds carries, not the cycles a rainflow count of the record finds.
     For a spectrum flat below ~2π/T the window takes out the same variance as the FFT
-    synthesis of a T-long series (:func:`specdesign.wind.synthesize`: nothing below π/T), and it
+    synthesis of a T-long series (:func:`specdesign.wind.gaussian_series`: nothing below π/T), and it
     is smooth, so the spectral figures converge as the grid's lowest frequency goes to 0.
 
     Parameters

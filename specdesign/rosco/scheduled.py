@@ -11,8 +11,8 @@ import dataclasses
 import math
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import control
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -28,6 +28,9 @@ from ..turbine.baseline import (
 )
 from ..turbine.plant import scheduled, turbine_plant
 from ..turbine.tables import DATA_DIR
+
+if TYPE_CHECKING:
+    import control
 
 __all__ = ["SCHEDULING_FILTERS", "ROSCO_SCHEDULE_CORNER", "ROSCO_SCHEDULE_DAMPING", "TOWER_DAMPER_DAMPING_RATIO",
            "TOWER_DAMPER_HPF_CORNER", "TOWER_DAMPER_INT_SAT", "TowerDamper", "iea15mw_discon", "rosco_scheduled",
@@ -193,6 +196,8 @@ def _default_speeds(model, sched):
 
 def _discon_scheduled(model, schedule, wind_speeds, name, form, scheduling_filter):
     """rosco_scheduled with a DisconSchedule: its own gains, speed filter and pitch limits."""
+    import control  # python-control loads matplotlib.pyplot: only when a schedule or damper is built
+
     where = f"schedule ({schedule.path})"
     if wind_speeds is not None:
         raise ValueError(f"wind_speeds must be None with a DisconSchedule: {where} schedules on its own PC_GS_angles")
@@ -266,6 +271,8 @@ class TowerDamper:
             The damper as the workbench's ATD controller (input ``tower_top_vel``, output
             ``pitch_cmd``).
         """
+        import control  # python-control loads matplotlib.pyplot: only when the damper is built
+
         return control.tf([-self.gain, 0.0], [1.0, self.hpf_corner], inputs="tower_top_vel", outputs="pitch_cmd")
 
     def discon_values(self) -> dict:
@@ -281,6 +288,8 @@ class TowerDamper:
 
 def _damper_loop(model: TurbineModel, wind_speed: float, hpf_corner: float):
     """(A, b, c, tower pole of the plant): speed loop closed with ROSCO's PI, Δβ = K·c·x closes the damper."""
+    import control  # python-control loads matplotlib.pyplot: only when a schedule or damper is built
+
     plant = model.linearize(wind_speed)
     g = plant[["gen_speed", "tower_top_vel"], "pitch_cmd"]
     pi = control.ss(rosco_baseline(model, wind_speed))

@@ -86,7 +86,6 @@ def as_discon(controller) -> DisconController:
         The library or parameter file does not exist.
     """
     if isinstance(controller, (str, Path)):
-
         lib, par = rosco_library(), Path(controller)
     elif hasattr(controller, "library") and hasattr(controller, "parameters"):
         lib, par = Path(controller.library), Path(controller.parameters)
