@@ -138,3 +138,19 @@ def test_fine_pitch_lift_against_an_independent_step_response(model):
         fine_pitch_lift(rosco, -0.1)
     with pytest.raises(ValueError, match="SISO"):
         fine_pitch_lift(control.ss(np.zeros((1, 1)), np.zeros((1, 2)), np.zeros((1, 1)), np.zeros((1, 2))), 0.2)
+
+
+def test_the_lifetime_demo_holds_the_lowest_design_that_keeps_fine_pitch(model):
+    """The lifetime demo holds its lowest design below rated; a design that lifts the pitch off
+    fine pitch for the speed deficit there (the swinging controller above: lift beyond the law's
+    pitch switch) would throttle the turbine in low winds, so the demo holds the first design,
+    from the lowest speed up, that does not (ROSCO's PI here), and 0 when none qualifies."""
+    from types import SimpleNamespace
+
+    from specdesign.demo import _held_from  # the demo's own rule, tested directly
+
+    swing = control.tf([-0.6, -0.08], [1.0, 0.0]) + control.tf([30.0, 0.0], [1.0, 0.2, 1.0])
+    lifts, keeps = SimpleNamespace(pitch_controller=swing), SimpleNamespace(pitch_controller=rosco_baseline(model, 13.0))
+    assert _held_from(model, (15.0, 17.0, 19.0), (lifts, keeps, keeps)) == 1
+    assert _held_from(model, (15.0, 17.0), (keeps, lifts)) == 0
+    assert _held_from(model, (15.0, 17.0), (lifts, lifts)) == 0
