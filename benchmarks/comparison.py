@@ -201,17 +201,17 @@ def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took):
 START, END = "<!-- comparison.py results: start -->", "<!-- comparison.py results: end -->"
 
 
-def splice(path, text):
-    """Write ``text`` between the result markers of ``path`` (the prose around is kept), or the
-    whole file when it has no markers."""
+def splice(path, text, start=START, end=END, append=False):
+    """Write ``text`` between the markers ``start``/``end`` of ``path`` (the prose around is kept);
+    without them the whole file, or, with ``append``, the marked text after what is there."""
     old = ""
     if os.path.exists(path):
         with open(path) as f:
             old = f.read()
-    if START in old and END in old:
-        new = old[:old.index(START) + len(START)] + "\n" + text + "\n" + old[old.index(END):]
+    if start in old and end in old:
+        new = old[:old.index(start) + len(start)] + "\n" + text + "\n" + old[old.index(end):]
     else:
-        new = START + "\n" + text + "\n" + END + "\n"
+        new = (old + "\n" if append else "") + start + "\n" + text + "\n" + end + "\n"
     with open(path, "w") as f:
         f.write(new)
 

@@ -23,23 +23,9 @@ import os
 import time
 
 import numpy as np
-from comparison import INDS, LABELS, SPEEDS, fmt
+from comparison import INDS, LABELS, SPEEDS, fmt, splice
 
 START, END = "<!-- tower_damper.py results: start -->", "<!-- tower_damper.py results: end -->"
-
-
-def splice(path, text):
-    """``text`` between this script's markers of ``path`` (appended with them when absent)."""
-    old = ""
-    if os.path.exists(path):
-        with open(path) as f:
-            old = f.read()
-    if START in old and END in old:
-        new = old[:old.index(START) + len(START)] + "\n" + text + "\n" + old[old.index(END):]
-    else:
-        new = old + "\n" + START + "\n" + text + "\n" + END + "\n"
-    with open(path, "w") as f:
-        f.write(new)
 
 
 def table(camps, baseline):
@@ -145,7 +131,7 @@ def main():
         text = "\n".join(head + ["Change vs ROSCO as shipped (tower damping off):", ""] + l1
                          + ["", "Change vs ROSCO with its tower damper (TD_Mode = 1):", ""] + l2 + ps)
         print(text, flush=True)
-        splice(a.out, text)
+        splice(a.out, text, START, END, append=True)
 
     run(ctrls)
     write(False)

@@ -56,3 +56,15 @@ def pytest_collection_modifyitems(config, items):
     # the tests that run OpenFAST go last: in CI its build (started in the background by
     # .ci/run) has the rest of the suite's time to finish, and one `python -m pytest -q` runs all
     items.sort(key=lambda item: "openfast" in getattr(item, "fixturenames", ()))
+
+
+@pytest.fixture(scope="session")
+def discon_in():
+    """The rosco package's DISCON.IN of the IEA 15 MW monopile (skipped without the package)."""
+    from specdesign.rosco import rosco_test_cases
+
+    try:
+        cases = rosco_test_cases()
+    except ModuleNotFoundError as e:
+        pytest.skip(f"the rosco package is not installed ({e})")
+    return cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"

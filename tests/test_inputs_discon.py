@@ -13,19 +13,10 @@ from pathlib import Path
 
 import pytest
 
-from specdesign.rosco import Discon, rosco_test_cases
+from specdesign.rosco import Discon
 from specdesign.rosco.discon import _OPENED_FILES
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-@pytest.fixture(scope="module")
-def discon_in():
-    try:
-        cases = rosco_test_cases()
-    except ModuleNotFoundError as e:
-        pytest.skip(f"the rosco package is not installed ({e})")
-    return cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"
 
 
 def _edit(discon_in, tmp_path, key, value):

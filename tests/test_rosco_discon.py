@@ -13,7 +13,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from specdesign.fatigue import del_rainflow
-from specdesign.rosco import Discon, from_discon, iea15mw_discon, rosco_scheduled, rosco_test_cases
+from specdesign.rosco import Discon, from_discon, iea15mw_discon, rosco_scheduled
 from specdesign.simulate import simulate
 from specdesign.turbine import iea15mw
 
@@ -21,15 +21,6 @@ from specdesign.turbine import iea15mw
 @pytest.fixture(scope="module")
 def model():
     return iea15mw()
-
-
-@pytest.fixture(scope="module")
-def discon_in():
-    try:
-        cases = rosco_test_cases()
-    except ModuleNotFoundError as e:
-        pytest.skip(f"the rosco package is not installed ({e})")
-    return cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"
 
 
 # ----------------------------------------------------------------------------- torque commands
