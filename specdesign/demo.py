@@ -399,14 +399,13 @@ def _held_from(model, speeds, designs) -> int:
     design held below rated leaves fine pitch and ROSCO's torque state machine goes to rated
     torque: the turbine loses most of its power in low winds (−84 % at 5 m/s, measured with the
     15 m/s design of a 25 % target). 0 when the model has no torque law or every design lifts."""
-    from .qft import fine_pitch_lift  # specdesign.qft loads python-control (the lifetime demo's own import)
+    from .qft import held_lift  # specdesign.qft loads python-control (the lifetime demo's own import)
 
     law = getattr(model, "torque_control", None)
     if law is None:
         return 0
-    deficit = law.pitch_reference_speed - law.min_speed
     for i, d in enumerate(designs):
-        if fine_pitch_lift(d.pitch_controller, deficit) <= law.pitch_switch:
+        if held_lift(model, d) <= law.pitch_switch:
             return i
     return 0
 

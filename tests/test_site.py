@@ -234,3 +234,16 @@ def test_site_renders_equations_and_figures_with_the_network_off(site):
         finally:
             b.close()
     assert not refused, f"the site asked the network for {refused[:5]}"
+
+
+def test_the_widget_loader_from_a_cdn_is_removed_from_notebook_pages():
+    sys.path.insert(0, str(ROOT / "docs" / "hooks"))
+    try:
+        offline = importlib.import_module("offline")
+    finally:
+        sys.path.pop(0)
+    page = ("<p>a</p><script>\n(function() {\n  function addWidgetsRenderer() {\n    var s = "
+            "'https://unpkg.com/@jupyter-widgets/html-manager@*/dist/embed-amd.js';\n  }\n}());\n</script><p>b</p>")
+    assert offline.strip_widget_loader(page) == "<p>a</p><p>b</p>"
+    with pytest.raises(ValueError, match="unpkg"):
+        offline.strip_widget_loader('<script src="https://unpkg.com/x.js"></script>')

@@ -80,7 +80,7 @@ from __future__ import annotations
 
 from ..closedloop import general_form, partial_loop
 from .checks import fine_pitch_lift
-from .design import SPEED_RELAX_DB, check_design_speed, design_qft, design_schedule, design_table, format_table
+from .design import SPEED_RELAX_DB, check_design_speed, design_qft, design_schedule, design_table, format_table, held_lift
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 
@@ -90,6 +90,7 @@ __all__ = [
     "partial_loop",
     "design_qft",
     "design_schedule",
+    "held_lift",
     "check_design_speed",
     "design_table",
     "format_table",

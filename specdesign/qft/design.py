@@ -37,7 +37,8 @@ if TYPE_CHECKING:
 
     from ..turbine import TurbineModel
 
-__all__ = ["design_qft", "design_schedule", "design_table", "format_table", "SPEED_RELAX_DB", "check_design_speed"]
+__all__ = ["design_qft", "design_schedule", "design_table", "format_table", "SPEED_RELAX_DB", "check_design_speed",
+           "held_lift"]
 
 
 #: Relaxations (dB) of the generator-speed spec the notch design (``spec="notch"``) tries in turn,
@@ -462,13 +463,39 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     return tuple(out)
 
 
-def _warn_held_design(model, design):
-    """Warn when a schedule's lowest design, held below rated, would lift the pitch off fine pitch."""
+def held_lift(model, design) -> float | None:
+    """How far ``design``, held below rated by a schedule, lifts the pitch off fine pitch (rad).
+
+    The speed deficit is the torque law's pitch reference minus its minimum speed
+    (:func:`fine_pitch_lift`); a lift above the law's ``pitch_switch`` leaves fine pitch and
+    ROSCO's torque state machine goes to rated torque.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine (its ``torque_control``).
+    design : QFTDesign
+        A design (its ``pitch_controller``).
+
+    Returns
+    -------
+    float or None
+        The lift, rad; None for a model without a torque law.
+    """
     law = getattr(model, "torque_control", None)
     if law is None:
-        return
+        return None
     deficit = law.pitch_reference_speed - law.min_speed  # the model's gen_speed output is the rotor-shaft speed
-    lift = fine_pitch_lift(design.pitch_controller, deficit)
+    return fine_pitch_lift(design.pitch_controller, deficit)
+
+
+def _warn_held_design(model, design):
+    """Warn when a schedule's lowest design, held below rated, would lift the pitch off fine pitch."""
+    lift = held_lift(model, design)
+    if lift is None:
+        return
+    law = model.torque_control
+    deficit = law.pitch_reference_speed - law.min_speed
     if lift > law.pitch_switch:
         warnings.warn(f"design_schedule: the lowest design ({design.wind_speed:g} m/s), which a schedule holds down to "
                       f"rated and below, answers the speed deficit below rated ({deficit:.3f} rad/s) by lifting the pitch "
