@@ -577,7 +577,7 @@ class Designer:
         title = fig.suptitle(self._title(st), fontsize=9, color=self._title_colour(st))
         # fixed margins (no layout engine: it would re-run on every redraw); room for the
         # three-line title above the axes
-        fig.subplots_adjust(left=0.08, right=0.98, bottom=0.11, top=0.79, wspace=0.28)
+        fig.subplots_adjust(left=0.08, right=0.98, bottom=0.11, top=0.79, wspace=0.42)
         self.figure = fig
         self._artists = dict(loop=loop, marks=marks, T=t_line, S=s_line, title=title)
         # the bounds and axes are rendered once into a cached background; an edit redraws only

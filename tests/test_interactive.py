@@ -262,3 +262,18 @@ def test_live_redraw_blits_the_changing_artists_and_full_renders_keep_them(loop)
         f.seek(0)
     np.testing.assert_array_equal(plt.imread(saved[0]), plt.imread(saved[1]))
     assert np.isfinite(live.update_ms) and live.update_ms > 0
+
+
+def test_the_designer_colour_key_leaves_the_closed_loop_panel_its_labels():
+    # notebook 04 in the browser: the key's label "bound frequency ω (rad/s)" was written over
+    # the closed-loop panel's "closed-loop magnitude (dB)"
+    P = ct.tf([1.0], [1.0, 1.4, 1.0])
+    tmpl = qft.Template.from_systems([0.8 * P, P, 1.25 * P], np.geomspace(0.05, 5.0, 24))
+    d = Designer(qft.bounds(tmpl, "stability", 1.3), tmpl, lc.Controller((lc.gain(2.0), lc.integrator())))
+    fig = d.draw()
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    key = next(ax for ax in fig.axes if ax.get_ylabel() == "bound frequency ω (rad/s)")
+    ax_b = fig.axes[1]
+    assert key.get_tightbbox(renderer).x1 < ax_b.get_tightbbox(renderer).x0
+    plt.close(fig)
