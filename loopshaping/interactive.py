@@ -161,6 +161,10 @@ class LiveArtists:
     :meth:`redraw` restores the background, draws only them and sends the changed pixels.
     Until the canvas has rendered once and the browser's view of it is connected it asks for
     a full redraw instead (a blit sent before the browser drew the figure once left it empty).
+    A live figure does not redraw itself when an artist changes (pyplot's interactive mode asks
+    ipympl's browser view for a full render on every change, even during a render; with a blit
+    arriving meanwhile the view kept asking, and the kernel rendered without end): after
+    changing it from code, call :meth:`redraw` or ``figure.canvas.draw_idle()``.
 
     Parameters
     ----------
@@ -200,6 +204,9 @@ class LiveArtists:
             for a in self.artists:
                 a.set_animated(True)
             canvas.mpl_connect("draw_event", self._on_draw)
+            # no full render requested by a change (pyplot's draw_idle on "stale"): the owner
+            # redraws, by a blit (see above for the endless renders this avoids)
+            figure.stale_callback = None
 
     def _on_draw(self, event):
         canvas, renderer = event.canvas, event.renderer

@@ -277,3 +277,26 @@ def test_the_designer_colour_key_leaves_the_closed_loop_panel_its_labels():
     ax_b = fig.axes[1]
     assert key.get_tightbbox(renderer).x1 < ax_b.get_tightbbox(renderer).x0
     plt.close(fig)
+
+
+def test_a_live_figure_asks_for_no_full_render_when_an_edit_blits(monkeypatch):
+    # in JupyterLab, pyplot's interactive mode asked ipympl's view for a full render on every
+    # change of the explorer's legend text; the blit's image arriving meanwhile let the view ask
+    # again after each render, and notebook 03's kernel rendered without end (busy for minutes)
+    from specdesign import spec
+    from specdesign.plots.spec import NotchExplorer
+    from specdesign.turbine import iea15mw
+
+    plt.close("all")
+    base = spec.baseline_analysis(iea15mw(), 19.0)
+    with plt.ion():
+        ex = NotchExplorer(base, live=True)
+        ex.fig.canvas.draw()
+        requests = []
+        monkeypatch.setattr(ex.fig.canvas, "draw_idle", lambda *a, **k: requests.append(1))
+        ex.update(1.1, 9.0, 0.3)  # the line, marker, title and legend text change: one blit
+        assert ex._redraw.ready and requests == []
+        assert "9 dB" in ex._legend_text.get_text()
+        ex.fig.axes[0].set_xlim(0.01, 10.0)  # a change from code: no automatic full render either
+        assert requests == []
+    plt.close("all")
