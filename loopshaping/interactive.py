@@ -161,10 +161,11 @@ class LiveArtists:
     :meth:`redraw` restores the background, draws only them and sends the changed pixels.
     Until the canvas has rendered once and the browser's view of it is connected it asks for
     a full redraw instead (a blit sent before the browser drew the figure once left it empty).
-    A live figure does not redraw itself when an artist changes (pyplot's interactive mode asks
-    ipympl's browser view for a full render on every change, even during a render; with a blit
-    arriving meanwhile the view kept asking, and the kernel rendered without end): after
-    changing it from code, call :meth:`redraw` or ``figure.canvas.draw_idle()``.
+    A live figure is not "stale" after a blit or a render (pyplot redraws every stale figure
+    after each message the kernel handles, a slider's included: drawing the artists on top
+    marked it stale again, and notebook 03's kernel rendered without end), and a change of one
+    of its artists asks for no render by itself (pyplot's interactive mode would, on every
+    change); a change made from code is drawn after the cell, as pyplot draws stale figures.
 
     Parameters
     ----------
@@ -204,8 +205,8 @@ class LiveArtists:
             for a in self.artists:
                 a.set_animated(True)
             canvas.mpl_connect("draw_event", self._on_draw)
-            # no full render requested by a change (pyplot's draw_idle on "stale"): the owner
-            # redraws, by a blit (see above for the endless renders this avoids)
+            # no full render requested by each change (pyplot's draw_idle on "stale" in
+            # interactive mode): the owner redraws, by a blit
             figure.stale_callback = None
 
     def _on_draw(self, event):
@@ -218,6 +219,7 @@ class LiveArtists:
         self._background = canvas.copy_from_bbox(self.figure.bbox)
         for a in self.artists:
             a.draw(renderer)
+        self.figure.stale = False  # drawn: their children's updates while drawing are on screen
 
     @property
     def ready(self) -> bool:
@@ -235,6 +237,7 @@ class LiveArtists:
         for a in self.artists:
             self.figure.draw_artist(a)
         canvas.blit(self.figure.bbox)
+        self.figure.stale = False  # what changed is on screen: no full render after this message
 
 
 def _where(omega):

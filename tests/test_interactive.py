@@ -280,9 +280,10 @@ def test_the_designer_colour_key_leaves_the_closed_loop_panel_its_labels():
 
 
 def test_a_live_figure_asks_for_no_full_render_when_an_edit_blits(monkeypatch):
-    # in JupyterLab, pyplot's interactive mode asked ipympl's view for a full render on every
-    # change of the explorer's legend text; the blit's image arriving meanwhile let the view ask
-    # again after each render, and notebook 03's kernel rendered without end (busy for minutes)
+    # in JupyterLab notebook 03's kernel rendered the explorer without end (busy for minutes):
+    # drawing the legend on top left the figure "stale", and pyplot redraws every stale figure
+    # after each message the kernel handles, the browser's render request included; and
+    # pyplot's interactive mode asked for a full render on every change of the legend's text
     from specdesign import spec
     from specdesign.plots.spec import NotchExplorer
     from specdesign.turbine import iea15mw
@@ -292,11 +293,12 @@ def test_a_live_figure_asks_for_no_full_render_when_an_edit_blits(monkeypatch):
     with plt.ion():
         ex = NotchExplorer(base, live=True)
         ex.fig.canvas.draw()
+        assert not ex.fig.stale  # a render leaves nothing for pyplot's post-execute redraw
         requests = []
         monkeypatch.setattr(ex.fig.canvas, "draw_idle", lambda *a, **k: requests.append(1))
         ex.update(1.1, 9.0, 0.3)  # the line, marker, title and legend text change: one blit
-        assert ex._redraw.ready and requests == []
+        assert ex._redraw.ready and requests == [] and not ex.fig.stale
         assert "9 dB" in ex._legend_text.get_text()
-        ex.fig.axes[0].set_xlim(0.01, 10.0)  # a change from code: no automatic full render either
-        assert requests == []
+        ex.fig.axes[0].set_xlim(0.01, 10.0)  # a change from code: drawn after the cell, as pyplot does
+        assert requests == [] and ex.fig.stale
     plt.close("all")
