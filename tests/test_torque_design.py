@@ -48,7 +48,7 @@ def test_closed_loop_map_matches_interconnect(model, design):
 def test_promise_recomputed_independently(model, design):
     # Dirlik on |T|²S_W (interconnect map, wind spectrum from specdesign.wind) vs the open-torque-controller baseline
     w = design.omega
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     s_w = rotor_effective_spectrum(w, 8.0, model.rotor_radius, turbulence_class="B") * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     base = ct.frequency_response(model.linearize(8.0)["tower_base_my", "wind"], w).complex.ravel()
     closed = ct.frequency_response(_closed_by_interconnect(model, 8.0, design.gain), w).complex.ravel()
