@@ -116,3 +116,46 @@ def test_nonlinear_direction(model, design):
     change = 100 * (dels["design"] / dels["rosco"] - 1)
     assert np.all(change < 0)
     assert change.mean() <= -0.4 * design.promise
+
+
+@pytest.mark.parametrize("w0", [0.1, 0.3, 1.0])
+def test_law_linearisation_matches_small_amplitude_response(model, w0):
+    """The mode-3 law linearised as simulated (torque_law_response) is the nonlinear loop's small-amplitude response.
+
+    8 m/s, the 20 % design's law (TorqueDesign.torque_law), pitch held (a zero pitch controller), wind
+    8 + 0.02·sin(ω₀t) m/s: the tower-base moment's first harmonic over 600 s after 600 s of transient
+    against T_MyT,w with G = L_lin − L (the general form). Measured: within 0.13 % and 0.05°
+    (benchmarks/below_rated_design.py --part torque_gap); the K·Ω² + k·δΩ map the promise uses is off
+    by 4-13 % and 1.5-10° there, so the tolerance (1 %, 0.5°) separates the two.
+    """
+    from specdesign.qft.torque_design import _form, _law_tf, _responses  # the general form's pieces, private
+
+    d = qft.design_torque(model, 8.0, target_reduction=20.0)
+    law = d.torque_law(model.torque_control)
+    A, B, _, D = (x[0] for x in _form(_responses(model.linearize(8.0), np.array([w0]))))
+    G = 2 * law.k_opt * model.trim(8.0).rotor_speed - ct.frequency_response(_law_tf(model, law, 8.0), [w0]).complex.ravel()[0]
+    linear, promised = (A + B * G) / (1 + D * G), (A - B * d.gain) / (1 - D * d.gain)
+    amp, per = 0.02, 2 * np.pi / w0
+    dur = np.ceil(600.0 / per) * per
+    t = np.arange(0.0, 600.0 + dur + 1.0, 0.1)
+    r = simulate(model, ct.tf([0.0], [1.0]), [8.0], wind=(8.0 + amp * np.sin(w0 * t))[None, None], duration=round(dur, 1),
+                 transient=600.0, torque_control=law, wind_dt=0.1)
+    tt = r.time + 600.0
+    c = np.linalg.lstsq(np.column_stack([np.sin(w0 * tt), np.cos(w0 * tt), np.ones_like(tt)]), r["tower_base_my"][0, 0],
+                        rcond=None)[0]
+    measured = (c[0] + 1j * c[1]) / amp
+    assert abs(abs(measured / linear) - 1) < 0.01
+    assert abs(np.degrees(np.angle(measured / linear))) < 0.5
+    assert abs(abs(measured / promised) - 1) > 0.01 or abs(np.degrees(np.angle(measured / promised))) > 1.0
+
+
+def test_law_promise(model):
+    d = qft.design_torque(model, 8.0, target_reduction=20.0)
+    # the law's own curve at s → 0: ROSCO's mode 1 and the design's mode 3 both give 2KΩ (N·m per rad/s)
+    stiff = 2 * model.torque_control.k_opt * model.trim(8.0).rotor_speed
+    for law in (model.torque_control, d.torque_law(model.torque_control)):
+        assert qft.torque_design.torque_law_response(model, law, 8.0, [1e-7])[0] == pytest.approx(stiff, rel=1e-4)
+    # docs/below_rated.md section 3: 20.56 % with the laws as simulated (the small-amplitude test above checks them)
+    assert qft.torque_design.law_promise(model, d) == pytest.approx(20.56, abs=0.01)
+    with pytest.raises(ValueError, match="torque region"):
+        qft.torque_design.torque_law_response(model, model.torque_control, 15.0, [1.0])
