@@ -9,6 +9,13 @@ import pytest
 
 from specdesign import qft
 from specdesign.fatigue import del_rainflow
+from specdesign.qft.torque_design import (
+    _form,
+    _law_tf,
+    _responses,
+    law_promise,
+    torque_law_response,
+)
 from specdesign.rosco import rosco_scheduled
 from specdesign.simulate import simulate
 from specdesign.spectral import del_spectral
@@ -128,8 +135,6 @@ def test_law_linearisation_matches_small_amplitude_response(model, w0):
     (benchmarks/below_rated_design.py --part torque_gap); the K·Ω² + k·δΩ map the promise uses is off
     by 4-13 % and 1.5-10° there, so the tolerance (1 %, 0.5°) separates the two.
     """
-    from specdesign.qft.torque_design import _form, _law_tf, _responses  # the general form's pieces, private
-
     d = qft.design_torque(model, 8.0, target_reduction=20.0)
     law = d.torque_law(model.torque_control)
     A, B, _, D = (x[0] for x in _form(_responses(model.linearize(8.0), np.array([w0]))))
@@ -154,8 +159,8 @@ def test_law_promise(model):
     # the law's own curve at s → 0: ROSCO's mode 1 and the design's mode 3 both give 2KΩ (N·m per rad/s)
     stiff = 2 * model.torque_control.k_opt * model.trim(8.0).rotor_speed
     for law in (model.torque_control, d.torque_law(model.torque_control)):
-        assert qft.torque_design.torque_law_response(model, law, 8.0, [1e-7])[0] == pytest.approx(stiff, rel=1e-4)
+        assert torque_law_response(model, law, 8.0, [1e-7])[0] == pytest.approx(stiff, rel=1e-4)
     # docs/below_rated.md section 3: 20.56 % with the laws as simulated (the small-amplitude test above checks them)
-    assert qft.torque_design.law_promise(model, d) == pytest.approx(20.56, abs=0.01)
+    assert law_promise(model, d) == pytest.approx(20.56, abs=0.01)
     with pytest.raises(ValueError, match="torque region"):
-        qft.torque_design.torque_law_response(model, model.torque_control, 15.0, [1.0])
+        torque_law_response(model, model.torque_control, 15.0, [1.0])
