@@ -114,9 +114,11 @@ def test_refusals(model):
 def test_nonlinear_direction(model, design):
     """8 m/s, 2 paired seeds x 600 s, ROSCO's pitch PI: the designed law lowers the rainflow tower DEL.
 
-    The linear promise is 25 %; the nonlinear PI (filtered speed, slow reference) is an
-    approximation of the linear gain, so the acceptance is the direction on every seed and at
-    least 40 % of the promise on the pair (measured −20.3 / −13.0 %, docs/below_rated.md).
+    The linear promise is 20 %; over 20 paired seeds the law gives −14.5 ± 1.7 % (72 % of it), the
+    gap measured row by row in docs/below_rated.md section 3 (the torque ceiling in gusts, the
+    minimum-speed region, Dirlik vs rainflow and the aerodynamics: nonlinear, not the law's
+    linearisation). The acceptance on the pair is the direction on every seed and at least 40 % of
+    the promise (measured −19.7 / −11.0 %).
     """
     ros = rosco_scheduled(model)
     dels = {}
