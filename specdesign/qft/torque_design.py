@@ -274,10 +274,9 @@ class _LawMaps:
         self.model, self.v, self.w = model, wind_speed, w
         self.R = _responses(P, w)
         self.loop = P["gen_speed", "gen_torque"]
-        base = model.torque_control
+        base, op = model.torque_control, model.trim(wind_speed)
         # the law model.linearize closes (controller.torque.close_torque_loop): 2KΩ or the PI on the raw speed
-        self.lin = (2.0 * base.k_opt * model.trim(wind_speed).rotor_speed if model.trim(wind_speed).region == "2"
-                    else -(base.kp + base.ki / control.tf("s")))
+        self.lin = 2.0 * base.k_opt * op.rotor_speed if op.region == "2" else -(base.kp + base.ki / control.tf("s"))
 
     def g(self, law):
         """G(jω) = L_lin − L of ``law`` and whether the loop with it is stable."""
