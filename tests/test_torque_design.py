@@ -171,3 +171,12 @@ def test_law_promise(model, design):
     assert law_promise(model, design, dataclasses.replace(law, filter_corner=30.0)) > design.promise + 0.5
     with pytest.raises(ValueError, match="torque region"):
         torque_law_response(model, model.torque_control, 15.0, [1.0])
+
+
+def test_region_one_and_a_half(model):
+    # 7 m/s trims at the minimum speed (region 1.5): both laws are PIs on the filtered speed there, and the
+    # linearised law's PI state and G's integrator share a mode at s = 0 that must not read as unstable
+    assert model.trim(7.0).region == "1.5"
+    d = qft.design_torque(model, 7.0, target_reduction=10.0)
+    assert d.gain > 0 and d.promise == pytest.approx(10.0, abs=1e-6)
+    assert law_promise(model, d) == pytest.approx(d.promise, abs=1e-9)
