@@ -51,7 +51,7 @@ def test_closed_loop_map_matches_interconnect(model, design):
 def test_promise_recomputed_independently(model, design):
     # Dirlik on |T|²S_W (interconnect maps, wind spectrum from specdesign.wind), design law vs ROSCO's law
     w = design.omega
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     s_w = rotor_effective_spectrum(w, 8.0, model.rotor_radius, turbulence_class="B") * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
 
     def dlt(law):
