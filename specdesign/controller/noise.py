@@ -77,8 +77,8 @@ class SensorNoise:
         The step at which the SDs above are the samples' SDs, s (their densities are
         SD²·sample_time/π per rad/s; default 0.02 s, the simulator's default step).
     gear_ratio : float, optional
-        Generator speed over rotor speed (-): the 3P frequency is 3·Ω_g,trim/gear_ratio (1 for
-        the direct-drive IEA 15 MW).
+        Generator speed over rotor speed (-): the simulator takes the rotor speed of the 3P as
+        Ω_g,trim/gear_ratio (1 for the direct-drive IEA 15 MW).
     stream : int, optional
         Another realisation of the same model for the same runs (0: the default stream).
 
@@ -150,23 +150,23 @@ class SensorNoise:
         level = self.sd(signal, dt) ** 2 * dt / math.pi
         return np.where(w <= math.pi / dt, level, 0.0)
 
-    def lines(self, gen_speed: float) -> tuple[float, float]:
+    def lines(self, rotor_speed: float) -> tuple[float, float]:
         """The 3P line in the measured generator speed at an operating point.
 
         Parameters
         ----------
-        gen_speed : float
-            The trim's generator speed, rad/s.
+        rotor_speed : float
+            The trim's rotor speed Ω_r, rad/s.
 
         Returns
         -------
         tuple of float
-            (ω_3P rad/s, variance (rad/s)² = A²/2).
+            (ω_3P = 3·Ω_r rad/s, its variance A²/2 in (rad/s)²).
         """
-        return 3.0 * positive_scalar(gen_speed, "gen_speed") / self.gear_ratio, 0.5 * self.ripple_3p ** 2
+        return 3.0 * positive_scalar(rotor_speed, "rotor_speed"), 0.5 * self.ripple_3p ** 2
 
     def series(self, signal: str, wind_speeds: ArrayLike, seeds: ArrayLike, nsteps: int, dt: float,
-               gen_speeds: ArrayLike | None = None) -> np.ndarray:
+               rotor_speeds: ArrayLike | None = None) -> np.ndarray:
         """The noise added to ``signal`` at every controller step of every run.
 
         Parameters
@@ -181,8 +181,8 @@ class SensorNoise:
             Steps per run (at t = k·dt, k = 0 … nsteps − 1).
         dt : float
             The controller's step, s.
-        gen_speeds : array_like, optional
-            (W,) trim generator speeds, rad/s: needed for the 3P ripple of ``"gen_speed"``.
+        rotor_speeds : array_like, optional
+            (W,) the trims' rotor speeds, rad/s: needed for the 3P ripple of ``"gen_speed"``.
 
         Returns
         -------
@@ -196,11 +196,11 @@ class SensorNoise:
         sd = self.sd(signal, dt)
         ripple = signal == "gen_speed" and self.ripple_3p > 0
         if ripple:
-            if gen_speeds is None:
-                raise ValueError("gen_speeds (the trims' generator speeds, rad/s) are needed for the 3P ripple")
-            gs = np.atleast_1d(np.asarray(gen_speeds, dtype=float))
+            if rotor_speeds is None:
+                raise ValueError("rotor_speeds (the trims' rotor speeds, rad/s) are needed for the 3P ripple")
+            gs = np.atleast_1d(np.asarray(rotor_speeds, dtype=float))
             if gs.shape != vs.shape:
-                raise ValueError(f"gen_speeds must have one entry per wind speed ({vs.size}), got {gs.shape}")
+                raise ValueError(f"rotor_speeds must have one entry per wind speed ({vs.size}), got {gs.shape}")
         out = np.zeros((vs.size, ss.size, int(nsteps)))
         if sd == 0 and not ripple:
             return out

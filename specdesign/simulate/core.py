@@ -367,7 +367,8 @@ def _measurement_noise(noise, plant, vs, seeds, S, times, trim_speeds):
     out = {}
     for name in MEASURED:
         if name in plant.output_names and (noise.sd(name, times.dt) > 0 or name == "gen_speed" and noise.ripple_3p > 0):
-            out[name] = noise.series(name, vs, labels, times.nsteps, times.dt, trim_speeds).reshape(vs.size * S, -1)
+            out[name] = noise.series(name, vs, labels, times.nsteps, times.dt,
+                                     trim_speeds / noise.gear_ratio).reshape(vs.size * S, -1)
     return out
 
 

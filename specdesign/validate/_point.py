@@ -66,6 +66,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
     omega = welch_psd(np.zeros((1, int(round(duration / record_dt)))), record_dt, nperseg)[0]
     sw = None
     plant = turbine_plant(model)
+    rate_limit = getattr(model, "pitch_rate_limit", None)  # the actuator's (rad/s), for the time at it
     for name, c in controllers.items():
         # the answer run_campaign's up-front check (check_campaign_step) already has
         bad = np.zeros(0)
@@ -88,7 +89,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
         if r is None:
             _nan_point(out, omega, len(seeds), linear_twin, volterra)
             continue
-        ind = indicators(r.outputs, r.dt, m)
+        ind = indicators(r.outputs, r.dt, m, pitch_rate_limit=rate_limit)
         for k, val in ind.as_dict().items():
             out["values"].setdefault(k, []).append(val[0])
         if linear_twin:
@@ -97,7 +98,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
                 try:
                     rl = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
                                   record_dt=record_dt, transient=transient, linear=True)
-                    lin = indicators(rl.outputs, rl.dt, m).as_dict()
+                    lin = indicators(rl.outputs, rl.dt, m, pitch_rate_limit=rate_limit).as_dict()
                 except SimulationDivergedError as err:  # keep the nonlinear results: only the twin is NaN
                     warnings.warn(f"controller {name!r}: {err}; the linear twin of {name!r} at {v:g} m/s is NaN",
                                   ClosedLoopUnstableWarning, stacklevel=3)

@@ -364,7 +364,8 @@ def _assemble(records, names, vs, seeds, settings) -> Campaign:
     first = [[row[0] for row in by_v] for by_v in cell]  # per-(controller, speed) entries: any seed has them
 
     def per_seed(group, keys):
-        return {k: np.array([[[c[group][k] for c in row] for row in by_v] for by_v in cell]) for k in keys}
+        # a cell stored before an indicator existed (the actuator's) reads NaN for it
+        return {k: np.array([[[c[group].get(k, np.nan) for c in row] for row in by_v] for by_v in cell]) for k in keys}
 
     def spectra(key, mean):
         if mean:  # the seed average as np.mean of the (S, nω) block a batch of seeds gives
