@@ -85,8 +85,8 @@ class SensorNoise:
     Examples
     --------
     >>> n = SensorNoise(speed_sd=0.005)
-    >>> float(n.psd("gen_speed", [1.0], dt=0.02)[0]) == 0.005**2 * 0.02 / np.pi
-    True
+    >>> n.psd("gen_speed", [1.0, 200.0], dt=0.02) == [0.005**2 * 0.02 / np.pi, 0.0]  # zero above π/dt
+    array([ True,  True])
     """
 
     speed_sd: float = 0.0
@@ -114,8 +114,20 @@ class SensorNoise:
         return any(getattr(self, f) > 0 for f in (*MEASURED.values(), "ripple_3p"))
 
     def sd(self, signal: str, dt: float) -> float:
-        """SD of the white noise on ``signal`` sampled at step ``dt`` (s), in its SI unit: the
-        same density, so sd·√(sample_time/dt).
+        """SD of the white noise on ``signal`` sampled at step ``dt``: the same density, so
+        sd·√(sample_time/dt).
+
+        Parameters
+        ----------
+        signal : str
+            One of :data:`MEASURED`.
+        dt : float
+            The sample time, s.
+
+        Returns
+        -------
+        float
+            The SD in the signal's SI unit (rad/s, m/s², m/s, N·m).
 
         Raises
         ------

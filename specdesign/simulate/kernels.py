@@ -240,12 +240,23 @@ NONFINITE = 63
 class LoopSetup(NamedTuple):
     """What every run of a batch shares, besides its controller (a record the compiled loop unpacks).
 
-    ``kind``: the kernel kind (:data:`KIND_TURBINE`, ...); ``wdt``, ``dt``: the wind's sample
-    spacing and the step (s); ``nsteps``, ``rec_every``: steps per run and between records;
-    ``ny``: plant outputs; ``i_speed``, ``i_vel``, ``i_power``, ``i_pitch``: the indices of the
-    generator speed, tower-top velocity, power and pitch among them (the last two read by the
-    torque law only); ``lim_idx``, ``lim_val``: the outputs with a physical limit and those
-    limits (SI).
+    Parameters
+    ----------
+    kind : int
+        The kernel kind (:data:`KIND_TURBINE`, :data:`KIND_LINEAR`, :data:`KIND_USER`).
+    wdt, dt : float
+        The wind's sample spacing and the step, s.
+    nsteps, rec_every : int
+        Steps per run and between records.
+    ny : int
+        Number of plant outputs.
+    i_speed, i_vel, i_power, i_pitch : int
+        Indices of the generator speed, tower-top velocity, power and pitch among them (the
+        last two read by the torque law only).
+    lim_idx : numpy.ndarray
+        int64 indices of the outputs with a physical limit.
+    lim_val : numpy.ndarray
+        Those limits (SI).
     """
 
     kind: int
@@ -266,12 +277,23 @@ class Bank(NamedTuple):
     """The discrete controller bank of :func:`specdesign.controller.scheduled.controller_bank`,
     padded to K locals of nc states (a record the compiled loop unpacks).
 
-    ``Ad`` (K, nc, nc), ``Bd`` (K, nc, 2) (inputs: speed error, −tower-top velocity), ``Cd``
-    (K, nc), ``Dd`` (K, 2): each local by Tustin; ``Rq`` (K,): the gain of its integrator run
-    apart, ``Ns`` (K,): its slow states (0: PI-like, clamped); ``same`` (K,): the first local
-    identical to each; ``sched_pitch`` (K,): the scheduling pitches (rad); ``sfilt``: the
-    scheduling filter (1 coefficient: first order; 5: second order); ``cmd_lim`` (2,): the
-    plant's pitch limits (rad).
+    Parameters
+    ----------
+    Ad, Bd, Cd, Dd : numpy.ndarray
+        (K, nc, nc), (K, nc, 2), (K, nc), (K, 2): each local by Tustin (inputs: the speed error
+        rad/s, minus the tower-top velocity m/s; output: pitch, rad).
+    Rq : numpy.ndarray
+        (K,) gain of each local's integrator, run apart.
+    Ns : numpy.ndarray
+        (K,) int64, each local's slow states (0: PI-like, clamped).
+    same : numpy.ndarray
+        (K,) int64, the first local identical to each.
+    sched_pitch : numpy.ndarray
+        (K,) scheduling pitches, rad.
+    sfilt : numpy.ndarray
+        The scheduling filter (1 coefficient: first order; 5: second order).
+    cmd_lim : numpy.ndarray
+        (2,) the plant's pitch limits, rad.
     """
 
     Ad: np.ndarray
@@ -287,9 +309,19 @@ class Bank(NamedTuple):
 
 
 class GainsPI(NamedTuple):
-    """ROSCO's gain-scheduled PI (``form="gains"``), off when ``on`` is False: (K,) gains ``kp``,
-    ``ki`` at the scheduling pitches, the error filter by Tustin (``Af``, ``Bf``, ``Cf``,
-    ``Df``), and the limits ``lim`` (2,) (rad) of its integrator and output."""
+    """ROSCO's gain-scheduled PI (``form="gains"``) of the compiled loop.
+
+    Parameters
+    ----------
+    on : bool
+        False: no such PI (the bank's locals alone).
+    kp, ki : numpy.ndarray
+        (K,) gains at the scheduling pitches, rad per rad/s and rad per rad.
+    Af, Bf, Cf, Df : numpy.ndarray
+        The speed-error filter by Tustin.
+    lim : numpy.ndarray
+        (2,) limits of its integrator and output, rad.
+    """
 
     on: bool
     kp: np.ndarray
@@ -304,12 +336,22 @@ class GainsPI(NamedTuple):
 class Runs(NamedTuple):
     """Per-run inputs of a batch, R runs along the first axis.
 
-    ``P`` (R, n_p): kernel parameters; ``X0`` (R, nx): initial states; ``W`` (R, n_w): wind
-    (m/s); ``beta0``, ``omega_ref``, ``torque`` (R,): trim pitch (rad), speed reference
-    (rad/s), trim torque (N·m); ``TQ`` (R, TORQUE_PARAMS): the torque law's parameters (mode
-    0: held); ``noise`` (R, 2, nsteps): what the controllers' measured generator speed (rad/s)
-    and tower-top velocity (m/s) add at each step, or (R, 0, 0) for none (the measurement is
-    then the output itself, bit for bit).
+    Parameters
+    ----------
+    P : numpy.ndarray
+        (R, n_p) kernel parameters.
+    X0 : numpy.ndarray
+        (R, nx) initial states.
+    W : numpy.ndarray
+        (R, n_w) wind, m/s.
+    beta0, omega_ref, torque : numpy.ndarray
+        (R,) trim pitch (rad), speed reference (rad/s), trim torque (N·m).
+    TQ : numpy.ndarray
+        (R, TORQUE_PARAMS) the torque law's parameters (mode 0: the torque held).
+    noise : numpy.ndarray
+        (R, 2, nsteps): what the controllers' measured generator speed (rad/s) and tower-top
+        velocity (m/s) add at each step, or (R, 0, 0) for none (the measurement is then the
+        output itself, bit for bit).
     """
 
     P: np.ndarray
