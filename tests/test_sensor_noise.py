@@ -127,7 +127,7 @@ def test_compiled_loop_reads_the_noisy_speed_and_velocity(model):
 def test_noise_off_is_bitwise_the_noise_free_simulator(model):
     # noise=None, an inactive SensorNoise, and noise only on a signal the compiled loop does not
     # read (the compiled kernel then takes its noisy path, adding zeros): the same numbers, bit
-    # for bit (build/bitwise.py compared 63 series of 7 cases before and after the kernel's records)
+    # for bit (benchmarks/simulate_series.py compared 63 series of 7 cases before and after the kernel's records)
     c = rosco_baseline(model, V)
     kw = dict(seeds=[1, 2], duration=20.0, transient=5.0)
     ref = simulate(model, c, [17.0, V], **kw)
