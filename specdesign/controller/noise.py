@@ -50,10 +50,11 @@ NOISE_ENTROPY = 0x6E6F697365
 #: The measured signals that carry white noise, as plant output names → the field holding its SD.
 MEASURED = {"gen_speed": "speed_sd", "tower_top_acc": "acc_sd", "tower_top_vel": "vel_sd",
             "blade_root_my": "blade_moment_sd"}
-#: Amplitude (rad/s) of the 3P line in the IEA 15 MW's generator speed in OpenFAST: ROSCO on the
-#: monopile deck at 19 m/s, steady wind with the deck's shear, fitted locked to the azimuth
-#: (``benchmarks/sensor_3p.py``; docs/sensors.md gives the run and the turbulent one beside it).
-RIPPLE_3P_IEA15MW = 0.0
+#: Amplitude (rad/s) of the 3P line in the IEA 15 MW's generator speed in OpenFAST v5.0.0: ROSCO on
+#: the monopile deck at 19 m/s, steady wind with the deck's shear, the last 60 s of 120 s, fitted
+#: locked to the azimuth: 4.90e-4 rad/s, 0.06 % of the rated 0.79 rad/s (``benchmarks/sensor_3p.py``;
+#: docs/sensors.md gives the run).
+RIPPLE_3P_IEA15MW = 4.9e-4
 
 
 @dataclass(frozen=True)
