@@ -4,9 +4,10 @@ numbers of docs/sensors.md.
 1. The achievable design's promise (``feasibility.achievable_pitch``, speed specification relaxed
    1 dB, pitch-rate SD at most ROSCO's, κ = 1) without noise, with the white generator-speed
    noise, and with the noise and the 3P ripple, at 15, 19 and 23 m/s.
-2. ROSCO (``rosco_scheduled``) simulated on the reduced model with and without the sensors
-   (``run_campaign(noise=...)``): the same winds, so paired; tower DEL, speed SD, pitch-rate SD,
-   pitch travel and time at the rate limit per wind speed.
+2. ROSCO (``rosco_scheduled``) and the QFT design at 19 m/s (``qft.design_qft``, 25 % target)
+   simulated on the reduced model with and without the sensors (``run_campaign(noise=...)``): the
+   same winds, so paired; tower DEL, speed SD, pitch-rate SD, pitch travel and time at the rate
+   limit.
 
 Run: ``nice -n 10 python benchmarks/sensors.py [--seeds 4] [--duration 600]`` (a few minutes).
 """
@@ -19,6 +20,7 @@ import numpy as np
 
 from specdesign.controller.noise import IEA15MW_SENSORS
 from specdesign.feasibility import achievable_pitch
+from specdesign.qft import design_qft
 from specdesign.rosco import rosco_scheduled
 from specdesign.spec import baseline_analysis
 from specdesign.turbine import iea15mw
@@ -43,21 +45,23 @@ def main() -> None:
         print(f"| {v:g} m/s | {r[0]:.2f} % | {r[1]:.2f} % | {r[2]:.2f} % |")
     seeds = list(range(args.seeds))
     kw = dict(model=model, duration=args.duration, predict=False, progress=False)
-    c = {"ROSCO": rosco_scheduled(model)}
-    clean = run_campaign(c, list(SPEEDS), seeds, **kw)
-    noisy = run_campaign(c, list(SPEEDS), seeds, noise=IEA15MW_SENSORS, **kw)
-    print(f"\nROSCO on the reduced model, {args.seeds} paired seeds × {args.duration:g} s, without → with the sensors (seeds pooled: DEL by damage, SDs by variance, the rest by mean):\n")
-    print("| wind speed | tower DEL (MN·m) | speed SD (rpm) | pitch-rate SD (deg/s) | pitch travel (deg/h) | "
+    rosco = rosco_scheduled(model)
+    qft19 = design_qft(model, 19.0, target_reduction=25.0).pitch_controller
+    print(f"\nOn the reduced model, {args.seeds} paired seeds × {args.duration:g} s, without → with the sensors "
+          "(seeds pooled: DEL by damage, SDs by variance, the rest by mean):\n")
+    print("| controller | wind speed | tower DEL (MN·m) | speed SD (rpm) | pitch-rate SD (deg/s) | pitch travel (deg/h) | "
           "time at the rate limit (%) |")
-    print("|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|")
     conv = {"tower_del": 1e-6, "gen_speed_sd": 30 / np.pi, "pitch_rate_sd": 180 / np.pi, "pitch_travel": 180 / np.pi,
             "rate_limit_time": 100.0}
-    for i, v in enumerate(SPEEDS):
-        cells = []
-        for k, f in conv.items():
-            a, b = (f * float(pool(k, x.values[k][0, i], x.m)) for x in (clean, noisy))  # seeds pooled as they add up
-            cells.append(f"{a:.3g} → {b:.3g}")
-        print(f"| {v:g} m/s | " + " | ".join(cells) + " |")
+    for name, c, speeds in (("ROSCO", rosco, SPEEDS), ("QFT (19 m/s design)", qft19, (19.0,))):
+        clean, noisy = (run_campaign({name: c}, list(speeds), seeds, noise=n, **kw) for n in (None, IEA15MW_SENSORS))
+        for i, v in enumerate(speeds):
+            cells = []
+            for k, f in conv.items():
+                a, b = (f * float(pool(k, x.values[k][0, i], x.m)) for x in (clean, noisy))  # seeds pooled as they add up
+                cells.append(f"{a:.3g} → {b:.3g}")
+            print(f"| {name} | {v:g} m/s | " + " | ".join(cells) + " |", flush=True)
 
 
 if __name__ == "__main__":
