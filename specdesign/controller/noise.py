@@ -53,7 +53,7 @@ MEASURED = {"gen_speed": "speed_sd", "tower_top_acc": "acc_sd", "tower_top_vel":
 #: Amplitude (rad/s) of the 3P line in the IEA 15 MW's generator speed in OpenFAST v5.0.0: ROSCO on
 #: the monopile deck at 19 m/s, steady wind with the deck's shear, the last 60 s of 120 s, fitted
 #: locked to the azimuth: 4.90e-4 rad/s, 0.06 % of the rated 0.79 rad/s (``benchmarks/sensor_3p.py``;
-#: docs/sensors.md gives the run).
+#: docs/sensors.md gives the run and a turbulent one, 4.19e-4 rad/s).
 RIPPLE_3P_IEA15MW = 4.9e-4
 
 
