@@ -12,7 +12,10 @@ The plant is a kernel pair ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` /
 the linear one of this module (:func:`linear_rhs`, parameters from :func:`linear_plant_params`), or
 any user pair (:func:`compiled_for` rebinds the same loop code to it). Everything here is driven
 by :func:`specdesign.simulate.simulate`; nothing is meant to be called directly but
-:func:`linear_plant_params`.
+:func:`linear_plant_params`. The loop's inputs come in four records that ``simulate`` builds and
+the loop unpacks (NamedTuples, which numba compiles): ``LoopSetup`` (what every run shares),
+``Bank`` (the discrete controller bank), ``GainsPI`` (ROSCO's gain-scheduled PI) and ``Runs``
+(per-run arrays, the sensor noise of :mod:`specdesign.controller.noise` among them).
 """
 from __future__ import annotations
 
@@ -46,10 +49,6 @@ __all__ = [
     "linear_plant_params",
     "compiled_for",
     "run_callable",
-    "LoopSetup",
-    "Bank",
-    "GainsPI",
-    "Runs",
 ]
 
 
@@ -240,7 +239,7 @@ NONFINITE = 63
 class LoopSetup(NamedTuple):
     """What every run of a batch shares, besides its controller (a record the compiled loop unpacks).
 
-    Parameters
+    Attributes
     ----------
     kind : int
         The kernel kind (:data:`KIND_TURBINE`, :data:`KIND_LINEAR`, :data:`KIND_USER`).
@@ -277,7 +276,7 @@ class Bank(NamedTuple):
     """The discrete controller bank of :func:`specdesign.controller.scheduled.controller_bank`,
     padded to K locals of nc states (a record the compiled loop unpacks).
 
-    Parameters
+    Attributes
     ----------
     Ad, Bd, Cd, Dd : numpy.ndarray
         (K, nc, nc), (K, nc, 2), (K, nc), (K, 2): each local by Tustin (inputs: the speed error
@@ -311,7 +310,7 @@ class Bank(NamedTuple):
 class GainsPI(NamedTuple):
     """ROSCO's gain-scheduled PI (``form="gains"``) of the compiled loop.
 
-    Parameters
+    Attributes
     ----------
     on : bool
         False: no such PI (the bank's locals alone).
@@ -336,7 +335,7 @@ class GainsPI(NamedTuple):
 class Runs(NamedTuple):
     """Per-run inputs of a batch, R runs along the first axis.
 
-    Parameters
+    Attributes
     ----------
     P : numpy.ndarray
         (R, n_p) kernel parameters.
