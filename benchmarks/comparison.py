@@ -40,9 +40,22 @@ import time
 import numpy as np
 
 SPEEDS = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
-INDS = ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd")
+INDS = ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "pitch_travel")
 LABELS = {"tower_del": "tower DEL", "blade_del": "blade DEL", "gen_speed_sd": "speed SD",
-          "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD"}
+          "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD",
+          "pitch_travel": "pitch travel"}
+
+
+def actuator_table(camps):
+    """Rows "controller | pitch travel (deg/h) | pitch-rate SD (deg/s) | time at the rate limit (%)":
+    the actuator's cost of each controller, absolute, mean over its speeds and seeds (a
+    subset's baseline under its own name)."""
+    lines = ["| controller | pitch travel (deg/h) | pitch-rate SD (deg/s) | time at the pitch-rate limit (% of the record) |",
+             "|---|---|---|---|"]
+    for name, c in camps.items():
+        travel, rate, at = (float(np.nanmean(c.values[k][0])) for k in ("pitch_travel", "pitch_rate_sd", "rate_limit_time"))
+        lines.append(f"| {name} | {np.degrees(travel):.0f} | {np.degrees(rate):.3f} | {100.0 * at:.2f} |")
+    return lines
 
 
 def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101, 102, 103), quick=False,
@@ -160,8 +173,8 @@ def fmt(x, se):
     return "–" if not np.isfinite(x) else (f"{x:+.1f} ± {se:.1f}" if np.isfinite(se) else f"{x:+.1f}")
 
 
-def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took):
-    """The tables of docs/comparison.md."""
+def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took, camps=None):
+    """The tables of docs/comparison.md (with ``camps``, the actuator's cost of each controller too)."""
     lines = []
     lines.append("| controller | " + " | ".join(f"{LABELS[k]} Δ% ± SE" for k in INDS)
                  + " | CPU/step: campaign (ms) | CPU/step: controller solve (ms) |")
@@ -196,7 +209,10 @@ def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took):
             pred.append(f"| {name} | {LABELS[k]} | Volterra (order 3) | " + " | ".join(f"{x:+.1f}" for x in vol) + " |")
             pred.append(f"| {name} | {LABELS[k]} | rainflow (simulated) | "
                         + " | ".join(fmt(c, s) for c, s in zip(sim.change, sim.se)) + " |")
-    return "\n".join(lines + per_speed + pred)
+    act = [] if camps is None else ["", "The pitch actuator's cost (absolute; mean over the speeds and seeds; pitch "
+                                    "travel Σ|Δβ| per hour on the 0.1 s records, the rate limit the model's "
+                                    "2 deg/s):", ""] + actuator_table(camps)
+    return "\n".join(lines + act + per_speed + pred)
 
 
 START, END = "<!-- comparison.py results: start -->", "<!-- comparison.py results: end -->"
@@ -266,7 +282,7 @@ def main():
                 + f". Took {took:.0f} s wall; load average {load[0]:.1f} at the start, {load_end[0]:.1f} at the end "
                 "(2 cores, shared). Campaign wall times: " + ", ".join(f"{n} {t:.0f} s" for n, t in wall.items()) + ".")
         text = head + "\n\n" + markdown(changes(camps), preds, cpu_per_step(camps, allc, cpu, duration, 30.0), speeds,
-                                        econ_speeds, a, load, took)
+                                        econ_speeds, a, load, took, camps=camps)
         print(text)
         splice(a.out, text)
         figure(changes(camps), a.figure)

@@ -23,7 +23,7 @@ import os
 import time
 
 import numpy as np
-from comparison import INDS, LABELS, SPEEDS, fmt, splice
+from comparison import INDS, LABELS, SPEEDS, actuator_table, fmt, splice
 
 START, END = "<!-- tower_damper.py results: start -->", "<!-- tower_damper.py results: end -->"
 
@@ -129,7 +129,9 @@ def main():
                 ch = per[(name, "tower_del")]
                 ps.append(f"| {name} | " + " | ".join(fmt(c, s) for c, s in zip(ch.change, ch.se)) + " |")
         text = "\n".join(head + ["Change vs ROSCO as shipped (tower damping off):", ""] + l1
-                         + ["", "Change vs ROSCO with its tower damper (TD_Mode = 1):", ""] + l2 + ps)
+                         + ["", "Change vs ROSCO with its tower damper (TD_Mode = 1):", ""] + l2 + ps
+                         + ["", "The pitch actuator's cost (absolute; mean over the speeds and seeds):", ""]
+                         + actuator_table(camps))
         print(text, flush=True)
         splice(a.out, text, START, END, append=True)
 

@@ -677,7 +677,7 @@ def _write_indicators(camp: Campaign, path: Path) -> None:
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["controller", "wind_speed_m_s", "seed", "tower_del_Nm", "gen_speed_sd_rad_s", "mean_power_W",
-                    "pitch_sd_rad", "pitch_rate_sd_rad_s", "blade_del_Nm"])
+                    "pitch_sd_rad", "pitch_rate_sd_rad_s", "blade_del_Nm", "pitch_travel_rad_per_h", "rate_limit_time"])
         for c, name in enumerate(camp.controllers):
             for i, v in enumerate(camp.wind_speeds):
                 for s, seed in enumerate(camp.seeds):

@@ -110,7 +110,8 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
                       "gen_speed": (7.56 + 0.2 * np.sin(1.3 * w * t)) * math.pi / 30,
                       "pitch": np.radians(15 + gain * np.sin(0.3 * w * t)), "power": 1e3 * (1.5e4 + 50 * np.sin(t)),
                       "blade_root_my": 1e3 * (3e4 + 8e3 * np.sin(0.8 * t + seed))}
-            want = indicators({k: a[None] for k, a in series.items()}, 0.05, 4.0).as_dict()
+            # the rate limit: PC_MaxRat of the shipped deck's DISCON.IN, 0.0349 rad/s (2 deg/s)
+            want = indicators({k: a[None] for k, a in series.items()}, 0.05, 4.0, pitch_rate_limit=0.0349).as_dict()
             for k, v in want.items():
                 assert_allclose(camp.values[k][ci, 0, si], v[0], rtol=1e-9, err_msg=f"{k} {ci} {seed}")
     assert camp.series["A"].outputs["tower_base_my"].shape == (1, 1, 800)

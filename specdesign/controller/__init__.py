@@ -14,6 +14,8 @@ Layout
   or ROSCO's gain-scheduled PI) and its discrete bank for the compiled loop.
 - :mod:`specdesign.controller.torque`: ROSCO's generator-torque controller below rated
   (:class:`TorqueLaw`, its steady state, its linearisation and its compiled step).
+- :mod:`specdesign.controller.noise`: what a controller measures, :class:`SensorNoise` (white
+  sensor noise and the 3P ripple the simulator adds between the plant and every controller).
 - :mod:`specdesign.controller.discon_file`: ROSCO's parameter file DISCON.IN read and written
   (:func:`read_discon`, :func:`from_discon`, :func:`write_discon`).
 
@@ -38,6 +40,7 @@ from .lti import (
     split_slow,
     tustin_matrices,
 )
+from .noise import IEA15MW_SENSORS, SensorNoise
 from .scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from .torque import (
     TORQUE_MODES,
@@ -51,6 +54,8 @@ from .torque import (
 )
 
 __all__ = [
+    "SensorNoise",
+    "IEA15MW_SENSORS",
     "DisconEntry",
     "DisconSchedule",
     "read_discon",

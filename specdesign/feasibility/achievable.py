@@ -120,8 +120,35 @@ class AchievablePitch:
         return control.minreal(control.feedback(y, control.tf(p), sign=+1), verbose=False)
 
 
+def _noise_rate(model, plant, c_base, wind_speed, noise, w, tw, c_ref, ob, phi_o, rr):
+    """The pitch rate driven by the measured speed's noise (:class:`~specdesign.controller.noise.SensorNoise`).
+
+    With β = −C·(Ω_g + n), T_{β,n} = −C·S = −Y: affine in the design, the rate spectrum is
+    |ω·Y|²·S_n with S_n the white noise's PSD at the noise's ``sample_time`` (flat on the grid),
+    integrated with the grid's trapezoid weights ``tw``, plus the 3P line's variance A²/2 at
+    ω_3P = 3·Ω_r (the trim's rotor speed) times |ω_3P·Y(jω_3P)|². ROSCO's side is the same with
+    its C (``c_base``, ``c_ref`` on the grid) and S. The white part counts on the design grid
+    only, as the wind's does: above its end (10 rad/s by default) neither is in the constraint.
+    Returns ROSCO's noise-driven rate variance, (rad/s)², and the rows R (complex, in the
+    orthonormal coordinates of ``phi_o``, ``rr``) with ‖R y‖² the design's.
+    """
+    s_ref = 1.0 / (1.0 + c_ref * ob)
+    sn = noise.psd("gen_speed", w, noise.sample_time)
+    ref = float(np.sum(tw * np.abs(w * c_ref * s_ref) ** 2 * sn))
+    rows = [w[:, None] * phi_o * np.sqrt(tw * sn)[:, None]]
+    w3, var3 = noise.lines(model.trim(wind_speed).rotor_speed)
+    if var3 > 0:
+        w2 = np.array([w3, 2.0 * w3])  # the maps take a grid of ≥ 2 frequencies: ω_3P is its first
+        c3 = siso_response(c_base, w2)[0]
+        ob3 = frequency_response(plant, w2, "gen_speed", "pitch_cmd")[0]
+        ref += float(w3 ** 2 * np.abs(c3 / (1.0 + c3 * ob3)) ** 2 * var3)
+        phi3 = np.linalg.solve(rr.T, _youla_basis(np.array([1j * w3]))[0])  # phi = q·rr: the row of q at ω_3P
+        rows.append((w3 * np.sqrt(var3) * phi3)[None, :])
+    return ref, rows
+
+
 def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=MAX_SENSITIVITY, max_pitch_rate_ratio=1.0,
-                     m=TOWER_M, omega=None, base=None, integral_action=True) -> AchievablePitch:
+                     m=TOWER_M, omega=None, base=None, integral_action=True, noise=None) -> AchievablePitch:
     """The pitch design that minimises the predicted tower damage under a generator-speed specification.
 
     Every stabilising controller of the stable plant is C = Y/(1 − P_{Ω,β}Y) with Y stable,
@@ -145,7 +172,8 @@ def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=M
         M_s (-).
     max_pitch_rate_ratio : float
         κ: the pitch-rate SD, ∫|ω·T_{β,w}|²S_W dω on the grid, at most κ² times ROSCO's
-        (a quadratic constraint; 1.0: no more pitch activity than ROSCO).
+        (a quadratic constraint; 1.0: no more pitch activity than ROSCO); its variance for
+        the square, with ``noise`` the noise-driven rate added on both sides.
     m : float
         Wöhler exponent (-).
     omega : array_like, optional
@@ -156,6 +184,11 @@ def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=M
         Require S(0) = 0 (a linear equality on Y(0)): the controller integrates the speed error
         as ROSCO's PI does, so T_{Ω,w} vanishes at 0 rad/s and the speed specification holds
         below the grid too (without it the design may trade the steady-state speed error).
+    noise : specdesign.controller.noise.SensorNoise, optional
+        Sensor noise on the measured generator speed: the pitch-rate variance of both the
+        design and ROSCO then includes ∫|ω·C·S|²·S_n dω on the grid (S_n the white noise's
+        PSD at the noise's ``sample_time``) and the 3P line's |ω_3P·C·S|²·A²/2. None (default):
+        the wind alone, as before.
 
     Returns
     -------
@@ -171,7 +204,7 @@ def achievable_pitch(model, wind_speed, speed_relax_db=0.0, *, max_sensitivity=M
     if not (np.isfinite(g) and g >= 0):
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB")
     return YoulaProblem(model, wind_speed, max_sensitivity=max_sensitivity, max_pitch_rate_ratio=max_pitch_rate_ratio,
-                        m=m, omega=omega, base=base, integral_action=integral_action).solve(g)
+                        m=m, omega=omega, base=base, integral_action=integral_action, noise=noise).solve(g)
 
 
 class YoulaProblem:
@@ -211,10 +244,12 @@ class YoulaProblem:
         Its cost on the IEA 15 MW is large (docs/feasibility.md, "A high-frequency gain bound").
     hf_omega : float, optional
         Lowest frequency of that bound, rad/s (default :data:`HF_OMEGA`).
+    noise : specdesign.controller.noise.SensorNoise, optional
+        Sensor noise in the pitch-rate constraint (see :func:`achievable_pitch`).
     """
 
     def __init__(self, model, wind_speed, *, max_sensitivity=MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
-                 base=None, integral_action=True, tower_bound=False, max_hf_gain_ratio=None, hf_omega=None):
+                 base=None, integral_action=True, tower_bound=False, max_hf_gain_ratio=None, hf_omega=None, noise=None):
         import cvxpy as cp
 
         from .. import spec
@@ -253,11 +288,19 @@ class YoulaProblem:
         self.s_bound = cp.Parameter(w.size, nonneg=True)  # min(M_s, W_Ω/|P_{Ω,w}|): |S| ≤ M_s and |P_{Ω,w}S| ≤ W_Ω
         constraints = [cp.SOC(self.s_bound, cp.vstack([1.0 + sl.real @ y, sl.imag @ y]), axis=0)]
         # pitch-rate activity: the rate spectrum |ω·T_{β,w}|²S_W, T_{β,w} = −P_{Ω,w}Y, integrated
-        # (trapezoid weights), at most κ² times ROSCO's: ‖rl·y‖ ≤ κ, as ‖R_rate y‖ ≤ κ
+        # (trapezoid weights), at most κ² times ROSCO's: ‖rl·y‖ ≤ κ, as ‖R_rate y‖ ≤ κ; with sensor
+        # noise, the rate its measured-speed noise drives on both sides too (_noise_rate)
         tw = trapezoid_weights(w)
-        c_ref = siso_response(spec.baseline_controller(model, self.wind_speed), w)
+        c_base = spec.baseline_controller(model, self.wind_speed)
+        c_ref = siso_response(c_base, w)
         rate_ref = float(np.sum(tw * np.abs(w * c_ref * self.ow / (1 + c_ref * self.ob)) ** 2 * base.wind_psd))
+        noise_rows = ()
+        if noise is not None:
+            noise_ref, noise_rows = _noise_rate(model, plant, c_base, self.wind_speed, noise, w, tw, c_ref, self.ob, phi_o,
+                                                self.rr)
+            rate_ref += noise_ref
         rl = (w * self.ow)[:, None] * phi_o * np.sqrt(tw * base.wind_psd / rate_ref)[:, None]  # scaled to ROSCO's: O(1)
+        rl = np.vstack([rl, *(r / np.sqrt(rate_ref) for r in noise_rows)])
         r_rate = np.linalg.qr(np.vstack([rl.real, rl.imag]), mode="r")
         constraints.append(cp.SOC(cp.Constant(kappa), r_rate @ y))
         if integral_action:  # S(0) = 1 − P_{Ω,β}(0)·Y(0) = 0, in the orthonormal coordinates

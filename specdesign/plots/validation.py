@@ -318,7 +318,8 @@ def plot_comparison(changes, indicators=("tower_del", "blade_del"), *, axes=None
     if axes.size != len(inds):
         raise ValueError(f"axes has {axes.size} entries; give one per indicator ({len(inds)})")
     labels = {"tower_del": "tower-base DEL", "blade_del": "blade-root DEL", "gen_speed_sd": "generator-speed SD",
-              "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD"}
+              "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD",
+              "pitch_travel": "pitch travel", "rate_limit_time": "time at the pitch-rate limit"}
     width = 0.8 / len(names)
     speeds = np.unique(np.concatenate([np.asarray(changes[n][ind].wind_speeds, dtype=float)
                                        for n in names for ind in inds]))

@@ -95,11 +95,13 @@ Layout
   :func:`split_slow` (:mod:`specdesign.controller.lti`), the plant :class:`KernelPlant`,
   :func:`turbine_plant` and :func:`scheduled` (:mod:`specdesign.turbine.plant`),
   :func:`rosco_scheduled` (:mod:`specdesign.rosco`), :func:`wind_series` and :func:`seed_for`
-  (:mod:`specdesign.wind`).
+  (:mod:`specdesign.wind`), the measurement model :class:`SensorNoise` and
+  :data:`IEA15MW_SENSORS` (:mod:`specdesign.controller.noise`, ``simulate(..., noise=...)``).
 """
 from __future__ import annotations
 
 from ..controller.lti import SLOW_OMEGA, as_lti, is_lti_like, split_integrator, split_slow, tustin_matrices
+from ..controller.noise import IEA15MW_SENSORS, SensorNoise
 from ..controller.scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from ..rosco import rosco_scheduled
 from ..turbine.plant import KernelPlant, scheduled, turbine_plant
@@ -109,6 +111,8 @@ from .core import WIND_MEAN_TOLERANCE, SimulationDivergedError, SimulationResult
 from .kernels import linear_plant_params
 
 __all__ = [
+    "SensorNoise",
+    "IEA15MW_SENSORS",
     "SimulationDivergedError",
     "KernelPlant",
     "ScheduledController",

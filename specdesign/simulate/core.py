@@ -8,20 +8,22 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 from ..controller.lti import is_lti_like
+from ..controller.noise import MEASURED, SensorNoise
 from ..controller.scheduled import ScheduledController, controller_bank, schedule_filter_coefficients
 from ..controller.torque import TORQUE_PARAMS, TorqueLaw
 from ..turbine import iea15mw
 from ..turbine.plant import KernelPlant, turbine_plant
 from ..wind import wind_series
 from .checks import check_step, warn_unstable
-from .kernels import NONFINITE, compiled_for, linear_outputs, linear_plant_params, linear_rhs, run_callable
+from .kernels import (NONFINITE, Bank, GainsPI, LoopSetup, Runs, compiled_for, linear_outputs, linear_plant_params,
+                      linear_rhs, run_callable)
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
@@ -101,7 +103,8 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
              seeds: ArrayLike | None = None, wind: ArrayLike | None = None, duration: float = 600.0, dt: float = 0.02,
              record_dt: float = 0.1, transient: float = 60.0, wind_dt: float | None = None,
              turbulence_class: str = "B", linear: bool = False, wind_rotor_radius: float | None = None,
-             wind_mean_tol: float = WIND_MEAN_TOLERANCE, torque_control: object = "auto") -> SimulationResult:
+             wind_mean_tol: float = WIND_MEAN_TOLERANCE, torque_control: object = "auto",
+             noise: SensorNoise | None = None) -> SimulationResult:
     """Simulate the closed loop for every (wind speed, seed), all runs batched.
 
     Parameters
@@ -148,6 +151,16 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         everywhere. Ignored with ``linear=True`` (the linearisation closes the law below
         rated, and above rated a constant-power one) and for a callable controller (it
         commands the torque itself, or holds the trim torque).
+    noise : specdesign.controller.noise.SensorNoise, optional
+        The sensors between the plant and the controller (white noise on the measured
+        generator speed, tower-top acceleration and velocity and blade-root moment, and a 3P
+        ripple on the speed; see :mod:`specdesign.controller.noise`), seeded per (wind speed,
+        seed) so that every controller run on the same runs reads the same noise. The compiled
+        loop's pitch controller, ATD and torque law read the noisy generator speed and tower-top
+        velocity; a callable gets every noisy signal in ``y``. The recorded outputs are the
+        plant's. None (default): the controllers read the outputs themselves (the results of
+        the simulator before the noise model, bit for bit). E.g.
+        :data:`specdesign.controller.noise.IEA15MW_SENSORS`.
 
     Returns
     -------
@@ -204,6 +217,65 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     """
     model_radius = getattr(plant, "rotor_radius", None)
     plant = turbine_plant(plant) if not isinstance(plant, KernelPlant) else plant
+    times = _times(dt, duration, record_dt, transient)
+    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    if vs.ndim != 1 or not np.all(np.isfinite(vs)) or np.any(vs <= 0):
+        raise ValueError(f"wind_speeds must be a 1-D array of positive mean wind speeds in m/s, got {wind_speeds!r}")
+    if noise is not None and not isinstance(noise, SensorNoise):
+        raise TypeError(f"noise must be a specdesign.controller.noise.SensorNoise or None, got {type(noise).__name__}")
+    radius = wind_rotor_radius if wind_rotor_radius is not None else model_radius
+    wind, wind_dt, seeds = _wind_records(vs, seeds, wind, wind_dt, times, radius, turbulence_class, wind_mean_tol)
+    S = wind.shape[1]
+    check_step(plant, vs, times.dt)
+    TQ, above = _torque_params(plant, torque_control, vs, S, linear)
+    rhs, outfn, runs, trim_speeds = _plant_runs(plant, vs, S, linear, wind, TQ)
+    noise_of = _measurement_noise(noise, plant, vs, seeds, S, times, trim_speeds)
+    kind, run_batch, step_all, outputs_all = compiled_for(rhs, outfn)
+    ny = len(plant.output_names)
+    lim_names = tuple(plant.output_limits)
+    setup = LoopSetup(kind, wind_dt, times.dt, times.nsteps, times.rec_every, ny, plant.index("gen_speed"),
+                      plant.index("tower_top_vel"), *_torque_outputs(plant, TQ),
+                      np.array([plant.index(n) for n in lim_names], dtype=np.int64),
+                      np.array([float(plant.output_limits[n]) for n in lim_names]))
+    Y = np.empty((runs.X0.shape[0], ny + 1, (times.nsteps + times.rec_every - 1) // times.rec_every))
+    status = np.full(runs.X0.shape[0], -1, dtype=np.int64)
+    if callable(controller) and not is_lti_like(controller) and not isinstance(controller, ScheduledController):
+        label = getattr(controller, "__name__", "callable")
+        if torque_control == "rosco" or TQ[:, 0].any() and torque_control != "auto":
+            raise ValueError("a callable controller commands the generator torque itself (or holds the trim torque): "
+                             "torque_control must be 'auto' or None with it")
+        run_callable(controller, step_all, outputs_all, kind, runs.P, runs.X0, runs.W, wind_dt, times.dt, times.nsteps,
+                     times.rec_every, runs.torque, runs.beta0, ny, Y, plant.output_names, setup.lim_idx, setup.lim_val,
+                     status, noise_of)
+    else:
+        label = getattr(controller, "name", None)
+        if label is None or _AUTO_NAME.fullmatch(str(label)):
+            # python-control names an unnamed system "sys[4]": a name the user never gave
+            label = "controller"
+        # below rated the pitch loop is open (its PI sits at the minimum pitch): not checked there
+        warn_unstable(plant, controller, vs[above], times.dt)
+        bank, gpi = _bank_records(controller, plant, times.dt)
+        if noise_of:  # the compiled loop reads the generator speed and the tower-top velocity
+            R, n = runs.X0.shape[0], times.nsteps
+            runs = runs._replace(noise=np.ascontiguousarray(np.stack(
+                [noise_of.get(k, np.zeros((R, n))) for k in ("gen_speed", "tower_top_vel")], axis=1)))
+        run_batch(setup, bank, gpi, runs, Y, status)
+    _raise_diverged(status, vs, seeds, S, times.dt, times.transient, lim_names, setup.lim_val, str(label), linear)
+    return _result(plant, Y, runs.W, wind_dt, vs, seeds, times, linear, str(label))
+
+
+class _Times(NamedTuple):
+    """The checked time settings of :func:`simulate` (s), the steps per run and between records."""
+
+    dt: float
+    duration: float
+    record_dt: float
+    transient: float
+    rec_every: int
+    nsteps: int
+
+
+def _times(dt, duration, record_dt, transient) -> _Times:
     dt = positive_scalar(dt, "dt")
     duration = positive_scalar(duration, "duration")
     record_dt = positive_scalar(record_dt, "record_dt")
@@ -213,62 +285,63 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     rec_every = int(round(record_dt / dt))
     if rec_every < 1 or abs(rec_every * dt - record_dt) > 1e-9 * record_dt:
         raise ValueError(f"record_dt={record_dt} must be a whole multiple of dt={dt}")
-    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
-    if vs.ndim != 1 or not np.all(np.isfinite(vs)) or np.any(vs <= 0):
-        raise ValueError(f"wind_speeds must be a 1-D array of positive mean wind speeds in m/s, got {wind_speeds!r}")
-    total = transient + duration
-    nsteps = int(round(total / dt))
+    return _Times(dt, duration, record_dt, transient, rec_every, int(round((transient + duration) / dt)))
+
+
+def _wind_records(vs, seeds, wind, wind_dt, times, radius, turbulence_class, wind_mean_tol):
+    """(W, S, n_w) wind (m/s), its spacing (s) and the seeds (or None): synthesised from the
+    seeds, or the given records checked."""
+    total = times.transient + times.duration
     if wind is None:
         if seeds is None:
             raise ValueError("give either seeds (turbulent wind is synthesised) or wind (W, S, n) in m/s")
         seeds = np.atleast_1d(np.asarray(seeds, dtype=np.int64))
-        wind_dt = record_dt if wind_dt is None else positive_scalar(wind_dt, "wind_dt")
-        radius = wind_rotor_radius if wind_rotor_radius is not None else model_radius
-        if radius is None:
-            radius = iea15mw().rotor_radius
-        wind = wind_series(radius, vs, seeds, total + wind_dt, wind_dt, turbulence_class)
-    else:
-        wind = np.asarray(wind, dtype=float)
-        if wind.ndim != 3 or wind.shape[0] != vs.size:
-            raise ValueError(f"wind must have shape (n_wind_speeds={vs.size}, n_seeds, n_samples), got {wind.shape}")
-        if wind_dt is None:
-            raise ValueError("wind_dt (s) is required with an explicit wind array")
-        wind_dt = positive_scalar(wind_dt, "wind_dt")
-        if (wind.shape[2] - 1) * wind_dt < total - 1e-9:
-            raise ValueError(f"wind covers {(wind.shape[2] - 1) * wind_dt:g} s but transient + duration = {total:g} s")
-        if not np.all(np.isfinite(wind)):
-            raise ValueError("wind contains NaN or inf")
-        # the record's own mean (a short run over part of a record sees ~1 m/s of turbulence in its mean)
-        means = wind.mean(axis=2)
-        off = np.abs(means - vs[:, None]) > positive_scalar(wind_mean_tol, "wind_mean_tol")
-        if np.any(off):
-            iw, js = np.argwhere(off)[0]
-            raise ValueError(f"wind[{iw}, {js}] has mean {means[iw, js]:.3f} m/s but wind_speeds[{iw}] = {vs[iw]:g} m/s "
-                             f"(tolerance {wind_mean_tol:g} m/s): pass the record's own mean wind speed, which sets "
-                             "the trim and the scheduling")
-        seeds = None if seeds is None else np.atleast_1d(np.asarray(seeds))
-        if seeds is not None and seeds.shape != (wind.shape[1],):
-            raise ValueError(f"seeds label the records of wind: {wind.shape[1]} of them, got {seeds.size}")
-    W, S = wind.shape[:2]
-    R = W * S
-    Wr = np.ascontiguousarray(wind.reshape(R, -1))
-    ny = len(plant.output_names)
-    i_speed, i_vel = plant.index("gen_speed"), plant.index("tower_top_vel")
+        wind_dt = times.record_dt if wind_dt is None else positive_scalar(wind_dt, "wind_dt")
+        radius = iea15mw().rotor_radius if radius is None else radius
+        return wind_series(radius, vs, seeds, total + wind_dt, wind_dt, turbulence_class), wind_dt, seeds
+    wind = np.asarray(wind, dtype=float)
+    if wind.ndim != 3 or wind.shape[0] != vs.size:
+        raise ValueError(f"wind must have shape (n_wind_speeds={vs.size}, n_seeds, n_samples), got {wind.shape}")
+    if wind_dt is None:
+        raise ValueError("wind_dt (s) is required with an explicit wind array")
+    wind_dt = positive_scalar(wind_dt, "wind_dt")
+    if (wind.shape[2] - 1) * wind_dt < total - 1e-9:
+        raise ValueError(f"wind covers {(wind.shape[2] - 1) * wind_dt:g} s but transient + duration = {total:g} s")
+    if not np.all(np.isfinite(wind)):
+        raise ValueError("wind contains NaN or inf")
+    # the record's own mean (a short run over part of a record sees ~1 m/s of turbulence in its mean)
+    means = wind.mean(axis=2)
+    off = np.abs(means - vs[:, None]) > positive_scalar(wind_mean_tol, "wind_mean_tol")
+    if np.any(off):
+        iw, js = np.argwhere(off)[0]
+        raise ValueError(f"wind[{iw}, {js}] has mean {means[iw, js]:.3f} m/s but wind_speeds[{iw}] = {vs[iw]:g} m/s "
+                         f"(tolerance {wind_mean_tol:g} m/s): pass the record's own mean wind speed, which sets "
+                         "the trim and the scheduling")
+    seeds = None if seeds is None else np.atleast_1d(np.asarray(seeds))
+    if seeds is not None and seeds.shape != (wind.shape[1],):
+        raise ValueError(f"seeds label the records of wind: {wind.shape[1]} of them, got {seeds.size}")
+    return wind, wind_dt, seeds
 
-    check_step(plant, vs, dt)
-    TQ, above = _torque_params(plant, torque_control, vs, S, linear)
+
+def _plant_runs(plant, vs, S, linear, wind, TQ):
+    """The kernel pair, the per-run inputs (:class:`Runs`, no noise yet) and the trims'
+    generator speeds (W,) (rad/s), of the nonlinear plant or its linearisations."""
+    R = vs.size * S
+    ny = len(plant.output_names)
+    i_speed = plant.index("gen_speed")
     trims = [plant.trim(v) for v in vs]
-    beta0 = np.repeat([t[1] for t in trims], S)
-    torque = np.repeat([t[2] for t in trims], S)
+    y0s = []
+    for v, (x0, b0, tq) in zip(vs, trims):
+        y0 = np.empty(ny)
+        plant.outputs(np.asarray(x0, float), float(v), b0, tq, plant.params, y0)
+        y0s.append(y0)
     if linear:
         if plant.linearize is None:
             raise ValueError("linear=True needs a plant with a linearize method")
         rhs, outfn = linear_rhs, linear_outputs
         rows, x0s = [], []
-        for v, (x0, b0, tq) in zip(vs, trims):
+        for v, (x0, b0, tq), y0 in zip(vs, trims, y0s):
             sys = plant.linearize(v)
-            y0 = np.empty(ny)
-            plant.outputs(np.asarray(x0, float), float(v), b0, tq, plant.params, y0)
             rows.append(linear_plant_params(sys, [v, b0, tq], y0))
             x0s.append(np.zeros(sys.nstates))
         P = np.repeat(np.stack(rows), S, axis=0)
@@ -278,70 +351,72 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
         # a writeable copy whatever R (a read-only array of one run would compile another kernel)
         P = np.repeat(np.asarray(plant.params, dtype=float)[None], R, axis=0)
         X0 = np.repeat(np.stack([np.asarray(t[0], float) for t in trims]), S, axis=0)
-    X0 = np.ascontiguousarray(X0)
-    kind, run_batch, step_all, outputs_all = compiled_for(rhs, outfn)
-    n_rec = (nsteps + rec_every - 1) // rec_every
-    Y = np.empty((R, ny + 1, n_rec))
-    omega_ref = np.full(R, plant.rated_speed)
-    lim_names = tuple(plant.output_limits)
-    lim_idx = np.array([plant.index(n) for n in lim_names], dtype=np.int64)
-    lim_val = np.array([float(plant.output_limits[n]) for n in lim_names])
-    status = np.full(R, -1, dtype=np.int64)
+    runs = Runs(P, np.ascontiguousarray(X0), np.ascontiguousarray(wind.reshape(R, -1)),
+                np.repeat([t[1] for t in trims], S), np.full(R, plant.rated_speed), np.repeat([t[2] for t in trims], S),
+                TQ, np.zeros((R, 0, 0)))
+    return rhs, outfn, runs, np.array([y0[i_speed] for y0 in y0s])
 
-    if callable(controller) and not is_lti_like(controller) and not isinstance(controller, ScheduledController):
-        label = getattr(controller, "__name__", "callable")
-        if torque_control == "rosco" or TQ[:, 0].any() and torque_control != "auto":
-            raise ValueError("a callable controller commands the generator torque itself (or holds the trim torque): "
-                             "torque_control must be 'auto' or None with it")
-        run_callable(controller, step_all, outputs_all, kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, torque, beta0, ny, Y,
-                      plant.output_names, lim_idx, lim_val, status)
-        _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
+
+def _measurement_noise(noise, plant, vs, seeds, S, times, trim_speeds):
+    """Output name → (R, nsteps) noise on what the controllers measure ({} without noise):
+    :class:`SensorNoise` on every measured signal the plant has; runs labelled by their seeds,
+    or by their record index when the wind was given without seeds."""
+    if noise is None or not noise.active:
+        return {}
+    labels = np.arange(S) if seeds is None else seeds
+    out = {}
+    for name in MEASURED:
+        if name in plant.output_names and (noise.sd(name, times.dt) > 0 or name == "gen_speed" and noise.ripple_3p > 0):
+            out[name] = noise.series(name, vs, labels, times.nsteps, times.dt,
+                                     trim_speeds / noise.gear_ratio).reshape(vs.size * S, -1)
+    return out
+
+
+def _bank_records(controller, plant, dt):
+    """The compiled loop's :class:`Bank` and :class:`GainsPI` of a controller at step ``dt``."""
+    sched_pitch, mats, fw, pi = controller_bank(controller, dt)
+    K = sched_pitch.size
+    nc = max(1, max(m[0].shape[0] for m in mats))
+    Ad = np.zeros((K, nc, nc))
+    Bd = np.zeros((K, nc, 2))
+    Cd = np.zeros((K, nc))
+    Dd = np.zeros((K, 2))
+    Rq, Ns = np.zeros(K), np.zeros(K, dtype=np.int64)
+    for q, (A, B, C, D, r, ns) in enumerate(mats):
+        n = A.shape[0]
+        Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :], Rq[q], Ns[q] = A, B, C, D, r, ns
+    same = _same_locals(Ad, Bd, Cd, Dd, Rq, Ns)
+    sfilt = schedule_filter_coefficients(fw, getattr(controller, "filter_damping", None), dt)
+    cmd_lim = np.array((-np.inf, np.inf) if plant.pitch_limits is None else plant.pitch_limits, dtype=float)
+    if pi is None:
+        pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
+        Af, Bf, Cf, Df, lim = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1), np.array([-np.inf, np.inf])
     else:
-        label = getattr(controller, "name", None)
-        if label is None or _AUTO_NAME.fullmatch(str(label)):
-            # python-control names an unnamed system "sys[4]": a name the user never gave
-            label = "controller"
-        # below rated the pitch loop is open (its PI sits at the minimum pitch): not checked there
-        warn_unstable(plant, controller, vs[above], dt)
-        sched_pitch, mats, fw, pi = controller_bank(controller, dt)
-        K = sched_pitch.size
-        nc = max(1, max(m[0].shape[0] for m in mats))
-        Ad = np.zeros((K, nc, nc))
-        Bd = np.zeros((K, nc, 2))
-        Cd = np.zeros((K, nc))
-        Dd = np.zeros((K, 2))
-        Rq, Ns = np.zeros(K), np.zeros(K, dtype=np.int64)
-        for q, (A, B, C, D, r, ns) in enumerate(mats):
-            n = A.shape[0]
-            Ad[q, :n, :n], Bd[q, :n, :], Cd[q, :n], Dd[q, :], Rq[q], Ns[q] = A, B, C, D, r, ns
-        same = _same_locals(Ad, Bd, Cd, Dd, Rq, Ns)
-        sfilt = schedule_filter_coefficients(fw, getattr(controller, "filter_damping", None), dt)
-        cmd_lim = np.array((-np.inf, np.inf) if plant.pitch_limits is None else plant.pitch_limits, dtype=float)
-        if pi is None:
-            pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
-            Af, Bf, Cf, Df, lim = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1), np.array([-np.inf, np.inf])
-        else:
-            pi_on, (kp, ki, Af, Bf, Cf, Df, lim) = True, pi
-            # the PI's integrator never holds more than the command can reach: its own limits
-            # narrowed to the plant's (the plant's alone when it has none), so it cannot wind up
-            lim = np.array([max(lim[0], cmd_lim[0]), min(lim[1], cmd_lim[1])])
-        run_batch(kind, P, X0, Wr, wind_dt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, np.ascontiguousarray(sched_pitch),
-                  beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on,
-                  *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim, cmd_lim)),
-                  lim_idx, lim_val, Rq, Ns, status, TQ, *_torque_outputs(plant, TQ), same)
-    _raise_diverged(status, vs, seeds, S, dt, transient, lim_names, lim_val, str(label), linear)
+        pi_on, (kp, ki, Af, Bf, Cf, Df, lim) = True, pi
+        # the PI's integrator never holds more than the command can reach: its own limits
+        # narrowed to the plant's (the plant's alone when it has none), so it cannot wind up
+        lim = np.array([max(lim[0], cmd_lim[0]), min(lim[1], cmd_lim[1])])
+    bank = Bank(Ad, Bd, Cd, Dd, Rq, Ns, same, np.ascontiguousarray(sched_pitch), sfilt, cmd_lim)
+    gpi = GainsPI(pi_on, *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim)))
+    return bank, gpi
 
-    skip = int(round(transient / record_dt))
-    t_rec = np.arange(n_rec) * record_dt
-    keep = slice(skip, skip + int(round(duration / record_dt)))
-    outs = {name: Y[:, i, keep].reshape(W, S, -1) for i, name in enumerate(plant.output_names)}
-    outs["pitch_cmd"] = Y[:, ny, keep].reshape(W, S, -1)
+
+def _result(plant, Y, Wr, wind_dt, vs, seeds, times, linear, label):
+    """The :class:`SimulationResult` of the records ``Y`` (R, ny + 1, n_rec), the transient dropped."""
+    W, R = vs.size, Wr.shape[0]
+    ny = len(plant.output_names)
+    skip = int(round(times.transient / times.record_dt))
+    t_rec = np.arange(Y.shape[2]) * times.record_dt
+    keep = slice(skip, skip + int(round(times.duration / times.record_dt)))
+    outs = {name: Y[:, i, keep].reshape(W, R // W, -1) for i, name in enumerate(plant.output_names)}
+    outs["pitch_cmd"] = Y[:, ny, keep].reshape(W, R // W, -1)
     # The wind at the recorded instants, for spectra and plots.
     idx_t = t_rec[keep]
-    outs["wind"] = np.stack([np.interp(idx_t, np.arange(Wr.shape[1]) * wind_dt, Wr[r]) for r in range(R)]).reshape(W, S, -1)
+    outs["wind"] = np.stack([np.interp(idx_t, np.arange(Wr.shape[1]) * wind_dt, Wr[r])
+                             for r in range(R)]).reshape(W, R // W, -1)
     return SimulationResult(
-        time=idx_t - idx_t[0], wind_speeds=vs, seeds=seeds, outputs=outs, dt=record_dt, sim_dt=dt,
-        linear=linear, controller=str(label),
+        time=idx_t - idx_t[0], wind_speeds=vs, seeds=seeds, outputs=outs, dt=times.record_dt, sim_dt=times.dt,
+        linear=linear, controller=label,
     )
 
 

@@ -12,14 +12,17 @@ The plant is a kernel pair ``rhs(x, wind, pitch_cmd, gen_torque, p, dx)`` /
 the linear one of this module (:func:`linear_rhs`, parameters from :func:`linear_plant_params`), or
 any user pair (:func:`compiled_for` rebinds the same loop code to it). Everything here is driven
 by :func:`specdesign.simulate.simulate`; nothing is meant to be called directly but
-:func:`linear_plant_params`.
+:func:`linear_plant_params`. The loop's inputs come in four records that ``simulate`` builds and
+the loop unpacks (NamedTuples, which numba compiles): ``LoopSetup`` (what every run shares),
+``Bank`` (the discrete controller bank), ``GainsPI`` (ROSCO's gain-scheduled PI) and ``Runs``
+(per-run arrays, the sensor noise of :mod:`specdesign.controller.noise` among them).
 """
 from __future__ import annotations
 
 import math
 import types
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -233,17 +236,152 @@ def _turbine_rk4(x, w, wdt, t, dt, beta_cmd, torque, p, k1):
 NONFINITE = 63
 
 
+class LoopSetup(NamedTuple):
+    """What every run of a batch shares, besides its controller (a record the compiled loop unpacks).
+
+    Attributes
+    ----------
+    kind : int
+        The kernel kind (:data:`KIND_TURBINE`, :data:`KIND_LINEAR`, :data:`KIND_USER`).
+    wdt, dt : float
+        The wind's sample spacing and the step, s.
+    nsteps, rec_every : int
+        Steps per run and between records.
+    ny : int
+        Number of plant outputs.
+    i_speed, i_vel, i_power, i_pitch : int
+        Indices of the generator speed, tower-top velocity, power and pitch among them (the
+        last two read by the torque law only).
+    lim_idx : numpy.ndarray
+        int64 indices of the outputs with a physical limit.
+    lim_val : numpy.ndarray
+        Those limits (SI).
+    """
+
+    kind: int
+    wdt: float
+    dt: float
+    nsteps: int
+    rec_every: int
+    ny: int
+    i_speed: int
+    i_vel: int
+    i_power: int
+    i_pitch: int
+    lim_idx: np.ndarray
+    lim_val: np.ndarray
+
+
+class Bank(NamedTuple):
+    """The discrete controller bank of :func:`specdesign.controller.scheduled.controller_bank`,
+    padded to K locals of nc states (a record the compiled loop unpacks).
+
+    Attributes
+    ----------
+    Ad, Bd, Cd, Dd : numpy.ndarray
+        (K, nc, nc), (K, nc, 2), (K, nc), (K, 2): each local by Tustin (inputs: the speed error
+        rad/s, minus the tower-top velocity m/s; output: pitch, rad).
+    Rq : numpy.ndarray
+        (K,) gain of each local's integrator, run apart.
+    Ns : numpy.ndarray
+        (K,) int64, each local's slow states (0: PI-like, clamped).
+    same : numpy.ndarray
+        (K,) int64, the first local identical to each.
+    sched_pitch : numpy.ndarray
+        (K,) scheduling pitches, rad.
+    sfilt : numpy.ndarray
+        The scheduling filter (1 coefficient: first order; 5: second order).
+    cmd_lim : numpy.ndarray
+        (2,) the plant's pitch limits, rad.
+    """
+
+    Ad: np.ndarray
+    Bd: np.ndarray
+    Cd: np.ndarray
+    Dd: np.ndarray
+    Rq: np.ndarray
+    Ns: np.ndarray
+    same: np.ndarray
+    sched_pitch: np.ndarray
+    sfilt: np.ndarray
+    cmd_lim: np.ndarray
+
+
+class GainsPI(NamedTuple):
+    """ROSCO's gain-scheduled PI (``form="gains"``) of the compiled loop.
+
+    Attributes
+    ----------
+    on : bool
+        False: no such PI (the bank's locals alone).
+    kp, ki : numpy.ndarray
+        (K,) gains at the scheduling pitches, rad per rad/s and rad per rad.
+    Af, Bf, Cf, Df : numpy.ndarray
+        The speed-error filter by Tustin.
+    lim : numpy.ndarray
+        (2,) limits of its integrator and output, rad.
+    """
+
+    on: bool
+    kp: np.ndarray
+    ki: np.ndarray
+    Af: np.ndarray
+    Bf: np.ndarray
+    Cf: np.ndarray
+    Df: np.ndarray
+    lim: np.ndarray
+
+
+class Runs(NamedTuple):
+    """Per-run inputs of a batch, R runs along the first axis.
+
+    Attributes
+    ----------
+    P : numpy.ndarray
+        (R, n_p) kernel parameters.
+    X0 : numpy.ndarray
+        (R, nx) initial states.
+    W : numpy.ndarray
+        (R, n_w) wind, m/s.
+    beta0, omega_ref, torque : numpy.ndarray
+        (R,) trim pitch (rad), speed reference (rad/s), trim torque (N·m).
+    TQ : numpy.ndarray
+        (R, TORQUE_PARAMS) the torque law's parameters (mode 0: the torque held).
+    noise : numpy.ndarray
+        (R, 2, nsteps): what the controllers' measured generator speed (rad/s) and tower-top
+        velocity (m/s) add at each step, or (R, 0, 0) for none (the measurement is then the
+        output itself, bit for bit).
+    """
+
+    P: np.ndarray
+    X0: np.ndarray
+    W: np.ndarray
+    beta0: np.ndarray
+    omega_ref: np.ndarray
+    torque: np.ndarray
+    TQ: np.ndarray
+    noise: np.ndarray
+
+
 @njit(cache=True)
-def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-             beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Yr, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
-             cmd_lim, lim_idx, lim_val, Rq, Ns, tq, i_power, i_pitch, same):
+def _run_one(setup, bank, gpi, p, x, w, beta0, omega_ref, torque, tq, noise, Yr):
     """One run; returns −1, or 64·step + code at the first step where it diverged (code: the
-    index of the output limit exceeded, or NONFINITE). ``tq``: the torque law's parameters
-    (mode 0: the torque held at ``torque``). ``same[q]``: the first local identical to local q
+    index of the output limit exceeded, or NONFINITE). ``setup``, ``bank``, ``gpi``: the
+    batch's :class:`LoopSetup`, :class:`Bank` and :class:`GainsPI`; the rest is the run's row
+    of :class:`Runs`. ``tq``: the torque law's parameters (mode 0: the torque held at
+    ``torque``). ``same[q]``: the first local identical to local q
     (its matrices, integrator gain and slow-state count): identical locals see the same inputs
     from the same zero state, so their states and outputs stay equal, bit for bit, and only
     the first is run (ROSCO's gains form pads its bank with K empty locals, a design often
     puts the same ATD on every local)."""
+    kind, wdt, dt, nsteps, rec_every = setup.kind, setup.wdt, setup.dt, setup.nsteps, setup.rec_every
+    ny, i_speed, i_vel, i_power, i_pitch = setup.ny, setup.i_speed, setup.i_vel, setup.i_power, setup.i_pitch
+    lim_idx, lim_val = setup.lim_idx, setup.lim_val
+    Ad, Bd, Cd, Dd, Rq, Ns, same = bank.Ad, bank.Bd, bank.Cd, bank.Dd, bank.Rq, bank.Ns, bank.same
+    sched_pitch, sfilt, cmd_lim = bank.sched_pitch, bank.sfilt, bank.cmd_lim
+    pi_on, kp, ki, Af, Bf, Cf, Df, lim = gpi.on, gpi.kp, gpi.ki, gpi.Af, gpi.Bf, gpi.Cf, gpi.Df, gpi.lim
+    K = sched_pitch.size
+    noisy = noise.shape[1] > 0
     nx = x.size
     nc = Ad.shape[1]
     nf = Af.shape[0]
@@ -305,13 +443,19 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
                 Yr[i, j] = y[i]
             Yr[ny, j] = bcmd
             j += 1
+        # what the controllers measure: the outputs, plus the sensor noise when there is some
+        speed = y[i_speed]
+        vel = y[i_vel]
+        if noisy:
+            speed += noise[0, k]
+            vel += noise[1, k]
         # Both loops feed back with a minus sign: β = −C_β·ΔΩ_g − C_atd·ẋ_top.
         if tq_on:  # ROSCO's torque law; its setpoint smoother moves the pitch reference
-            torque, wref = torque_step(tq, tst, y[i_speed], y[i_power], y[i_pitch], dt, k == 0)
-            e = -(y[i_speed] - wref)
+            torque, wref = torque_step(tq, tst, speed, y[i_power], y[i_pitch], dt, k == 0)
+            e = -(speed - wref)
         else:
-            e = -(y[i_speed] - omega_ref)
-        v = -y[i_vel]
+            e = -(speed - omega_ref)
+        v = -vel
         slow = False
         for q in range(K):
             if same[q] != q:
@@ -426,17 +570,13 @@ def _run_one(kind, p, x, w, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pi
 
 # nogil: a local campaign post-processes one wind speed while another is simulated
 @njit(cache=True, parallel=True, nogil=True)
-def _run_batch(kind, P, X0, W, wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch,
-               beta0, omega_ref, torque, sfilt, i_speed, i_vel, ny, Y, pi_on, kp, ki, Af, Bf, Cf, Df, lim,
-               cmd_lim, lim_idx, lim_val, Rq, Ns, status, TQ, i_power, i_pitch, same):
+def _run_batch(setup, bank, gpi, runs, Y, status):
     """All runs, one per prange iteration; the controller bank is shared by the batch.
     ``status[r]``: −1, or where run r diverged (see :func:`_run_one`)."""
-    K = sched_pitch.size
-    for r in prange(X0.shape[0]):
-        x = X0[r].copy()
-        status[r] = _run_one(kind, P[r], x, W[r], wdt, dt, nsteps, rec_every, Ad, Bd, Cd, Dd, sched_pitch, K,
-                             beta0[r], omega_ref[r], torque[r], sfilt, i_speed, i_vel, ny, Y[r], pi_on, kp, ki, Af, Bf,
-                             Cf, Df, lim, cmd_lim, lim_idx, lim_val, Rq, Ns, TQ[r], i_power, i_pitch, same)
+    for r in prange(runs.X0.shape[0]):
+        x = runs.X0[r].copy()
+        status[r] = _run_one(setup, bank, gpi, runs.P[r], x, runs.W[r], runs.beta0[r], runs.omega_ref[r],
+                             runs.torque[r], runs.TQ[r], runs.noise[r], Y[r])
 
 
 @njit(cache=True)
@@ -532,7 +672,7 @@ def _bad_inputs(given, t):
 def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: int, P: np.ndarray, X0: np.ndarray,
                  Wr: np.ndarray, wdt: float, dt: float, nsteps: int, rec_every: int, torque: np.ndarray,
                  beta0: np.ndarray, ny: int, Y: np.ndarray, names: Sequence[str], lim_idx: np.ndarray,
-                 lim_val: np.ndarray, status: np.ndarray) -> None:
+                 lim_val: np.ndarray, status: np.ndarray, noise: dict | None = None) -> None:
     """Run a batch with a Python controller ``fn(t, y) -> pitch_cmd`` (the slow path).
 
     ``fn`` is called once per step with ``y`` a dict of the outputs, each an array over all
@@ -584,6 +724,9 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
     status : numpy.ndarray
         Output: (R,) int64, −1 or 64·step + code where the run diverged (code: index into
         the limits, or :data:`NONFINITE`).
+    noise : dict, optional
+        Output name → (R, nsteps) sensor noise added to what ``fn`` is given at each step
+        (SI; :class:`specdesign.controller.noise.SensorNoise`); the records keep the outputs.
 
     Raises
     ------
@@ -611,6 +754,8 @@ def run_callable(fn: Callable, step_all: Callable, outputs_all: Callable, kind: 
                 status[r] = 64 * k + np.where(nonfinite, NONFINITE, over)
                 return
         given = {n: y[:, i].copy() for i, n in enumerate(names)}
+        for n, a in (noise or {}).items():
+            given[n] += a[:, k]
         cmd = fn(t, given)
         if isinstance(cmd, tuple):
             if len(cmd) != 2:

@@ -44,20 +44,20 @@ from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
 from .campaign import check_campaign_step, check_plant_step, concat_campaigns, run_campaign
 from .campaign_record import Campaign
 from .lifetime_del import DEL_CHANNELS, LifetimeDEL, WindClimate, lifetime, weibull_bins, wind_climate
-from .metrics import INDICATORS, Indicators, indicators
+from .metrics import ACTUATOR_INDICATORS, INDICATORS, Indicators, indicators
 from .prediction import LinearPrediction, closed_loop_response, linear_prediction, loop_plant, prediction_grid
 from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, seeds_from, weibull_weights,
                     welch_psd)
 from .surrogate import (CONDITIONS, DelData, GPSurrogate, LookupTable, SurrogateComparison, SurrogatePrediction,
                         compare_surrogates, del_data, fit_gp, fit_lut)
-from .tables import Acceptance, Table, acceptance, linear_table3, table2, table3
+from .tables import Acceptance, Table, acceptance, actuator_rows, linear_table3, table2, table3
 from .volterra import VolterraPrediction, volterra_prediction, volterra_response
 
 __all__ = [
     # stats
     "WEIBULL_K", "WEIBULL_A", "weibull_weights", "welch_psd", "pool", "resampled_se", "PairedChange", "paired_change",
     # indicators
-    "INDICATORS", "Indicators", "indicators",
+    "INDICATORS", "ACTUATOR_INDICATORS", "Indicators", "indicators",
     # OpenFAST outputs (home: specdesign.openfast)
     "OPENFAST_CHANNELS", "series_from_openfast",
     # prediction
@@ -70,7 +70,7 @@ __all__ = [
     "CONDITIONS", "DelData", "del_data", "SurrogatePrediction", "GPSurrogate", "fit_gp", "LookupTable", "fit_lut",
     "SurrogateComparison", "compare_surrogates",
     # tables
-    "Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance",
+    "Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance", "actuator_rows",
     # lifetime
     "DEL_CHANNELS", "WindClimate", "weibull_bins", "wind_climate", "LifetimeDEL", "lifetime",
 ]

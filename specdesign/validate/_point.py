@@ -48,14 +48,16 @@ def _nan_point(out, omega, n_seeds, linear_twin, volterra):
 # threaded BLAS reduction may sum in another order)
 @on_one_blas_thread
 def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transient, m, predict,
-                    turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0, torque_control="auto"):
+                    turbulence_class, keep_series, nperseg, linear_twin=False, volterra=0, torque_control="auto",
+                    noise=None):
     """One wind speed, every controller, the same seeds: indicators, per-seed spectra, predictions.
 
     The results of a seed do not depend on the other seeds of the call (the wind of a run
     depends on (v, seed) only and the runs of a batch do not interact), which is what lets
     a resumed campaign run only its missing seeds. ``torque_control`` goes to the simulator
     for the compiled controllers; a callable one commands the torque itself (or holds the
-    trim torque), so it runs with "auto" unless None is asked.
+    trim torque), so it runs with "auto" unless None is asked. ``noise``: the sensors every
+    controller reads through (:class:`specdesign.controller.noise.SensorNoise`), seeded per run.
     """
     n_keep = len(seeds) if keep_series is True else int(keep_series)
     radius = rotor_radius(model)
@@ -66,6 +68,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
     omega = welch_psd(np.zeros((1, int(round(duration / record_dt)))), record_dt, nperseg)[0]
     sw = None
     plant = turbine_plant(model)
+    rate_limit = getattr(model, "pitch_rate_limit", None)  # the actuator's (rad/s), for the time at it
     for name, c in controllers.items():
         # the answer run_campaign's up-front check (check_campaign_step) already has
         bad = np.zeros(0)
@@ -79,7 +82,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
             tc = torque_control if has_linear_form(c) or torque_control is None else "auto"
             try:
                 r = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
-                             record_dt=record_dt, transient=transient, torque_control=tc)
+                             record_dt=record_dt, transient=transient, torque_control=tc, noise=noise)
             except SimulationDivergedError as err:
                 warnings.warn(f"controller {name!r}: {err}; campaign results of {name!r} at {v:g} m/s are NaN",
                               ClosedLoopUnstableWarning, stacklevel=3)
@@ -88,7 +91,7 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
         if r is None:
             _nan_point(out, omega, len(seeds), linear_twin, volterra)
             continue
-        ind = indicators(r.outputs, r.dt, m)
+        ind = indicators(r.outputs, r.dt, m, pitch_rate_limit=rate_limit)
         for k, val in ind.as_dict().items():
             out["values"].setdefault(k, []).append(val[0])
         if linear_twin:
@@ -96,8 +99,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
             if has_linear_form(c):
                 try:
                     rl = simulate(model, c, [v], seeds=seeds, wind=wind, wind_dt=wdt, duration=duration, dt=dt,
-                                  record_dt=record_dt, transient=transient, linear=True)
-                    lin = indicators(rl.outputs, rl.dt, m).as_dict()
+                                  record_dt=record_dt, transient=transient, linear=True, noise=noise)
+                    lin = indicators(rl.outputs, rl.dt, m, pitch_rate_limit=rate_limit).as_dict()
                 except SimulationDivergedError as err:  # keep the nonlinear results: only the twin is NaN
                     warnings.warn(f"controller {name!r}: {err}; the linear twin of {name!r} at {v:g} m/s is NaN",
                                   ClosedLoopUnstableWarning, stacklevel=3)

@@ -17,6 +17,7 @@ from tqdm.auto import tqdm
 from .. import turbine
 from .._blas import on_one_blas_thread
 from .._checks import positive_scalar
+from ..controller.noise import SensorNoise
 from ..controller.torque import TorqueLaw
 from ..fatigue import TOWER_M
 from ..simulate import SimulationResult, check_step, turbine_plant
@@ -98,7 +99,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
                  volterra: int = 0, executor=None, progress: bool | None = None,
                  nperseg: int | None = None, store=None, torque_control="auto", plant=None,
-                 openfast: Mapping | None = None) -> Campaign:
+                 openfast: Mapping | None = None, noise: SensorNoise | None = None) -> Campaign:
     """Run every controller at every wind speed on the same seeds and post-process.
 
     Parameters
@@ -186,6 +187,11 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     openfast : dict, optional
         With ``plant``: further options of ``run_openfast_campaign`` (``processes``,
         ``grid_points``, ``hydro``, ``cpu_limit``, ``timeout``, ``nice``, ``install``, ``dt``).
+    noise : specdesign.controller.noise.SensorNoise, optional
+        The sensors every controller reads through (``simulate(..., noise=...)``): the same
+        noise for every controller on the same (wind speed, seed), the comparison stays paired;
+        the linear twin reads it too. None (default): the plant's outputs themselves. Not with
+        an OpenFAST ``plant`` (its controllers read ServoDyn's signals).
 
     Returns
     -------
@@ -204,10 +210,12 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     """
     if not isinstance(controllers, dict) or not controllers:
         raise TypeError("controllers must be a non-empty dict {name: controller}")
+    if noise is not None and not isinstance(noise, SensorNoise):
+        raise TypeError(f"noise must be a specdesign.controller.noise.SensorNoise or None, got {type(noise).__name__}")
     if plant is not None:
-        if linear_twin or volterra or executor is not None:
-            raise ValueError("linear_twin, volterra and executor are options of the reduced model's campaign, not of "
-                             "an OpenFAST plant (its processes: openfast={'processes': n})")
+        if linear_twin or volterra or executor is not None or noise is not None:
+            raise ValueError("linear_twin, volterra, executor and noise are options of the reduced model's campaign, not "
+                             "of an OpenFAST plant (its processes: openfast={'processes': n})")
         return run_openfast_campaign(controllers, wind_speeds, seeds, deck=plant, duration=duration, transient=transient,
                                      record_dt=record_dt, m=m, turbulence_class=turbulence_class,
                                      keep_series=keep_series, nperseg=nperseg, progress=progress, folder=store,
@@ -230,6 +238,8 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                 "linear_twin": bool(linear_twin),
                 "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg),
                 "torque_control": _torque_setting(torque_control)}
+    if noise is not None:  # only then: a store made before the noise model still matches a noise-free campaign
+        settings["noise"] = dataclasses.asdict(noise)
     if torque_control == "rosco" and turbine_plant(model).torque_law is None:
         raise ValueError("torque_control='rosco' needs a model with a torque law (a TurbineModel with torque_control, "
                          "e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw or torque_control='auto'")
@@ -261,7 +271,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         # the kept seeds are a prefix of the task's seeds (both in campaign order)
         return (model, {n: controllers[n] for n in group}, v, todo, duration, dt, record_dt, transient, m, predict,
                 turbulence_class, sum(s in kept for s in todo.tolist()), nperseg, bool(linear_twin), int(volterra),
-                torque_control)
+                torque_control, noise)
 
     def finish(task, point):
         new = _cells(task, point)
@@ -364,7 +374,8 @@ def _assemble(records, names, vs, seeds, settings) -> Campaign:
     first = [[row[0] for row in by_v] for by_v in cell]  # per-(controller, speed) entries: any seed has them
 
     def per_seed(group, keys):
-        return {k: np.array([[[c[group][k] for c in row] for row in by_v] for by_v in cell]) for k in keys}
+        # a cell stored before an indicator existed (the actuator's) reads NaN for it
+        return {k: np.array([[[c[group].get(k, np.nan) for c in row] for row in by_v] for by_v in cell]) for k in keys}
 
     def spectra(key, mean):
         if mean:  # the seed average as np.mean of the (S, nω) block a batch of seeds gives

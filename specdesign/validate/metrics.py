@@ -1,5 +1,7 @@
 """Per-run indicators: tower-base DEL (m = 4 by default) and blade-root DEL (m = 10) by
-rainflow, generator-speed SD, mean power, pitch and pitch-rate SD, from arrays (a simulation's outputs or :func:`specdesign.openfast.series_from_openfast`)."""
+rainflow, generator-speed SD, mean power, pitch and pitch-rate SD, and the actuator's cost
+(pitch travel per hour, time at the pitch-rate limit), from arrays (a simulation's outputs or
+:func:`specdesign.openfast.series_from_openfast`)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -10,10 +12,18 @@ import numpy as np
 from .._checks import positive_scalar
 from ..fatigue import BLADE_M, TOWER_M, del_rainflow
 
-__all__ = ["INDICATORS", "Indicators", "indicators"]
+__all__ = ["INDICATORS", "ACTUATOR_INDICATORS", "RATE_LIMIT_MARGIN", "Indicators", "indicators"]
 
 #: Names of the indicators, in the order of :meth:`Indicators.as_dict` and of the output files.
-INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "blade_del")
+INDICATORS = ("tower_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "blade_del", "pitch_travel",
+              "rate_limit_time")
+#: The actuator's indicators (with ``pitch_rate_sd``): what a pitch controller costs the bearings and drives.
+ACTUATOR_INDICATORS = ("pitch_travel", "pitch_rate_sd", "rate_limit_time")
+#: Relative margin below the rate limit at which a sample interval counts as at the limit: the
+#: recorded pitch of a rate-saturated interval differs by |Δβ|/Δt = limit up to the rounding of
+#: the recorded samples and of the actuator's clip (1e-3 would do on the reduced model; 1 %
+#: leaves room for an OpenFAST controller's own rate clip, which acts on its command).
+RATE_LIMIT_MARGIN = 0.01
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
@@ -36,6 +46,13 @@ class Indicators:
         Blade-root flapwise DEL (N·m, a range, 1 Hz convention, Wöhler exponent
         :data:`BLADE_M` = 10) of the output ``blade_root_my``; NaN where the series has no
         such output (e.g. an OpenFAST file without it).
+    pitch_travel : numpy.ndarray
+        Pitch travel per hour, Σ|Δβ| over the recorded samples × 3600 s / duration (rad/h; tables
+        show deg/h). Sampled at the record's spacing: motion faster than its Nyquist
+        frequency is not counted.
+    rate_limit_time : numpy.ndarray
+        Fraction of the record (-) spent at the pitch-rate limit: of the sample intervals, those
+        with |Δβ|/Δt ≥ (1 − :data:`RATE_LIMIT_MARGIN`)·limit; NaN where no limit was given.
     m : float
         Wöhler exponent of the tower-base DEL.
     duration : float
@@ -52,11 +69,13 @@ class Indicators:
     pitch_sd: np.ndarray
     pitch_rate_sd: np.ndarray
     blade_del: np.ndarray
+    pitch_travel: np.ndarray
+    rate_limit_time: np.ndarray
     m: float
     duration: float
 
     def as_dict(self) -> dict[str, np.ndarray]:
-        """The six indicators by name (:data:`INDICATORS`), without ``m`` and ``duration``.
+        """The indicators by name (:data:`INDICATORS`), without ``m`` and ``duration``.
 
         Returns
         -------
@@ -66,7 +85,7 @@ class Indicators:
         return {k: getattr(self, k) for k in INDICATORS}
 
 
-def indicators(series: Mapping, dt: float, m: float = TOWER_M) -> Indicators:
+def indicators(series: Mapping, dt: float, m: float = TOWER_M, *, pitch_rate_limit: float | None = None) -> Indicators:
     """Compute the indicators of every run in ``series``.
 
     Parameters
@@ -81,6 +100,9 @@ def indicators(series: Mapping, dt: float, m: float = TOWER_M) -> Indicators:
     m : float, default 4.0
         Wöhler exponent of the tower-base DEL (S-N curve with S the range); the blade-root
         DEL always uses :data:`BLADE_M`.
+    pitch_rate_limit : float, optional
+        The actuator's pitch-rate limit, rad/s (e.g. ``TurbineModel.pitch_rate_limit``, or
+        ROSCO's ``PC_MaxRat``), for ``rate_limit_time``; None: that indicator is NaN.
 
     Returns
     -------
@@ -104,6 +126,7 @@ def indicators(series: Mapping, dt: float, m: float = TOWER_M) -> Indicators:
     """
     dt = positive_scalar(dt, "dt")
     m = positive_scalar(m, "m")
+    rate_limit = None if pitch_rate_limit is None else positive_scalar(pitch_rate_limit, "pitch_rate_limit")
     get = series.__getitem__
     try:
         my, om, pw, pb = (np.asarray(get(k), dtype=float) for k in ("tower_base_my", "gen_speed", "power", "pitch"))
@@ -124,6 +147,9 @@ def indicators(series: Mapping, dt: float, m: float = TOWER_M) -> Indicators:
         if bm.shape != my.shape:
             raise ValueError(f"series['blade_root_my'] must have the shape {my.shape} of the other series; got {bm.shape}")
         blade = np.array([del_rainflow(row, BLADE_M, duration) for row in bm.reshape(-1, n)]).reshape(my.shape[:-1])
+    step = np.abs(np.diff(pb, axis=-1))
+    at_limit = (np.full(my.shape[:-1], np.nan) if rate_limit is None
+                else np.mean(step >= (1.0 - RATE_LIMIT_MARGIN) * rate_limit * dt, axis=-1))
     return Indicators(
         tower_del=dels,
         gen_speed_sd=om.std(axis=-1),
@@ -131,6 +157,8 @@ def indicators(series: Mapping, dt: float, m: float = TOWER_M) -> Indicators:
         pitch_sd=pb.std(axis=-1),
         pitch_rate_sd=(np.diff(pb, axis=-1) / dt).std(axis=-1),
         blade_del=blade,
+        pitch_travel=step.sum(axis=-1) * 3600.0 / duration,
+        rate_limit_time=at_limit,
         m=m,
         duration=duration,
     )

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
+from ..controller.discon_file import read_discon
 from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
@@ -212,6 +213,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                 "hydro": bool(hydro), "openfast": install.version, "initial_conditions": bool(initial_conditions),
                 "nperseg": None if nperseg is None else int(nperseg), "waves": "wave_seed_for(speed, seed)"}
     trim = _trim(deck) if initial_conditions else None
+    rate_limit = _rate_limit(deck)
     tmp = None
     if folder is None:
         tmp = tempfile.TemporaryDirectory(prefix="specdesign_openfast_")
@@ -245,7 +247,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                           hydro=hydro, wave_seed=wave_seed_for(v, s) if hydro else None,
                           name=f"{_slug(name)}_{v:g}mps_seed{s}")
         out = run_case(case, install, cpu_limit=cpu_limit, timeout=timeout, nice=nice)
-        return _post(case, out, settings, meta, keep=s in kept, wind=wind)
+        return _post(case, out, settings, meta, keep=s in kept, wind=wind, rate_limit=rate_limit)
 
     try:
         with cf.ThreadPoolExecutor(processes or _cpus()) as pool:  # threads wait on OpenFAST processes
@@ -294,6 +296,17 @@ def _trim(deck: Deck):
     return at
 
 
+def _rate_limit(deck: Deck) -> float | None:
+    """The turbine's pitch-rate limit (rad/s): ``PC_MaxRat`` of the deck's own DISCON.IN (ROSCO's
+    file beside the ``.fst``, ``<name>_DISCON.IN``), the limit its controller applies; None
+    without that file (the time at the limit is then NaN)."""
+    path = deck.fst.with_name(deck.name + "_DISCON.IN")
+    if not path.is_file():
+        return None
+    entry = read_discon(path)[0].get("PC_MaxRat")
+    return None if entry is None else float(entry.values[0])
+
+
 def _slug(name: str) -> str:
     return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in name)
 
@@ -329,8 +342,9 @@ def _load(root: Path, run, meta):
         return {k: z[k] for k in z.files}
 
 
-def _post(case: Case, out, settings, meta, keep: bool, wind) -> dict:
-    """Indicators, Welch spectra and (kept) series of one OpenFAST run, saved in its folder."""
+def _post(case: Case, out, settings, meta, keep: bool, wind, rate_limit: float | None = None) -> dict:
+    """Indicators, Welch spectra and (kept) series of one OpenFAST run, saved in its folder
+    (``rate_limit``: the pitch-rate limit, rad/s, for the time at it)."""
     t0 = settings["transient"]
     n = int(round(settings["duration"] / settings["record_dt"]))
     series, dt = series_from_openfast(out, OPENFAST_SERIES)
@@ -339,7 +353,7 @@ def _post(case: Case, out, settings, meta, keep: bool, wind) -> dict:
         raise OpenFASTRunError(case, f"wrote {out.time[-1]:g} s, fewer than transient + duration "
                                      f"({t0 + settings['duration']:g} s)", "")
     rec = {k: a[0, i0:i0 + n] for k, a in series.items()}
-    ind = indicators({k: a[None] for k, a in rec.items()}, dt, settings["m"]).as_dict()
+    ind = indicators({k: a[None] for k, a in rec.items()}, dt, settings["m"], pitch_rate_limit=rate_limit).as_dict()
     res = {f"value_{k}": np.asarray(ind[k][0], float) for k in INDICATORS}
     for k in SPECTRA:
         omega, p = welch_psd(rec[k], dt, settings["nperseg"])
@@ -375,8 +389,8 @@ def _assemble(results, names, vs, seeds, settings, n_keep) -> Campaign:
                 if r is None:
                     unstable[ci, wi] = True
                     continue
-                for k in INDICATORS:
-                    values[k][ci, wi, si] = float(r[f"value_{k}"])
+                for k in INDICATORS:  # a run post-processed before an indicator existed reads NaN for it
+                    values[k][ci, wi, si] = float(r.get(f"value_{k}", np.nan))
                 for k in SPECTRA:
                     acc[k].append(r[f"welch_{k}"])
                 if si < n_keep:

@@ -156,8 +156,9 @@ def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
     -------
     numpy.ndarray
         ``tower_del``: (mean DEL^m)^{1/m} (the DEL of the summed damage), ``blade_del``
-        the same with m = :data:`~specdesign.fatigue.BLADE_M`; ``mean_power``:
-        the mean; a standard deviation: √(mean of the variances).
+        the same with m = :data:`~specdesign.fatigue.BLADE_M`; ``mean_power``, ``pitch_travel``
+        (per hour) and ``rate_limit_time`` (a fraction): the mean; a standard deviation: √(mean
+        of the variances).
 
     Examples
     --------
@@ -169,7 +170,7 @@ def pool(indicator: str, x: np.ndarray, m: float, axis: int = -1) -> np.ndarray:
         return np.mean(x**m, axis=axis) ** (1.0 / m)
     if indicator == "blade_del":  # its own S-N slope, whatever the campaign's tower m
         return np.mean(x**BLADE_M, axis=axis) ** (1.0 / BLADE_M)
-    if indicator == "mean_power":
+    if indicator in ("mean_power", "pitch_travel", "rate_limit_time"):  # rates and fractions: the mean
         return np.mean(x, axis=axis)
     return np.sqrt(np.mean(x**2, axis=axis))
 

@@ -24,7 +24,7 @@ from .stats import (
     weibull_weights,
 )
 
-__all__ = ["Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance"]
+__all__ = ["Table", "table2", "table3", "linear_table3", "Acceptance", "acceptance", "actuator_rows"]
 
 _LABELS = {
     "gen_speed_sd": "Generator speed SD",
@@ -33,7 +33,57 @@ _LABELS = {
     "pitch_sd": "Pitch activity (SD)",
     "pitch_rate_sd": "Pitch rate SD",
     "blade_del": "Blade root DEL (m = 10)",
+    "pitch_travel": "Pitch travel per hour",
+    "rate_limit_time": "Time at the pitch-rate limit",
 }
+#: The actuator's cost in the tables, absolute per controller: indicator → (row label, factor
+#: from the campaign's SI value, format). Pitch in degrees as the tables show it
+#: (:mod:`specdesign.plots.conventions`); the time at the rate limit as % of the record.
+_ACTUATOR_ROWS = {
+    "pitch_travel": ("pitch travel (deg/h)", 180.0 / math.pi, "{:.0f} deg/h"),
+    "pitch_rate_sd": ("pitch-rate SD (deg/s)", 180.0 / math.pi, "{:.3f} deg/s"),
+    "rate_limit_time": ("time at the pitch-rate limit (% of the record)", 100.0, "{:.2f} %"),
+}
+
+
+def _seed_mean(campaign: Campaign, name: str, ind: str) -> np.ndarray:
+    """(W,) mean over the seeds of one controller's indicator (NaN seeds left out: a run
+    stored before the indicator existed; all NaN: NaN)."""
+    x = np.asarray(campaign.values[ind][campaign.index(name)], dtype=float)
+    n = np.sum(~np.isnan(x), axis=-1)
+    with np.errstate(invalid="ignore"):  # 0/0 where every seed is NaN: NaN, as wanted
+        return np.nansum(x, axis=-1) / n
+
+
+def actuator_rows(campaign: Campaign, names, weights=None) -> tuple[list, list]:
+    """Rows of the actuator's cost of each controller: pitch travel (deg/h), pitch-rate SD
+    (deg/s) and time at the pitch-rate limit (% of the record), seed means per wind speed and
+    their ``weights``-weighted mean (NaN without weights).
+
+    Parameters
+    ----------
+    campaign : Campaign
+        The campaign.
+    names : sequence of str
+        Controllers, in row order.
+    weights : array_like, optional
+        (W,) weights of the Mean column (e.g. the Weibull pdf, normalised).
+
+    Returns
+    -------
+    rows : list
+        (label, values) pairs: per speed, then the mean.
+    formats : list
+        (label, fmt) pairs for :class:`Table`'s ``row_fmt``.
+    """
+    rows, fmts = [], []
+    for ind, (label, factor, fmt) in _ACTUATOR_ROWS.items():
+        for n in names:
+            x = factor * _seed_mean(campaign, n, ind)
+            mean = float(np.asarray(weights, dtype=float) @ x) if weights is not None else float("nan")
+            rows.append((f"{n}: {label}", tuple(x) + (mean,)))
+            fmts.append((f"{n}: {label}", fmt))
+    return rows, fmts
 
 
 @dataclass(frozen=True)
@@ -184,17 +234,28 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
     if climate is not None:
         life = lifetime(campaign, climate, controllers=(baseline, designed), m=campaign.m)
     rows = []
-    for ind in ("gen_speed_sd", "mean_power", "tower_del", "pitch_sd", "pitch_rate_sd"):
+    for ind in ("gen_speed_sd", "mean_power", "tower_del", "pitch_sd", "pitch_rate_sd", "pitch_travel"):
         with np.errstate(invalid="ignore", divide="ignore"):  # 0/0: the pitch held at fine pitch by both (below rated), shown empty
             ch = campaign.change(designed, baseline, ind).change
         row = tuple(ch) + (float(w @ ch),)
         if life is not None:
             row += (_lifetime_cell(campaign, designed, baseline, ind, life),)
         rows.append((_LABELS[ind], row))
+    # the time at the rate limit is a fraction, often 0 for the baseline: its change in
+    # percentage points of the record, not relative
+    diff = 100.0 * (_seed_mean(campaign, designed, "rate_limit_time") - _seed_mean(campaign, baseline, "rate_limit_time"))
+    row = tuple(diff) + (float(w @ diff),)
+    if life is not None:
+        row += (float(life.probabilities @ diff / life.probabilities.sum()),)
+    rows.append((_LABELS["rate_limit_time"], row))
+    actuator, fmts = actuator_rows(campaign, (designed, baseline), w)
+    rows += [(label, vals + ((float("nan"),) if life is not None else ())) for label, vals in actuator]
     note = (f"Relative change 100·(X_{designed}/X_{baseline} − 1), negative: lower than {baseline} (Table 3 gives "
             f"the DEL's as a reduction, positive), over {campaign.seeds.size} paired seeds of "
             f"{campaign.duration:g} s; DEL with m = {campaign.m:g}, 1 Hz. Mean: weighted by the Weibull pdf "
-            f"(k = {k}, A = {scale} m/s) at the operating points, normalised.")
+            f"(k = {k}, A = {scale} m/s) at the operating points, normalised. Time at the pitch-rate limit: "
+            f"difference in percentage points of the record. Below: the actuator's cost of each controller, seed "
+            f"means (pitch travel Σ|Δβ| per hour, counted on the record's {campaign.dt:g} s samples).")
     marks = _unstable_marks(campaign, designed, baseline)
     columns = _speed_columns(campaign.wind_speeds)
     if life is not None:
@@ -208,7 +269,7 @@ def table2(campaign: Campaign, designed: str, baseline: str, *, k: float = WEIBU
             note += (f" MISSING bins (not simulated, excluded): {', '.join(f'{x:g}' for x in life.missing_speeds)} "
                      f"m/s, probability {float(life.missing_probability.sum()):.4g}.")
     return Table(title=f"Table 2: change of the indicators, {designed} vs {baseline}", columns=columns,
-                 rows=tuple(rows), note=note, marks=marks)
+                 rows=tuple(rows), note=note, marks=marks, row_fmt=((_LABELS["rate_limit_time"], "{:+.2f} pp"), *fmts))
 
 
 def _lifetime_cell(campaign, designed, baseline, ind, life):
@@ -216,10 +277,10 @@ def _lifetime_cell(campaign, designed, baseline, ind, life):
     if ind == "tower_del":
         return float(life.change[1, 0])
     # pooled over the covered time as each adds up (a bin's share of it is p_b): the energy for
-    # the power, √(mean variance) for a standard deviation; lifetime() keeps the campaign's order
+    # the power, the travel for the pitch travel, √(mean variance) for a standard deviation; lifetime() keeps the campaign's order
     p = life.probabilities / life.probabilities.sum()
     x = [np.asarray(campaign.values[ind][campaign.index(c)], dtype=float) for c in (designed, baseline)]
-    if ind == "mean_power":
+    if ind in ("mean_power", "pitch_travel"):  # rates: the time-weighted mean
         des, base = (p @ a.mean(axis=-1) for a in x)
     else:
         des, base = (np.sqrt(p @ (a**2).mean(axis=-1)) for a in x)
@@ -446,12 +507,17 @@ def table3(campaign: Campaign, designed: str, baseline: str, *, promised: Mappin
         rows.append((name, tuple(vals) + (nan,)))
         if fmt:
             pp.append((name, fmt))
+    # what the reduction costs the pitch actuator, beside it
+    actuator, fmts = actuator_rows(campaign, (designed, baseline))
+    rows += actuator
+    pp += fmts
     return Table(
         title=f"Table 3: tower-base fatigue (DEL) reduction, {designed} vs {baseline}",
         columns=_speed_columns(campaign.wind_speeds), rows=tuple(rows),
         note=f"Reduction 100·(1 − DEL_{designed}/DEL_{baseline}), positive: lower than {baseline} (Table 2 gives "
              f"it as a change, negative); {acc.n_seeds} paired seeds of {campaign.duration:g} s; DEL with "
-             f"m = {campaign.m:g} at 1 Hz; linear prediction by Dirlik on |T|²S_W; deviation in percentage points.",
+             f"m = {campaign.m:g} at 1 Hz; linear prediction by Dirlik on |T|²S_W; deviation in percentage points; "
+             "below, the actuator's cost of each controller (seed means; pitch travel Σ|Δβ| per hour).",
         row_fmt=tuple(pp),
         marks=_unstable_marks(campaign, designed, baseline),
     )
