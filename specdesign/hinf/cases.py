@@ -390,10 +390,10 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     Examples
     --------
     >>> from specdesign import feasibility, turbine
-    >>> from specdesign.hinf import design_hinf, refine_on_cases
+    >>> from specdesign.hinf import design_hinf, refine_on_cases, spec_from_certified
     >>> model = turbine.iea15mw()
     >>> ts = feasibility.specification_for_target(model, 19.0, 25.0)  # doctest: +SKIP
-    >>> start = -design_hinf(model, 19.0, spec=ts).reduction.controller  # the Riccati controller  # doctest: +SKIP
+    >>> start = -design_hinf(model, 19.0, spec=spec_from_certified(ts)).reduction.controller  # the Riccati controller  # doctest: +SKIP
     >>> c, chk = refine_on_cases(model, ts, start)  # doctest: +SKIP
     >>> chk.met  # doctest: +SKIP
     True

@@ -43,7 +43,7 @@ __all__ = ["design_qft", "design_schedule", "design_table", "format_table", "SPE
 
 #: Relaxations (dB) of the generator-speed spec the notch design (``spec="notch"``) tries in turn,
 #: smallest first: ROSCO's T_{Ω,w} dips at the tower mode where a well-damped loop cannot follow
-#: it, and 3 dB is the least that the IEA 15 MW designs met; design_hinf(spec="qft") uses the same.
+#: it, and 3 dB is the least that the IEA 15 MW designs met; hinf.spec_like_qft uses the same.
 SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
 
 
