@@ -180,32 +180,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     >>> print(d.summary())  # doctest: +SKIP
     >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
     """
-    options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
-    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
-    if unknown:  # named here, not as a TypeError of an internal function
-        raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
-    if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
-        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
-                        f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
-    check_design_speed(model, wind_speed)
-    if isinstance(spec, str) and spec not in ("target", "notch"):
-        raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
-                         "(tower, speed)")
-    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets"}
-    if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
-        named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
-        raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
-                        "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
-                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
-    if speed_relax_db is None:
-        speed_relax_db = SPEED_RELAX_DB
-    ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
-    if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
-        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
-    if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
-        raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
-    if structure not in (None, "certificate", "fixed"):
-        raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
+    ladder = _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs)
     if isinstance(spec, str) and spec == "target":
         # the plant cases the pair is certified on are the ones the design must meet it on
         offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
@@ -240,6 +215,39 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {ladder[-1]:g} dB): {design.message}",
                   RuntimeWarning, stacklevel=2)
     return design
+
+
+def _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs) -> np.ndarray:
+    """:func:`design_qft`'s arguments checked at the door, in its order (unknown options, the
+    model, the wind speed, ``spec``, options of the other design, the relaxation ladder,
+    ``structure``): the ladder of speed relaxations (dB, increasing)."""
+    options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
+    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
+    if unknown:  # named here, not as a TypeError of an internal function
+        raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
+    if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
+        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
+                        f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
+    check_design_speed(model, wind_speed)
+    if isinstance(spec, str) and spec not in ("target", "notch"):
+        raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
+                         "(tower, speed)")
+    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets"}
+    if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
+        named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
+        raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
+                        "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
+                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
+    if speed_relax_db is None:
+        speed_relax_db = SPEED_RELAX_DB
+    ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
+    if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
+    if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
+    if structure not in (None, "certificate", "fixed"):
+        raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
+    return ladder
 
 
 def check_design_speed(model, wind_speed: float) -> float:
