@@ -296,12 +296,12 @@ def test_own_local_imports_are_heavy():
 
 # ----------------------------------------------------------------------------- one source per default (issue 32)
 def _signatures():
-    """(qualified name, inspect.Signature) of every function and method defined in specdesign."""
+    """(qualified name, inspect.Signature) of every function and method defined in both packages."""
     import importlib
     import inspect
 
     for path, modname in _modules():
-        if not modname.startswith("specdesign.") or modname.endswith("__main__"):
+        if modname.endswith("__main__"):
             continue
         mod = importlib.import_module(modname.removesuffix(".__init__"))
         for name, obj in vars(mod).items():
@@ -339,6 +339,50 @@ def test_shared_defaults_have_one_source():
                if "speed_relax_db" in sig.parameters and sig.parameters["speed_relax_db"].default == SPEED_RELAX_DB
                and sig.parameters["speed_relax_db"].default is not SPEED_RELAX_DB]
     assert not copies, "defaults written as literals instead of their module constant:\n" + "\n".join(copies)
+
+
+def _named_constants():
+    """Parameter name → [(constant's qualified name, value)] for every public upper-case module
+    constant (a number or a tuple) of both packages, keyed by its name lower-cased without a
+    ``DEFAULT_`` prefix (SLACK_DB → slack_db, DEFAULT_DECAY_RATE → decay_rate)."""
+    import importlib
+
+    out = {}
+    for path, modname in _modules():
+        if modname.endswith("__main__"):
+            continue
+        mod = importlib.import_module(modname.removesuffix(".__init__"))
+        for node in ast.parse(path.read_text()).body:
+            for target in node.targets if isinstance(node, ast.Assign) else []:
+                for n in ast.walk(target):
+                    v = getattr(mod, n.id, None) if isinstance(n, ast.Name) else None
+                    if n.__class__ is ast.Name and n.id.isupper() and not n.id.startswith("_") and (
+                            isinstance(v, (float, int, tuple)) and not isinstance(v, bool)):
+                        out.setdefault(n.id.removeprefix("DEFAULT_").lower(), []).append((f"{modname}.{n.id}", v))
+    return out
+
+
+def test_a_named_default_is_used_by_every_signature_that_shares_it():
+    # wherever a module constant names a default (its name is the parameter's, e.g. SLACK_DB and
+    # slack_db, or listed below), a signature with that parameter and that value uses the constant
+    # itself, in specdesign and in loopshaping (which has its own constants: it never imports
+    # specdesign); a literal copy of the value fails here
+    from specdesign import closedloop, fatigue
+
+    named = _named_constants()
+    for param, const in (("m", "TOWER_M"), ("blade_m", "BLADE_M")):
+        named.setdefault(param, []).append((f"specdesign.fatigue.{const}", getattr(fatigue, const)))
+    named.setdefault("min_decay", []).append(("specdesign.closedloop.MIN_DECAY_RATE", closedloop.MIN_DECAY_RATE))
+    copies = []
+    for qual, sig in _signatures():
+        for p in sig.parameters.values():
+            d = p.default
+            if p.name not in named or isinstance(d, bool) or not isinstance(d, (float, int, tuple)):
+                continue
+            same = [c for c, v in named[p.name] if type(v) is type(d) and v == d]
+            if same and not any(v is d for _, v in named[p.name]):
+                copies.append(f"{qual}({p.name}={d!r}): use {' or '.join(sorted(set(same)))}")
+    assert not copies, "defaults written as literals where a module constant names them:\n" + "\n".join(copies)
 
 
 def test_ordered_constants_stay_ordered():

@@ -63,6 +63,7 @@ from .target import (
     MAX_RELAX_DB,
     SLACK_DB,
     SPEED_SLACK_DB,
+    TARGET_REDUCTION,
     TOLERANCE_DB,
     CertificateSearch,
     recertify,
@@ -494,7 +495,7 @@ def _fit_above(model, cert, base, promise, grid, t0, t, aim, max_notches, headro
 
 
 @on_one_blas_thread  # L-BFGS-B's small BLAS calls: 10× faster on one thread (specdesign._blas)
-def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_pp=HEADROOM_PP,
+def element_specification(model, wind_speed, target_reduction=TARGET_REDUCTION, *, headroom_pp=HEADROOM_PP,
                           max_notches=MAX_NOTCHES, m=TOWER_M, omega=None, **target_options):
     """A certified tower specification for ``target_reduction``, as ROSCO's map times shaping elements.
 

@@ -24,11 +24,12 @@ from .. import closedloop, spectral, wind
 from .. import spec as sp
 from .._blas import one_blas_thread
 from .._checks import finite_system, spec_made_at
-from ..closedloop import closed_loop_mimo, refine_grid
+from ..closedloop import MIN_DECAY_RATE, closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
 from ..fatigue import TOWER_M
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
+from ..feasibility.target import TARGET_REDUCTION
 from .specs import HinfSpecification, spec_for_target
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
 
@@ -41,8 +42,9 @@ if TYPE_CHECKING:
 
 __all__ = ['HinfDesign', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf']
 
-#: α (1/s) of the α-shifted synthesis in :func:`design_hinf`.
-DEFAULT_DECAY_RATE = 0.02
+#: α (1/s) of the α-shifted synthesis in :func:`design_hinf`: the least decay rate of a designed
+#: loop, :data:`specdesign.closedloop.MIN_DECAY_RATE`.
+DEFAULT_DECAY_RATE = MIN_DECAY_RATE
 #: Half-width of the tower-mode band (relative) over which ``tower_excess_db`` is the maximum.
 TOWER_BAND = 0.1
 
@@ -216,7 +218,7 @@ def _tower_mode(plant):
 def design_hinf(
     model: TurbineModel,
     wind_speed: float,
-    target_reduction: float = 25.0,
+    target_reduction: float = TARGET_REDUCTION,
     *,
     spec: HinfSpecification | None = None,
     measurements: Sequence[str] | None = None,

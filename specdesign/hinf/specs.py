@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 from .. import spec as sp
 from ..fatigue import TOWER_M
 from ..feasibility import TargetSpecification, specification_for_target
+from ..feasibility.target import TARGET_REDUCTION
 from ..qft.design import SPEED_RELAX_DB
 
 if TYPE_CHECKING:
@@ -135,7 +136,7 @@ def spec_from_certified(target: TargetSpecification, *, kind: str = "given") -> 
                              target=target, wind_speed=float(target.wind_speed))
 
 
-def spec_for_target(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
+def spec_for_target(model: TurbineModel, wind_speed: float, target_reduction: float = TARGET_REDUCTION, *,
                     m: float = TOWER_M) -> HinfSpecification:
     """The certified pair for a tower-base DEL target, as :func:`specdesign.qft.design_qft` makes it.
 
@@ -250,8 +251,8 @@ def spec_from_qft(design: Any) -> HinfSpecification:
 
 
 def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
-                       spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                       keep_below: float = 0.6, m: float = TOWER_M,
+                       spec_reduction: float = sp.SPEC_REDUCTION, tower_relax_db: float = sp.TOWER_RELAX_DB,
+                       tower_relax_omega: float = sp.TOWER_RELAX_OMEGA, keep_below: float = sp.KEEP_BELOW, m: float = TOWER_M,
                        omega: ArrayLike | None = None) -> tuple[Specification, Specification, Specification]:
     """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
 
@@ -318,7 +319,8 @@ def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db
 
 
 def spec_like_qft(model: TurbineModel, wind_speed: float, *, speed_relax_db: float | Sequence[float] = SPEED_RELAX_DB,
-                  spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
+                  spec_reduction: float = sp.SPEC_REDUCTION, tower_relax_db: float = sp.TOWER_RELAX_DB,
+                  tower_relax_omega: float = sp.TOWER_RELAX_OMEGA,
                   m: float = TOWER_M, omega: ArrayLike | None = None) -> HinfSpecification:
     """QFT's notch specifications (those of ``design_qft(spec="notch")``), one pair per relaxation.
 
@@ -378,7 +380,7 @@ def spec_like_qft(model: TurbineModel, wind_speed: float, *, speed_relax_db: flo
     return HinfSpecification("qft", pairs, relax, notch=notch, wind_speed=float(wind_speed))
 
 
-def spec_from_rosco(model: TurbineModel, wind_speed: float, *, spec_reduction: float = 15.0, m: float = TOWER_M,
+def spec_from_rosco(model: TurbineModel, wind_speed: float, *, spec_reduction: float = sp.SPEC_REDUCTION, m: float = TOWER_M,
                     omega: ArrayLike | None = None) -> HinfSpecification:
     """The unrelaxed notch specification and ROSCO's T_{Ω,w}: design_hinf's default before QFT's.
 

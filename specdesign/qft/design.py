@@ -21,12 +21,15 @@ from .. import turbine
 from .._checks import del_target, positive_scalar, spec_made_at
 from ..closedloop import (
     DESIGN_MAX_SENSITIVITY,
+    MIN_DECAY_RATE,
     case_speeds,
     closed_loop,
     lightly_damped,
     refine_grid,
 )
 from ..feasibility import TargetSpecification, specification_for_target
+from ..feasibility.target import TARGET_REDUCTION
+from ..spec import KEEP_BELOW, SPEC_REDUCTION, TOWER_RELAX_DB, TOWER_RELAX_OMEGA
 from .certificate import design_from_certificate
 from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign, assemble_design
@@ -67,7 +70,7 @@ def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01
     return np.unique(w[(w >= 0.005) & (w <= 20.0)])
 
 
-def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
+def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = TARGET_REDUCTION, *,
                speed_relax_db: float | Sequence[float] | None = None, spec: Any = "target",
                structure: str | None = None, **kwargs: Any) -> QFTDesign:
     """QFT design at ``wind_speed`` (m/s) that meets a fatigue-based specification pair.
@@ -311,10 +314,11 @@ def _given_spec(spec):
     return pair
 
 
-def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec_reduction=15.0,
+def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, given=None, spec_reduction=SPEC_REDUCTION,
                    template_offsets=(-1.0, -0.5, 0.5, 1.0),
-                   design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
-                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
+                   design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=TOWER_RELAX_DB,
+                   tower_relax_omega=TOWER_RELAX_OMEGA,
+                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=MIN_DECAY_RATE, keep_below=KEEP_BELOW, refine=2, maxfev=3000) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
     from .. import spec as sp
 
@@ -396,7 +400,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
 
 
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
-                    target_reduction: float | Sequence[float] = 25.0, *, specification: str = "target",
+                    target_reduction: float | Sequence[float] = TARGET_REDUCTION, *, specification: str = "target",
                     progress: bool = True, **kwargs: Any) -> tuple[QFTDesign, ...]:
     """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
 
