@@ -15,7 +15,7 @@ notches) and |T_{Ω,w}(jω)| ≤ |W_Ω(jω)| (generator speed, the baseline's T_
 :func:`design_hinf` takes the feasible pair of a DEL target, as ``specdesign.qft.design_qft`` does
 (:func:`specdesign.feasibility.specification_for_target`, 25 %, certified over plant cases), and
 meets it at every case (pitch only); ``spec=spec_like_qft(model, v)`` takes the specifications of
-``design_qft(spec="notch")`` (:func:`qft_specifications`: the tower spec relaxed above ≈ 1.3
+``design_qft(spec="notch")`` (the tower spec relaxed above ≈ 1.3
 rad/s, the speed spec relaxed by QFT's dB ladder). Either way H∞ and QFT are compared on the same
 specifications. Dividing each
 output by its specification gives performance outputs whose H∞ norm is ≤ 1 exactly when
@@ -38,7 +38,6 @@ from .design import DEFAULT_DECAY_RATE, TOWER_BAND, HinfDesign, design_hinf
 from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
 from .specs import (
     HinfSpecification,
-    qft_specifications,
     spec_for_target,
     spec_from_certified,
     spec_from_pair,
@@ -60,7 +59,6 @@ __all__ = [
     "design_hinf",
     "generalized_plant",
     "inverse_weight",
-    "qft_specifications",
     "siso_weight",
     "spec_for_target",
     "spec_from_certified",

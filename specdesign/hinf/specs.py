@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from ..turbine import TurbineModel
 
 __all__ = ["HinfSpecification", "spec_for_target", "spec_from_certified", "spec_from_pair", "spec_from_qft",
-           "spec_like_qft", "spec_from_rosco", "qft_specifications"]
+           "spec_like_qft", "spec_from_rosco"]
 
 #: The kinds of :class:`HinfSpecification`, one per function that makes one.
 KINDS = ("target", "given", "qft_design", "qft", "rosco")
@@ -145,12 +145,10 @@ def spec_for_target(model: TurbineModel, wind_speed: float, target_reduction: fl
 
     Parameters
     ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine.
-    wind_speed : float
-        Operating point, m/s.
+    model, wind_speed : specdesign.turbine.TurbineModel, float
+        The turbine and the operating point (m/s) the pair is made and certified at.
     target_reduction : float
-        Tower-base DEL reduction (1 Hz, m = ``m``) vs ROSCO, % (0-100).
+        The DEL target: tower-base DEL reduction (1 Hz, m = ``m``) vs ROSCO, % (0-100).
     m : float
         Wöhler exponent of the tower-base S-N curve on ranges (-).
 
@@ -250,101 +248,30 @@ def spec_from_qft(design: Any) -> HinfSpecification:
                              notch=design.shaping.specification, wind_speed=float(design.wind_speed))
 
 
-def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
-                       spec_reduction: float = sp.SPEC_REDUCTION, tower_relax_db: float = sp.TOWER_RELAX_DB,
-                       tower_relax_omega: float = sp.TOWER_RELAX_OMEGA, keep_below: float = sp.KEEP_BELOW, m: float = TOWER_M,
-                       omega: ArrayLike | None = None) -> tuple[Specification, Specification, Specification]:
-    """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
-
-    Tower load: W_MyT = T^ROSCO_{MyT,w} × the notches of :func:`specdesign.spec.shape_to_target`
-    (``spec_reduction`` % damage, notches above ``keep_below`` rad/s) × two leads
-    (1 + s/ω_r)/(1 + s/(ω_r·10^(tower_relax_db/40))), ω_r = ``tower_relax_omega`` (rad/s): the
-    spec is relaxed by ``tower_relax_db`` at high frequency, where ΔD% is negligible (the
-    leads already lift it by ≈ 1.9 dB at the tower mode, 1.06 rad/s, with the defaults).
-    Generator speed: W_Ω = T^ROSCO_{Ω,w}·10^(speed_relax_db/20), ROSCO's dip at the tower
-    mode (a ζ = 0.01 zero pair) kept. Built by :func:`specdesign.spec.design_specifications`.
-
-    Parameters
-    ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine.
-    wind_speed : float
-        Operating point, m/s.
-    speed_relax_db : float
-        Relaxation of the generator-speed specification, dB (≥ 0).
-    spec_reduction : float
-        Damage reduction the notches promise, %.
-    tower_relax_db : float
-        High-frequency relaxation of the tower specification, dB (≥ 0; 0 for none).
-    tower_relax_omega : float
-        Corner ω_r of the relaxation, rad/s.
-    keep_below : float
-        No notch below this frequency, rad/s.
-    m : float
-        Wöhler exponent of the tower-base S-N curve (-).
-    omega : array_like, optional
-        Frequency grid of the baseline analysis, rad/s (default
-        :func:`specdesign.spec.default_omega`).
-
-    Returns
-    -------
-    tower_spec : specdesign.spec.Specification
-        W_MyT, N·m per m/s: the notch spec × the relaxation.
-    speed_spec : specdesign.spec.Specification
-        W_Ω, rad/s per m/s.
-    notch_spec : specdesign.spec.Specification
-        The unrelaxed notch spec whose promise :func:`specdesign.spec.shape_to_target` reports.
-
-    Raises
-    ------
-    ValueError
-        If no notch specification reaches ``spec_reduction`` at this wind speed, a relaxation
-        is negative or not finite, ``tower_relax_omega`` is not positive, or ``wind_speed`` is
-        outside ``model.wind_range``.
-
-    Examples
-    --------
-    >>> from specdesign import turbine
-    >>> from specdesign.hinf import qft_specifications
-    >>> tower, speed, notch = qft_specifications(turbine.iea15mw(), 19.0)  # doctest: +SKIP
-    >>> speed.elements  # doctest: +SKIP
-    (Gain(gain_db=4.5),)
-    """
-    d = sp.design_specifications(model, wind_speed, speed_relax_db=speed_relax_db, spec_reduction=spec_reduction,
-                                 tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
-                                 keep_below=keep_below, m=m, omega=omega)
-    if not d.shaping.success:
-        raise ValueError(f"no tower specification at {float(wind_speed):g} m/s: {d.shaping.message}")
-    return d.tower, d.speed, d.shaping.specification
-
-
 def spec_like_qft(model: TurbineModel, wind_speed: float, *, speed_relax_db: float | Sequence[float] = SPEED_RELAX_DB,
                   spec_reduction: float = sp.SPEC_REDUCTION, tower_relax_db: float = sp.TOWER_RELAX_DB,
                   tower_relax_omega: float = sp.TOWER_RELAX_OMEGA,
                   m: float = TOWER_M, omega: ArrayLike | None = None) -> HinfSpecification:
     """QFT's notch specifications (those of ``design_qft(spec="notch")``), one pair per relaxation.
 
-    The pairs of :func:`qft_specifications`: the notch spec relaxed by ``tower_relax_db`` above
-    ≈ ``tower_relax_omega`` and ROSCO's T_{Ω,w} relaxed by each of ``speed_relax_db``; the
-    design tries them in turn and keeps the smallest relaxation whose reduced design meets both
+    Built as :func:`specdesign.spec.design_specifications` builds them for QFT: W_MyT is ROSCO's
+    T_{MyT,w} × the notches of :func:`specdesign.spec.shape_to_target` × two leads relaxing it by
+    ``tower_relax_db`` above ≈ ``tower_relax_omega`` (where ΔD% is negligible; they already lift
+    it by ≈ 1.9 dB at the tower mode, 1.06 rad/s, with the defaults), and W_Ω is ROSCO's T_{Ω,w}
+    relaxed by each of ``speed_relax_db`` (its ζ = 0.01 dip at the tower mode kept). The design
+    tries the pairs in turn and keeps the smallest relaxation whose reduced design meets both
     specs on the refined grid (speed everywhere, tower over the tower-mode band), as QFT does.
 
     Parameters
     ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine.
-    wind_speed : float
-        Operating point, m/s.
+    model, wind_speed : specdesign.turbine.TurbineModel, float
+        The turbine and its operating point (m/s).
     speed_relax_db : float or sequence of float
         Relaxation(s) of ROSCO's T_{Ω,w}, dB (≥ 0), tried in the order given (default
         :data:`specdesign.qft.SPEED_RELAX_DB`, QFT's ladder).
-    spec_reduction : float
-        % of tower-base damage the notch specification (:func:`specdesign.spec.shape_to_target`)
-        promises.
-    tower_relax_db : float
-        High-frequency relaxation of the tower spec, dB.
-    tower_relax_omega : float
-        Corner of that relaxation, rad/s.
+    spec_reduction, tower_relax_db, tower_relax_omega : float
+        The notch specification's promise (% of tower-base damage), the tower spec's
+        high-frequency relaxation (dB) and its corner (rad/s).
     m : float
         Wöhler exponent of the tower-base S-N curve on ranges (-).
     omega : array_like, optional
@@ -353,28 +280,32 @@ def spec_like_qft(model: TurbineModel, wind_speed: float, *, speed_relax_db: flo
     Returns
     -------
     HinfSpecification
-        Kind "qft", one pair per relaxation.
+        Kind "qft", one pair per relaxation; ``notch`` the unrelaxed notch spec (whose promise
+        ``shape_to_target`` reports).
 
     Raises
     ------
     ValueError
-        If ``speed_relax_db`` is not a relaxation ≥ 0 dB or a sequence of them, or no notch
-        specification reaches ``spec_reduction`` (see :func:`qft_specifications`).
+        If ``speed_relax_db`` is not a relaxation ≥ 0 dB or a sequence of them, a relaxation or
+        corner is invalid, ``wind_speed`` is outside ``model.wind_range``, or no notch
+        specification reaches ``spec_reduction`` at this wind speed.
 
     Examples
     --------
     >>> from specdesign import hinf, turbine
     >>> s = hinf.spec_like_qft(turbine.iea15mw(), 19.0)  # doctest: +SKIP
-    >>> s.kind, s.speed_relax_db  # doctest: +SKIP
-    ('qft', (3.0, 4.5, 6.0, 8.0))
+    >>> s.kind, s.speed_relax_db, s.speed.elements  # doctest: +SKIP
+    ('qft', (3.0, 4.5, 6.0, 8.0), (Gain(gain_db=3.0),))
     """
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
     if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
         raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
     relax = tuple(float(x) for x in ladder)
-    tower, _, notch = qft_specifications(model, wind_speed, speed_relax_db=relax[0], spec_reduction=spec_reduction,
-                                         tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
-                                         m=m, omega=omega)
+    ds = sp.design_specifications(model, wind_speed, speed_relax_db=relax[0], spec_reduction=spec_reduction,
+                                  tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega, m=m, omega=omega)
+    if not ds.shaping.success:
+        raise ValueError(f"no tower specification at {float(wind_speed):g} m/s: {ds.shaping.message}")
+    tower, notch = ds.tower, ds.shaping.specification
     # the tower spec does not depend on the speed relaxation: one per rung, as design_specifications builds it
     pairs = tuple((tower, sp.speed_specification(model, float(wind_speed), margin_db=r)) for r in relax)
     return HinfSpecification("qft", pairs, relax, notch=notch, wind_speed=float(wind_speed))
@@ -390,16 +321,15 @@ def spec_from_rosco(model: TurbineModel, wind_speed: float, *, spec_reduction: f
     Parameters
     ----------
     model : specdesign.turbine.TurbineModel
-        The turbine.
+        The turbine, linearised at ``wind_speed`` (m/s, a float).
     wind_speed : float
-        Operating point, m/s.
+        See ``model``.
     spec_reduction : float
-        % of tower-base damage the notch specification (:func:`specdesign.spec.shape_to_target`)
-        promises.
+        What the notches promise, % of tower-base damage (:func:`specdesign.spec.shape_to_target`).
     m : float
-        Wöhler exponent of the tower-base S-N curve on ranges (-).
+        The S-N curve's Wöhler exponent (tower base, ranges).
     omega : array_like, optional
-        Frequency grid of the baseline analysis, rad/s (default :func:`specdesign.spec.default_omega`).
+        The baseline analysis' grid (rad/s); default :func:`specdesign.spec.default_omega`.
 
     Returns
     -------
