@@ -79,7 +79,7 @@ class HinfDesign:
         The generator-speed specification W_Ω used as the weight, rad/s per m/s.
     promised_del_reduction : float
         The tower specification's exact (Dirlik) promise, % (a TargetSpecification's own
-        ``promise``: with the default ``spec="target"`` the promise of the pair met).
+        ``promise``: by default, without ``spec``, the promise of the pair met).
     predicted_del_reduction : float
         Dirlik on the reduced controller's closed loop vs ROSCO's, tower-base DEL, %.
     speed_excess_db : float

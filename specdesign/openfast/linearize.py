@@ -97,6 +97,7 @@ from .linear_turbine import LinearTurbine
 __all__ = [
     "DEFAULT_DOFS",
     "LIN_OUTPUTS",
+    "TRIM_TOWER_DAMPING",
     "LinearizationCase",
     "default_lin_cache",
     "linearization_case",

@@ -6,7 +6,7 @@ import numpy as np
 
 from .conventions import SI_UNITS, TIME_SERIES, show_se
 
-__all__ = ["plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage", "plot_comparison"]
+__all__ = ["SPECTRA_MAX_OMEGA", "plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage", "plot_comparison"]
 
 _NAMES = {"gen_speed": "Generator speed", "tower_base_my": "Tower-base fore-aft moment", "blade_root_my": "Blade-root flapwise moment"}
 
