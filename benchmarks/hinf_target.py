@@ -2,7 +2,7 @@
 
 For each wind speed: ``specification_for_target(model, v, target)`` (the pair certified over the
 plant cases v + (−1, −0.5, 0.5, 1) m/s within the model's range, by a pitch-only controller,
-docs/spec_driven.md), then ``design_hinf(model, v, spec=pair)`` (pitch only: Riccati synthesis,
+docs/spec_driven.md), then ``design_hinf(model, v, spec=spec_from_certified(pair))`` (pitch only: Riccati synthesis,
 balanced truncation to 8 states, the multi-model H∞ step of specdesign.hinf.cases). The check
 is recomputed here by the explicit closed-loop formula (closedloop.t_tower_wind /
 t_gen_speed_wind) at every plant case, each case's weight from ROSCO's loop at that speed
@@ -32,7 +32,7 @@ import numpy as np
 
 from specdesign import closedloop, feasibility, spec
 from specdesign.closedloop import plant_responses
-from specdesign.hinf import design_hinf
+from specdesign.hinf import design_hinf, spec_from_certified
 from specdesign.turbine import iea15mw
 
 
@@ -85,7 +85,7 @@ def main():
             ts = make(model, v, args.target)
             t, cpu = time.perf_counter(), time.process_time()
             try:
-                d = design_hinf(model, v, spec=ts)
+                d = design_hinf(model, v, spec=spec_from_certified(ts))
             except ValueError as err:  # e.g. a weight pole slower than the α-shift
                 print(f"| {v:g} | | {ts.promise.exact_del:.2f} | synthesis refused: {err} |||||||", flush=True)
                 continue

@@ -204,6 +204,64 @@ def _tiles(phases, lo, hi):
     return s[(phases.max() + s > lo) & (phases.min() + s < hi)]
 
 
+def _draw_bounds(ax, bounds, lo, hi, colours):
+    """The lower (solid) and upper (dashed) bounds of every design frequency, tiled over the
+    window [lo, hi] degrees, with the legend entries (or a colour key) and the styles' meaning."""
+    design = bounds.omega
+    lower, upper = bounds.edges()
+    ph = bounds.phases_deg
+    shifts = _tiles(ph, lo, hi)
+    styles = set()
+    for i, w in enumerate(design):
+        lab = _omega_label(w) + (": EMPTY bound" if bounds.empty[i] else "")
+        # One artist per frequency and style (curves joined by NaN breaks): fast redraws.
+        for edge, style in ((lower, "-"), (upper, "--")):
+            curves = edge[i].T[np.any(np.isfinite(edge[i].T), axis=1)]
+            if curves.size:
+                xs = np.concatenate([np.r_[ph + d, np.nan] for d in shifts for _ in curves])
+                ys = np.concatenate([np.r_[c, np.nan] for _ in shifts for c in curves])
+                ax.plot(xs, ys, style, color=colours[i], lw=1.5, label=lab)
+                styles.add(style)
+                lab = None
+        if lab is not None:  # no curve to carry the frequency's legend entry
+            ax.plot([], [], "-", color=colours[i], lw=1.5, label=lab)
+    if len(design) > 10:
+        # dozens of frequencies share a continuous colour map: a colour key says which
+        # colour is which frequency (a legend of dozens of entries would say nothing)
+        from matplotlib import colormaps
+        from matplotlib.cm import ScalarMappable
+        from matplotlib.colors import LogNorm
+
+        key = ScalarMappable(norm=LogNorm(design.min(), design.max()), cmap=colormaps["viridis"])
+        ax.figure.colorbar(key, ax=ax, pad=0.01, fraction=0.05, label="bound frequency ω (rad/s)")
+    # Legend-only entries (no data) saying what the line styles mean, in a neutral grey.
+    meaning = {"-": "solid: lower bound, L0 must pass above", "--": "dashed: upper bound, L0 must pass below"}
+    for style in ("-", "--"):
+        if style in styles:
+            ax.plot([], [], style, color="0.5", lw=1.5, label=meaning[style])
+
+
+def _draw_loop(ax, loop, omega, design, lo, hi, colours):
+    """The nominal loop wrapped into [lo, lo + 360) degrees (black), with markers at the design
+    frequencies ``design`` (rad/s) in the bounds' colours."""
+    if omega is None:
+        w_lo = design.min() / 100 if design.size else 1e-2
+        w_hi = design.max() * 100 if design.size else 1e3
+        omega = np.logspace(np.log10(w_lo), np.log10(w_hi), 2000)
+    grid = check_grid(omega, "omega")
+    if isinstance(loop, np.ndarray):
+        L = loop  # markers go to the nearest grid points
+    else:
+        # Add the design frequencies so the markers sit exactly on the curve.
+        grid = np.unique(np.concatenate([grid, design]))
+        L = loop.response(grid) if isinstance(loop, Controller) else evaluate(loop, grid, "loop")
+    ph, mag = loop_nichols(L, grid, (lo, hi))
+    ax.plot(*wrap_phase(ph, mag, (lo, hi)), "k-", lw=1.5, label="nominal loop L0")
+    for i, w in enumerate(design):
+        j = int(np.argmin(np.abs(grid - w)))
+        ax.plot(lo + np.mod(ph[j] - lo, 360.0), mag[j], "o", color=colours[i], mec="k", ms=7)
+
+
 def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes | None" = None,
          omega: ArrayLike | None = None, m_contours_db: ArrayLike | None = None, xlim: tuple = (-360.0, 0.0),
          ylim: tuple | None = None, legend: bool = True) -> "matplotlib.axes.Axes":
@@ -258,59 +316,14 @@ def draw(bounds: Bounds | None, loop: object = None, ax: "matplotlib.axes.Axes |
     design = bounds.omega if bounds is not None else np.array([])
     colours = _colours(len(design))
     if bounds is not None:
-        lower, upper = bounds.edges()
-        ph = bounds.phases_deg
-        shifts = _tiles(ph, lo, hi)
-        styles = set()
-        for i, w in enumerate(design):
-            lab = _omega_label(w) + (": EMPTY bound" if bounds.empty[i] else "")
-            # One artist per frequency and style (curves joined by NaN breaks): fast redraws.
-            for edge, style in ((lower, "-"), (upper, "--")):
-                curves = edge[i].T[np.any(np.isfinite(edge[i].T), axis=1)]
-                if curves.size:
-                    xs = np.concatenate([np.r_[ph + d, np.nan] for d in shifts for _ in curves])
-                    ys = np.concatenate([np.r_[c, np.nan] for _ in shifts for c in curves])
-                    ax.plot(xs, ys, style, color=colours[i], lw=1.5, label=lab)
-                    styles.add(style)
-                    lab = None
-            if lab is not None:  # no curve to carry the frequency's legend entry
-                ax.plot([], [], "-", color=colours[i], lw=1.5, label=lab)
-        if len(design) > 10:
-            # dozens of frequencies share a continuous colour map: a colour key says which
-            # colour is which frequency (a legend of dozens of entries would say nothing)
-            from matplotlib import colormaps
-            from matplotlib.cm import ScalarMappable
-            from matplotlib.colors import LogNorm
-
-            key = ScalarMappable(norm=LogNorm(design.min(), design.max()), cmap=colormaps["viridis"])
-            ax.figure.colorbar(key, ax=ax, pad=0.01, fraction=0.05, label="bound frequency ω (rad/s)")
-        # Legend-only entries (no data) saying what the line styles mean, in a neutral grey.
-        meaning = {"-": "solid: lower bound, L0 must pass above", "--": "dashed: upper bound, L0 must pass below"}
-        for style in ("-", "--"):
-            if style in styles:
-                ax.plot([], [], style, color="0.5", lw=1.5, label=meaning[style])
+        _draw_bounds(ax, bounds, lo, hi, colours)
     for n, m in enumerate(() if m_contours_db is None else np.atleast_1d(m_contours_db)):
         ph, mag = m_contour(float(m), np.arange(lo + 0.25, hi, 0.5))
         ax.plot(ph, mag, ":", color="0.5", lw=0.8, label=None if n else "M-contours: closed-loop |L0/(1+L0)|")
         j = np.nanargmin(np.abs(ph - (lo + np.mod(-220.0 - lo, 360.0))))
         ax.annotate(f"M = {m:.3g} dB", (ph[j], mag[j]), color="0.4", fontsize=7)
     if loop is not None:
-        if omega is None:
-            w_lo = design.min() / 100 if design.size else 1e-2
-            w_hi = design.max() * 100 if design.size else 1e3
-            omega = np.logspace(np.log10(w_lo), np.log10(w_hi), 2000)
-        grid = check_grid(omega, "omega")
-        if isinstance(loop, np.ndarray):
-            L = loop  # markers go to the nearest grid points
-        else:
-            # Add the design frequencies so the markers sit exactly on the curve.
-            grid = np.unique(np.concatenate([grid, design]))
-            L = loop.response(grid) if isinstance(loop, Controller) else evaluate(loop, grid, "loop")
-        ph, mag = loop_nichols(L, grid, (lo, hi))
-        ax.plot(*wrap_phase(ph, mag, (lo, hi)), "k-", lw=1.5, label="nominal loop L0")
-        for i, w in enumerate(design):
-            j = int(np.argmin(np.abs(grid - w)))
-            ax.plot(lo + np.mod(ph[j] - lo, 360.0), mag[j], "o", color=colours[i], mec="k", ms=7)
+        _draw_loop(ax, loop, omega, design, lo, hi, colours)
     # the critical point (−180° + k·360°, 0 dB) in every period the window shows: the loop's
     # distance to it is the stability margin a reader looks for first
     crit = [p for p in -180.0 + 360.0 * np.arange(np.floor((lo + 180.0) / 360.0), np.ceil((hi + 180.0) / 360.0) + 1)

@@ -34,6 +34,8 @@ from .plots.qft import plot_design_bode, plot_design_nichols
 from .plots.validation import plot_lifetime_damage, save_validation_figures
 from .rosco import rosco_baseline, rosco_scheduled
 from .simulate import scheduled
+from .feasibility.target import TARGET_REDUCTION
+from .spec import KEEP_BELOW, SPEC_REDUCTION
 from .turbine import iea15mw
 
 __all__ = ["run_demo", "run_lifetime_demo", "LIFETIME_DESIGN_SPEEDS", "check_demo_options", "check_lifetime_options",
@@ -88,8 +90,8 @@ def _seeds_and_duration(n_seeds, duration, default_seeds, default_duration):
     return int(n), float(d)
 
 
-def check_demo_options(wind_speed=19.0, target_reduction=25.0, n_seeds=None, duration=None, *, fast=False,
-                       spec_reduction=15.0, model=None) -> DemoOptions:
+def check_demo_options(wind_speed=19.0, target_reduction=TARGET_REDUCTION, n_seeds=None, duration=None, *, fast=False,
+                       spec_reduction=SPEC_REDUCTION, model=None) -> DemoOptions:
     """The design demo's options (:func:`run_demo`), checked before any work.
 
     Parameters
@@ -132,7 +134,7 @@ def check_demo_options(wind_speed=19.0, target_reduction=25.0, n_seeds=None, dur
 
 
 def check_lifetime_options(n_seeds=None, duration=None, design_speeds=LIFETIME_DESIGN_SPEEDS, bin_width=2.0, *,
-                           fast=False, target_reduction=25.0, cut_in=3.0, cut_out=25.0, k=None, scale=None,
+                           fast=False, target_reduction=TARGET_REDUCTION, cut_in=3.0, cut_out=25.0, k=None, scale=None,
                            model=None) -> DemoOptions:
     """The lifetime demo's options (:func:`run_lifetime_demo`), checked before any design.
 
@@ -192,7 +194,7 @@ def _say(msg):
 
 
 def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False, wind_speed: float = 19.0,
-             spec_reduction: float = 15.0, target_reduction: float = 25.0, n_seeds: int | None = None,
+             spec_reduction: float = SPEC_REDUCTION, target_reduction: float = TARGET_REDUCTION, n_seeds: int | None = None,
              duration: float | None = None, method: str = "target") -> dict:
     """Run the design loop at one wind speed and write its tables and figures into ``out``.
 
@@ -275,7 +277,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         tower, p = target.tower, target.promise
     else:
         _say(f"[2/4] specification promising {spec_reduction:g} % less damage (notches above 0.6 rad/s)")
-        shaped = spec.shape_to_target(base, spec_reduction, keep_below=0.6)
+        shaped = spec.shape_to_target(base, spec_reduction, keep_below=KEEP_BELOW)
         for n in shaped.notches:
             _say(f"      notch {n.omega_n:.3f} rad/s, {n.depth_db:.2f} dB, width {n.width:.3f}")
         spec_text = f"{len(shaped.notches)} notch(es)"
@@ -411,7 +413,7 @@ def _held_from(model, speeds, designs) -> int:
 def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False, n_seeds: int | None = None,
                       duration: float | None = None, design_speeds=LIFETIME_DESIGN_SPEEDS, bin_width: float = 2.0,
                       cut_in: float = 3.0, cut_out: float = 25.0, k: float | None = None,
-                      scale: float | None = None, target_reduction: float = 25.0) -> dict:
+                      scale: float | None = None, target_reduction: float = TARGET_REDUCTION) -> dict:
     """Lifetime comparison, ROSCO vs the designed controller, from cut-in to cut-out.
 
     The designed controller: the specification-driven QFT designs of

@@ -50,6 +50,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "SLSQP_OPTIONS",
+    "KEEP_BELOW",
+    "SPEC_REDUCTION",
+    "TOWER_RELAX_DB",
+    "TOWER_RELAX_OMEGA",
     "check_shaping_request",
     "Notch",
     "Gain",
@@ -77,6 +81,15 @@ __all__ = [
 #: SciPy SLSQP settings of the workbench's constrained fits (the notch shaper here, the QFT
 #: tuner's polish): at most 300 iterations, converged when the cost changes by less than 1e-10.
 SLSQP_OPTIONS = {"maxiter": 300, "ftol": 1e-10}
+#: No notch below this frequency (rad/s) by default: the low frequencies are kept for power
+#: regulation (the seed paper shapes around the tower mode, ≈ 1.1 rad/s on the IEA 15 MW).
+KEEP_BELOW = 0.6
+#: Damage reduction (%) the notch-shaped tower specification of the notch designs promises by
+#: default (design_qft(spec="notch"), hinf.spec_like_qft, the demo).
+SPEC_REDUCTION = 15.0
+#: High-frequency relaxation (dB) of the notch designs' tower specification and the corner
+#: (rad/s) above which it applies: ΔD% is negligible there (:func:`design_specifications`).
+TOWER_RELAX_DB, TOWER_RELAX_OMEGA = 6.0, 1.3
 
 
 # --------------------------------------------------------------------------------------
@@ -1039,7 +1052,7 @@ def check_shaping_request(base: Baseline, target_reduction: float, quantity: str
     return t
 
 
-def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", keep_below: float = 0.6,
+def shape_to_target(base: Baseline, target_reduction: float, *, quantity: str = "damage", keep_below: float = KEEP_BELOW,
                     n_notches: int | None = None, max_notches: int = 3, max_depth_db: float = 30.0,
                     width_range: tuple[float, float] = (0.05, 0.8), tolerance: float = 0.5) -> ShapingResult:
     """Shape a tower-load specification that promises a target reduction: notches above ``keep_below``.
@@ -1307,8 +1320,8 @@ def specification_pair(obj) -> tuple | None:
 
 
 def design_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
-                          spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                          keep_below: float = 0.6, m: float = TOWER_M,
+                          spec_reduction: float = SPEC_REDUCTION, tower_relax_db: float = TOWER_RELAX_DB,
+                          tower_relax_omega: float = TOWER_RELAX_OMEGA, keep_below: float = KEEP_BELOW, m: float = TOWER_M,
                           omega: ArrayLike | None = None) -> DesignSpecifications:
     """The tower-load and generator-speed specifications that QFT and H∞ designs are given.
 

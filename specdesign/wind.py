@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 from ._checks import as_omega, positive_scalar
 
 __all__ = ["TURBULENCE_CLASSES", "kaimal_spectrum", "disc_coherence", "rotor_effective_spectrum", "gaussian_series", "seed_for",
-           "wind_series"]
+           "wind_series", "RECORD_LENGTH", "LOWEST_OMEGA", "record_window"]
 
 #: IEC 61400-1 ed. 3/4 reference turbulence intensities I_ref by turbulence class.
 TURBULENCE_CLASSES = {"A+": 0.18, "A": 0.16, "B": 0.14, "C": 0.12}

@@ -95,8 +95,14 @@ def test_bad_arguments_are_named(model, pair):
         hinf.refine_on_cases(model, pair, c, decay_rate=0.0)
     with pytest.raises(ValueError, match="target_reduction"):
         hinf.design_hinf(model, V, 150.0)
-    with pytest.raises(ValueError, match="spec='hinf'"):
-        hinf.design_hinf(model, V, spec="hinf")
+    # one kind of specification: a string or a record of another kind is refused, naming the
+    # functions that make one (issue 32)
+    with pytest.raises(TypeError, match=r"spec must be a hinf.HinfSpecification, got 'qft'.*spec_like_qft"):
+        hinf.design_hinf(model, V, spec="qft")
+    with pytest.raises(TypeError, match="spec_from_certified"):
+        hinf.design_hinf(model, V, spec=pair)
+    with pytest.raises(TypeError, match="target must be a feasibility.TargetSpecification"):
+        hinf.spec_from_certified((pair.tower, pair.speed))
     with pytest.raises(TypeError, match="specs"):  # the former name of spec is gone
         hinf.design_hinf(model, V, specs="qft")
 

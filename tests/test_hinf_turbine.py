@@ -5,7 +5,7 @@ within 1 dB, tower-load spec met at the tower mode, predicted tower-base DEL red
 least the specification's promise, on a grid that cannot miss narrow peaks
 (:func:`specdesign.closedloop.refine_grid`). Every number is recomputed here by the explicit
 closed-loop formula of specdesign.closedloop (not the interconnection design_hinf uses).
-The design on QFT's specifications (``spec="qft"``, pitch + ATD, 1×2; the default before the
+The design on QFT's specifications (``spec=spec_like_qft(model, V)``, pitch + ATD, 1×2; the default before the
 certified pair of tests/test_hinf_target.py) meets it, the tower spec at the
 mode against both QFT's relaxed spec and the unrelaxed notch spec whose 3.98 % DEL promise
 is quoted; the pitch-only design does not (strict xfail, docs/hinf.md).
@@ -40,7 +40,7 @@ def specs(model):
 @pytest.fixture(scope="module", params=[("gen_speed",), ("gen_speed", "tower_top_vel")],
                 ids=["pitch", "pitch+ATD"])
 def design(request, model):
-    return hinf.design_hinf(model, V, spec="qft", measurements=request.param, order=8)
+    return hinf.design_hinf(model, V, spec=hinf.spec_like_qft(model, V), measurements=request.param, order=8)
 
 
 def _resp(sys, w):
@@ -276,8 +276,8 @@ def test_acceptance_at_19_mps(design, request):
 
 
 def test_qft_specs_are_design_qfts(model):
-    # specs="qft" builds exactly the specs design_qft gives its bounds (a QFT run cut short
-    # here: only its specs are used), and specs=<QFTDesign> takes them as they are.
+    # spec_like_qft builds exactly the specs design_qft gives its bounds (a QFT run cut short
+    # here: only its specs are used), and spec_from_qft(<QFTDesign>) takes them as they are.
     import warnings
 
     from specdesign import qft
@@ -285,27 +285,32 @@ def test_qft_specs_are_design_qfts(model):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         q = qft.design_qft(model, V, spec="notch", speed_relax_db=4.5, maxfev=1, refine=0)
-    tower, speed, notch = hinf.qft_specifications(model, V, speed_relax_db=4.5)
+    like = hinf.spec_like_qft(model, V, speed_relax_db=4.5)
+    tower, speed, notch = like.tower, like.speed, like.notch
     w = np.logspace(-2, 1, 300)
     for a, b in ((tower, q.tower_spec), (speed, q.speed_spec), (notch, q.shaping.specification)):
         np.testing.assert_allclose(a.response(w), b.response(w), rtol=1e-9)
-    d = hinf.design_hinf(model, V, spec=q)
+    d = hinf.design_hinf(model, V, spec=hinf.spec_from_qft(q))
     assert d.specs == "qft_design" and d.speed_relax_db == 4.5
     assert d.w_tower is q.tower_spec and d.w_speed is q.speed_spec
     assert d.notch_promised_del_reduction == pytest.approx(q.shaping.promise.exact_del, abs=1e-6)
     # the first rung (3 dB) leaves the 1×2 design 0.15 dB over the speed spec, inside
     # ROSCO's dip at 1.08 rad/s: the ladder moves on to 4.5 dB
-    d3 = hinf.design_hinf(model, V, spec="qft", speed_relax_db=3.0)
+    d3 = hinf.design_hinf(model, V, spec=hinf.spec_like_qft(model, V, speed_relax_db=3.0))
     assert 0 < d3.speed_excess_db < 0.5
-    with pytest.raises(ValueError, match="spec"):
-        hinf.design_hinf(model, V, spec="hinf")
+    with pytest.raises(TypeError, match="spec_from_qft"):
+        hinf.design_hinf(model, V, spec=q)
+    with pytest.raises(TypeError, match="QFTDesign"):
+        hinf.spec_from_qft("hinf")
+    with pytest.raises(ValueError, match="speed_relax_db"):
+        hinf.spec_like_qft(model, V, speed_relax_db=-1.0)
 
 
 def test_rosco_specs_ask_for_the_dip(model):
-    # spec="rosco" (the default before QFT's specs): ROSCO's own T_Ω,w unrelaxed, with its ζ = 0.01 dip
+    # spec_from_rosco (the default before QFT's specs): ROSCO's own T_Ω,w unrelaxed, with its ζ = 0.01 dip
     # at 1.081 rad/s. The damped 1×2 loop meets the tower spec but exceeds the speed spec by
     # ≈ 2.9 dB, by more than 1 dB only inside the dip.
-    d = hinf.design_hinf(model, V, spec="rosco")
+    d = hinf.design_hinf(model, V, spec=hinf.spec_from_rosco(model, V))
     assert d.specs == "rosco" and d.speed_relax_db == 0.0
     assert 2.5 < d.speed_excess_db < 3.5 and d.tower_excess_db < -3.0 and d.zeta_min > 0.1
     from specdesign import closedloop
@@ -334,7 +339,8 @@ def test_loopshaping_check_agrees(design):
 def test_undamped_default_of_before_is_still_available(model):
     # min_damping=0, decay_rate=0 is the design this module used to make: ζ ≈ 0.003 at
     # 1.08 rad/s and a +6.9 dB narrow-band speed excess that a 400-point grid missed.
-    d = hinf.design_hinf(model, V, spec="rosco", measurements=("gen_speed",), min_damping=0.0, decay_rate=0.0)
+    d = hinf.design_hinf(model, V, spec=hinf.spec_from_rosco(model, V), measurements=("gen_speed",), min_damping=0.0,
+                         decay_rate=0.0)
     assert d.zeta_min < 0.005 and abs(d.zeta_min_frequency - 1.08) < 0.01
     assert d.speed_excess_db > 5.0
 
@@ -348,13 +354,14 @@ def test_sign_convention_matches_rosco(design, model):
 
 
 def test_discrete_controller_exact_at_the_tower_mode(model):
-    d = hinf.design_hinf(model, V, spec="qft", order=8, dt=0.05)
+    qs = hinf.spec_like_qft(model, V)
+    d = hinf.design_hinf(model, V, spec=qs, order=8, dt=0.05)
     assert d.discrete_controller.dt == 0.05
     wm = d.tower_mode
     kd = np.asarray(d.discrete_controller(np.exp(1j * wm * 0.05))).ravel()[0]
     kc = np.asarray(d.controller(1j * wm)).ravel()[0]
     assert kd == pytest.approx(kc, rel=1e-8)
-    assert hinf.design_hinf(model, V, spec="qft", order=8).discrete_controller is None
+    assert hinf.design_hinf(model, V, spec=qs, order=8).discrete_controller is None
 
 
 def test_reduction_report_is_consistent(design):
@@ -370,19 +377,22 @@ def test_reduction_report_is_consistent(design):
 
 
 def test_a_given_specification_pair_is_the_weights(model):
-    # specs=(W_MyT, W_Ω): the pair handed over is what the synthesis weighs and the assessment
+    # spec_from_pair(W_MyT, W_Ω): the pair handed over is what the synthesis weighs and the assessment
     # measures (a loose pair: ROSCO's tower map + 3 dB, its speed map + 6 dB)
     d = spec.design_specifications(model, V, speed_relax_db=6.0, tower_relax_db=0.0)
     tower = spec.Specification(d.base.system, (spec.Gain(3.0),), name="W_tower")
-    res = hinf.design_hinf(model, V, spec=(tower, d.speed), measurements=("gen_speed", "tower_top_vel"), order=8)
+    res = hinf.design_hinf(model, V, spec=hinf.spec_from_pair(tower, d.speed), measurements=("gen_speed", "tower_top_vel"),
+                           order=8)
     assert res.specs == "given" and res.w_tower is tower and res.w_speed is d.speed
     assert res.speed_excess_db <= 0.1
-    with pytest.raises(ValueError, match="pair"):
-        hinf.design_hinf(model, V, spec=(tower,))
+    with pytest.raises(TypeError, match="spec_from_pair"):
+        hinf.design_hinf(model, V, spec=(tower, d.speed))
+    with pytest.raises(TypeError, match="speed must be"):
+        hinf.spec_from_pair(tower, "W")
 
 
 def test_a_certified_pair_it_does_not_meet_is_said_with_the_miss(model):
-    # specs=TargetSpecification with pitch + ATD (issue 14): the multi-model step that makes the
+    # spec_from_certified(TargetSpecification) with pitch + ATD (issue 14): the multi-model step that makes the
     # pitch-only design meet the pair at every case (tests/test_hinf_target.py) is not taken for a
     # 1×2 controller, and the synthesis alone (it bounds the root-sum-square of the weighted
     # outputs) does not reproduce the pair's narrow pole-zero pattern at the tower mode: the miss
@@ -397,7 +407,7 @@ def test_a_certified_pair_it_does_not_meet_is_said_with_the_miss(model):
         warnings.simplefilter("ignore", UserWarning)  # cvxpy: "solution may be inaccurate" on some rungs
         ts = feasibility.specification_for_target(model, V, 25.0)
     with pytest.warns(RuntimeWarning, match="not met") as rec:
-        res = hinf.design_hinf(model, V, spec=ts, measurements=("gen_speed", "tower_top_vel"))
+        res = hinf.design_hinf(model, V, spec=hinf.spec_from_certified(ts), measurements=("gen_speed", "tower_top_vel"))
     assert res.case_check is None
     msg = next(str(w.message) for w in rec if "not met" in str(w.message))
     assert res.notes[-1] == msg

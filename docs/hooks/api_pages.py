@@ -1,14 +1,17 @@
 """MkDocs hook: one API-reference page per public module of ``specdesign`` and ``loopshaping``.
 
 The pages are generated at build time from the packages themselves, so a new module or a new
-name in a module's ``__all__`` is documented without editing the site: a leaf module's page is
-rendered by mkdocstrings (its ``__all__`` decides the members); a package's page shows its
-docstring and, for each name it re-exports from a submodule, a link to the one place that
-name is documented (rendering it twice would give two anchors for one object).
-``tests/test_site.py`` checks that every name of every ``__all__`` has an anchor.
+name in a module's ``__all__`` is documented without editing the site: each page is rendered by
+mkdocstrings from the module's ``__all__``, each public object on one page only (:func:`home`:
+the module that defines it); a module (package or leaf) that re-exports a name defined elsewhere
+shows a link to that one place (rendering it twice would give two anchors for one object).
+``tests/test_site.py`` checks that every name of every ``__all__`` has an anchor and that each
+object is rendered once.
 """
 from __future__ import annotations
 
+import ast
+import functools
 import importlib
 from pathlib import Path
 
@@ -24,6 +27,7 @@ def _all_names(module: str) -> list[str]:
     return list(getattr(importlib.import_module(module), "__all__", []))
 
 
+@functools.cache
 def public_modules() -> dict[str, tuple[Path, bool]]:
     """Module name → (source file, is a package) for every module without a private part."""
     out = {}
@@ -43,43 +47,58 @@ def _page_path(module: str) -> str:
     return "api/" + module.replace(".", "/") + ".md"
 
 
-def _home(package: str, name: str, modules: dict) -> str | None:
-    """The public leaf module documenting ``package.name``: the one exporting the same object,
-    its defining module first, then the package's own submodules (None: defined in the package)."""
-    obj = getattr(importlib.import_module(package), name)
+@functools.cache
+def _top_level_names(module: str) -> frozenset[str]:
+    """The names ``module``'s source binds at its top level (def, class or assignment)."""
+    names = set()
+    for node in ast.parse(public_modules()[module][0].read_text(encoding="utf-8")).body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(node, ast.AnnAssign) else []
+        names.update(n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name))
+    return frozenset(names)
+
+
+def home(module: str, name: str, modules: dict) -> str | None:
+    """The one public leaf module whose page renders ``module.name``: the leaf that defines the
+    object (its ``__module__``, or for a constant the leaf whose source assigns it) when it
+    exports it, else the first leaf exporting the same object, the module's own submodules
+    first; None when no other leaf exports it (``module`` renders it itself)."""
+    obj = getattr(importlib.import_module(module), name)
     leaves = [m for m in modules if not modules[m][1]]
-    first = getattr(obj, "__module__", None)
-    ordered = ([first] if first in leaves else []) + [m for m in leaves if m.startswith(package + ".")] + leaves
-    for m in ordered:
-        if name in _all_names(m) and getattr(importlib.import_module(m), name) is obj:
-            return m
-    return None
+    exports = [m for m in leaves if name in _all_names(m) and getattr(importlib.import_module(m), name) is obj]
+    defined = getattr(obj, "__module__", None)
+    ordered = ([defined] + [m for m in exports if name in _top_level_names(m)] + [m for m in exports if m.startswith(module + ".")]
+               + exports)
+    return next((m for m in ordered if m in exports), None)
+
+
+def rendered(module: str, modules: dict) -> tuple[list[str], dict[str, str]]:
+    """(names ``module``'s page renders, {name: the module whose page renders it} for the rest of
+    its ``__all__``): every public object is rendered on one page only, and linked from the others."""
+    own, linked = [], {}
+    for name in _all_names(module):
+        where = home(module, name, modules)
+        if where is None or where == module:
+            own.append(name)
+        else:
+            linked[name] = where
+    return own, linked
 
 
 def _page(module: str, modules: dict) -> str:
-    path, is_pkg = modules[module]
-    names = _all_names(module)
-    title = f"# `{module}`\n\n"
-    if not is_pkg:
-        return title + f"::: {module}\n    options:\n      show_root_heading: false\n"
-    # a package: each re-exported name links to the one leaf module that documents it
-    subs = [m for m in modules if m.startswith(module + ".") and m.count(".") == module.count(".") + 1]
-    home, own = {}, []
-    for name in names:
-        where = _home(module, name, modules)
-        if where is None:
-            own.append(name)
-        else:
-            home[name] = where
-    text = title + f"::: {module}\n    options:\n      show_root_heading: false\n"
+    is_pkg = modules[module][1]
+    own, linked = rendered(module, modules)
+    text = f"# `{module}`\n\n::: {module}\n    options:\n      show_root_heading: false\n"
     text += "      members: " + ("[" + ", ".join(own) + "]" if own else "false") + "\n\n"
-    if subs:
+    subs = [m for m in modules if m.startswith(module + ".") and m.count(".") == module.count(".") + 1]
+    if is_pkg and subs:
         text += "## Submodules\n\n" + "".join(f"- [`{m}`]({Path(_page_path(m)).relative_to(Path(_page_path(module)).parent)})\n"
                                                for m in subs) + "\n"
-    if home:
+    if linked:
         text += "## Names exported here\n\nEach is documented in its own module:\n\n"
-        for name, where in home.items():
-            # an empty anchor (autorefs registers it): a reference to the package's name lands here
+        for name, where in linked.items():
+            # an empty anchor (autorefs registers it): a reference to the re-exported name lands here
             text += f"- [](){{#{module}.{name}}}[`{name}`][{where}.{name}] (`{where}`)\n"
     return text
 

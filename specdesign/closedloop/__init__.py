@@ -60,6 +60,7 @@ from .stability import (
                            CERTIFICATE_MAX_SENSITIVITY,
                            DESIGN_MAX_SENSITIVITY,
                            MAX_SENSITIVITY,
+                           MIN_DECAY_RATE,
                            ORIGIN_TOL,
                            UNSTABLE_CONTROLLER_RATE,
                            ClosedLoopUnstableWarning,
@@ -112,6 +113,7 @@ __all__ = [
     "MAX_SENSITIVITY",
     "DESIGN_MAX_SENSITIVITY",
     "CERTIFICATE_MAX_SENSITIVITY",
+    "MIN_DECAY_RATE",
     "PLANT_INPUTS",
     "LOOP_OUTPUTS",
 ]

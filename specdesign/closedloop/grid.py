@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:
     import control
 
-__all__ = ["case_speeds", "lightly_damped", "refine_grid", "system_roots"]
+__all__ = ["CASE_TOLERANCE", "case_speeds", "lightly_damped", "refine_grid", "system_roots"]
 
 #: Plant cases closer than this (m/s) to another one are the same operating point.
 CASE_TOLERANCE = 1e-6

@@ -27,7 +27,8 @@ if TYPE_CHECKING:
 
 __all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_loop_matrices", "turbine_loop_poles",
            "hidden_origin_poles", "unstable_poles", "unstable_message", "trim_weights", "ORIGIN_TOL",
-           "UNSTABLE_CONTROLLER_RATE", "MAX_SENSITIVITY", "DESIGN_MAX_SENSITIVITY", "CERTIFICATE_MAX_SENSITIVITY"]
+           "UNSTABLE_CONTROLLER_RATE", "MAX_SENSITIVITY", "DESIGN_MAX_SENSITIVITY", "CERTIFICATE_MAX_SENSITIVITY",
+           "MIN_DECAY_RATE"]
 
 
 #: Growth rate (1/s) above which a controller's own pole counts as unstable (a controller with
@@ -48,6 +49,10 @@ DESIGN_MAX_SENSITIVITY = 1.9
 #: :data:`DESIGN_MAX_SENSITIVITY`, so that the plant cases and a reduced-order controller fitted
 #: to the certificate keep their margins in the design.
 CERTIFICATE_MAX_SENSITIVITY = 1.8
+#: Least decay rate (1/s) of a designed closed loop, every pole left of −0.02: the QFT designs'
+#: ``min_decay``, the H∞ synthesis' α-shift (:data:`specdesign.hinf.DEFAULT_DECAY_RATE`) and the
+#: multi-model H∞ step's ``decay_rate``; a mode that decays at 0.02 1/s falls by e in 50 s.
+MIN_DECAY_RATE = 0.02
 
 
 class ClosedLoopUnstableWarning(UserWarning):

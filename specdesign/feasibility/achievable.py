@@ -12,7 +12,7 @@ from ..closedloop import MAX_SENSITIVITY, frequency_response, siso_response
 from ..fatigue import TOWER_M
 from ..spectral import trapezoid_weights
 
-__all__ = ["SOLVER_FALLBACK_OPTIONS", "SOLVER_OPTIONS", "YOULA_REAL_POLES", "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "YoulaProblem"]
+__all__ = ["HF_OMEGA", "SOLVER_FALLBACK_OPTIONS", "SOLVER_OPTIONS", "YOULA_REAL_POLES", "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "YoulaProblem"]
 
 
 #: Poles (rad/s) of the Youla basis: real poles spanning the wind band, and lightly damped pairs

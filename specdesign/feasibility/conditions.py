@@ -15,6 +15,7 @@ from ..closedloop import (
     siso_response,
 )
 from ..fatigue import TOWER_M
+from .. import spectral
 from ..spectral import trapezoid_weights
 from .achievable import YoulaProblem
 
@@ -433,7 +434,7 @@ def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8
     >>> bool(f["achievable"][1] >= f["achievable"][0] and (f["bound"] >= f["achievable"]).all())
     True
     """
-    from .. import spec, spectral
+    from .. import spec
 
     g = np.atleast_1d(np.asarray(speed_relax_db, float))
     if g.ndim != 1 or g.size == 0 or not np.all(np.isfinite(g)) or np.any(g < 0):

@@ -58,7 +58,16 @@ from ..closedloop import (
     system_roots,
 )
 from ..fatigue import TOWER_M
-from .target import DENSE_POINTS_PER_WIDTH, CertificateSearch, recertify
+from .target import (
+    DENSE_POINTS_PER_WIDTH,
+    MAX_RELAX_DB,
+    SLACK_DB,
+    SPEED_SLACK_DB,
+    TARGET_REDUCTION,
+    TOLERANCE_DB,
+    CertificateSearch,
+    recertify,
+)
 
 __all__ = ["BELOW_WEIGHT", "ENVELOPES", "ENVELOPE_LOSS_PP", "FIT_OMEGA", "FOLLOW", "FOLLOW_GAIN_DB", "HEADROOM_PP",
            "MAX_ITERATIONS", "MAX_NOTCHES", "PROMISE_MARGIN_PP", "REGULARISATION", "SMOOTHING_DB",
@@ -116,6 +125,46 @@ BELOW_WEIGHT = 10.0
 NOTCH_BAND = (0.01, 5.0)
 #: Least improvement (dB of room) for which one more notch is kept.
 FOLLOW_GAIN_DB = 0.05
+#: L-BFGS-B's stopping tolerances in the promise fit (:func:`_fit`): projected gradient (% of
+#: promise per unit of parameter) and relative change of the cost; tight enough that the fit
+#: runs to convergence (a continuous function of its input), not to :data:`MAX_ITERATIONS`.
+FIT_GTOL, FIT_FTOL = 1e-4, 1e-10
+#: The same for the least-squares fit that follows the envelope (:func:`_follow`: a cost in dB²
+#: with weights summing to 1), also run to convergence.
+FOLLOW_GTOL, FOLLOW_FTOL = 1e-8, 1e-12
+#: L-BFGS-B's memory in both fits (corrections kept; scipy's default is 10): each notch's centre,
+#: depth and damping act together on e(ω), and a longer memory models that coupling.
+LBFGS_MEMORY = 30
+#: Largest uniform gain shift searched, dB: no promise changes beyond ±80 dB of gain (the
+#: bracket search of :func:`_shift_to` and :func:`_settle` stops there).
+SHIFT_CAP_DB = 80.0
+#: Absolute (dB) and relative tolerances of the gain root (brentq): far below any promise's
+#: resolution, so the settled gain is the root to rounding.
+ROOT_XTOL_DB, ROOT_RTOL = 1e-12, 1e-14
+#: Corners of the starting lag and lead, rad/s: the lag returns the DC level to 0 dB by 0.05 rad/s,
+#: below the tower mode's band, and the lead lifts above 1.5 rad/s, above the IEA 15 MW's tower mode
+#: (1.06 rad/s); the notches are seeded between them.
+LAG_OMEGA, LEAD_OMEGA = 0.05, 1.5
+#: Room (dB) the starting lag and lead leave above the certificate's ratio.
+START_MARGIN_DB = 0.5
+#: Bounds of the gain, dB, and of a notch's depth, dB (negative: a bump), in the fits.
+GAIN_BOUNDS_DB, NOTCH_DEPTH_BOUNDS_DB = (-20.0, 20.0), (-20.0, 40.0)
+#: Bounds of a notch's pole damping ratio (-) in the fits, and its start for a notch and for a bump.
+NOTCH_ZETA_BOUNDS, NOTCH_ZETA_START, BUMP_ZETA_START = (0.01, 1.5), 0.3, 0.05
+#: Floor of the fit's ΔD% weight, as a fraction of its peak: where ΔD% is nil the elements still
+#: follow the certificate a little (5 %).
+WEIGHT_FLOOR = 0.05
+#: Points of the dense check of the elements against the certificate (:func:`_dense_ratio`),
+#: before its refinement around the lightly damped roots.
+DENSE_POINTS = 2000
+#: Notch seeds (:func:`_seeds`): a rise of the certificate's ratio is r above SEED_ABOVE_DB, or
+#: SEED_RISE_DB above its minimum over a window SEED_WINDOW wide in ln ω (±5 %: the narrow bump
+#: between two dips beside the tower mode); bumps are ranked by rise·(ΔD% + SEED_SENS_FLOOR·peak),
+#: so one where ΔD% is nil still ranks; two seeds lie at least SEED_SPACING apart in ln ω (2 %).
+SEED_ABOVE_DB, SEED_RISE_DB, SEED_WINDOW, SEED_SENS_FLOOR, SEED_SPACING = 0.1, 3.0, 0.1, 1e-3, 0.02
+#: A bump is seeded this far (dB) above the ratio it follows, and every seed's depth is clipped to
+#: SEED_DEPTH_DB (negative: a bump), inside the fits' :data:`NOTCH_DEPTH_BOUNDS_DB`.
+SEED_BUMP_LIFT_DB, SEED_DEPTH_DB = 0.3, (-15.0, 30.0)
 _DB = 10 / np.log(10)  # 10·log10(x) = _DB·ln(x)
 _ORDERS = (0.0, 0.75, 1.0, 1.5, 2.0, 4.0)  # the moments spectral.SpectralStats holds, in its order
 
@@ -175,7 +224,7 @@ class _Promise:
         mom = psd @ self.a
         if not grad:
             return 100 * (1 - (float(np.real(self._damage(mom)[0])) / self.d0) ** (1 / self.m))
-        h = 1e-30 * np.abs(mom)
+        h = 1e-30 * np.abs(mom)  # complex step: no difference is taken, so a step far below rounding is exact
         d = self._damage(mom[None, :] + self.steps * h)
         d_e = float(d[0].real)
         ratio = (d_e / self.d0) ** (1 / self.m)
@@ -226,7 +275,7 @@ def _fit(promise, grid, r, n_notch, x, bounds):
             return REGULARISATION * float(wk @ e**2) - p, grad
 
         x = minimize(cost, x, jac=True, method="L-BFGS-B", bounds=bounds,
-                     options={"maxiter": MAX_ITERATIONS, "gtol": 1e-4, "ftol": 1e-10, "maxcor": 30}).x
+                     options={"maxiter": MAX_ITERATIONS, "gtol": FIT_GTOL, "ftol": FIT_FTOL, "maxcor": LBFGS_MEMORY}).x
     x[0] = 0.0
     s = _element_db(grid, x, n_notch)[0]
     x[0] = float(np.max(r - s))
@@ -247,7 +296,7 @@ def _follow(grid, r, weight, n_notch, x, bounds):
         return float(k @ (d * d)), (2 * k * d) @ de
 
     return minimize(cost, x, jac=True, method="L-BFGS-B", bounds=bounds,
-                    options={"maxiter": MAX_ITERATIONS, "gtol": 1e-8, "ftol": 1e-12, "maxcor": 30}).x
+                    options={"maxiter": MAX_ITERATIONS, "gtol": FOLLOW_GTOL, "ftol": FOLLOW_FTOL, "maxcor": LBFGS_MEMORY}).x
 
 
 def _shift_to(promise, e, aim):
@@ -257,13 +306,13 @@ def _shift_to(promise, e, aim):
     lo, hi = -1.0, 1.0
     while promise(e + lo, grad=False) < aim:
         lo *= 2
-        if lo < -80:
+        if lo < -SHIFT_CAP_DB:
             return lo
     while promise(e + hi, grad=False) > aim:
         hi *= 2
-        if hi > 80:
+        if hi > SHIFT_CAP_DB:
             return hi
-    return brentq(lambda g: promise(e + g, grad=False) - aim, lo, hi, xtol=1e-12, rtol=1e-14)
+    return brentq(lambda g: promise(e + g, grad=False) - aim, lo, hi, xtol=ROOT_XTOL_DB, rtol=ROOT_RTOL)
 
 
 def _fit_grid(omega):
@@ -288,9 +337,9 @@ def _settle(promise, omega, x, n_notch, lift_db, aim):
         hi = 1.0
         while promise(e + hi, grad=False) > aim:
             hi *= 2
-            if hi > 80:  # bounded as _shift_to's search: 80 dB above any promise's reach
+            if hi > SHIFT_CAP_DB:  # bounded as _shift_to's search: above any promise's reach
                 break
-        dx = brentq(lambda g: promise(e + g, grad=False) - aim, 0.0, hi, xtol=1e-12, rtol=1e-14)
+        dx = brentq(lambda g: promise(e + g, grad=False) - aim, 0.0, hi, xtol=ROOT_XTOL_DB, rtol=ROOT_RTOL)
         x[0] += dx
         p = promise(e + dx, grad=False)
     return x, p
@@ -300,11 +349,12 @@ def _start(grid, r):
     """The gain, lag and lead to start from, and their bounds: the lag returns the DC level to
     0 dB by 0.05 rad/s, the lead lifts above 1.5 rad/s by what the certificate needs there."""
     lo, hi = np.log(grid[0]), np.log(grid[-1])
-    hf, lf = grid > 1.5, grid < 0.05
-    lead_db = float(max(np.max(r[hf]), 0.0) + 0.5) if np.any(hf) else 0.5
-    lag_db = float(max(np.max(r[lf]), 0.0) + 0.5) if np.any(lf) else 0.5
-    x = [lag_db, np.log(0.05), np.log(0.05 * 10 ** (-lag_db / 20)), np.log(1.5), np.log(1.5 * 10 ** (lead_db / 20))]
-    return np.asarray(x, float), [(-20.0, 20.0)] + [(lo, hi)] * 4
+    hf, lf = grid > LEAD_OMEGA, grid < LAG_OMEGA
+    lead_db = float(max(np.max(r[hf]), 0.0) + START_MARGIN_DB) if np.any(hf) else START_MARGIN_DB
+    lag_db = float(max(np.max(r[lf]), 0.0) + START_MARGIN_DB) if np.any(lf) else START_MARGIN_DB
+    x = [lag_db, np.log(LAG_OMEGA), np.log(LAG_OMEGA * 10 ** (-lag_db / 20)), np.log(LEAD_OMEGA),
+         np.log(LEAD_OMEGA * 10 ** (lead_db / 20))]
+    return np.asarray(x, float), [GAIN_BOUNDS_DB] + [(lo, hi)] * 4
 
 
 def _dense_ratio(cert, base):
@@ -312,7 +362,7 @@ def _dense_ratio(cert, base):
     the lightly damped roots of both maps: the final check of the elements (between the fit's
     grid points a narrow dip of the certificate's ratio could rise above them)."""
     roots = np.concatenate([system_roots(cert.tower.baseline), system_roots(base.system)])
-    w = refine_grid(np.geomspace(base.omega[0], base.omega[-1], 2000), lightly_damped(roots),
+    w = refine_grid(np.geomspace(base.omega[0], base.omega[-1], DENSE_POINTS), lightly_damped(roots),
                     points_per_width=DENSE_POINTS_PER_WIDTH)
     return w, 20 * np.log10(np.abs(cert.tower.response(w)) / np.abs(siso_response(base.system, w)))
 
@@ -325,18 +375,19 @@ def _seeds(base, grid, r):
     from scipy.ndimage import minimum_filter1d
 
     sens = np.interp(grid, base.omega, base.sensitivity)
-    band = (grid > 0.05) & (grid < 1.5)
-    rise = r - minimum_filter1d(r, size=max(3, round(0.1 / np.log(grid[1] / grid[0]))), mode="nearest")
+    band = (grid > LAG_OMEGA) & (grid < LEAD_OMEGA)
+    rise = r - minimum_filter1d(r, size=max(3, round(SEED_WINDOW / np.log(grid[1] / grid[0]))), mode="nearest")
 
     def peaks(s):
         k = [i for i in range(1, len(grid) - 1) if s[i] > 0 and s[i] >= s[i - 1] and s[i] >= s[i + 1]]
         return sorted(k, key=lambda i: -s[i])
 
     out = []
-    bumps = np.where(band & ((r > 0.1) | (rise > 3.0)), (np.maximum(r, 0.0) + rise) * (sens + sens.max() * 1e-3), 0.0)
+    bumps = np.where(band & ((r > SEED_ABOVE_DB) | (rise > SEED_RISE_DB)),
+                     (np.maximum(r, 0.0) + rise) * (sens + sens.max() * SEED_SENS_FLOOR), 0.0)
     for k in peaks(bumps) + peaks(sens * np.maximum(-r, 0.0)):
-        if all(abs(np.log(grid[k] / w)) > 0.02 for w, _ in out):
-            out.append((float(grid[k]), float(np.clip(-r[k] - (0.3 if r[k] > 0 else 0.0), -15.0, 30.0))))
+        if all(abs(np.log(grid[k] / w)) > SEED_SPACING for w, _ in out):
+            out.append((float(grid[k]), float(np.clip(-r[k] - (SEED_BUMP_LIFT_DB if r[k] > 0 else 0.0), *SEED_DEPTH_DB))))
     return out
 
 
@@ -367,7 +418,7 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
     # elements that dip into the certificate's narrow dips would ask the cases for what they cannot give
     r = maximum_filter1d(r, size=max(1, round(2 * envelope / np.log(w[1] / w[0]))), mode="nearest")
     sens = np.maximum(base.sensitivity, 0.0)
-    weight = (sens + 0.05 * sens.max()) * np.gradient(np.log(w))
+    weight = (sens + WEIGHT_FLOOR * sens.max()) * np.gradient(np.log(w))
     weight = weight / weight.sum()
     seeds = _seeds(base, w, r)
     x, bounds = _start(w, r)
@@ -377,8 +428,8 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
     for n in range(min(int(max_notches), len(seeds)) + 1):  # the fewest notches that follow it
         if n:  # warm start: the n − 1 solution and the next seed
             wn, depth = seeds[n - 1]
-            x = np.r_[x, np.log(wn), depth, np.log(0.3 if depth > 0 else 0.05)]
-            bounds = bounds + [(lo, hi), (-20.0, 40.0), (np.log(0.01), np.log(1.5))]
+            x = np.r_[x, np.log(wn), depth, np.log(NOTCH_ZETA_START if depth > 0 else BUMP_ZETA_START)]
+            bounds = bounds + [(lo, hi), NOTCH_DEPTH_BOUNDS_DB, (np.log(NOTCH_ZETA_BOUNDS[0]), np.log(NOTCH_ZETA_BOUNDS[1]))]
         x = _follow(w, r, weight, n, x, bounds)
         delta = _shift_to(promise, _element_db(w, x, n)[0], aim)
         if best is None or delta > best[0] + FOLLOW_GAIN_DB:
@@ -395,8 +446,56 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
     return replace(ts, promise=spec.promise_of(tower, base), target_reduction=t)
 
 
+def _fit_above(model, cert, base, promise, grid, t0, t, aim, max_notches, headroom_pp, tried):
+    """The fallback at one headroom: elements fitted above the upper envelope of ``cert``'s
+    ratio to ROSCO's map (the widest envelope of :data:`ENVELOPES` first, the fewest notches
+    that promise ``aim``), settled and recertified through ``cert``. Returns (the
+    TargetSpecification, None), or (None, the last recertification error or None) when none
+    certifies; appends what each envelope promised to ``tried``."""
+    from scipy.ndimage import maximum_filter1d
+
+    from .. import spec
+    h, why = headroom_pp, None
+    ratio = 20 * np.log10(np.abs(cert.tower.response(grid)) / t0)
+    dense = None
+    for env in ENVELOPES:  # the widest envelope first: the fewest, widest elements
+        r = maximum_filter1d(ratio, size=max(1, round(2 * env / np.log(grid[1] / grid[0]))), mode="nearest")
+        reach = promise(np.interp(base.omega, grid, r), grad=False)
+        tried.append(f"{h:g} pp, ±{100 * env:g} %: envelope {reach:.1f} %")
+        if reach < aim + ENVELOPE_LOSS_PP:  # elements above r promise at most what r does
+            continue
+        seeds = _seeds(base, grid, r)
+        x, bounds = _start(grid, r)
+        fits = []
+        lo, hi = max(bounds[1][0], np.log(NOTCH_BAND[0])), min(bounds[1][1], np.log(NOTCH_BAND[1]))
+        for n in range(min(int(max_notches), len(seeds)) + 1):  # the fewest notches that do
+            if n:  # warm start: the n − 1 solution and the next seed
+                wn, depth = seeds[n - 1]
+                x = np.r_[x, np.log(wn), depth, np.log(NOTCH_ZETA_START if depth > 0 else BUMP_ZETA_START)]
+                bounds = bounds + [(lo, hi), NOTCH_DEPTH_BOUNDS_DB, (np.log(NOTCH_ZETA_BOUNDS[0]), np.log(NOTCH_ZETA_BOUNDS[1]))]
+            x, best = _fit(promise, grid, r, n, x, bounds)
+            fits.append(best)
+            if best < aim:
+                continue
+            if dense is None:
+                dense = _dense_ratio(cert, base)
+            lift = max(0.0, float(np.max(dense[1] - _element_db(dense[0], x, n)[0])))
+            xs, got = _settle(promise, base.omega, x, n, lift, aim)
+            if got < t:
+                continue
+            tower = spec.Specification(base.system, _unpack(xs, n), name="W_tower_base_my")
+            try:
+                ts = recertify(model, cert, tower=tower)
+                # the promise on the fit's grid, which sees the elements' cost beyond the certificate's grid
+                return replace(ts, promise=spec.promise_of(tower, base), target_reduction=t), None
+            except ValueError as e:  # between grid points: said, and the next structure tried
+                why = str(e)
+        tried[-1] += f", elements up to {max(fits):.1f} %"
+    return None, why
+
+
 @on_one_blas_thread  # L-BFGS-B's small BLAS calls: 10× faster on one thread (specdesign._blas)
-def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_pp=HEADROOM_PP,
+def element_specification(model, wind_speed, target_reduction=TARGET_REDUCTION, *, headroom_pp=HEADROOM_PP,
                           max_notches=MAX_NOTCHES, m=TOWER_M, omega=None, **target_options):
     """A certified tower specification for ``target_reduction``, as ROSCO's map times shaping elements.
 
@@ -454,8 +553,6 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
     >>> [type(e).__name__ for e in ts.tower.elements]        # doctest: +SKIP
     ['Gain', 'LeadLag', 'LeadLag', 'Notch', 'Notch']
     """
-    from scipy.ndimage import maximum_filter1d
-
     from .. import spec
     t = del_target(target_reduction)
     heads = np.atleast_1d(np.asarray(headroom_pp, float))
@@ -465,9 +562,9 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
         raise ValueError(f"max_notches={max_notches!r} must be a whole number ≥ 0")
     # the certificate's options checked here, before the baseline and the search are built (a
     # tolerance ≤ 0 would otherwise only stop the first bisection, forever)
-    margin_db(target_options.get("slack_db", 0.5), "slack_db")
-    margin_db(target_options.get("speed_slack_db", 0.2), "speed_slack_db")
-    search_options(target_options.get("tolerance_db", 0.05), target_options.get("max_relax_db", 12.0),
+    margin_db(target_options.get("slack_db", SLACK_DB), "slack_db")
+    margin_db(target_options.get("speed_slack_db", SPEED_SLACK_DB), "speed_slack_db")
+    search_options(target_options.get("tolerance_db", TOLERANCE_DB), target_options.get("max_relax_db", MAX_RELAX_DB),
                    target_options.get("speed_relax_db"))
     v = model.check_wind_speed(wind_speed)
     base = spec.baseline_analysis(model, v, m=m, omega=FIT_OMEGA if omega is None else omega)
@@ -505,41 +602,10 @@ def element_specification(model, wind_speed, target_reduction=25.0, *, headroom_
         if p is not None:  # design_qft would refuse the design reduced from it: the next headroom
             tried.append(f"{h:g} pp: the certificate's controller is unstable (pole {p.real:.4f}{p.imag:+.4f}j 1/s)")
             continue
-        ratio = 20 * np.log10(np.abs(cert.tower.response(grid)) / t0)
-        dense = None
-        for env in ENVELOPES:  # the widest envelope first: the fewest, widest elements
-            r = maximum_filter1d(ratio, size=max(1, round(2 * env / np.log(grid[1] / grid[0]))), mode="nearest")
-            reach = promise(np.interp(base.omega, grid, r), grad=False)
-            tried.append(f"{h:g} pp, ±{100 * env:g} %: envelope {reach:.1f} %")
-            if reach < aim + ENVELOPE_LOSS_PP:  # elements above r promise at most what r does
-                continue
-            seeds = _seeds(base, grid, r)
-            x, bounds = _start(grid, r)
-            fits = []
-            lo, hi = max(bounds[1][0], np.log(NOTCH_BAND[0])), min(bounds[1][1], np.log(NOTCH_BAND[1]))
-            for n in range(min(int(max_notches), len(seeds)) + 1):  # the fewest notches that do
-                if n:  # warm start: the n − 1 solution and the next seed
-                    wn, depth = seeds[n - 1]
-                    x = np.r_[x, np.log(wn), depth, np.log(0.3 if depth > 0 else 0.05)]
-                    bounds = bounds + [(lo, hi), (-20.0, 40.0), (np.log(0.01), np.log(1.5))]
-                x, best = _fit(promise, grid, r, n, x, bounds)
-                fits.append(best)
-                if best < aim:
-                    continue
-                if dense is None:
-                    dense = _dense_ratio(cert, base)
-                lift = max(0.0, float(np.max(dense[1] - _element_db(dense[0], x, n)[0])))
-                xs, got = _settle(promise, base.omega, x, n, lift, aim)
-                if got < t:
-                    continue
-                tower = spec.Specification(base.system, _unpack(xs, n), name="W_tower_base_my")
-                try:
-                    ts = recertify(model, cert, tower=tower)
-                    # the promise on the fit's grid, which sees the elements' cost beyond the certificate's grid
-                    return replace(ts, promise=spec.promise_of(tower, base), target_reduction=t)
-                except ValueError as e:  # between grid points: said, and the next structure tried
-                    why = str(e)
-            tried[-1] += f", elements up to {max(fits):.1f} %"
+        ts, failed = _fit_above(model, cert, base, promise, grid, t0, t, aim, max_notches, h, tried)
+        if ts is not None:
+            return ts
+        why = failed if failed is not None else why
     raise ValueError(f"no element specification above a certified one promises {t:g} % at {v:g} m/s with up to "
                      f"{max_notches} notches (headroom, envelope half-width: promise "
                      f"{'; '.join(tried) if tried else 'none tried'}; an envelope must promise ≥ target + "

@@ -23,8 +23,8 @@ from ..closedloop import (
 from ..fatigue import TOWER_M
 from .achievable import AchievablePitch, YoulaProblem
 
-__all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
-           "SEARCH_MARGIN_PP", "UNSTABLE_POLE_TOL", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
+__all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "MAX_RELAX_DB",
+           "RELAX_LADDER_DB", "SEARCH_MARGIN_PP", "SLACK_DB", "SPEED_SLACK_DB", "TARGET_REDUCTION", "TOLERANCE_DB", "UNSTABLE_POLE_TOL", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
 
 
 #: Wind-speed offsets (m/s) of the plant cases a target specification is certified on: the
@@ -56,6 +56,19 @@ UNSTABLE_POLE_TOL = 1e-6
 #: (~1e-6 pp, the solver's path), so no decision of the search rests on the last digits of a
 #: promise, and the pair returned promises at least the target plus this margin.
 SEARCH_MARGIN_PP = 0.01
+#: Tower-base DEL reduction (%) the specification-driven designs aim at by default
+#: (specification_for_target, design_qft, design_hinf, the demo).
+TARGET_REDUCTION = 25.0
+#: The designer's room above the certificate's |T_{MyT,w}| in W_MyT, dB, by default: room for a
+#: design of lower order than the certificate to meet the pair (the searches' shared default).
+SLACK_DB = 0.5
+#: Room left above the certificate's speed maps in W_Ω, dB, by default (the searches' shared default).
+SPEED_SLACK_DB = 0.2
+#: Largest speed relaxation the searches try, dB: the last rung after :data:`RELAX_LADDER_DB`
+#: (whose top, 8 dB, is also QFT's largest, :data:`specdesign.qft.SPEED_RELAX_DB`).
+MAX_RELAX_DB = 12.0
+#: Bisection tolerance of the searches on the relaxation and on the slack, dB.
+TOLERANCE_DB = 0.05
 
 
 @dataclass(frozen=True)
@@ -133,9 +146,10 @@ class TargetSpecification:
 
 
 @on_one_blas_thread
-def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
-                             max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
-                             m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
+def specification_for_target(model, wind_speed, target_reduction=TARGET_REDUCTION, *, slack_db=SLACK_DB, speed_relax_db=None,
+                             max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0,
+                             max_relax_db=MAX_RELAX_DB, tolerance_db=TOLERANCE_DB,
+                             m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=SPEED_SLACK_DB,
                              dense_omega=None) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
@@ -302,8 +316,8 @@ class CertificateSearch:
         return d, _slack_promise(d, self.base, slack + rob[0]), rob
 
     @on_one_blas_thread
-    def for_target(self, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None, max_relax_db=12.0,
-                   tolerance_db=0.05, speed_slack_db=0.2) -> TargetSpecification:
+    def for_target(self, target_reduction=TARGET_REDUCTION, *, slack_db=SLACK_DB, speed_relax_db=None, max_relax_db=MAX_RELAX_DB,
+                   tolerance_db=TOLERANCE_DB, speed_slack_db=SPEED_SLACK_DB) -> TargetSpecification:
         """The feasible specification pair for ``target_reduction`` (see :func:`specification_for_target`).
 
         Parameters
@@ -374,7 +388,7 @@ class CertificateSearch:
                                                       self.m), self.dense)
 
     def for_tower(self, tower, target_reduction, *, relax_ladder_db=(0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0),
-                  max_relax_db=12.0, speed_slack_db=0.2, margin_steps=4) -> TargetSpecification:
+                  max_relax_db=MAX_RELAX_DB, speed_slack_db=SPEED_SLACK_DB, margin_steps=4) -> TargetSpecification:
         """The certified pair with a given tower specification: the least speed relaxation on a ladder.
 
         At each relaxation g the Youla design is made to meet ``tower`` at the nominal plant on

@@ -35,6 +35,7 @@ from scipy import linalg, optimize
 from .._blas import one_blas_thread
 from ..closedloop import (
     DESIGN_MAX_SENSITIVITY,
+    MIN_DECAY_RATE,
     closed_map,
     lightly_damped,
     plant_responses,
@@ -322,7 +323,7 @@ class _Objective:
         return float(top + _SMOOTH_DB * np.log(total)) + f, _DB * (w @ jac).real + g
 
 
-def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float = 0.15, decay_rate: float = 0.02,
+def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float = 0.15, decay_rate: float = MIN_DECAY_RATE,
                     max_sensitivity: float = DESIGN_MAX_SENSITIVITY, margins_db: tuple = CONTINUATION_DB, omega: ArrayLike | None = None,
                     max_iterations: int = 5000) -> tuple[ct.StateSpace, CaseCheck]:
     """The multi-model H∞ step: adjust a pitch controller until it meets a certified pair at every case.
@@ -390,10 +391,10 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
     Examples
     --------
     >>> from specdesign import feasibility, turbine
-    >>> from specdesign.hinf import design_hinf, refine_on_cases
+    >>> from specdesign.hinf import design_hinf, refine_on_cases, spec_from_certified
     >>> model = turbine.iea15mw()
     >>> ts = feasibility.specification_for_target(model, 19.0, 25.0)  # doctest: +SKIP
-    >>> start = -design_hinf(model, 19.0, spec=ts).reduction.controller  # the Riccati controller  # doctest: +SKIP
+    >>> start = -design_hinf(model, 19.0, spec=spec_from_certified(ts)).reduction.controller  # the Riccati controller  # doctest: +SKIP
     >>> c, chk = refine_on_cases(model, ts, start)  # doctest: +SKIP
     >>> chk.met  # doctest: +SKIP
     True

@@ -20,15 +20,17 @@ from numpy.typing import ArrayLike
 from loopshaping import check, qft
 from loopshaping import hinf as lhinf
 
+from .. import closedloop, spectral, wind
+from .. import spec as sp
 from .._blas import one_blas_thread
 from .._checks import finite_system, spec_made_at
-from ..closedloop import closed_loop_mimo, refine_grid
+from ..closedloop import MIN_DECAY_RATE, closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
 from ..fatigue import TOWER_M
-from ..feasibility import TargetSpecification, specification_for_target
-from ..qft.design import SPEED_RELAX_DB
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
+from ..feasibility.target import TARGET_REDUCTION
+from .specs import HinfSpecification, spec_for_target
 from .weights import DEFAULT_MIN_DAMPING, siso_weight
 
 if TYPE_CHECKING:
@@ -38,10 +40,11 @@ if TYPE_CHECKING:
     from ..spec import Specification
     from ..turbine import TurbineModel
 
-__all__ = ['HinfDesign', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf', 'qft_specifications']
+__all__ = ['HinfDesign', 'DEFAULT_DECAY_RATE', 'TOWER_BAND', 'design_hinf']
 
-#: α (1/s) of the α-shifted synthesis in :func:`design_hinf`.
-DEFAULT_DECAY_RATE = 0.02
+#: α (1/s) of the α-shifted synthesis in :func:`design_hinf`: the least decay rate of a designed
+#: loop, :data:`specdesign.closedloop.MIN_DECAY_RATE`.
+DEFAULT_DECAY_RATE = MIN_DECAY_RATE
 #: Half-width of the tower-mode band (relative) over which ``tower_excess_db`` is the maximum.
 TOWER_BAND = 0.1
 
@@ -76,7 +79,7 @@ class HinfDesign:
         The generator-speed specification W_Ω used as the weight, rad/s per m/s.
     promised_del_reduction : float
         The tower specification's exact (Dirlik) promise, % (a TargetSpecification's own
-        ``promise``: with the default ``spec="target"`` the promise of the pair met).
+        ``promise``: by default, without ``spec``, the promise of the pair met).
     predicted_del_reduction : float
         Dirlik on the reduced controller's closed loop vs ROSCO's, tower-base DEL, %.
     speed_excess_db : float
@@ -113,9 +116,10 @@ class HinfDesign:
     tower_band_excess_db : float
         Maximum of the tower excess over ``tower_mode``·(1 ± :data:`TOWER_BAND`), dB.
     specs : str
-        Which specifications were the weights: "target" (the certified pair of
+        Which specifications were the weights, the ``kind`` of the
+        :class:`~specdesign.hinf.HinfSpecification`: "target" (the certified pair of
         ``target_reduction``, the default), "given" (a pair or TargetSpecification handed
-        over), "qft", "qft_design", "rosco" or "custom".
+        over), "qft", "qft_design" or "rosco" ("custom", the field's default, for a record built directly).
     speed_relax_db : float
         The relaxation of ROSCO's T_{Ω,w} in the speed spec, dB (nan for custom specs).
     notch_spec : specdesign.spec.Specification or control.LTI
@@ -211,98 +215,15 @@ def _tower_mode(plant):
     return float(np.abs(p[np.argmin(zeta)]))
 
 
-def _is_design(obj) -> bool:
-    """A design record carrying the specifications it met (e.g. :class:`specdesign.qft.QFTDesign`)."""
-    return all(hasattr(obj, k) for k in ("tower_spec", "speed_spec", "shaping", "options"))
-
-
-def qft_specifications(model: TurbineModel, wind_speed: float, *, speed_relax_db: float = 4.5,
-                       spec_reduction: float = 15.0, tower_relax_db: float = 6.0, tower_relax_omega: float = 1.3,
-                       keep_below: float = 0.6, m: float = TOWER_M,
-                       omega: ArrayLike | None = None) -> tuple[Specification, Specification, Specification]:
-    """The specifications :func:`specdesign.qft.design_qft` designs against, built the same way.
-
-    Tower load: W_MyT = T^ROSCO_{MyT,w} × the notches of :func:`specdesign.spec.shape_to_target`
-    (``spec_reduction`` % damage, notches above ``keep_below`` rad/s) × two leads
-    (1 + s/ω_r)/(1 + s/(ω_r·10^(tower_relax_db/40))), ω_r = ``tower_relax_omega`` (rad/s): the
-    spec is relaxed by ``tower_relax_db`` at high frequency, where ΔD% is negligible (the
-    leads already lift it by ≈ 1.9 dB at the tower mode, 1.06 rad/s, with the defaults).
-    Generator speed: W_Ω = T^ROSCO_{Ω,w}·10^(speed_relax_db/20), ROSCO's dip at the tower
-    mode (a ζ = 0.01 zero pair) kept. Built by :func:`specdesign.spec.design_specifications`.
-
-    Parameters
-    ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine.
-    wind_speed : float
-        Operating point, m/s.
-    speed_relax_db : float
-        Relaxation of the generator-speed specification, dB (≥ 0).
-    spec_reduction : float
-        Damage reduction the notches promise, %.
-    tower_relax_db : float
-        High-frequency relaxation of the tower specification, dB (≥ 0; 0 for none).
-    tower_relax_omega : float
-        Corner ω_r of the relaxation, rad/s.
-    keep_below : float
-        No notch below this frequency, rad/s.
-    m : float
-        Wöhler exponent of the tower-base S-N curve (-).
-    omega : array_like, optional
-        Frequency grid of the baseline analysis, rad/s (default
-        :func:`specdesign.spec.default_omega`).
-
-    Returns
-    -------
-    tower_spec : specdesign.spec.Specification
-        W_MyT, N·m per m/s: the notch spec × the relaxation.
-    speed_spec : specdesign.spec.Specification
-        W_Ω, rad/s per m/s.
-    notch_spec : specdesign.spec.Specification
-        The unrelaxed notch spec whose promise :func:`specdesign.spec.shape_to_target` reports.
-
-    Raises
-    ------
-    ValueError
-        If no notch specification reaches ``spec_reduction`` at this wind speed, a relaxation
-        is negative or not finite, ``tower_relax_omega`` is not positive, or ``wind_speed`` is
-        outside ``model.wind_range``.
-
-    Examples
-    --------
-    >>> from specdesign import turbine
-    >>> from specdesign.hinf import qft_specifications
-    >>> tower, speed, notch = qft_specifications(turbine.iea15mw(), 19.0)  # doctest: +SKIP
-    >>> speed.elements  # doctest: +SKIP
-    (Gain(gain_db=4.5),)
-    """
-    from .. import spec
-
-    d = spec.design_specifications(model, wind_speed, speed_relax_db=speed_relax_db, spec_reduction=spec_reduction,
-                                   tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
-                                   keep_below=keep_below, m=m, omega=omega)
-    if not d.shaping.success:
-        raise ValueError(f"no tower specification at {float(wind_speed):g} m/s: {d.shaping.message}")
-    return d.tower, d.speed, d.shaping.specification
-
-
-
-
 def design_hinf(
     model: TurbineModel,
     wind_speed: float,
-    target_reduction: float = 25.0,
+    target_reduction: float = TARGET_REDUCTION,
     *,
-    spec: str | Any = "target",
-    spec_reduction: float = 15.0,
+    spec: HinfSpecification | None = None,
     measurements: Sequence[str] | None = None,
     order: int = 8,
-    w_tower: Specification | ct.LTI | None = None,
-    w_speed: Specification | ct.LTI | None = None,
     w_pitch: ct.LTI | float | None = None,
-    speed_relax_db: float | Sequence[float] = SPEED_RELAX_DB,
-    tower_relax_db: float = 6.0,
-    tower_relax_omega: float = 1.3,
     m: float = TOWER_M,
     omega: ArrayLike | None = None,
     suboptimality: float = 0.05,
@@ -328,50 +249,31 @@ def design_hinf(
         Operating point, m/s, above rated.
     target_reduction : float
         Tower-base DEL reduction (1 Hz, m = ``m``) vs ROSCO, % (0-100), as in
-        :func:`specdesign.qft.design_qft`: with ``spec="target"`` the promise of the
-        specification that is made and met. Not used with another ``spec``.
-    spec : "target", "qft", "rosco", specdesign.qft.QFTDesign, TargetSpecification or (W_MyT, W_Ω)
-        Which specifications are the weights (``w_tower``/``w_speed``, when given, override).
-        ``"target"`` (default, as :func:`specdesign.qft.design_qft`): the feasible pair
-        ``specdesign.feasibility.specification_for_target(model, wind_speed, target_reduction)``,
-        certified over plant cases around ``wind_speed``, then as for a TargetSpecification
-        (label ``"target"``). A :class:`specdesign.feasibility.TargetSpecification` or a pair
-        (W_MyT, W_Ω): those specifications as given (label ``"given"``; the design is assessed
-        against them). A TargetSpecification with pitch only (the default measurement then)
-        adds the multi-model H∞ step :func:`specdesign.hinf.refine_on_cases`: the reduced
-        controller is adjusted until the pair holds at every plant case it was certified on,
-        checked by :func:`specdesign.hinf.check_pair` (``case_check``; 5-15 s per speed).
-        ``"qft"``: those of ``specdesign.qft.design_qft(spec="notch")``
-        (:func:`qft_specifications`): the notch spec relaxed by ``tower_relax_db`` above
-        ≈ ``tower_relax_omega`` and ROSCO's T_{Ω,w} relaxed by ``speed_relax_db``; given a
-        sequence (default :data:`specdesign.qft.SPEED_RELAX_DB`, QFT's ladder) the relaxations are tried
-        in turn and the smallest whose reduced design meets both specs on the refined grid
-        (speed everywhere, tower over the tower-mode band) is kept, as QFT does (this
-        function's default before the certified pair).
-        A ``QFTDesign``: its own ``tower_spec`` and ``speed_spec``, for a comparison on
-        exactly the specs that design met. ``"rosco"``: the unrelaxed notch spec and ROSCO's
-        T_{Ω,w} (its ζ = 0.01 dip at the tower mode is a spec no well-damped loop can follow,
-        docs/hinf.md).
-    spec_reduction : float
-        % of tower-base damage the automatic notch specification
-        (:func:`specdesign.spec.shape_to_target`) must promise with ``spec="qft"`` or
-        ``"rosco"`` (the name :func:`specdesign.qft.design_qft` uses).
+        :func:`specdesign.qft.design_qft`: without ``spec``, the promise of the specification
+        that is made and met. Not used with a ``spec``.
+    spec : HinfSpecification, optional
+        The specifications that are the weights and that the design is assessed against.
+        Default: ``spec_for_target(model, wind_speed, target_reduction, m=m)``, the feasible
+        pair of the DEL target certified over plant cases around ``wind_speed`` (as
+        :func:`specdesign.qft.design_qft` does). Made from other sources by
+        :func:`spec_from_certified` (a TargetSpecification made beforehand),
+        :func:`spec_from_pair` (W_MyT, W_Ω), :func:`spec_from_qft` (exactly the specs a QFT
+        design met), :func:`spec_like_qft` (QFT's notch specs, a ladder of speed relaxations
+        tried in turn, the smallest whose reduced design meets both specs on the refined grid
+        kept) or :func:`spec_from_rosco` (the unrelaxed notch spec and ROSCO's T_{Ω,w}, whose
+        ζ = 0.01 dip at the tower mode no well-damped loop can follow, docs/hinf.md). A
+        certified pair with pitch only (the default measurement then) adds the multi-model H∞
+        step :func:`specdesign.hinf.refine_on_cases`: the reduced controller is adjusted until
+        the pair holds at every plant case it was certified on, checked by
+        :func:`specdesign.hinf.check_pair` (``case_check``; 5-15 s per speed).
     measurements : tuple of str, optional
         ``("gen_speed", "tower_top_vel")`` (1×2 controller, pitch + active tower damping) or
         ``("gen_speed",)`` (pitch only). Default: pitch only for a certified pair (its
         certificate's actuator), pitch + ATD otherwise.
     order : int
         States of the reduced controller.
-    w_tower, w_speed : Specification or SISO LTI, optional
-        Explicit specifications (override ``spec``).
     w_pitch : optional
         Pitch-activity weight, see :func:`generalized_plant`.
-    speed_relax_db : float or sequence of float
-        Relaxation(s) of ROSCO's T_{Ω,w} in the speed spec, dB (≥ 0); see ``spec="qft"``.
-    tower_relax_db : float
-        High-frequency relaxation of the tower spec, dB; see ``spec="qft"``.
-    tower_relax_omega : float
-        Corner of that relaxation, rad/s; see ``spec="qft"``.
     m : float
         Wöhler exponent of the tower-base DEL (S-N curve on ranges).
     omega : array, optional
@@ -404,27 +306,26 @@ def design_hinf(
     Returns
     -------
     HinfDesign
-        The reduced design and its assessment; with a ladder of ``speed_relax_db`` the
-        smallest relaxation met (else the last one, said in ``notes``).
+        The reduced design and its assessment; with a ladder of relaxations the smallest one
+        met (else the last one, said in ``notes``).
 
     Raises
     ------
+    TypeError
+        If ``spec`` is not a :class:`HinfSpecification` (the message names the function that
+        makes one), a weight is not an LTI system or a number, or ``plant_options`` has an
+        unknown key.
     ValueError
-        If ``spec`` is not "target", "qft", "rosco", a design record or a pair, or both
-        ``spec`` and ``specs`` are given; ``spec`` is a record made at another wind speed
-        (a TargetSpecification, a QFTDesign, DesignSpecifications: the same check as
-        :func:`specdesign.qft.design_qft`'s); the plant at ``wind_speed`` has a NaN or inf entry; ``target_reduction`` is not in (0, 100) % with
-        ``spec="target"``; ``speed_relax_db`` is not a
-        relaxation ≥ 0 dB or a sequence of them; no notch specification reaches
-        ``spec_reduction``; ``wind_speed`` is outside ``model.wind_range``; or a weight,
-        the generalized plant, the synthesis or the reduction rejects its arguments
-        (:func:`inverse_weight`, :func:`generalized_plant`, :func:`loopshaping.hinf.synthesize`,
-        :func:`loopshaping.hinf.reduce`); an ill-posed synthesis names the wind speed.
+        If ``spec`` was made at another wind speed (the same check as
+        :func:`specdesign.qft.design_qft`'s); the plant at ``wind_speed`` has a NaN or inf
+        entry; ``target_reduction`` is not in (0, 100) % without ``spec``; ``wind_speed`` is
+        outside ``model.wind_range``; or a weight, the generalized plant, the synthesis or the
+        reduction rejects its arguments (:func:`inverse_weight`, :func:`generalized_plant`,
+        :func:`loopshaping.hinf.synthesize`, :func:`loopshaping.hinf.reduce`); an ill-posed
+        synthesis names the wind speed.
     RuntimeError
         If the reduced controller of the last relaxation tried does not stabilise the
         turbine (raise ``order``).
-    TypeError
-        If a weight is not an LTI system or a number, or ``plant_options`` has an unknown key.
 
     Warns
     -----
@@ -432,7 +333,7 @@ def design_hinf(
         When a reduced controller does not stabilise the turbine (before the RuntimeError, or
         before the next relaxation is tried).
     RuntimeWarning
-        With a TargetSpecification and pitch only: when the multi-model step leaves the pair
+        With a certified pair and pitch only: when the multi-model step leaves the pair
         missed at a plant case ("infeasible ... because": by how much, where, at which case;
         also in ``notes``). With a pair or with pitch + ATD (no multi-model step): when the
         reduced design does not meet it on the nominal plant's refined grid. The synthesis
@@ -442,91 +343,38 @@ def design_hinf(
     Examples
     --------
     >>> from specdesign import turbine
-    >>> from specdesign.hinf import design_hinf
-    >>> d = design_hinf(turbine.iea15mw(), 19.0)  # the certified pair for 25 %  # doctest: +SKIP
+    >>> from specdesign.hinf import design_hinf, spec_like_qft
+    >>> model = turbine.iea15mw()
+    >>> d = design_hinf(model, 19.0)  # the certified pair for 25 %  # doctest: +SKIP
     >>> d.specs, d.case_check.met, d.predicted_del_reduction >= d.promised_del_reduction  # doctest: +SKIP
     ('target', True, True)
-    >>> q = design_hinf(turbine.iea15mw(), 19.0, spec="qft")  # QFT's notch specs, pitch + ATD  # doctest: +SKIP
+    >>> q = design_hinf(model, 19.0, spec=spec_like_qft(model, 19.0))  # QFT's notch specs, pitch + ATD  # doctest: +SKIP
     >>> q.speed_excess_db <= 0 and q.tower_band_excess_db <= 0  # doctest: +SKIP
     True
     """
-    from .. import spec as sp
-    specs, made = spec, False
     v = model.check_wind_speed(wind_speed)
     # a NaN plant: said here, naming the wind speed, before the specification search, the
     # baseline analysis or SLICOT meet it ("SVD did not converge")
     finite_system(model.linearize(v), f"the plant linearised at {v:g} m/s")
-    if not isinstance(specs, str):
-        spec_made_at(specs, v)  # the same check as design_qft's: a record's promise holds at its own speed only
-    if isinstance(specs, str) and specs == "target":
-        made = w_tower is None or w_speed is None
-        try:
-            reduction = float(target_reduction)
-        except (TypeError, ValueError):
-            reduction = float("nan")
-        if not 0 < reduction < 100:
-            raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % (0-100)")
-        # design_qft's default: the feasible (certified) pair for the DEL target, then meet it
-        specs = "custom" if w_tower is not None and w_speed is not None else specification_for_target(
-            model, v, reduction, m=m)
-    target = specs if isinstance(specs, TargetSpecification) and w_tower is None and w_speed is None else None
+    if spec is None:  # design_qft's default: the feasible (certified) pair for the DEL target, then meet it
+        spec = spec_for_target(model, v, target_reduction, m=m)
+    elif not isinstance(spec, HinfSpecification):
+        raise TypeError(f"spec must be a hinf.HinfSpecification, got {spec!r}: make it with hinf.spec_for_target, "
+                        "spec_from_certified (a feasibility.TargetSpecification), spec_from_pair (W_MyT, W_Ω), "
+                        "spec_from_qft (a QFTDesign), spec_like_qft (QFT's notch specs) or spec_from_rosco")
+    # the same check as design_qft's: a record's promise holds at its own speed only
+    spec_made_at(spec.target if spec.target is not None else spec, v)
     if measurements is None:
-        measurements = ("gen_speed",) if target is not None else ("gen_speed", "tower_top_vel")
+        measurements = ("gen_speed",) if spec.target is not None else ("gen_speed", "tower_top_vel")
     base = sp.baseline_analysis(model, v, m=m, omega=omega)
-    notch_spec, ladder, label = None, [None], "custom"
-    if isinstance(specs, str) and specs == "custom":
-        pass
-    elif not isinstance(specs, str) and not _is_design(specs):
-        # a given pair: a feasibility.TargetSpecification (tower, speed) or a tuple (W_MyT, W_Ω)
-        pair = sp.specification_pair(specs)
-        if pair is None:
-            raise ValueError(f"spec={specs!r} must be 'target', 'qft', 'rosco', a specdesign.qft.QFTDesign, a "
-                             "feasibility.TargetSpecification or a pair (W_MyT, W_Ω)")
-        label, w_tower, w_speed = "target" if made else "given", pair[0] if w_tower is None else w_tower, pair[1] if w_speed is None else w_speed
-    elif _is_design(specs):
-        label = "qft_design"
-        w_tower = specs.tower_spec if w_tower is None else w_tower
-        w_speed = specs.speed_spec if w_speed is None else w_speed
-        notch_spec = specs.shaping.specification
-        ladder = [float(specs.options.get("speed_relax_db", np.nan))]
-    elif isinstance(specs, str) and specs in ("qft", "rosco"):
-        label = specs
-        if specs == "qft":
-            ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
-            if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
-                raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
-            ladder = [float(x) for x in ladder] if w_speed is None else [float(ladder[0])]
-        else:
-            ladder = [0.0]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            shaped = sp.shape_to_target(base, spec_reduction)
-        if not shaped.success:
-            raise ValueError(f"no tower specification at {v:g} m/s: {shaped.message}")
-        notch_spec = shaped.specification
-    elif label != "given":
-        raise ValueError(f"spec={specs!r} must be 'target', 'qft', 'rosco', a specdesign.qft.QFTDesign, a "
-                         "feasibility.TargetSpecification or a pair (W_MyT, W_Ω)")
-    if w_tower is not None and w_speed is not None and label in ("qft", "rosco"):
-        label, ladder, notch_spec = "custom", [None], None
     design = None
-    for k, relax in enumerate(ladder):
-        wt, ws = w_tower, w_speed
-        if label == "qft":
-            t_q, s_q, _ = qft_specifications(model, v, speed_relax_db=relax, spec_reduction=spec_reduction,
-                                             tower_relax_db=tower_relax_db, tower_relax_omega=tower_relax_omega,
-                                             m=m, omega=omega)
-            wt = t_q if wt is None else wt
-            ws = s_q if ws is None else ws
-        elif label == "rosco":
-            wt = notch_spec if wt is None else wt
-            ws = sp.speed_specification(model, v) if ws is None else ws
-        last = k == len(ladder) - 1
+    for k, ((wt, ws), relax) in enumerate(zip(spec.pairs, spec.speed_relax_db)):
+        last = k == len(spec.pairs) - 1
         try:
             # small dense algebra throughout: a second BLAS thread only synchronises (≈ 1.6× the
             # CPU time on the shared 2-core machine)
             with one_blas_thread():
-                design = _design_once(model, v, base, wt, ws, notch_spec, label, relax, target,
+                design = _design_once(model, v, base, wt, ws, spec.notch, spec.kind, relax, spec.target,
                                       measurements=measurements, order=order, w_pitch=w_pitch, m=m,
                                       suboptimality=suboptimality, reduction_method=reduction_method, dt=dt,
                                       min_damping=min_damping, decay_rate=decay_rate,
@@ -537,27 +385,25 @@ def design_hinf(
             continue
         if last or (design.speed_excess_db <= 0 and design.tower_band_excess_db <= 0):
             break
-    if label == "qft" and len(ladder) > 1:
+    if len(spec.pairs) > 1:
         met = design.speed_excess_db <= 0 and design.tower_band_excess_db <= 0
         design = replace(design, notes=design.notes + (
-            f"specs='qft': speed spec relaxed by {design.speed_relax_db:g} dB, the smallest of {tuple(ladder)} "
-            "with both specs met on the refined grid" if met else
-            f"specs='qft': no relaxation of {tuple(ladder)} met both specs; the last is returned",))
+            f"specs='{spec.kind}': speed spec relaxed by {design.speed_relax_db:g} dB, the smallest of "
+            f"{spec.speed_relax_db} with both specs met on the refined grid" if met else
+            f"specs='{spec.kind}': no relaxation of {spec.speed_relax_db} met both specs; the last is returned",))
     return design
 
 
 def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, target, *, measurements, order, w_pitch, m,
                  suboptimality, reduction_method, dt, min_damping, decay_rate, integral_corner, **plant_options):
     """One synthesis, reduction and assessment of :func:`design_hinf` on fixed specifications."""
-    from .. import closedloop, spec, spectral, wind
-
     plant = model.linearize(v)
     Wt, Ws = siso_weight(w_tower, "w_tower"), siso_weight(w_speed, "w_speed")
     wt_resp = _response(Wt, base.omega)
-    promise = spec.promise_of(wt_resp / base.t_response, base)
+    promise = sp.promise_of(wt_resp / base.t_response, base)
     Wn = Wt if notch_spec is None else siso_weight(notch_spec, "notch_spec")
     wn_resp = _response(Wn, base.omega)
-    notch_promise = spec.promise_of(wn_resp / base.t_response, base)
+    notch_promise = sp.promise_of(wn_resp / base.t_response, base)
 
     if integral_corner is None and decay_rate > 0:
         integral_corner = DEFAULT_INTEGRAL_CORNER
@@ -594,7 +440,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
             f"the {order}-state reduced controller does not stabilise the turbine at {v:g} m/s "
             f"(reduction error {red.error_hinf:.3g}); raise order"
         )
-    rosco = spec.baseline_controller(model, v)
+    rosco = sp.baseline_controller(model, v)
     cl0 = closedloop.closed_loop(plant, rosco, warn=False)
     cl_full = closed_loop_mimo(plant, K_full, measurements)
     omega = refine_grid(base.omega, [

@@ -56,7 +56,7 @@ import time
 import numpy as np
 
 from .._checks import bad_measurements, positive_scalar
-from ..fatigue import SNCurve
+from ..fatigue import BLADE_M, SNCurve
 from ..fatigue_online import StreamingDamage
 from .base import MEASURED, SampledController
 from .lpv import LPVTurbine, lpv_observer, lpv_turbine
@@ -292,7 +292,7 @@ class HealthMPC(SampledController):
 
     def __init__(self, model, ts: float = 0.2, horizon: int = 30, *, speed_weight: float = 100.0,
                  tower_weight: float = 100.0, activity_weight: float = 0.1, health_weight: float = 0.0,
-                 stress_weight: float = 0.0, blade_m: float = 10.0, del_budget: float | None = None,
+                 stress_weight: float = 0.0, blade_m: float = BLADE_M, del_budget: float | None = None,
                  budget_prior: float = 60.0, mean_time: float = 60.0, speed_integral_time: float | None = 30.0,
                  lpv: bool = True, wind_speeds=None, measured=MEASURED,
                  solver: str = "OSQP", name: str = "health MPC"):

@@ -97,6 +97,7 @@ from .linear_turbine import LinearTurbine
 __all__ = [
     "DEFAULT_DOFS",
     "LIN_OUTPUTS",
+    "TRIM_TOWER_DAMPING",
     "LinearizationCase",
     "default_lin_cache",
     "linearization_case",
@@ -340,19 +341,26 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
         sd[f"{kind}files"] = []
         vt[kind] = []
 
-    # openfast-io resolves the deck's "unused"/"none" file names to absolute paths: back to the
-    # bare word, so that a case (and its digest) does not depend on where the deck lies
+    _bare_unused_names(vt)
+    for module, channels in vt["outlist"].items():
+        for ch in channels:
+            channels[ch] = module in LIN_OUTPUTS and ch in LIN_OUTPUTS[module]
+    _apply_overrides(vt, overrides)
+    return vt
+
+
+def _bare_unused_names(vt: dict) -> None:
+    """openfast-io resolves the deck's "unused"/"none" file names to absolute paths: back to the
+    bare word (in place), so that a case (and its digest) does not depend on where the deck lies."""
     for module in vt.values():
         if isinstance(module, dict):
             for key, value in module.items():
                 if isinstance(value, str) and os.path.isabs(value) and os.path.basename(value).lower() in ("unused", "none"):
                     module[key] = os.path.basename(value)
 
-    out = vt["outlist"]
-    for module, channels in out.items():
-        for ch in channels:
-            channels[ch] = module in LIN_OUTPUTS and ch in LIN_OUTPUTS[module]
 
+def _apply_overrides(vt: dict, overrides: Mapping | None) -> None:
+    """Set ``{(module, key): value}`` in ``vt`` (in place), refusing a key the deck does not have."""
     for key, value in (overrides or {}).items():
         if not (isinstance(key, tuple) and len(key) == 2):
             raise ValueError(f"overrides key {key!r} must be a (module, key) pair, e.g. ('InflowWind', 'PLExp')")
@@ -360,7 +368,6 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
         if module not in vt or not isinstance(vt[module], dict) or name not in vt[module]:
             raise ValueError(f"overrides: {module!r} has no key {name!r} in the deck read by openfast-io")
         vt[module][name] = value
-    return vt
 
 
 def write_linearization_case(fst_path, wind_speed: float, folder, *, fst_vt: dict | None = None,

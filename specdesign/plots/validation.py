@@ -9,8 +9,8 @@ import numpy as np
 
 from .conventions import SI_UNITS, TIME_SERIES, show_se
 
-__all__ = ["plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage", "plot_comparison",
-           "save_validation_figures"]
+__all__ = ["SPECTRA_MAX_OMEGA", "plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage",
+           "plot_comparison", "save_validation_figures"]
 
 _NAMES = {"gen_speed": "Generator speed", "tower_base_my": "Tower-base fore-aft moment", "blade_root_my": "Blade-root flapwise moment"}
 

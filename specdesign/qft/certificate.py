@@ -26,6 +26,7 @@ from loopshaping import reduction
 
 from ..closedloop import (
     DESIGN_MAX_SENSITIVITY,
+    MIN_DECAY_RATE,
     closed_loop,
     closed_map,
     lightly_damped,
@@ -53,7 +54,7 @@ ORDER_AXIS_TOL = 1e-6
 ORDER_MARGIN_DB = 0.01
 
 
-def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MAX_SENSITIVITY, min_decay: float = 0.02,
+def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MAX_SENSITIVITY, min_decay: float = MIN_DECAY_RATE,
                             min_order: int = 4, design_omega=None, dense_omega=None) -> Any:
     """QFT design at a target specification's operating point from its certificate.
 

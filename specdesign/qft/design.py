@@ -21,12 +21,15 @@ from .. import turbine
 from .._checks import del_target, positive_scalar, spec_made_at
 from ..closedloop import (
     DESIGN_MAX_SENSITIVITY,
+    MIN_DECAY_RATE,
     case_speeds,
     closed_loop,
     lightly_damped,
     refine_grid,
 )
 from ..feasibility import TargetSpecification, specification_for_target
+from ..feasibility.target import TARGET_REDUCTION
+from ..spec import KEEP_BELOW, SPEC_REDUCTION, TOWER_RELAX_DB, TOWER_RELAX_OMEGA
 from .certificate import design_from_certificate
 from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign, assemble_design
@@ -43,7 +46,7 @@ __all__ = ["design_qft", "design_schedule", "design_table", "format_table", "SPE
 
 #: Relaxations (dB) of the generator-speed spec the notch design (``spec="notch"``) tries in turn,
 #: smallest first: ROSCO's T_{Ω,w} dips at the tower mode where a well-damped loop cannot follow
-#: it, and 3 dB is the least that the IEA 15 MW designs met; design_hinf(spec="qft") uses the same.
+#: it, and 3 dB is the least that the IEA 15 MW designs met; hinf.spec_like_qft uses the same.
 SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
 
 
@@ -67,7 +70,7 @@ def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01
     return np.unique(w[(w >= 0.005) & (w <= 20.0)])
 
 
-def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = 25.0, *,
+def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = TARGET_REDUCTION, *,
                speed_relax_db: float | Sequence[float] | None = None, spec: Any = "target",
                structure: str | None = None, **kwargs: Any) -> QFTDesign:
     """QFT design at ``wind_speed`` (m/s) that meets a fatigue-based specification pair.
@@ -180,32 +183,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     >>> print(d.summary())  # doctest: +SKIP
     >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
     """
-    options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
-    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
-    if unknown:  # named here, not as a TypeError of an internal function
-        raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
-    if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
-        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
-                        f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
-    check_design_speed(model, wind_speed)
-    if isinstance(spec, str) and spec not in ("target", "notch"):
-        raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
-                         "(tower, speed)")
-    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets"}
-    if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
-        named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
-        raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
-                        "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
-                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
-    if speed_relax_db is None:
-        speed_relax_db = SPEED_RELAX_DB
-    ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
-    if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
-        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
-    if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
-        raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
-    if structure not in (None, "certificate", "fixed"):
-        raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
+    ladder = _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs)
     if isinstance(spec, str) and spec == "target":
         # the plant cases the pair is certified on are the ones the design must meet it on
         offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
@@ -240,6 +218,39 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {ladder[-1]:g} dB): {design.message}",
                   RuntimeWarning, stacklevel=2)
     return design
+
+
+def _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs) -> np.ndarray:
+    """:func:`design_qft`'s arguments checked at the door, in its order (unknown options, the
+    model, the wind speed, ``spec``, options of the other design, the relaxation ladder,
+    ``structure``): the ladder of speed relaxations (dB, increasing)."""
+    options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
+    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
+    if unknown:  # named here, not as a TypeError of an internal function
+        raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
+    if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
+        raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
+                        f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
+    check_design_speed(model, wind_speed)
+    if isinstance(spec, str) and spec not in ("target", "notch"):
+        raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
+                         "(tower, speed)")
+    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets"}
+    if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
+        named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
+        raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
+                        "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
+                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
+    if speed_relax_db is None:
+        speed_relax_db = SPEED_RELAX_DB
+    ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
+    if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
+    if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
+        raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
+    if structure not in (None, "certificate", "fixed"):
+        raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
+    return ladder
 
 
 def check_design_speed(model, wind_speed: float) -> float:
@@ -303,10 +314,11 @@ def _given_spec(spec):
     return pair
 
 
-def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec_reduction=15.0,
+def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, given=None, spec_reduction=SPEC_REDUCTION,
                    template_offsets=(-1.0, -0.5, 0.5, 1.0),
-                   design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
-                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
+                   design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=TOWER_RELAX_DB,
+                   tower_relax_omega=TOWER_RELAX_OMEGA,
+                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=MIN_DECAY_RATE, keep_below=KEEP_BELOW, refine=2, maxfev=3000) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
     from .. import spec as sp
 
@@ -388,7 +400,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
 
 
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
-                    target_reduction: float | Sequence[float] = 25.0, *, specification: str = "target",
+                    target_reduction: float | Sequence[float] = TARGET_REDUCTION, *, specification: str = "target",
                     progress: bool = True, **kwargs: Any) -> tuple[QFTDesign, ...]:
     """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
 

@@ -207,6 +207,14 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         Invalid seeds, ``volterra`` or ``torque_control``, a step too large (:func:`check_campaign_step`) or a
         store of another campaign, before the first simulation; errors of
         :func:`specdesign.simulate.simulate`.
+
+    Notes
+    -----
+    Complexity: radon grade E. The branches are the campaign's documented options checked at the
+    door before any simulation (OpenFAST plant or reduced model, Volterra order, torque control,
+    store), the resumable store (only missing seeds run) and the three ways of running the tasks
+    (in process, two local threads, a given executor), which share the ``args``/``finish``
+    closures over one record dictionary; split apart they would pass that state around.
     """
     if not isinstance(controllers, dict) or not controllers:
         raise TypeError("controllers must be a non-empty dict {name: controller}")

@@ -25,7 +25,7 @@ from .._checks import positive_scalar
 from ..fatigue import TOWER_M
 from .stats import resampled_se
 
-__all__ = ["DEL_CHANNELS", "WindClimate", "weibull_bins", "wind_climate", "LifetimeDEL", "lifetime"]
+__all__ = ["DEL_CHANNELS", "MAX_BINS", "WindClimate", "weibull_bins", "wind_climate", "LifetimeDEL", "lifetime"]
 
 #: Channel of a campaign → the per-run DEL indicator it holds.
 DEL_CHANNELS = {"tower_base_my": "tower_del"}
