@@ -448,10 +448,7 @@ import pytest  # noqa: E402
 COMPLEXITY_REASON = "Complexity:"
 #: Public functions allowed above grade D for now, by qualified name, with the reason (each one
 #: an open piece of work, not a permanent exception).
-COMPLEXITY_PENDING = {
-    "specdesign.simulate.core.simulate": "being split on another branch (issue 32, item 3: one entry point per "
-                                         "kind of input; the compiled loop's parameters grouped into records)",
-}
+COMPLEXITY_PENDING: dict[str, str] = {}
 
 
 def _complexity():

@@ -201,6 +201,18 @@ def wave_seed_for(wind_speed: float, seed: int) -> int:
     of a campaign meets the same sea at the same (speed, seed): runs stay paired while the
     seed-to-seed spread includes the waves'.
 
+    Parameters
+    ----------
+    wind_speed : float
+        Mean wind speed of the run, m/s.
+    seed : int
+        The run's wind seed (as :func:`specdesign.wind.seed_for` takes it).
+
+    Returns
+    -------
+    int
+        SeaState's ``WaveSeed(1)``: :func:`specdesign.wind.seed_for` + :data:`WAVE_SEED_OFFSET`.
+
     Examples
     --------
     >>> from specdesign.openfast.deck import wave_seed_for

@@ -207,14 +207,6 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
         Invalid seeds, ``volterra`` or ``torque_control``, a step too large (:func:`check_campaign_step`) or a
         store of another campaign, before the first simulation; errors of
         :func:`specdesign.simulate.simulate`.
-
-    Notes
-    -----
-    Complexity: radon grade E. The branches are the campaign's documented options checked at the
-    door before any simulation (OpenFAST plant or reduced model, Volterra order, torque control,
-    store), the resumable store (only missing seeds run) and the three ways of running the tasks
-    (in process, two local threads, a given executor), which share the ``args``/``finish``
-    closures over one record dictionary; split apart they would pass that state around.
     """
     if not isinstance(controllers, dict) or not controllers:
         raise TypeError("controllers must be a non-empty dict {name: controller}")
@@ -228,29 +220,9 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                                      record_dt=record_dt, m=m, turbulence_class=turbulence_class,
                                      keep_series=keep_series, nperseg=nperseg, progress=progress, folder=store,
                                      **dict(openfast or {}))
-    if model is None:
-        model = turbine.iea15mw()
-    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
-    seeds = seeds_from(seeds)
-    if volterra not in (0, 1, 2, 3) or isinstance(volterra, bool):
-        raise ValueError(f"volterra={volterra!r} must be 0 (none) or an order 1, 2 or 3")
-    if volterra and not hasattr(model, "aero_expansion"):
-        raise TypeError(f"volterra={volterra} needs a turbine.TurbineModel, got {type(model).__name__}")
-    check_campaign_step(model, controllers, vs, dt)
-    names = tuple(controllers)
-    n_keep = len(seeds) if keep_series is True else int(keep_series)
-    settings = {"duration": float(duration), "dt": float(dt), "record_dt": float(record_dt),
-                "transient": float(transient), "m": float(m), "predict": bool(predict),
-                # True (every seed) stays True: a store grown by more seeds keeps theirs too
-                "turbulence_class": turbulence_class, "keep_series": True if keep_series is True else n_keep,
-                "linear_twin": bool(linear_twin),
-                "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg),
-                "torque_control": _torque_setting(torque_control)}
-    if noise is not None:  # only then: a store made before the noise model still matches a noise-free campaign
-        settings["noise"] = dataclasses.asdict(noise)
-    if torque_control == "rosco" and turbine_plant(model).torque_law is None:
-        raise ValueError("torque_control='rosco' needs a model with a torque law (a TurbineModel with torque_control, "
-                         "e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw or torque_control='auto'")
+    model, vs, seeds, names, n_keep, settings = _checked_campaign(
+        controllers, wind_speeds, seeds, model, duration, dt, record_dt, transient, m, predict, turbulence_class,
+        keep_series, linear_twin, volterra, nperseg, torque_control, noise)
     wanted = [(float(v), int(s), n) for v in vs for s in seeds for n in names]
     records, st = {}, None
     if store is not None:
@@ -260,17 +232,7 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     # a stored run among the first keep_series seeds but stored without its records (the
     # seeds were reordered) runs again, rather than showing NaN records
     records = {c: r for c, r in records.items() if not (c[1] in kept and r["series"] is None and not r["unstable"])}
-    tasks = []
-    for v in vs:
-        # controllers missing the same seeds at this speed share one task (one wind synthesis,
-        # seeds batched); a fresh campaign has one task per wind speed
-        groups = {}
-        for n in names:
-            todo = tuple(int(s) for s in seeds if (float(v), int(s), n) not in records)
-            if todo:
-                groups.setdefault(todo, []).append(n)
-        for todo, group in groups.items():
-            tasks.append((float(v), np.asarray(todo, dtype=np.int64), tuple(group)))
+    tasks = _tasks(vs, seeds, names, records)
     show = (sys.stderr.isatty()) if progress is None else bool(progress)
     bar = tqdm(total=sum(t[1].size * len(t[2]) for t in tasks), desc="validation", unit="run", disable=not show)
 
@@ -317,6 +279,52 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     finally:
         bar.close()
     return _assemble(records, names, vs, seeds, settings)
+
+
+def _checked_campaign(controllers, wind_speeds, seeds, model, duration, dt, record_dt, transient, m, predict,
+                      turbulence_class, keep_series, linear_twin, volterra, nperseg, torque_control, noise):
+    """:func:`run_campaign`'s door on the reduced model: the model, speeds, seeds, names, number
+    of kept series and the store's settings, every option checked before any simulation."""
+    if model is None:
+        model = turbine.iea15mw()
+    vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
+    seeds = seeds_from(seeds)
+    if volterra not in (0, 1, 2, 3) or isinstance(volterra, bool):
+        raise ValueError(f"volterra={volterra!r} must be 0 (none) or an order 1, 2 or 3")
+    if volterra and not hasattr(model, "aero_expansion"):
+        raise TypeError(f"volterra={volterra} needs a turbine.TurbineModel, got {type(model).__name__}")
+    check_campaign_step(model, controllers, vs, dt)
+    names = tuple(controllers)
+    n_keep = len(seeds) if keep_series is True else int(keep_series)
+    settings = {"duration": float(duration), "dt": float(dt), "record_dt": float(record_dt),
+                "transient": float(transient), "m": float(m), "predict": bool(predict),
+                # True (every seed) stays True: a store grown by more seeds keeps theirs too
+                "turbulence_class": turbulence_class, "keep_series": True if keep_series is True else n_keep,
+                "linear_twin": bool(linear_twin),
+                "volterra": int(volterra), "nperseg": None if nperseg is None else int(nperseg),
+                "torque_control": _torque_setting(torque_control)}
+    if noise is not None:  # only then: a store made before the noise model still matches a noise-free campaign
+        settings["noise"] = dataclasses.asdict(noise)
+    if torque_control == "rosco" and turbine_plant(model).torque_law is None:
+        raise ValueError("torque_control='rosco' needs a model with a torque law (a TurbineModel with torque_control, "
+                         "e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw or torque_control='auto'")
+    return model, vs, seeds, names, n_keep, settings
+
+
+def _tasks(vs, seeds, names, records) -> list:
+    """The runs still to make: (speed, seeds, controllers) per wind speed."""
+    tasks = []
+    for v in vs:
+        # controllers missing the same seeds at this speed share one task (one wind synthesis,
+        # seeds batched); a fresh campaign has one task per wind speed
+        groups = {}
+        for n in names:
+            todo = tuple(int(s) for s in seeds if (float(v), int(s), n) not in records)
+            if todo:
+                groups.setdefault(todo, []).append(n)
+        for todo, group in groups.items():
+            tasks.append((float(v), np.asarray(todo, dtype=np.int64), tuple(group)))
+    return tasks
 
 
 def _overlap(controllers) -> bool:
