@@ -162,6 +162,20 @@ shutil.copy({str(outb)!r}, pathlib.Path(sys.argv[1]).stem + '.outb')""")
         linearize_deck(deck, [19.0, 19.0], openfast=fake, cache=cache)
 
 
+def test_openfast_runs_with_the_chosen_blas(deck, tmp_path, monkeypatch):
+    # the BLAS folder of specdesign.openfast.install.run_environment reaches the OpenFAST process:
+    # the stand-in prints its LD_LIBRARY_PATH and fails, and the error quotes OpenFAST's last words
+    blas = tmp_path / "blas"
+    blas.mkdir()
+    (blas / "libblas.so.3").write_bytes(b"")
+    monkeypatch.setenv("SPECDESIGN_OPENFAST_BLAS", str(blas))
+    monkeypatch.setenv("LD_LIBRARY_PATH", "/opt/mine")
+    echo = _fake_openfast(tmp_path, "echo", """
+import os; print('LD_LIBRARY_PATH=' + os.environ.get('LD_LIBRARY_PATH', '')); sys.exit(1)""")
+    with pytest.raises(OpenFASTRunError, match=f"LD_LIBRARY_PATH={blas.resolve()}:/opt/mine"):
+        linearize_deck(deck, [17.0], n_azimuths=1, openfast=echo, cache=tmp_path / "cache", progress=False)
+
+
 @pytest.mark.slow
 def test_openfast_linearisation_at_19_mps(deck, tmp_path, openfast):
     """One speed, one azimuth: OpenFAST's plant has the rotor and the tower of the references.

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-from .install import OpenFASTInstall, check_deck_version, find_openfast
+from .install import OpenFASTInstall, check_deck_version, find_openfast, run_environment
 from .outputs import OpenFASTOutput, read_outputs
 
 __all__ = ["Deck", "Case", "OpenFASTRunError", "iea15mw_monopile", "write_case", "run_case", "CAMPAIGN_CHANNELS"]
@@ -390,7 +390,8 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
 
     # gfortran buffers a redirected stdout: unbuffered, the log keeps OpenFAST's last words
     # even when the process is killed
-    env = dict(os.environ, GFORTRAN_UNBUFFERED_PRECONNECTED="y")
+    # even when the process is killed; the BLAS is install.run_environment's (a serial OpenBLAS when there is one)
+    env = dict(run_environment(), GFORTRAN_UNBUFFERED_PRECONNECTED="y")
     with open(case.log, "w") as log:
         try:
             rc = subprocess.run([str(install.openfast), case.fst.name], cwd=case.folder, stdout=log,
