@@ -17,7 +17,7 @@ import signal
 import subprocess
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -343,7 +343,8 @@ def _set_outputs(vt: dict, channels) -> None:
 
 
 def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: float | None = None,
-             timeout: float | None = None, channels: Sequence[str] | None = None, nice: int = 0) -> OpenFASTOutput:
+             timeout: float | None = None, channels: Sequence[str] | None = None, nice: int = 0,
+             env: Mapping[str, str] | None = None) -> OpenFASTOutput:
     """Run OpenFAST on a case in a subprocess and read its outputs.
 
     Parameters
@@ -363,6 +364,10 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
         Channels read; default the case's (every channel when the case kept the deck's list).
     nice : int, default 0
         Niceness added to the OpenFAST process (POSIX), for runs in the background.
+    env : mapping, optional
+        Environment variables set for this run on top of this process's, e.g.
+        ``{"SPECDESIGN_OPENFAST_BLAS": "system"}`` (the BLAS is
+        :func:`specdesign.openfast.install.run_environment`'s).
 
     Returns
     -------
@@ -391,7 +396,7 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
     # gfortran buffers a redirected stdout: unbuffered, the log keeps OpenFAST's last words
     # even when the process is killed
     # even when the process is killed; the BLAS is install.run_environment's (a serial OpenBLAS when there is one)
-    env = dict(run_environment(), GFORTRAN_UNBUFFERED_PRECONNECTED="y")
+    env = dict(run_environment({**os.environ, **(env or {})}), GFORTRAN_UNBUFFERED_PRECONNECTED="y")
     with open(case.log, "w") as log:
         try:
             rc = subprocess.run([str(install.openfast), case.fst.name], cwd=case.folder, stdout=log,
