@@ -29,7 +29,6 @@ import numpy as np
 
 from specdesign import feasibility, qft, spec, turbine, validate
 from specdesign.openfast import find_openfast, iea15mw_monopile
-from specdesign.simulate import scheduled
 
 
 def designs(model, speeds, target) -> dict:
@@ -115,7 +114,8 @@ def main() -> None:
         # the design's own baseline: ROSCO's PI on the design plant (on OpenFAST's linearisations,
         # LinearTurbine's pole placement; turbine.rosco_baseline takes a TurbineModel only)
         pred[0, wi] = validate.linear_prediction(model, spec.baseline_controller(model, v), v).del_
-        pred[1, wi] = validate.linear_prediction(model, scheduled(model, {v: c}, name="QFT"), v).del_
+        # the pitch controller as an LTI (a one-speed schedule is that LTI; scheduled() needs a TurbineModel)
+        pred[1, wi] = validate.linear_prediction(model, c, v).del_
     camp = dataclasses.replace(camp, predicted_del=pred[[camp.index("ROSCO"), camp.index("QFT")]])
     t3 = validate.table3(camp, "QFT", "ROSCO", promised={v: made[v]["promise"] for v in speeds})
     text = t3.to_markdown() if hasattr(t3, "to_markdown") else str(t3)
