@@ -184,9 +184,10 @@ def test_openfast_linearisation_at_19_mps(deck, tmp_path, openfast):
     IEA 15 MW rotor, floating, 12 azimuths): ∂Ω̇/∂β = -0.865 rad/s² per rad at 19 m/s;
     ROSCO's tuning (rosco_gain_schedule.json): 16.5° of pitch at 19 m/s; the first tower
     fore-aft mode of monopile + tower + rotor-nacelle assembly, tower_fe.json: 0.172 Hz.
-    Measured here (2 cores shared with other jobs): the trim converges after ~31 s of
-    simulated time (~1 min of CPU); the one linearisation takes ~4.5 min of CPU, most of it
-    in the LU solve of OpenFAST's glue system on the reference BLAS (docs/openfast_linearization.md).
+    Measured here: the trim converges after ~31 s of simulated time (~50 s of CPU); the one
+    linearisation takes 285 s of CPU on Debian's reference BLAS, 50-58 s on a serial OpenBLAS
+    (CI installs one), most of it in the LU solve of OpenFAST's glue system
+    (docs/openfast_linearization.md).
     """
     install = openfast  # tests/conftest.py: found, or built in CI; skipped or failed without one
     t0 = time.perf_counter()
