@@ -428,7 +428,6 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
             os.nice(nice)
 
     # gfortran buffers a redirected stdout: unbuffered, the log keeps OpenFAST's last words
-    # even when the process is killed
     # even when the process is killed; the BLAS is install.run_environment's (a serial OpenBLAS when there is one)
     env = dict(run_environment({**os.environ, **(env or {})}), GFORTRAN_UNBUFFERED_PRECONNECTED="y")
     with open(case.log, "w") as log:
