@@ -5,13 +5,18 @@ with ROSCO's DISCON at 19 m/s on one TurbSim field (13 × 13 grid, NTM class B),
 - ``campaign``: the same model, only the campaign's 9 channels every 0.05 s;
 - ``no_hydro``: as ``campaign`` with SeaState and HydroDyn off;
 - ``dt_0.01``: as ``campaign`` with DT = 0.01 s;
+- ``reference_blas``: as ``campaign`` on the reference BLAS the executable links
+  (``SPECDESIGN_OPENFAST_BLAS=system``), against the serial OpenBLAS the workbench picks when
+  it is installed (``campaign``; give its folder in ``SPECDESIGN_OPENFAST_BLAS`` when it is not
+  installed system-wide);
 
 printing OpenFAST's CPU time per simulated second and each indicator's change against the
 reference (tower-base DEL m = 4, blade-root DEL m = 10, pitch and speed SDs), after the
 transient. Also TurbSim's time per grid. docs/openfast.md records a run.
 
-Run: ``nice python benchmarks/openfast_settings.py [--tmax 160] [--transient 40] [--out DIR]``
-(about 4 × 1.3 × tmax s of CPU, the four at once).
+Run: ``nice python benchmarks/openfast_settings.py [--tmax 160] [--transient 40] [--out DIR]
+[--variants campaign,reference_blas] [--processes 1]`` (about 1.5 × tmax s of CPU per variant,
+all at once unless ``--processes`` says otherwise).
 """
 from __future__ import annotations
 
@@ -36,6 +41,7 @@ VARIANTS = {
     "campaign": dict(),
     "no_hydro": dict(hydro=False),
     "dt_0.01": dict(dt=0.01),
+    "reference_blas": dict(blas="system"),
 }
 
 
@@ -52,6 +58,7 @@ def main() -> None:
     ap.add_argument("--transient", type=float, default=40.0)
     ap.add_argument("--wind-speed", type=float, default=19.0)
     ap.add_argument("--out", default="build/openfast_settings")
+    ap.add_argument("--processes", type=int, default=None, help="OpenFAST runs at a time (default: all at once)")
     ap.add_argument("--variants", default=",".join(VARIANTS),
                     help="comma-separated, the first is the reference of the changes (default: %(default)s)")
     args = ap.parse_args()
@@ -67,10 +74,13 @@ def main() -> None:
     def run(name, kw):
         base = dict(tmax=args.tmax, wind_speed=args.wind_speed, wind_file=wind.path, seed=0, library=rosco_library(),
                     parameters=discon_in, dt_out=0.05, initial_pitch=op.pitch, initial_rotor_speed=op.rotor_speed)
+        kw = dict(kw)
+        blas = kw.pop("blas", None)
         base.update(kw)
         case = write_case(deck, out / name, **base)
         t = time.monotonic()
-        o = run_case(case, inst, channels=list(OPENFAST_SERIES))
+        o = run_case(case, inst, channels=list(OPENFAST_SERIES),
+                     env=None if blas is None else {"SPECDESIGN_OPENFAST_BLAS": blas})
         wall = time.monotonic() - t
         series, dt = series_from_openfast(o, OPENFAST_SERIES)
         keep = o.time >= args.transient - 1e-9
@@ -88,7 +98,7 @@ def main() -> None:
             return None
 
     chosen = {k: VARIANTS[k] for k in args.variants.split(",")}
-    with cf.ThreadPoolExecutor(len(chosen)) as pool:  # all at once: CPU time is what is compared
+    with cf.ThreadPoolExecutor(args.processes or len(chosen)) as pool:  # CPU time is what is compared
         res = {r[0]: r[1:] for r in pool.map(attempt, chosen.items()) if r is not None}
     first = next(iter(chosen))
     ref = res[first][0]

@@ -27,10 +27,8 @@ from pathlib import Path
 import control as ct
 import numpy as np
 
-from specdesign import feasibility, qft, turbine, validate
+from specdesign import feasibility, qft, spec, turbine, validate
 from specdesign.openfast import find_openfast, iea15mw_monopile
-from specdesign.rosco.discon import rosco_library
-from specdesign.simulate import scheduled
 
 
 def designs(model, speeds, target) -> dict:
@@ -39,9 +37,9 @@ def designs(model, speeds, target) -> dict:
     res = {}
     for v in speeds:
         t = time.monotonic()
-        spec = feasibility.specification_for_target(model, v, target)
-        d = qft.design_qft(model, v, spec=spec)
-        res[v] = {"design": d, "promise": float(spec.promise.exact_del)}
+        pair = feasibility.specification_for_target(model, v, target)
+        d = qft.design_qft(model, v, spec=pair)
+        res[v] = {"design": d, "promise": float(pair.promise.exact_del)}
         print(f"design at {v:g} m/s: {time.monotonic() - t:.0f} s; {d.summary()}", file=sys.stderr, flush=True)
     return res
 
@@ -70,13 +68,17 @@ def main() -> None:
     export = None
     if not args.rosco_only:
         try:
-            from specdesign.export import export_discon as export  # issue 27's DISCON export
+            from specdesign.export import (
+                export_discon as export,  # issue 27's DISCON export
+            )
         except ImportError:
             print("specdesign.export is not available: ROSCO only", file=sys.stderr)
     if export is not None and args.plant == "openfast":
         from specdesign.openfast import linearize_deck  # issue 27's linearisations
 
-        model = linearize_deck(deck.fst, speeds)
+        # cached in ~/.cache/specdesign/linearizations (keyed by the case's files and the OpenFAST
+        # version): a resumed run, or examples/openfast_chain.py, reads them back
+        model = linearize_deck(deck, speeds, processes=args.processes or 2, nice=args.nice, progress=True)
     made = designs(model, speeds, args.target) if export is not None else {}
     camps = []
     for v in speeds:
@@ -109,8 +111,11 @@ def main() -> None:
     pred = np.full((2, len(speeds)), np.nan)
     for wi, v in enumerate(speeds):
         c = ct.tf(made[v]["design"].pitch_controller)
-        pred[0, wi] = validate.linear_prediction(model, turbine.rosco_baseline(model, v), v).del_
-        pred[1, wi] = validate.linear_prediction(model, scheduled(model, {v: c}, name="QFT"), v).del_
+        # the design's own baseline: ROSCO's PI on the design plant (on OpenFAST's linearisations,
+        # LinearTurbine's pole placement; turbine.rosco_baseline takes a TurbineModel only)
+        pred[0, wi] = validate.linear_prediction(model, spec.baseline_controller(model, v), v).del_
+        # the pitch controller as an LTI (a one-speed schedule is that LTI; scheduled() needs a TurbineModel)
+        pred[1, wi] = validate.linear_prediction(model, c, v).del_
     camp = dataclasses.replace(camp, predicted_del=pred[[camp.index("ROSCO"), camp.index("QFT")]])
     t3 = validate.table3(camp, "QFT", "ROSCO", promised={v: made[v]["promise"] for v in speeds})
     text = t3.to_markdown() if hasattr(t3, "to_markdown") else str(t3)

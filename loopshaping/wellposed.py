@@ -44,6 +44,18 @@ def _invariant_zeros(A, B, C, D):
     return z[np.isfinite(z)].astype(complex)
 
 
+def _balanced(A, B1, B2, C1, C2):
+    """(A, B1, B2, C1, C2) after SLICOT tb01id's diagonal state scaling of the whole plant (job 'A')."""
+    n = A.shape[0]
+    if n == 0:
+        return A, B1, B2, C1, C2
+    m1, p1 = B1.shape[1], C1.shape[0]
+    B, C = np.hstack([B1, B2]), np.vstack([C1, C2])
+    _, Ab, Bb, Cb, _ = slycot_routine("tb01id")(n, B.shape[1], C.shape[0], 0.0, np.array(A, order="F"),
+                                                 np.array(B, order="F"), np.array(C, order="F"), job="A")
+    return Ab, Bb[:, :m1], Bb[:, m1:], Cb[:p1], Cb[p1:]
+
+
 def _on_axis(values, axis_tol):
     values = np.asarray(values, dtype=complex)
     return values[np.abs(values.real) <= axis_tol * np.maximum(1.0, np.abs(values))]
@@ -141,6 +153,14 @@ def check_well_posed(generalized_plant: ct.StateSpace | ct.TransferFunction, n_m
             "noise-free. Remedy: add a sensor-noise input to every measurement, or pass "
             "regularize=True to add epsilon·(noise) to the measurements."
         )
+
+    # (A1), (A3), (A4) hold or fail alike in every state coordinate; their numerical tests do
+    # not: a model whose states mix scales (a stiff structure's displacements beside a slow
+    # integrator, N·m beside rad) has ‖[A B2]‖ set by its stiffest rows, and a well-controllable
+    # slow mode then looks rank deficient against that norm. The tests run after the diagonal
+    # state similarity of SLICOT's tb01id (the one the synthesis solves with), which leaves
+    # every transfer function and mode unchanged.
+    A, B1, B2, C1, C2 = _balanced(A, B1, B2, C1, C2)
 
     # (A1): stabilisable / detectable by the PBH test at every closed-RHP eigenvalue.
     if n:

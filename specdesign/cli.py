@@ -26,7 +26,7 @@ from loopshaping.controller import Controller
 
 from . import __version__, turbine
 from ._checks import distinct_keys
-from .openfast.install import build_openfast, find_openfast
+from .openfast.install import blas_folder, build_openfast, find_openfast
 from .plots import validation as pv
 from .rosco import rosco_scheduled
 from .simulate import ScheduledController, scheduled
@@ -207,7 +207,9 @@ def _openfast_command(args) -> None:
             raise ConfigError(str(e)) from None
     else:
         found = find_openfast(require_turbsim=False)
-    print(f"openfast {found.openfast}\nturbsim {found.turbsim}\nversion {found.version}")
+    blas = blas_folder()
+    print(f"openfast {found.openfast}\nturbsim {found.turbsim}\nversion {found.version}\n"
+          f"blas {blas if blas is not None else 'the libblas.so.3 the executables link (no serial OpenBLAS found)'}")
 
 
 def _speeds_arg(text, default):

@@ -264,6 +264,33 @@ def test_not_stabilisable_and_not_detectable_raise():
         hinf.synthesize(ct.ss(A.T, C.T, B.T, D.T), 1, 1)
 
 
+def _rescaled(P, scales):
+    """P in the state coordinates x = diag(scales)·x': the same transfer functions and modes."""
+    T = np.diag(scales)
+    return ct.ss(np.linalg.solve(T, P.A @ T), np.linalg.solve(T, P.B), P.C @ T, P.D)
+
+
+def test_well_posedness_does_not_depend_on_the_state_units():
+    # The unstable mode (s = 0.5) of _general_plant is reached by the control through the
+    # coupling A[0, 1]. In units that make that coupling 1e-7 and B2 1e7 (a stiff state beside
+    # a slow one, as a structural model's N·m beside rad), the PBH test's smallest singular value
+    # (~1e-7) falls below 1e-9·‖[A B2]‖ (~1e-2) unless the check balances the states first; the
+    # mode is as controllable as before, and the synthesis (which balances) finds the same γ.
+    P = _general_plant(0.0)
+    scaled = _rescaled(P, [1.0, 1e-7])
+    assert np.abs(np.asarray(scaled.B)[1, 2]) == pytest.approx(1e7)
+    hinf.check_well_posed(scaled, 1, 1)
+    assert hinf.synthesize(scaled, 1, 1).gamma == pytest.approx(hinf.synthesize(P, 1, 1).gamma, rel=1e-3)
+    # an unstabilisable mode stays unstabilisable in any units
+    A = np.diag([1.0, -1.0])
+    B = np.array([[0.0, 0.0], [1.0, 1.0]])
+    C = np.array([[1.0, 1.0], [1.0, 1.0]])
+    D = np.array([[0.0, 1.0], [1.0, 0.0]])
+    for scales in ([1.0, 1.0], [1e-7, 1.0], [1.0, 1e-7], [1e6, 1e-6]):
+        with pytest.raises(ValueError, match="not stabilisable"):
+            hinf.check_well_posed(_rescaled(ct.ss(A, B, C, D), scales), 1, 1)
+
+
 def test_d21_rank_deficient_raises():
     P = _general_plant(0.0)
     D = np.asarray(P.D).copy()

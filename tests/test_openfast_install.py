@@ -2,6 +2,7 @@
 executables (shell scripts printing a version) and a fake CMake project stand in for the real
 ones: no Fortran is compiled here (the real build is .ci/run's, tests/test_openfast_run.py runs it)."""
 import os
+import platform
 import shutil
 import subprocess
 import sys
@@ -156,3 +157,47 @@ def test_cli_build_without_source_is_a_user_error():
     r = subprocess.run([sys.executable, "-m", "specdesign", "openfast", "build"], capture_output=True, text=True,
                        cwd=Path(__file__).parents[1])
     assert r.returncode == 2 and "needs SOURCE" in r.stderr and "Traceback" not in r.stderr
+
+
+def _blas(folder: Path) -> Path:
+    """A folder that looks like a BLAS/LAPACK install to the loader's search (empty stand-in files)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for lib in ("libblas.so.3", "liblapack.so.3"):
+        (folder / lib).write_bytes(b"")
+    return folder
+
+
+def test_serial_openblas_goes_first_on_the_library_path(tmp_path, monkeypatch):
+    # Debian's libopenblas0-serial is found where its package puts it; the user's own path follows it
+    debian = _blas(tmp_path / "openblas-serial")
+    monkeypatch.setattr(install, "_debian_openblas_serial", lambda: debian)
+    env = install.run_environment({"LD_LIBRARY_PATH": "/opt/x", "HOME": "/h"})
+    assert env["LD_LIBRARY_PATH"].split(os.pathsep) == [str(debian), "/opt/x"]
+    assert env["HOME"] == "/h"
+    assert install.run_environment({})["LD_LIBRARY_PATH"] == str(debian)
+    # no optimised BLAS installed: the environment is left as it is
+    monkeypatch.setattr(install, "_debian_openblas_serial", lambda: None)
+    assert "LD_LIBRARY_PATH" not in install.run_environment({"HOME": "/h"})
+
+
+def test_the_users_blas_choice_wins(tmp_path, monkeypatch):
+    debian = _blas(tmp_path / "openblas-serial")
+    monkeypatch.setattr(install, "_debian_openblas_serial", lambda: debian)
+    mine = _blas(tmp_path / "mkl")
+    # an explicit folder, or "system" for the libraries the executable links
+    assert install.blas_folder({"SPECDESIGN_OPENFAST_BLAS": str(mine)}) == mine.resolve()
+    env = install.run_environment({"SPECDESIGN_OPENFAST_BLAS": "system", "LD_LIBRARY_PATH": "/opt/x"})
+    assert env["LD_LIBRARY_PATH"] == "/opt/x"
+    # a libblas.so.3 already on the user's LD_LIBRARY_PATH is theirs: nothing is put before it
+    env = install.run_environment({"LD_LIBRARY_PATH": str(mine)})
+    assert env["LD_LIBRARY_PATH"] == str(mine)
+    with pytest.raises(ValueError, match="SPECDESIGN_OPENFAST_BLAS=.*libblas.so.3.*'system'"):
+        install.blas_folder({"SPECDESIGN_OPENFAST_BLAS": str(tmp_path / "nothing-here")})
+
+
+def test_debian_serial_openblas_folder_is_the_packages():
+    # the folder libopenblas0-serial installs: /usr/lib/<arch>-linux-gnu/openblas-serial (Debian's
+    # multiarch path), found only when both libraries are there
+    expected = Path("/usr/lib") / f"{platform.machine()}-linux-gnu" / "openblas-serial"
+    present = all((expected / lib).is_file() for lib in ("libblas.so.3", "liblapack.so.3"))
+    assert install._debian_openblas_serial() == (expected if present else None)

@@ -162,6 +162,20 @@ shutil.copy({str(outb)!r}, pathlib.Path(sys.argv[1]).stem + '.outb')""")
         linearize_deck(deck, [19.0, 19.0], openfast=fake, cache=cache)
 
 
+def test_openfast_runs_with_the_chosen_blas(deck, tmp_path, monkeypatch):
+    # the BLAS folder of specdesign.openfast.install.run_environment reaches the OpenFAST process:
+    # the stand-in prints its LD_LIBRARY_PATH and fails, and the error quotes OpenFAST's last words
+    blas = tmp_path / "blas"
+    blas.mkdir()
+    (blas / "libblas.so.3").write_bytes(b"")
+    monkeypatch.setenv("SPECDESIGN_OPENFAST_BLAS", str(blas))
+    monkeypatch.setenv("LD_LIBRARY_PATH", "/opt/mine")
+    echo = _fake_openfast(tmp_path, "echo", """
+import os; print('LD_LIBRARY_PATH=' + os.environ.get('LD_LIBRARY_PATH', '')); sys.exit(1)""")
+    with pytest.raises(OpenFASTRunError, match=f"LD_LIBRARY_PATH={blas.resolve()}:/opt/mine"):
+        linearize_deck(deck, [17.0], n_azimuths=1, openfast=echo, cache=tmp_path / "cache", progress=False)
+
+
 @pytest.mark.slow
 def test_openfast_linearisation_at_19_mps(deck, tmp_path, openfast):
     """One speed, one azimuth: OpenFAST's plant has the rotor and the tower of the references.
@@ -170,9 +184,10 @@ def test_openfast_linearisation_at_19_mps(deck, tmp_path, openfast):
     IEA 15 MW rotor, floating, 12 azimuths): ∂Ω̇/∂β = -0.865 rad/s² per rad at 19 m/s;
     ROSCO's tuning (rosco_gain_schedule.json): 16.5° of pitch at 19 m/s; the first tower
     fore-aft mode of monopile + tower + rotor-nacelle assembly, tower_fe.json: 0.172 Hz.
-    Measured here (2 cores shared with other jobs): the trim converges after ~31 s of
-    simulated time (~1 min of CPU); the one linearisation takes ~4.5 min of CPU, most of it
-    in the LU solve of OpenFAST's glue system on the reference BLAS (docs/openfast_linearization.md).
+    Measured here: the trim converges after ~31 s of simulated time (~50 s of CPU); the one
+    linearisation takes 285 s of CPU on Debian's reference BLAS, 50-58 s on a serial OpenBLAS
+    (CI installs one), most of it in the LU solve of OpenFAST's glue system
+    (docs/openfast_linearization.md).
     """
     install = openfast  # tests/conftest.py: found, or built in CI; skipped or failed without one
     t0 = time.perf_counter()

@@ -87,7 +87,8 @@ class HinfDesign:
     tower_excess_db : float
         The same for MyT at ``tower_mode``, dB.
     tower_mode : float
-        Frequency of the least-damped open-loop pole pair (the tower mode), rad/s.
+        Frequency of the tower mode (the open-loop pole pair with the highest wind → tower-base
+        moment resonance), rad/s.
     pitch_std : float
         Pitch-command standard deviation from the linear model, rad.
     pitch_std_baseline : float
@@ -206,13 +207,22 @@ def _response(sys, omega, output=None, input="wind"):
 
 
 def _tower_mode(plant):
-    """Frequency (rad/s) of the least-damped complex open-loop pole pair: the tower mode."""
-    p = np.asarray(plant.poles())
-    p = p[p.imag > 1e-6]
-    if p.size == 0:
+    """Frequency (rad/s) of the tower mode: the open-loop pole pair with the highest resonance from wind to tower-base moment.
+
+    The resonance of a pole λ with residue r is |r|/|Re λ| (its term r/(s − λ) at s = j·Im λ).
+    Not simply the least-damped pair: OpenFAST's monopile plant has a foundation mode at
+    7.1 Hz with 0.7 % damping beside the tower's 0.17 Hz at 12 %.
+    """
+    A = np.asarray(plant.A, dtype=float)
+    lam, V = np.linalg.eig(A)
+    osc = lam.imag > 1e-6
+    if not np.any(osc):
         raise ValueError("plant has no oscillatory pole: cannot locate the tower mode")
-    zeta = -p.real / np.abs(p)
-    return float(np.abs(p[np.argmin(zeta)]))
+    b = np.asarray(plant.B, dtype=float)[:, plant.input_labels.index("wind")]
+    c = np.asarray(plant.C, dtype=float)[plant.output_labels.index("tower_base_my")]
+    residue = (c @ V) * np.linalg.solve(V, b)
+    peak = np.abs(residue[osc]) / np.maximum(np.abs(lam[osc].real), np.finfo(float).tiny)
+    return float(np.abs(lam[osc][np.argmax(peak)]))
 
 
 def design_hinf(

@@ -18,13 +18,13 @@ import signal
 import subprocess
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
 from ..wind import seed_for
-from .install import OpenFASTInstall, check_deck_version, find_openfast
+from .install import OpenFASTInstall, check_deck_version, find_openfast, run_environment
 from .outputs import OpenFASTOutput, read_outputs
 
 __all__ = ["Deck", "Case", "OpenFASTRunError", "iea15mw_monopile", "write_case", "run_case", "CAMPAIGN_CHANNELS", "wave_seed_for",
@@ -389,7 +389,8 @@ def _set_outputs(vt: dict, channels) -> None:
 
 
 def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: float | None = None,
-             timeout: float | None = None, channels: Sequence[str] | None = None, nice: int = 0) -> OpenFASTOutput:
+             timeout: float | None = None, channels: Sequence[str] | None = None, nice: int = 0,
+             env: Mapping[str, str] | None = None) -> OpenFASTOutput:
     """Run OpenFAST on a case in a subprocess and read its outputs.
 
     Parameters
@@ -409,6 +410,10 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
         Channels read; default the case's (every channel when the case kept the deck's list).
     nice : int, default 0
         Niceness added to the OpenFAST process (POSIX), for runs in the background.
+    env : mapping, optional
+        Environment variables set for this run on top of this process's, e.g.
+        ``{"SPECDESIGN_OPENFAST_BLAS": "system"}`` (the BLAS is
+        :func:`specdesign.openfast.install.run_environment`'s).
 
     Returns
     -------
@@ -435,8 +440,8 @@ def run_case(case: Case, install: OpenFASTInstall | None = None, *, cpu_limit: f
             os.nice(nice)
 
     # gfortran buffers a redirected stdout: unbuffered, the log keeps OpenFAST's last words
-    # even when the process is killed
-    env = dict(os.environ, GFORTRAN_UNBUFFERED_PRECONNECTED="y")
+    # even when the process is killed; the BLAS is install.run_environment's (a serial OpenBLAS when there is one)
+    env = dict(run_environment({**os.environ, **(env or {})}), GFORTRAN_UNBUFFERED_PRECONNECTED="y")
     with open(case.log, "w") as log:
         try:
             rc = subprocess.run([str(install.openfast), case.fst.name], cwd=case.folder, stdout=log,

@@ -15,6 +15,17 @@ Cache layout (default ``~/.cache/specdesign/openfast``, or ``SPECDESIGN_OPENFAST
         bin/openfast, bin/turbsim
         manifest.json            version, source, digest, cmake options (written last)
     <cache>/<digest16>.lock      held while building (two calls never build at once)
+
+BLAS: OpenFAST and TurbSim link ``libblas.so.3``/``liblapack.so.3`` dynamically, and on Debian
+those are the reference (unoptimised) BLAS unless an optimised one is installed. OpenFAST's
+linearisation spends nearly all its time in one LU solve of its glue system (LAPACK
+``dgetrf``/``dgetrs``, then ``dgemm``), and its time steps in small ``dtrsm``/``dgemm`` calls, so
+every process of the workbench is run with Debian's *serial* OpenBLAS when it is installed
+(``libopenblas0-serial``, :func:`blas_folder`): its folder goes first on ``LD_LIBRARY_PATH``
+(:func:`run_environment`); nothing is rebuilt. Serial, not threaded: campaigns run one OpenFAST
+process per core. ``SPECDESIGN_OPENFAST_BLAS`` overrides the choice: a folder holding another
+``libblas.so.3``/``liblapack.so.3``, or ``system`` for the libraries the executable links; a
+``libblas.so.3`` already on the user's ``LD_LIBRARY_PATH`` is left to win.
 """
 from __future__ import annotations
 
@@ -23,6 +34,7 @@ import fcntl
 import hashlib
 import json
 import os
+import platform
 import re
 import shutil
 import subprocess
@@ -33,7 +45,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["OpenFASTInstall", "OpenFASTNotFound", "find_openfast", "build_openfast", "openfast_version",
-           "check_deck_version", "default_cache", "CMAKE_OPTIONS", "BUILD_TARGETS"]
+           "check_deck_version", "default_cache", "CMAKE_OPTIONS", "BUILD_TARGETS", "blas_folder", "run_environment"]
 
 #: cmake options of :func:`build_openfast`: an optimised, double-precision build without tests
 CMAKE_OPTIONS = ("-DCMAKE_BUILD_TYPE=Release", "-DDOUBLE_PRECISION=ON", "-DBUILD_TESTING=OFF")
@@ -41,6 +53,8 @@ CMAKE_OPTIONS = ("-DCMAKE_BUILD_TYPE=Release", "-DDOUBLE_PRECISION=ON", "-DBUILD
 BUILD_TARGETS = ("openfast", "turbsim")
 _ENV_EXE = "SPECDESIGN_OPENFAST"
 _ENV_CACHE = "SPECDESIGN_OPENFAST_CACHE"
+_ENV_BLAS = "SPECDESIGN_OPENFAST_BLAS"
+_BLAS_LIBS = ("libblas.so.3", "liblapack.so.3")
 _BUILD_HINT = ("build one with `python -m specdesign openfast build SOURCE` (SOURCE: an OpenFAST source tarball "
                "or folder, e.g. openfast-v5.0.0-src.tar.gz; needs gfortran, cmake and LAPACK) or point "
                f"{_ENV_EXE} to an openfast executable or to a folder holding openfast and turbsim")
@@ -85,6 +99,73 @@ def default_cache() -> Path:
     """
     env = os.environ.get(_ENV_CACHE)
     return Path(env).expanduser() if env else Path.home() / ".cache" / "specdesign" / "openfast"
+
+
+def _debian_openblas_serial() -> Path | None:
+    """Debian's serial OpenBLAS folder (package ``libopenblas0-serial``) for this machine's architecture, if installed."""
+    folder = Path("/usr/lib") / f"{platform.machine()}-linux-gnu" / "openblas-serial"
+    return folder if all((folder / lib).is_file() for lib in _BLAS_LIBS) else None
+
+
+def blas_folder(environ=None) -> Path | None:
+    """The folder of the ``libblas.so.3``/``liblapack.so.3`` OpenFAST and TurbSim are run with.
+
+    ``$SPECDESIGN_OPENFAST_BLAS`` when set (a folder, or ``system``: None), else None when the
+    user's ``LD_LIBRARY_PATH`` already holds a ``libblas.so.3`` (theirs wins), else Debian's
+    serial OpenBLAS (``/usr/lib/<arch>-linux-gnu/openblas-serial``, package
+    ``libopenblas0-serial``) when installed, else None.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        The environment read (default ``os.environ``).
+
+    Returns
+    -------
+    pathlib.Path or None
+        The folder put first on ``LD_LIBRARY_PATH``; None: the libraries the executable links.
+
+    Raises
+    ------
+    ValueError
+        ``SPECDESIGN_OPENFAST_BLAS`` names something that is neither ``system`` nor a folder
+        holding ``libblas.so.3`` or ``liblapack.so.3``.
+    """
+    environ = os.environ if environ is None else environ
+    chosen = environ.get(_ENV_BLAS)
+    if chosen is not None:
+        if chosen.strip().lower() in ("", "system"):
+            return None
+        folder = Path(chosen).expanduser()
+        if not any((folder / lib).is_file() for lib in _BLAS_LIBS):
+            raise ValueError(f"{_ENV_BLAS}={chosen!r} must be a folder holding libblas.so.3 and/or liblapack.so.3 "
+                             "(e.g. /usr/lib/x86_64-linux-gnu/openblas-serial), or 'system' for the libraries "
+                             "the executables link")
+        return folder.resolve()
+    user = [Path(p) for p in environ.get("LD_LIBRARY_PATH", "").split(os.pathsep) if p]
+    if any((p / "libblas.so.3").is_file() for p in user):
+        return None
+    return _debian_openblas_serial()
+
+
+def run_environment(environ=None) -> dict:
+    """The environment of an OpenFAST or TurbSim process: ``environ`` with :func:`blas_folder` first on ``LD_LIBRARY_PATH``.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        The base environment (default ``os.environ``); not modified.
+
+    Returns
+    -------
+    dict
+        A new environment.
+    """
+    env = dict(os.environ if environ is None else environ)
+    folder = blas_folder(env)
+    if folder is not None:
+        env["LD_LIBRARY_PATH"] = os.pathsep.join([str(folder), *(p for p in env.get("LD_LIBRARY_PATH", "").split(os.pathsep) if p)])
+    return env
 
 
 def openfast_version(executable: str | os.PathLike, timeout: float = 60.0) -> str:

@@ -21,7 +21,7 @@ from types import SimpleNamespace
 from openfast_io.turbsim_util import TurbsimWriter
 
 from ..wind import seed_for
-from .install import OpenFASTInstall, find_openfast
+from .install import OpenFASTInstall, find_openfast, run_environment
 
 __all__ = ["WindField", "turbsim_field", "turbsim_cache", "TURBSIM_GRID"]
 
@@ -160,7 +160,7 @@ def turbsim_field(wind_speed: float, seed: int, *, length: float = 660.0, hub_he
         t0 = time.monotonic()
         try:
             r = subprocess.run([str(install.turbsim), f"{part}.inp"], cwd=folder, capture_output=True, text=True,
-                               stdin=subprocess.DEVNULL, timeout=timeout or 3600.0)
+                               stdin=subprocess.DEVNULL, timeout=timeout or 3600.0, env=run_environment())
         except subprocess.TimeoutExpired:
             raise RuntimeError(f"TurbSim ({wind_speed:g} m/s, seed {seed}) did not finish in {timeout or 3600:g} s "
                                f"(folder {folder})") from None
