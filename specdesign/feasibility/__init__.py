@@ -56,7 +56,8 @@ shapes the paper's notches).
 
 Units: ω in rad/s, magnitudes linear (dB only in messages), DEL reductions in %.
 """
-from .achievable import YOULA_PAIRS, YOULA_REAL_POLES, AchievablePitch, YoulaProblem, achievable_pitch
+from .achievable import (HF_END, HF_GAIN_RATIO, HF_OMEGA, YOULA_PAIRS, YOULA_REAL_POLES, AchievablePitch, YoulaProblem,
+                         achievable_pitch, hf_gain_bound)
 from .conditions import (PitchChecker, PitchFeasibility, combine, pitch_checkers, pitch_feasibility, pitch_frontier,
                          sensitivity_disks)
 from .elements import element_specification
@@ -66,4 +67,4 @@ from .target import CertificateSearch, TargetSpecification, recertify, specifica
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
            "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks",
            "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification", "CertificateSearch",
-           "shape_whole_band"]
+           "shape_whole_band", "HF_GAIN_RATIO", "HF_OMEGA", "HF_END", "hf_gain_bound"]

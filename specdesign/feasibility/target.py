@@ -21,7 +21,7 @@ from ..closedloop import (
     system_roots,
 )
 from ..fatigue import TOWER_M
-from .achievable import AchievablePitch, YoulaProblem
+from .achievable import HF_END, HF_GAIN_RATIO, HF_OMEGA, AchievablePitch, YoulaProblem, hf_gain_bound, hf_ratio
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
            "SEARCH_MARGIN_PP", "UNSTABLE_POLE_TOL", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
@@ -99,6 +99,10 @@ class TargetSpecification:
         its case speed m/s) of the certificate's maps at any plant case over the nominal W itself
         (not the per-case W_i above), on the dense check's grid; > 0 where a plant case exceeds
         the W the user sees (its resonance moved, its gain changed with its operating point).
+    max_hf_gain_ratio : float or None
+        κ of the high-frequency gain bound the certificate meets, |C_β| ≤ κ·|C_ROSCO| on
+        :data:`~specdesign.feasibility.achievable.HF_OMEGA`-:data:`~specdesign.feasibility.achievable.HF_END`
+        rad/s with C_β strictly proper (None: made without it); the design step meets it too.
     """
 
     tower: object
@@ -113,6 +117,7 @@ class TargetSpecification:
     speed_slack_db: float = 0.0
     m: float = TOWER_M
     strict_excess: tuple = ()
+    max_hf_gain_ratio: float | None = None
 
     @property
     def wind_speed(self) -> float:
@@ -136,7 +141,7 @@ class TargetSpecification:
 def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
                              max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
                              m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
-                             dense_omega=None) -> TargetSpecification:
+                             dense_omega=None, max_hf_gain_ratio=HF_GAIN_RATIO) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
     A ladder (:data:`RELAX_LADDER_DB`) then bisection on the relaxation g of ROSCO's
@@ -190,6 +195,11 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         Room left above the certificate's speed maps in W_Ω, dB (≥ 0).
     dense_omega : array_like, optional
         Grid of the plant-case check, rad/s (default 600 points, 0.005-20, refined).
+    max_hf_gain_ratio : float or None
+        κ of the high-frequency gain bound on the certificate, |C_β| ≤ κ·|C_ROSCO| on
+        HF_OMEGA-HF_END (2-10 rad/s, 3P inside) with C_β strictly proper (default
+        :data:`~specdesign.feasibility.HF_GAIN_RATIO`, from OpenFAST: docs/feasibility.md;
+        None switches it off). Checked on the dense grid too.
 
     Returns
     -------
@@ -202,7 +212,8 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         For a bool or a string where a number is meant (``target_reduction=True`` is not 1 %).
     ValueError
         For a target outside (0, 100), a negative slack, a tolerance ≤ 0, invalid offsets, or when even
-        ``max_relax_db`` does not reach the target (the message gives the promise reached there).
+        ``max_relax_db`` does not reach the target (the message gives the promise reached there and,
+        with the high-frequency gain bound on, names it and its κ).
 
     Examples
     --------
@@ -215,7 +226,7 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     search_options(tolerance_db, max_relax_db, speed_relax_db)
     search = CertificateSearch(model, wind_speed, max_sensitivity=max_sensitivity,
                                max_pitch_rate_ratio=max_pitch_rate_ratio, m=m, omega=omega, case_offsets=case_offsets,
-                               dense_omega=dense_omega)
+                               dense_omega=dense_omega, max_hf_gain_ratio=max_hf_gain_ratio)
     return search.for_target(target_reduction, slack_db=slack_db, speed_relax_db=speed_relax_db,
                              max_relax_db=max_relax_db, tolerance_db=tolerance_db, speed_slack_db=speed_slack_db)
 
@@ -241,7 +252,7 @@ class CertificateSearch:
         The turbine.
     wind_speed : float
         Operating point, m/s.
-    max_sensitivity, max_pitch_rate_ratio, m, omega, case_offsets, dense_omega
+    max_sensitivity, max_pitch_rate_ratio, m, omega, case_offsets, dense_omega, max_hf_gain_ratio
         As in :func:`specification_for_target`.
 
     Raises
@@ -259,7 +270,7 @@ class CertificateSearch:
     """
 
     def __init__(self, model, wind_speed, *, max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
-                 case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None):
+                 case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None, max_hf_gain_ratio=HF_GAIN_RATIO):
         from .. import spec
         self.model, self.m = model, float(m)
         self.wind_speed = v = model.check_wind_speed(wind_speed)
@@ -268,8 +279,12 @@ class CertificateSearch:
                       else as_omega(dense_omega, "dense_omega", allow_zero=False))
         self.base = spec.baseline_analysis(model, v, m=m, omega=omega)
         self._cases = _Cases(model, self.case_speeds, v)
-        self._youla_options = {"max_sensitivity": max_sensitivity, "max_pitch_rate_ratio": max_pitch_rate_ratio}
+        self.max_hf_gain_ratio = hf_ratio(max_hf_gain_ratio)
+        self._youla_options = {"max_sensitivity": max_sensitivity, "max_pitch_rate_ratio": max_pitch_rate_ratio,
+                               "max_hf_gain_ratio": self.max_hf_gain_ratio}
         self._youla = YoulaProblem(model, v, base=self.base, **self._youla_options)
+        # the bound on the dense grid's points in its band (the certificate is checked there too)
+        self._hf = hf_gain_bound(model, v, self.dense, self.max_hf_gain_ratio)
         self._youla_tower = None  # the same problem with a tower bound, made on first use (for_tower)
         self._designs = {}
 
@@ -288,10 +303,25 @@ class CertificateSearch:
                 # no implementable design: design_qft refuses such a controller (its loop opens
                 # wherever the pitch saturates), so that relaxation counts as one with no design
                 p = np.asarray(control.ss(controller).poles())
-                if not np.any(p.real > UNSTABLE_POLE_TOL * np.maximum(1.0, np.abs(p))):
+                if not np.any(p.real > UNSTABLE_POLE_TOL * np.maximum(1.0, np.abs(p))) and self.hf_met(controller):
                     rob = self._cases.excess(controller, self.dense)
             self._designs[g] = (d, rob)
         return self._designs[g]
+
+    def hf_met(self, controller) -> bool:
+        """Whether ``controller`` meets the high-frequency gain bound on the dense grid (True without one)."""
+        if self._hf is None:
+            return True
+        band = np.isfinite(self._hf)
+        return bool(np.all(np.abs(siso_response(controller, self.dense[band])) <= self._hf[band]))
+
+    def _hf_words(self):
+        """How the high-frequency gain bound enters an infeasibility message ('' without it)."""
+        if self.max_hf_gain_ratio is None:
+            return ""
+        return (f" under the high-frequency gain bound |C| ≤ {self.max_hf_gain_ratio:g}·|C_ROSCO| on {HF_OMEGA:g}-"
+                f"{HF_END:g} rad/s (max_hf_gain_ratio={self.max_hf_gain_ratio:g}; a larger one, or None to switch it "
+                "off, allows more)")
 
     def _reached(self, g, slack):
         d, rob = self._design(g)
@@ -330,10 +360,11 @@ class CertificateSearch:
             design, best, rob = self._reached(g, 0.0)
             if design is None or rob is None:
                 raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {v:g} m/s over the plant "
-                                 f"cases {speeds} m/s")
+                                 f"cases {speeds} m/s" + self._hf_words())
             if best < t + SEARCH_MARGIN_PP:
                 raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s with the speed map relaxed by "
-                                 f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs); relax it more")
+                                 f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs)"
+                                 + self._hf_words() + "; relax it more")
             lo_s, hi_s = 0.0, 40.0
             for _ in range(MAX_BISECTIONS):  # bounded: a tolerance below float64's spacing is never reached
                 if hi_s - lo_s <= tolerance_db:
@@ -342,7 +373,7 @@ class CertificateSearch:
                 reaches = _slack_promise(design, base, mid + rob[0]) >= t + SEARCH_MARGIN_PP
                 lo_s, hi_s = (mid, hi_s) if reaches else (lo_s, mid)
             return self._cases.with_strict(_target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t,
-                                                          self.m), self.dense)
+                                                          self.m, self.max_hf_gain_ratio), self.dense)
         # a ladder first, then bisection inside the first rung that reaches the target: the promise
         # over the plant cases is not monotone in g (bolder designs are less robust), so a bisection
         # over the whole range could step past the smallest relaxation that works
@@ -358,8 +389,8 @@ class CertificateSearch:
         if found is None:
             raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s over the plant cases {speeds} m/s "
                              f"with the speed map relaxed up to {max_relax_db:g} dB (best {best_red:.1f} % with "
-                             f"{slack:g} dB slack over the plant cases' needs); lower the target or the slack, or allow "
-                             "more pitch activity")
+                             f"{slack:g} dB slack over the plant cases' needs)" + self._hf_words()
+                             + "; lower the target or the slack, or allow more pitch activity")
         hi_g, best, best_rob = found
         for _ in range(MAX_BISECTIONS):
             if hi_g - lo_g <= tolerance_db:
@@ -371,7 +402,7 @@ class CertificateSearch:
             else:
                 lo_g = mid
         return self._cases.with_strict(_target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t,
-                                                      self.m), self.dense)
+                                                      self.m, self.max_hf_gain_ratio), self.dense)
 
     def for_tower(self, tower, target_reduction, *, relax_ladder_db=(0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0),
                   max_relax_db=12.0, speed_slack_db=0.2, margin_steps=4) -> TargetSpecification:
@@ -456,6 +487,9 @@ class CertificateSearch:
                     tried.append(f"{g:g} dB: no design")
                     break
                 controller = d.controller(self.model)
+                if not self.hf_met(controller):
+                    tried.append(f"{g:g} dB: over the high-frequency gain bound between grid points")
+                    break
                 speed_g = spec.speed_specification(self.model, self.wind_speed, margin_db=g)
                 checked = self._cases.spec_excess(controller, tower, speed_g, self.dense)
                 if checked is None:
@@ -469,7 +503,8 @@ class CertificateSearch:
                     # the check just made is that pair's: W_Ω relaxed further only lifts its bound,
                     # and the grid is refined around the same roots (ROSCO's speed map either way)
                     record = TargetSpecification(tower, speed, None, relax, 0.0, d, t, self.case_speeds,
-                                                 float(margin.max()), sslack, self.m)
+                                                 float(margin.max()), sslack, self.m,
+                                                 max_hf_gain_ratio=self.max_hf_gain_ratio)
                     return _checked_record(self.model, record, self._cases, tower, speed, *checked[1:])
                 tried.append(f"{g:g} dB, margin {margin.max():.2f} dB: {x:.2f} dB over W_MyT at {wk:.3g} rad/s "
                              f"({case:g} m/s)")
@@ -486,8 +521,8 @@ class CertificateSearch:
                 margin += np.max(np.where(near, profile[over][None, :] + 0.05, 0.0), axis=1)
             hopeless = hopeless + 1 if rung_hopeless else 0
         raise ValueError(f"no pitch design meets the tower specification at every plant case {self.case_speeds} m/s at "
-                         f"{self.wind_speed:g} m/s with the speed map relaxed up to {max_relax_db:g} dB ("
-                         + "; ".join(tried) + ")")
+                         f"{self.wind_speed:g} m/s with the speed map relaxed up to {max_relax_db:g} dB"
+                         + self._hf_words() + " (" + "; ".join(tried) + ")")
 
 
 class _Cases:
@@ -620,7 +655,7 @@ def _slack_promise(design, base, slack_db):
     return spec.promise_of(10 ** (slack_db / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
 
 
-def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target, m):
+def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target, m, kappa_hf):
     import control
 
     from .. import spec
@@ -634,7 +669,7 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     relax = max(g, speed_needed) + speed_slack
     speed = spec.speed_specification(model, float(wind_speed), margin_db=relax)
     return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, total, design, target,
-                               tuple(speeds), robust, speed_slack, float(m))
+                               tuple(speeds), robust, speed_slack, float(m), max_hf_gain_ratio=kappa_hf)
 
 
 def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> TargetSpecification:
@@ -726,5 +761,5 @@ def _checked_record(model, target, cases, tower, speed, w, t0, rs0):
     relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs0)))
     record = TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, design,
                                  target.target_reduction, cases.speeds, target.robustness_db, target.speed_slack_db,
-                                 target.m)
+                                 target.m, max_hf_gain_ratio=target.max_hf_gain_ratio)
     return cases.with_strict(record, w)

@@ -33,7 +33,7 @@ from ..closedloop import (
     refine_grid,
     siso_response,
 )
-from ..feasibility import TargetSpecification
+from ..feasibility import HF_END, HF_OMEGA, TargetSpecification, hf_gain_bound
 from .checks import spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, assemble_design
 from .tuner import TuningProblem
@@ -84,7 +84,11 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
         exact DEL promise. Every plant case meets its own W_i = T^ROSCO_i·W/T^ROSCO (the
         specification at that case's speed); ``options["strict_excess_db"]`` gives the largest
         excess of any case over the nominal W_MyT and W_Ω themselves (dB, the pair read strictly:
-        > 0 where a case exceeds the W the user sees).
+        > 0 where a case exceeds the W the user sees). With the high-frequency gain bound of
+        ``target.max_hf_gain_ratio`` the controller also meets |C_β| ≤ κ·|C_ROSCO| on
+        HF_OMEGA-HF_END (the dense grid's points there and 3P) with the order margin and is
+        strictly proper (its certificate is, and balanced truncation keeps D = 0); the check
+        "hf_gain" of ``pitch_check`` says so, and ``options["max_hf_gain_ratio"]`` records κ.
 
     Raises
     ------
@@ -120,6 +124,13 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
     if sharp.size:
         prob.set_design(np.unique(np.r_[prob.wd, sharp]))
     wdense = refine_grid(wdense, roots)
+    kappa = target.max_hf_gain_ratio
+    if kappa is not None:
+        # the bound's check includes 3P (three times the rated rotor speed, rad/s) where the model has one
+        three_p = 3.0 * float(getattr(model, "rated_rotor_speed", np.nan))
+        if HF_OMEGA <= three_p <= HF_END:
+            wdense = np.union1d(wdense, [three_p])
+        prob.controller_bound = (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     full = ct.ss(target.design.controller(model))
     strict = (np.abs(np.asarray(target.speed.response(wdense))), np.abs(np.asarray(target.tower.response(wdense))))
     cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict)
@@ -133,15 +144,15 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
                            parameters={"order": float(order)},
                            options=dict(structure="certificate", template_offsets=target.template_offsets,
                                         speed_relax_db=target.speed_relax_db, tower_slack_db=target.slack_db,
-                                        strict_excess_db=strict_excess,
+                                        strict_excess_db=strict_excess, max_hf_gain_ratio=kappa,
                                         max_sensitivity=max_sensitivity, min_decay=min_decay))
 
 
 def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
     """The lowest-order balanced truncation of ``full`` (its stable part; poles within
     :data:`ORDER_AXIS_TOL` of the axis kept) that meets every specification on ``omega`` at every
-    plant case, keeps |S| ≤ ``ms`` and is stable with decay ≥ ``min_decay``, each with the margin
-    :data:`ORDER_MARGIN_DB`; else ``full``. Each case meets its own W_i (ROSCO's map at its speed
+    plant case, keeps |S| ≤ ``ms``, meets ``prob.controller_bound`` (if any) strictly proper, and is
+    stable with decay ≥ ``min_decay``, each with the margin :data:`ORDER_MARGIN_DB`; else ``full``. Each case meets its own W_i (ROSCO's map at its speed
     times the nominal ratio). Returns (controller, order, (largest excess over the nominal W_MyT,
     over the nominal W_Ω) dB at any case: the pair read strictly, ``strict`` = (|W_Ω|, |W_MyT|) on
     ``omega``, reported beside it))."""
@@ -149,6 +160,7 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
     w_speed, w_tower = prob.weights(omega)
     ob = R[("gen_speed", "pitch_cmd")]
     shrink = 10 ** (-ORDER_MARGIN_DB / 20)
+    hf = None if prob.controller_bound is None else prob.controller_bound[0](omega)
     for n in range(min_order, full.nstates + 1):
         if n < full.nstates:
             try:
@@ -160,7 +172,8 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
         c = siso_response(cand, omega)[:, None]
         if (np.any(np.abs(closed_map(R, c, 0.0, "tower_base_my")) > shrink * w_tower)
                 or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > shrink * w_speed)
-                or np.any(np.abs(1 / (1 + c * ob)) > shrink * ms)):
+                or np.any(np.abs(1 / (1 + c * ob)) > shrink * ms)
+                or (hf is not None and (np.any(np.abs(c[:, 0]) > shrink * hf) or np.any(np.asarray(ct.ss(cand).D) != 0)))):
             continue
         with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
             warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")

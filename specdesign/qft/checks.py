@@ -11,6 +11,7 @@ import numpy as np
 
 from loopshaping import qft as lqft
 from loopshaping.check import check as lcheck
+from loopshaping.specs import controller_gain
 
 from .._checks import positive_scalar
 from ..closedloop import (
@@ -50,6 +51,8 @@ def loop_checks(prob, cb, ca, wdense):
         (pitch_check, atd_check, pitch_template, atd_template, pitch_specs, atd_specs): the
         :class:`loopshaping.check.CheckResult` of each loop, its
         :class:`loopshaping.templates.Template` and its list of :class:`loopshaping.qft.Spec`.
+        With ``prob.controller_bound`` the pitch loop's check includes "hf_gain", |C_β| ≤ the
+        bound on its band (wdense's points there); the specs returned are the loops' own.
     """
     plants, nom = prob.plants, prob.nom
 
@@ -100,7 +103,11 @@ def loop_checks(prob, cb, ca, wdense):
     atd_plants = [partial_loop(P, cb, "gen_speed")["tower_top_vel", "pitch_cmd"] for P in plants]
     pitch_t = lqft.Template.from_systems(pitch_plants, prob.wd, nom)
     atd_t = lqft.Template.from_systems(atd_plants, prob.wd, nom)
-    pitch_check = lcheck(pitch_t, cb, pitch_specs, wdense)
+    # the controller's own high-frequency gain bound is checked with the pitch loop's specifications
+    # (not a QFT bound of the loop: it is the same for every case)
+    gain = [] if prob.controller_bound is None else [controller_gain(prob.controller_bound[0], prob.controller_bound[1],
+                                                                     name="hf_gain")]
+    pitch_check = lcheck(pitch_t, cb, pitch_specs + gain, wdense)
     atd_check = lcheck(atd_t, ca, atd_specs, wdense)
     return pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs
 

@@ -26,7 +26,8 @@ from ..closedloop import (
     lightly_damped,
     refine_grid,
 )
-from ..feasibility import TargetSpecification, specification_for_target
+from ..feasibility import HF_END, HF_GAIN_RATIO, HF_OMEGA, TargetSpecification, hf_gain_bound, specification_for_target
+from ..feasibility.achievable import hf_ratio
 from .certificate import design_from_certificate
 from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign, assemble_design
@@ -139,6 +140,14 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             Required closed-loop decay rate, 1/s (poles left of −min_decay).
         keep_below : float, default 0.6
             Protected band of the notch specification, rad/s (power regulation).
+        max_hf_gain_ratio : float or None, default :data:`~specdesign.feasibility.HF_GAIN_RATIO`
+            κ of the high-frequency gain bound, |C_β(jω)| ≤ κ·|C_ROSCO(jω)| on HF_OMEGA-HF_END
+            (2-10 rad/s, 3P inside) with C_β strictly proper; None switches it off. With
+            ``spec="target"`` the certificate is made under it
+            (``specification_for_target(max_hf_gain_ratio=...)``, which refuses a target the bound
+            makes infeasible, naming it) and the design meets it with its order margin; a
+            TargetSpecification carries its own. The fixed structures are checked against it
+            (dense check "hf_gain").
         refine : int, default 2
             Rounds adding the dense check's failing frequencies to the design set.
         maxfev : int, default 3000
@@ -191,12 +200,14 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     if isinstance(spec, str) and spec not in ("target", "notch"):
         raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
                          "(tower, speed)")
-    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets"}
+    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets",
+                                "max_hf_gain_ratio"}
     if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
         named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
         raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
                         "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
-                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
+                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets, "
+                        "max_hf_gain_ratio")
     if speed_relax_db is None:
         speed_relax_db = SPEED_RELAX_DB
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
@@ -209,8 +220,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     if isinstance(spec, str) and spec == "target":
         # the plant cases the pair is certified on are the ones the design must meet it on
         offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
+        # the certificate meets the high-frequency gain bound, and so does the design reduced from it
+        hf = {"max_hf_gain_ratio": kwargs.pop("max_hf_gain_ratio")} if structure != "fixed" and "max_hf_gain_ratio" in kwargs else {}
         spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction,
-                                        **({} if offsets is None else {"case_offsets": offsets}))
+                                        **({} if offsets is None else {"case_offsets": offsets}), **hf)
     elif isinstance(spec, str):  # "notch"
         spec = None
     if structure == "certificate" and not isinstance(spec, TargetSpecification):
@@ -222,6 +235,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             raise TypeError("design_qft(spec=TargetSpecification) meets the pair on the plant cases it was certified on "
                             "(spec.case_speeds): make the specification with specification_for_target(..., "
                             "case_offsets=...) instead of passing template_offsets=")
+        if "max_hf_gain_ratio" in kwargs:
+            raise TypeError("design_qft(spec=TargetSpecification) meets the high-frequency gain bound its certificate "
+                            "was made with (spec.max_hf_gain_ratio): make the specification with "
+                            "specification_for_target(..., max_hf_gain_ratio=...) instead of passing it here")
         if set(kwargs) - allowed:
             raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
                             f"got {sorted(set(kwargs) - allowed)}")
@@ -306,7 +323,8 @@ def _given_spec(spec):
 def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec_reduction=15.0,
                    template_offsets=(-1.0, -0.5, 0.5, 1.0),
                    design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=6.0, tower_relax_omega=1.3,
-                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000) -> QFTDesign:
+                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=0.02, keep_below=0.6, refine=2, maxfev=3000,
+                   max_hf_gain_ratio=HF_GAIN_RATIO) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
     from .. import spec as sp
 
@@ -342,8 +360,10 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
     if t is None:
         t = float(promise.exact_del)  # the target the specification carries
 
+    kappa = hf_ratio(max_hf_gain_ratio)
+    bound = None if kappa is None else (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, speed_relax_db, max_sensitivity, base,
-                         speed_shaping=speed_shaping)
+                         speed_shaping=speed_shaping, controller_bound=bound)
     # Sharp features of the specs (the lightly damped tower-mode poles and zeros of every case's
     # ROSCO loop) are design frequencies and dense-check points too: a bound that holds on
     # both sides of a narrow dip of W can still fail inside it.
@@ -383,7 +403,7 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
                            options=dict(spec_reduction=spec_reduction, template_offsets=tuple(offsets),
                                         speed_relax_db=speed_relax_db, tower_relax_db=tower_relax_db,
                                         tower_relax_omega=tower_relax_omega, max_sensitivity=max_sensitivity,
-                                        min_decay=min_decay, refine_rounds=rounds),
+                                        min_decay=min_decay, refine_rounds=rounds, max_hf_gain_ratio=kappa),
                            checks=(pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs))
 
 

@@ -75,6 +75,10 @@ class TuningProblem:
         How the plant cases are evaluated (:func:`specdesign.closedloop.plant_responses`); the
         fixed-structure design keeps python-control's round-off, the certificate design the
         fast batched solve.
+    controller_bound : tuple, optional
+        (ω → allowed |C_β(jω)| in rad per rad/s, (low, high) band in rad/s): the high-frequency
+        gain bound the pitch controller must meet (:func:`specdesign.feasibility.hf_gain_bound`),
+        checked on the dense grid with the loops' specifications; None: none.
 
     Attributes
     ----------
@@ -112,7 +116,7 @@ class TuningProblem:
     def __init__(self, model: TurbineModel, v: float, speeds: Sequence[float], nominal: int, design_omega: ArrayLike,
                  tower_shaping: Callable[[np.ndarray], np.ndarray], speed_relax_db: float, max_sensitivity: float,
                  base: Baseline, speed_shaping: Callable[[np.ndarray], np.ndarray] | None = None,
-                 response_method: str = "python-control") -> None:
+                 response_method: str = "python-control", controller_bound: tuple | None = None) -> None:
         from ..spec import baseline_controllers
 
         self.v, self.speeds, self.nom = v, speeds, nominal
@@ -123,6 +127,7 @@ class TuningProblem:
         self.speed_gain = 10 ** (speed_relax_db / 20)
         self.speed_shaping = speed_shaping  # callable ω → W_Ω/T^ROSCO_{Ω,w} (nominal), or None: speed_gain
         self.ms = max_sensitivity
+        self.controller_bound = controller_bound
         self.base = base
         self.wf, self.S = base.omega, base.wind_psd
         self.Rf = plant_responses(self.plants, self.wf, method=response_method)
