@@ -21,7 +21,15 @@ from ..closedloop import (
     system_roots,
 )
 from ..fatigue import TOWER_M
-from .achievable import HF_END, HF_GAIN_RATIO, HF_OMEGA, AchievablePitch, YoulaProblem, hf_gain_bound, hf_ratio
+from .achievable import (
+    HF_END,
+    HF_GAIN_RATIO,
+    HF_OMEGA,
+    AchievablePitch,
+    YoulaProblem,
+    hf_gain_bound,
+    hf_ratio,
+)
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "RELAX_LADDER_DB",
            "SEARCH_MARGIN_PP", "UNSTABLE_POLE_TOL", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]

@@ -26,7 +26,14 @@ from ..closedloop import (
     lightly_damped,
     refine_grid,
 )
-from ..feasibility import HF_END, HF_GAIN_RATIO, HF_OMEGA, TargetSpecification, hf_gain_bound, specification_for_target
+from ..feasibility import (
+    HF_END,
+    HF_GAIN_RATIO,
+    HF_OMEGA,
+    TargetSpecification,
+    hf_gain_bound,
+    specification_for_target,
+)
 from ..feasibility.achievable import hf_ratio
 from .certificate import design_from_certificate
 from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
