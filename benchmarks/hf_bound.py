@@ -19,8 +19,8 @@ within the actuator's rate limit r (`model.pitch_rate_limit`):
 σ_lf the SD of ROSCO's measured pitch rate (BldPitch1, differentiated) below ω_hf. The default
 is the smallest κ over the wind speeds run (the tightest), rounded down to two significant
 figures; it is `specdesign.feasibility.HF_GAIN_RATIO`. The OpenFAST runs are cached under
-~/.cache/specdesign/hf_bound/ (keyed by wind speed, seed and length); the script rewrites the
-section "The default factor" of docs/feasibility.md between its markers.
+~/.cache/specdesign/hf_bound/ (keyed by wind speed, seed and length; $SPECDESIGN_HF_CACHE); the
+script rewrites the section "The default factor κ" of docs/feasibility.md between its markers.
 
 Run: nice -n 10 python benchmarks/hf_bound.py [--speeds 19 15 23] [--tmax 120] [--no-docs]
 """
@@ -32,6 +32,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+from comparison import splice
 from scipy import signal
 
 from specdesign import closedloop, spec
@@ -47,7 +48,7 @@ ROOT = Path(__file__).resolve().parents[1]
 HF_END = 10.0
 #: Start-up transient discarded from each run (s)
 TRANSIENT = 20.0
-START, END = "<!-- hf_bound.py: start -->", "<!-- hf_bound.py: end -->"
+START, END = "<!-- hf_bound.py: start -->", "<!-- hf_bound.py: end -->"  # also in benchmarks/frontier.py
 
 
 def cache_dir() -> Path:
@@ -112,7 +113,7 @@ def default_kappa(rows):
 
 
 def section(rows, kappa, tmax):
-    lines = [START, "",
+    lines = ["### The default factor κ", "",
              f"Measured by `nice -n 10 python benchmarks/hf_bound.py` (ROSCO in OpenFAST v5, IEA 15 MW monopile, "
              f"TurbSim NTM class B, seed {rows[0]['seed']}, {tmax:g} s of which the first {TRANSIENT:g} s are "
              "discarded; Welch, 40 s Hann segments). σ_hf: ROSCO's pitch rate driven by the measured generator-speed "
@@ -128,7 +129,7 @@ def section(rows, kappa, tmax):
                      f"({math.degrees(r['sigma_hf_measured']):.2e}) | {math.degrees(r['rate_limit']):.1f} °/s "
                      f"| {r['kappa']:.0f} |")
     lines += ["", f"Default: κ = **{kappa:g}** (the tightest wind speed, rounded down to two significant figures): "
-              "`specdesign.feasibility.HF_GAIN_RATIO`.", "", END]
+              "`specdesign.feasibility.HF_GAIN_RATIO`."]
     return "\n".join(lines)
 
 
@@ -145,13 +146,8 @@ def main(argv=None):
     text = section(rows, kappa, args.tmax)
     print(text)
     print(f"kappa = {kappa:g}")
-    if not args.no_docs:
-        doc = ROOT / "docs" / "feasibility.md"
-        old = doc.read_text()
-        if START not in old:
-            raise SystemExit(f"{doc}: markers {START!r} … {END!r} missing")
-        head, rest = old.split(START, 1)
-        doc.write_text(head + text + rest.split(END, 1)[1])
+    if not args.no_docs:  # between its markers (benchmarks/frontier.py keeps them when it rewrites the page)
+        splice(ROOT / "docs" / "feasibility.md", text, START, END, append=True)
 
 
 if __name__ == "__main__":
