@@ -14,6 +14,7 @@ from ..closedloop import (
     case_speeds,
     closed_loop,
     closed_map,
+    fine_pitch_lift,
     lightly_damped,
     plant_responses,
     refine_grid,
@@ -111,6 +112,11 @@ class TargetSpecification:
         κ of the high-frequency gain bound the certificate meets, |C_β| ≤ κ·|C_ROSCO| on
         :data:`~specdesign.feasibility.achievable.HF_OMEGA`-:data:`~specdesign.feasibility.achievable.HF_END`
         rad/s with C_β strictly proper (None: made without it); the design step meets it too.
+    held_lift_limit : tuple or None
+        (speed deficit rad/s, largest lift rad) for a pair made to be held below rated
+        (``held_below_rated``): the certificate's answer to that sustained deficit lifts the
+        pitch off fine pitch by at most the limit (:func:`specdesign.closedloop.fine_pitch_lift`),
+        and the design step's controller too; None: not required.
     """
 
     tower: object
@@ -126,6 +132,7 @@ class TargetSpecification:
     m: float = TOWER_M
     strict_excess: tuple = ()
     max_hf_gain_ratio: float | None = None
+    held_lift_limit: tuple | None = None
 
     @property
     def wind_speed(self) -> float:
@@ -149,7 +156,8 @@ class TargetSpecification:
 def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_db=0.5, speed_relax_db=None,
                              max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, max_relax_db=12.0, tolerance_db=0.05,
                              m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=0.2,
-                             dense_omega=None, max_hf_gain_ratio=HF_GAIN_RATIO) -> TargetSpecification:
+                             dense_omega=None, max_hf_gain_ratio=HF_GAIN_RATIO,
+                             held_below_rated=False) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
     A ladder (:data:`RELAX_LADDER_DB`) then bisection on the relaxation g of ROSCO's
@@ -208,6 +216,13 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
         HF_OMEGA-HF_END (2-10 rad/s, 3P inside) with C_β strictly proper (default
         :data:`~specdesign.feasibility.HF_GAIN_RATIO`, from OpenFAST: docs/feasibility.md;
         None switches it off). Checked on the dense grid too.
+    held_below_rated : bool
+        The pair's design is held below rated by a schedule (its lowest design speed): a
+        certificate counts only if its answer to the torque law's sustained speed deficit
+        (``model.torque_control``: pitch reference minus minimum speed) lifts the pitch off fine
+        pitch by at most the law's ``pitch_switch`` (:func:`specdesign.closedloop.fine_pitch_lift`;
+        above it ROSCO's torque state machine leaves the below-rated law, docs/below_rated.md).
+        Ignored for a model without a torque law.
 
     Returns
     -------
@@ -234,7 +249,8 @@ def specification_for_target(model, wind_speed, target_reduction=25.0, *, slack_
     search_options(tolerance_db, max_relax_db, speed_relax_db)
     search = CertificateSearch(model, wind_speed, max_sensitivity=max_sensitivity,
                                max_pitch_rate_ratio=max_pitch_rate_ratio, m=m, omega=omega, case_offsets=case_offsets,
-                               dense_omega=dense_omega, max_hf_gain_ratio=max_hf_gain_ratio)
+                               dense_omega=dense_omega, max_hf_gain_ratio=max_hf_gain_ratio,
+                               held_below_rated=held_below_rated)
     return search.for_target(target_reduction, slack_db=slack_db, speed_relax_db=speed_relax_db,
                              max_relax_db=max_relax_db, tolerance_db=tolerance_db, speed_slack_db=speed_slack_db)
 
@@ -260,7 +276,7 @@ class CertificateSearch:
         The turbine.
     wind_speed : float
         Operating point, m/s.
-    max_sensitivity, max_pitch_rate_ratio, m, omega, case_offsets, dense_omega, max_hf_gain_ratio
+    max_sensitivity, max_pitch_rate_ratio, m, omega, case_offsets, dense_omega, max_hf_gain_ratio, held_below_rated
         As in :func:`specification_for_target`.
 
     Raises
@@ -278,7 +294,8 @@ class CertificateSearch:
     """
 
     def __init__(self, model, wind_speed, *, max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
-                 case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None, max_hf_gain_ratio=HF_GAIN_RATIO):
+                 case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None, max_hf_gain_ratio=HF_GAIN_RATIO,
+                 held_below_rated=False):
         from .. import spec
         self.model, self.m = model, float(m)
         self.wind_speed = v = model.check_wind_speed(wind_speed)
@@ -293,6 +310,10 @@ class CertificateSearch:
         self._youla = YoulaProblem(model, v, base=self.base, **self._youla_options)
         # the bound on the dense grid's points in its band (the certificate is checked there too)
         self._hf = hf_gain_bound(model, v, self.dense, self.max_hf_gain_ratio)
+        law = getattr(model, "torque_control", None) if held_below_rated else None
+        # (speed deficit rad/s, largest lift rad): the model's gen_speed output is the rotor-shaft speed
+        self.held_lift_limit = None if law is None else (float(law.pitch_reference_speed - law.min_speed),
+                                                         float(law.pitch_switch))
         self._youla_tower = None  # the same problem with a tower bound, made on first use (for_tower)
         self._designs = {}
 
@@ -311,7 +332,8 @@ class CertificateSearch:
                 # no implementable design: design_qft refuses such a controller (its loop opens
                 # wherever the pitch saturates), so that relaxation counts as one with no design
                 p = np.asarray(control.ss(controller).poles())
-                if not np.any(p.real > UNSTABLE_POLE_TOL * np.maximum(1.0, np.abs(p))) and self.hf_met(controller):
+                if (not np.any(p.real > UNSTABLE_POLE_TOL * np.maximum(1.0, np.abs(p))) and self.hf_met(controller)
+                        and self.lift_met(controller)):
                     rob = self._cases.excess(controller, self.dense)
             self._designs[g] = (d, rob)
         return self._designs[g]
@@ -323,13 +345,25 @@ class CertificateSearch:
         band = np.isfinite(self._hf)
         return bool(np.all(np.abs(siso_response(controller, self.dense[band])) <= self._hf[band]))
 
+    def lift_met(self, controller) -> bool:
+        """Whether ``controller``, held below rated, keeps fine pitch (True unless ``held_below_rated``)."""
+        if self.held_lift_limit is None:
+            return True
+        deficit, limit = self.held_lift_limit
+        return fine_pitch_lift(controller, deficit) <= limit
+
     def _hf_words(self):
-        """How the high-frequency gain bound enters an infeasibility message ('' without it)."""
-        if self.max_hf_gain_ratio is None:
-            return ""
-        return (f" under the high-frequency gain bound |C| ≤ {self.max_hf_gain_ratio:g}·|C_ROSCO| on {HF_OMEGA:g}-"
-                f"{HF_END:g} rad/s (max_hf_gain_ratio={self.max_hf_gain_ratio:g}; a larger one, or None to switch it "
-                "off, allows more)")
+        """How the high-frequency gain bound and the held design's lift limit enter an
+        infeasibility message ('' without either)."""
+        words = ""
+        if self.max_hf_gain_ratio is not None:
+            k = self.max_hf_gain_ratio
+            words += (f" under the high-frequency gain bound |C| ≤ {k:g}·|C_ROSCO| on {HF_OMEGA:g}-{HF_END:g} rad/s "
+                      f"(max_hf_gain_ratio={k:g}; a larger one, or None to switch it off, allows more)")
+        if self.held_lift_limit is not None:
+            words += (f"{' and' if words else ''} keeping fine pitch when held below rated (lift ≤ "
+                      f"{np.degrees(self.held_lift_limit[1]):.2f}° for the torque law's speed deficit: held_below_rated)")
+        return words
 
     def _reached(self, g, slack):
         d, rob = self._design(g)
@@ -381,7 +415,8 @@ class CertificateSearch:
                 reaches = _slack_promise(design, base, mid + rob[0]) >= t + SEARCH_MARGIN_PP
                 lo_s, hi_s = (mid, hi_s) if reaches else (lo_s, mid)
             return self._cases.with_strict(_target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t,
-                                                          self.m, self.max_hf_gain_ratio), self.dense)
+                                                          self.m, self.max_hf_gain_ratio, self.held_lift_limit),
+                                           self.dense)
         # a ladder first, then bisection inside the first rung that reaches the target: the promise
         # over the plant cases is not monotone in g (bolder designs are less robust), so a bisection
         # over the whole range could step past the smallest relaxation that works
@@ -410,7 +445,8 @@ class CertificateSearch:
             else:
                 lo_g = mid
         return self._cases.with_strict(_target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t,
-                                                      self.m, self.max_hf_gain_ratio), self.dense)
+                                                      self.m, self.max_hf_gain_ratio, self.held_lift_limit),
+                                       self.dense)
 
     def for_tower(self, tower, target_reduction, *, relax_ladder_db=(0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0),
                   max_relax_db=12.0, speed_slack_db=0.2, margin_steps=4) -> TargetSpecification:
@@ -498,6 +534,9 @@ class CertificateSearch:
                 if not self.hf_met(controller):
                     tried.append(f"{g:g} dB: over the high-frequency gain bound between grid points")
                     break
+                if not self.lift_met(controller):
+                    tried.append(f"{g:g} dB: lifts the pitch off fine pitch when held below rated")
+                    break
                 speed_g = spec.speed_specification(self.model, self.wind_speed, margin_db=g)
                 checked = self._cases.spec_excess(controller, tower, speed_g, self.dense)
                 if checked is None:
@@ -512,7 +551,8 @@ class CertificateSearch:
                     # and the grid is refined around the same roots (ROSCO's speed map either way)
                     record = TargetSpecification(tower, speed, None, relax, 0.0, d, t, self.case_speeds,
                                                  float(margin.max()), sslack, self.m,
-                                                 max_hf_gain_ratio=self.max_hf_gain_ratio)
+                                                 max_hf_gain_ratio=self.max_hf_gain_ratio,
+                                                 held_lift_limit=self.held_lift_limit)
                     return _checked_record(self.model, record, self._cases, tower, speed, *checked[1:])
                 tried.append(f"{g:g} dB, margin {margin.max():.2f} dB: {x:.2f} dB over W_MyT at {wk:.3g} rad/s "
                              f"({case:g} m/s)")
@@ -663,7 +703,7 @@ def _slack_promise(design, base, slack_db):
     return spec.promise_of(10 ** (slack_db / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
 
 
-def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target, m, kappa_hf):
+def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target, m, kappa_hf, held):
     import control
 
     from .. import spec
@@ -677,7 +717,8 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     relax = max(g, speed_needed) + speed_slack
     speed = spec.speed_specification(model, float(wind_speed), margin_db=relax)
     return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, total, design, target,
-                               tuple(speeds), robust, speed_slack, float(m), max_hf_gain_ratio=kappa_hf)
+                               tuple(speeds), robust, speed_slack, float(m), max_hf_gain_ratio=kappa_hf,
+                               held_lift_limit=held)
 
 
 def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> TargetSpecification:
@@ -769,5 +810,6 @@ def _checked_record(model, target, cases, tower, speed, w, t0, rs0):
     relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs0)))
     record = TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, design,
                                  target.target_reduction, cases.speeds, target.robustness_db, target.speed_slack_db,
-                                 target.m, max_hf_gain_ratio=target.max_hf_gain_ratio)
+                                 target.m, max_hf_gain_ratio=target.max_hf_gain_ratio,
+                                 held_lift_limit=target.held_lift_limit)
     return cases.with_strict(record, w)

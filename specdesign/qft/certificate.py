@@ -28,6 +28,7 @@ from ..closedloop import (
     DESIGN_MAX_SENSITIVITY,
     closed_loop,
     closed_map,
+    fine_pitch_lift,
     lightly_damped,
     plant_responses,
     refine_grid,
@@ -133,7 +134,8 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
         prob.controller_bound = (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     full = ct.ss(target.design.controller(model))
     strict = (np.abs(np.asarray(target.speed.response(wdense))), np.abs(np.asarray(target.tower.response(wdense))))
-    cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict)
+    cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict,
+                                             target.held_lift_limit)
     ca = ct.tf([0.0], [1.0])
     c = siso_response(cb, base.omega)[:, None]
     performance = prob.performance_of(c, np.zeros_like(c))
@@ -145,14 +147,16 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
                            options=dict(structure="certificate", template_offsets=target.template_offsets,
                                         speed_relax_db=target.speed_relax_db, tower_slack_db=target.slack_db,
                                         strict_excess_db=strict_excess, max_hf_gain_ratio=kappa,
+                                        held_lift_limit=target.held_lift_limit,
                                         max_sensitivity=max_sensitivity, min_decay=min_decay))
 
 
-def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
+def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict, held=None):
     """The lowest-order balanced truncation of ``full`` (its stable part; poles within
     :data:`ORDER_AXIS_TOL` of the axis kept) that meets every specification on ``omega`` at every
-    plant case, keeps |S| ≤ ``ms``, meets ``prob.controller_bound`` (if any) strictly proper, and is
-    stable with decay ≥ ``min_decay``, each with the margin :data:`ORDER_MARGIN_DB`; else ``full``. Each case meets its own W_i (ROSCO's map at its speed
+    plant case, keeps |S| ≤ ``ms``, meets ``prob.controller_bound`` (if any) strictly proper, keeps
+    its fine-pitch lift within ``held`` = (deficit rad/s, limit rad) if given, and is stable with
+    decay ≥ ``min_decay``, each with the margin :data:`ORDER_MARGIN_DB`; else ``full``. Each case meets its own W_i (ROSCO's map at its speed
     times the nominal ratio). Returns (controller, order, (largest excess over the nominal W_MyT,
     over the nominal W_Ω) dB at any case: the pair read strictly, ``strict`` = (|W_Ω|, |W_MyT|) on
     ``omega``, reported beside it))."""
@@ -178,7 +182,7 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
         with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
             warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
-        if decay >= min_decay / shrink:
+        if decay >= min_decay / shrink and (held is None or fine_pitch_lift(cand, held[0]) <= held[1]):
             return cand, n, _strict_excess(R, cand, omega, strict)
     return full, full.nstates, _strict_excess(R, full, omega, strict)
 

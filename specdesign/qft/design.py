@@ -155,6 +155,12 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             makes infeasible, naming it) and the design meets it with its order margin; a
             TargetSpecification carries its own. The fixed structures are checked against it
             (dense check "hf_gain").
+        held_below_rated : bool, default False
+            Only with ``spec="target"``: the design is held below rated by a schedule (its
+            lowest design speed): the certificate, and the controller reduced from it, lift the
+            pitch off fine pitch for the torque law's speed deficit by at most its
+            ``pitch_switch`` (``specification_for_target(held_below_rated=True)``;
+            :func:`held_lift`). :func:`design_schedule` sets it for its lowest speed.
         refine : int, default 2
             Rounds adding the dense check's failing frequencies to the design set.
         maxfev : int, default 3000
@@ -197,7 +203,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
     """
     options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
-    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
+    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db", "held_below_rated"})
     if unknown:  # named here, not as a TypeError of an internal function
         raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
     if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
@@ -208,13 +214,16 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
                          "(tower, speed)")
     fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets",
-                                "max_hf_gain_ratio"}
+                                "max_hf_gain_ratio", "held_below_rated"}
     if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
         named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
         raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
                         "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
                         "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets, "
                         "max_hf_gain_ratio")
+    if "held_below_rated" in kwargs and not (isinstance(spec, str) and spec == "target" and structure != "fixed"):
+        raise TypeError("design_qft's held_below_rated belongs to the specification-driven design (spec='target'): "
+                        "the certificate is made to keep fine pitch below rated")
     if speed_relax_db is None:
         speed_relax_db = SPEED_RELAX_DB
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
@@ -228,7 +237,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         # the plant cases the pair is certified on are the ones the design must meet it on
         offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
         # the certificate meets the high-frequency gain bound, and so does the design reduced from it
-        hf = {"max_hf_gain_ratio": kwargs.pop("max_hf_gain_ratio")} if structure != "fixed" and "max_hf_gain_ratio" in kwargs else {}
+        hf = {k: kwargs.pop(k) for k in ("max_hf_gain_ratio", "held_below_rated") if structure != "fixed" and k in kwargs}
         spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction,
                                         **({} if offsets is None else {"case_offsets": offsets}), **hf)
     elif isinstance(spec, str):  # "notch"
@@ -242,10 +251,11 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             raise TypeError("design_qft(spec=TargetSpecification) meets the pair on the plant cases it was certified on "
                             "(spec.case_speeds): make the specification with specification_for_target(..., "
                             "case_offsets=...) instead of passing template_offsets=")
-        if "max_hf_gain_ratio" in kwargs:
-            raise TypeError("design_qft(spec=TargetSpecification) meets the high-frequency gain bound its certificate "
-                            "was made with (spec.max_hf_gain_ratio): make the specification with "
-                            "specification_for_target(..., max_hf_gain_ratio=...) instead of passing it here")
+        for k in ("max_hf_gain_ratio", "held_below_rated"):
+            if k in kwargs:
+                raise TypeError(f"design_qft(spec=TargetSpecification) meets the {k} its certificate was made with "
+                                f"(spec.max_hf_gain_ratio, spec.held_lift_limit): make the specification with "
+                                f"specification_for_target(..., {k}=...) instead of passing it here")
         if set(kwargs) - allowed:
             raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
                             f"got {sorted(set(kwargs) - allowed)}")
@@ -458,7 +468,10 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         As :func:`design_qft`, for each wind speed whose design does not meet every spec; and
         for a model with a torque law when the lowest design, which a schedule holds below
         rated, lifts the pitch off fine pitch for the speed deficit there
-        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``).
+        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``). With
+        ``"target"`` that design is made with ``held_below_rated=True`` (its certificate and
+        its reduction keep the lift within ``pitch_switch``), so the warning is for the notch
+        designs or a target that cannot be met so.
 
     Examples
     --------
@@ -483,10 +496,14 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
                         enumerate(target_reduction if per_speed else [target_reduction] * vs.size)])
 
     out = []
-    for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
-                      disable=not progress):
-        out.append(design_qft(model, float(v), float(tr), spec=specification, **kwargs))
-    _warn_held_design(model, out[int(np.argmin(vs))])
+    lowest = int(np.argmin(vs))
+    held = specification == "target" and getattr(model, "torque_control", None) is not None
+    for i, (v, tr) in enumerate(tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)",
+                                     unit="speed", disable=not progress)):
+        # the lowest design is held below rated: made to keep fine pitch for the speed deficit there
+        extra = {"held_below_rated": True} if held and i == lowest else {}
+        out.append(design_qft(model, float(v), float(tr), spec=specification, **kwargs, **extra))
+    _warn_held_design(model, out[lowest])
     return tuple(out)
 
 
