@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from specdesign import feasibility as fz
 from specdesign import fatigue, simulate, spec
+from specdesign import feasibility as fz
 from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw
 

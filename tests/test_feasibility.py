@@ -8,7 +8,8 @@ import warnings
 import numpy as np
 import pytest
 
-from specdesign import closedloop, feasibility as fz, spec, validate
+from specdesign import closedloop, spec, validate
+from specdesign import feasibility as fz
 from specdesign.feasibility import conditions as fzc
 from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw

@@ -13,7 +13,8 @@ import warnings
 import numpy as np
 import pytest
 
-from specdesign import closedloop, feasibility as fz, spectral, wind
+from specdesign import closedloop, spectral, wind
+from specdesign import feasibility as fz
 from specdesign.qft import design_qft
 from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw

@@ -65,6 +65,7 @@ from .achievable import (
                          AchievablePitch,
                          YoulaProblem,
                          achievable_pitch,
+                         hf_check_omega,
                          hf_gain_bound,
 )
 from .conditions import (
@@ -88,4 +89,4 @@ from .target import (
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
            "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks",
            "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification", "CertificateSearch",
-           "shape_whole_band", "HF_GAIN_RATIO", "HF_OMEGA", "HF_END", "hf_gain_bound"]
+           "shape_whole_band", "HF_GAIN_RATIO", "HF_OMEGA", "HF_END", "hf_check_omega", "hf_gain_bound"]

@@ -13,7 +13,7 @@ from ..fatigue import TOWER_M
 from ..spectral import trapezoid_weights
 
 __all__ = ["HF_END", "HF_GAIN_RATIO", "HF_OMEGA", "SOLVER_FALLBACK_OPTIONS", "SOLVER_OPTIONS", "YOULA_REAL_POLES",
-           "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "hf_gain_bound", "YoulaProblem"]
+           "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "hf_check_omega", "hf_gain_bound", "YoulaProblem"]
 
 
 #: Poles (rad/s) of the Youla basis: real poles spanning the wind band, and lightly damped pairs
@@ -33,7 +33,7 @@ HF_END = 10.0
 #: the IEA 15 MW monopile with a TurbSim field at 19 m/s; the control band's pitch rate (ROSCO's)
 #: and κ times ROSCO's pitch rate driven by the measured generator-speed content above HF_OMEGA,
 #: in quadrature, keep 3σ within the pitch-rate limit.
-HF_GAIN_RATIO = None
+HF_GAIN_RATIO = 110.0
 #: The Youla design keeps |C| this factor below the bound at its grid points, so that the bound
 #: holds between them (a smooth Y interpolated between points 1.7 % apart: < 1 %) and after the
 #: QFT step's balanced truncation (which must meet it by ORDER_MARGIN_DB = 0.01 dB).
@@ -116,6 +116,19 @@ def hf_gain_bound(model, wind_speed, omega, max_hf_gain_ratio=HF_GAIN_RATIO, hf_
     out = np.full(w.shape, np.inf)
     out[band] = kappa * np.abs(siso_response(spec.baseline_controller(model, float(wind_speed)), w[band]))
     return out
+
+
+def hf_check_omega(model, omega):
+    """Where the high-frequency gain bound is checked: the points of ``omega`` on
+    [HF_OMEGA, HF_END], both ends and 3P (three times ``model.rated_rotor_speed``, where the
+    model has one), rad/s. A bound relative to ROSCO's fast-falling |C| binds at the band's
+    ends, which a logarithmic grid of the whole band need not hold."""
+    w = np.asarray(omega, float)
+    extra = [HF_OMEGA, HF_END]
+    three_p = 3.0 * float(getattr(model, "rated_rotor_speed", np.nan))
+    if HF_OMEGA <= three_p <= HF_END:
+        extra.append(three_p)
+    return np.union1d(w[(w >= HF_OMEGA) & (w <= HF_END)], extra)
 
 
 @dataclass(frozen=True)

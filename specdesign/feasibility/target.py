@@ -28,6 +28,7 @@ from .achievable import (
     HF_OMEGA,
     AchievablePitch,
     YoulaProblem,
+    hf_check_omega,
     hf_gain_bound,
     hf_ratio,
 )
@@ -308,8 +309,9 @@ class CertificateSearch:
         self._youla_options = {"max_sensitivity": max_sensitivity, "max_pitch_rate_ratio": max_pitch_rate_ratio,
                                "max_hf_gain_ratio": self.max_hf_gain_ratio}
         self._youla = YoulaProblem(model, v, base=self.base, **self._youla_options)
-        # the bound on the dense grid's points in its band (the certificate is checked there too)
-        self._hf = hf_gain_bound(model, v, self.dense, self.max_hf_gain_ratio)
+        # the bound where the certificate is checked: the dense grid's points in its band, its ends and 3P
+        self._hf_omega = hf_check_omega(model, self.dense)
+        self._hf = hf_gain_bound(model, v, self._hf_omega, self.max_hf_gain_ratio)
         law = getattr(model, "torque_control", None) if held_below_rated else None
         # (speed deficit rad/s, largest lift rad): the model's gen_speed output is the rotor-shaft speed
         self.held_lift_limit = None if law is None else (float(law.pitch_reference_speed - law.min_speed),
@@ -342,8 +344,7 @@ class CertificateSearch:
         """Whether ``controller`` meets the high-frequency gain bound on the dense grid (True without one)."""
         if self._hf is None:
             return True
-        band = np.isfinite(self._hf)
-        return bool(np.all(np.abs(siso_response(controller, self.dense[band])) <= self._hf[band]))
+        return bool(np.all(np.abs(siso_response(controller, self._hf_omega)) <= self._hf))
 
     def lift_met(self, controller) -> bool:
         """Whether ``controller``, held below rated, keeps fine pitch (True unless ``held_below_rated``)."""

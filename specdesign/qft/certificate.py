@@ -34,7 +34,13 @@ from ..closedloop import (
     refine_grid,
     siso_response,
 )
-from ..feasibility import HF_END, HF_OMEGA, TargetSpecification, hf_gain_bound
+from ..feasibility import (
+    HF_END,
+    HF_OMEGA,
+    TargetSpecification,
+    hf_check_omega,
+    hf_gain_bound,
+)
 from .checks import spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, assemble_design
 from .tuner import TuningProblem
@@ -127,10 +133,8 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
     wdense = refine_grid(wdense, roots)
     kappa = target.max_hf_gain_ratio
     if kappa is not None:
-        # the bound's check includes 3P (three times the rated rotor speed, rad/s) where the model has one
-        three_p = 3.0 * float(getattr(model, "rated_rotor_speed", np.nan))
-        if HF_OMEGA <= three_p <= HF_END:
-            wdense = np.union1d(wdense, [three_p])
+        # the bound's check includes its band's ends and 3P (hf_check_omega)
+        wdense = np.union1d(wdense, hf_check_omega(model, wdense))
         prob.controller_bound = (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     full = ct.ss(target.design.controller(model))
     strict = (np.abs(np.asarray(target.speed.response(wdense))), np.abs(np.asarray(target.tower.response(wdense))))

@@ -31,6 +31,7 @@ from ..feasibility import (
     HF_GAIN_RATIO,
     HF_OMEGA,
     TargetSpecification,
+    hf_check_omega,
     hf_gain_bound,
     specification_for_target,
 )
@@ -379,6 +380,8 @@ def _design_single(model, wind_speed, target_reduction=25.0, *, given=None, spec
 
     kappa = hf_ratio(max_hf_gain_ratio)
     bound = None if kappa is None else (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
+    if bound is not None:  # the bound's check includes its band's ends and 3P
+        wdense = np.union1d(wdense, hf_check_omega(model, wdense))
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, speed_relax_db, max_sensitivity, base,
                          speed_shaping=speed_shaping, controller_bound=bound)
     # Sharp features of the specs (the lightly damped tower-mode poles and zeros of every case's
