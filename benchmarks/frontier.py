@@ -149,11 +149,12 @@ def main(argv=None):
         print(f"{v:g} m/s: 25 % needs the speed map relaxed {ts.speed_relax_db:.2f} dB; promise "
               f"{ts.promise.exact_del:.2f} % ({dt:.1f} s)")
     # ---------------------------------------------------------------- a high-frequency gain bound
-    kappas = (None, 20.0, 50.0, 100.0)
+    kappas = (None, 20.0, 50.0, 100.0, fz.HF_GAIN_RATIO)
     lines += ["", "## A high-frequency gain bound and what it costs", "",
-              "`YoulaProblem(model, v, max_sensitivity=1.8, max_hf_gain_ratio=κ)`: |Y| = |C·S| ≤ κ·|C_ROSCO| "
+              "`YoulaProblem(model, v, max_sensitivity=1.8, max_hf_gain_ratio=κ)`: |C| ≤ κ·|C_ROSCO| "
               f"from {fz.achievable.HF_OMEGA:g} rad/s to 10 rad/s (3P = 2.375 rad/s inside) and Y(∞) = 0 (C strictly "
-              "proper): above the crossover S → 1 and this bounds the controller's gain, convexly. The nominal "
+              "proper), imposed convexly as |Y| ≤ b/(1 + b·|P_Ω,β|), b = κ·|C_ROSCO| (C = Y/(1 − P_Ω,β·Y)), "
+              "with 2 % of room for between the grid points. The nominal "
               "achievable DEL reduction at a speed relaxation of 3 dB, per κ (none: the frontier's design, whose "
               "gain at 10 rad/s is thousands of times ROSCO's):", "",
               "| wind speed | " + " | ".join("no bound" if k is None else f"κ = {k:g}" for k in kappas) + " |",
