@@ -175,3 +175,24 @@ def test_the_default_25_percent_target_is_refused_under_the_default_bound(model)
         design_qft(model, 19.0)  # 25 %: the best certified promise under the bound is 24.8 % here
     d = design_qft(model, 19.0, 25.0, max_hf_gain_ratio=None)  # switched off: the pair of before
     assert d.success and d.options["max_hf_gain_ratio"] is None
+
+
+def test_the_bode_and_nichols_figures_draw_the_bound(model, qft_designs):
+    import matplotlib.pyplot as plt
+
+    from specdesign.plots.qft import plot_design_bode, plot_design_nichols
+
+    d = qft_designs[19.0]
+    fig = plot_design_bode(d, model)
+    assert len(fig.axes) == 3  # the pitch controller's gain under the two maps
+    labels = [line.get_label() for line in fig.axes[2].get_lines()]
+    bound = [line for line in fig.axes[2].get_lines() if "high-frequency gain bound" in line.get_label()]
+    assert len(bound) == 1, labels
+    w, y = bound[0].get_data()
+    # the line is κ·|C_ROSCO| in dB on 2-10 rad/s, ROSCO's controller evaluated here
+    c_r = np.abs(closedloop.siso_response(spec.baseline_controller(model, 19.0), w))
+    np.testing.assert_allclose(y, 20 * np.log10(HF_GAIN_RATIO * c_r), rtol=1e-9)
+    assert w.min() >= HF_OMEGA and w.max() <= HF_END
+    nic = plot_design_nichols(d, model=model)
+    assert any("high-frequency gain bound" in line.get_label() for line in nic.axes[0].get_lines())
+    plt.close("all")
