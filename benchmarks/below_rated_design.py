@@ -1,6 +1,6 @@
 """The design loop below rated and through the transition (issue 16, part 1): the numbers of docs/below_rated.md.
 
-Run: python benchmarks/below_rated_design.py [--part analysis|designs|held|transition|torque|torque_design|bins|all]
+Run: python benchmarks/below_rated_design.py [--part analysis|designs|held|transition|torque|torque_design|torque_gap|bins|all]
 Prints
 (0) ``analysis``: ``spec.baseline_analysis`` from cut-in to cut-out (the torque law closed in the
     plant; ROSCO's pitch loop linearised at the trim: open below rated): tower DEL and ΔD% (~5 s);
@@ -23,6 +23,10 @@ Prints
     max_power_loss_pct=1.0)`` at 5-10 m/s for 10-30 % (gain, promise, costs, or the refusal), and
     the designs for 10 % at 7, 20 % at 8-9 m/s and 25 % at 8 m/s run nonlinear (``TorqueDesign.torque_law``: ROSCO's
     mode-3 PI), ROSCO's pitch PI, 20 paired seeds x 600 s (issue 28: the promise checked over >= 20 seeds; ~2 min);
+(3c) ``torque_gap``: where the 8 m/s 20 % design's promise and rainflow part, one change per row (the linearised
+    turbine in the time domain, the nonlinear one with the law the linearisation assumes, the torque limits, the
+    compiled laws, the pitch PI, the filter/integral/reference, the minimum speed), 20 paired seeds x 600 s each,
+    and the laws' linearisation against the nonlinear loop's small-amplitude response (~2 min);
 (4) ``bins``: every 2 m/s wind bin 3-25 m/s x 6 paired seeds x 600 s, ROSCO vs the demo's
     schedule (the same campaign as ``python -m specdesign demo --lifetime``) vs the schedule from
     13 m/s, and both again with the stiffer torque loop: tower DEL change per bin with its SE,
@@ -41,6 +45,7 @@ import numpy as np
 from specdesign import qft, validate
 from specdesign.closedloop.maps import state_space_response
 from specdesign.fatigue import del_rainflow
+from specdesign.qft.torque_design import torque_law_response
 from specdesign.rosco import rosco_baseline, rosco_scheduled
 from specdesign.simulate import scheduled, simulate
 from specdesign.spec import baseline_analysis
@@ -234,8 +239,15 @@ def torque_law_nonlinear(model, speeds=(5.0, 7.0, 8.0, 9.0)):
 TORQUE_SEEDS = range(1, 21)
 
 
+def _tower_dels(model, ctrl, v, torque_control, linear=False):
+    """Rainflow tower-base DEL (N·m, m = 4, 1 Hz) per seed of TORQUE_SEEDS x 600 s, and the run."""
+    r = simulate(model, ctrl, [v], seeds=TORQUE_SEEDS, duration=600.0, torque_control=torque_control, linear=linear)
+    return np.array([del_rainflow(x, 4.0, 600.0) for x in r["tower_base_my"][0]]), r
+
+
 def torque_design(model):
-    print("\n## The torque-loop design: qft.design_torque(model, v, target, max_power_loss_pct=1.0) (linear, class B, m = 4)")
+    print("\n## The torque-loop design: qft.design_torque(model, v, target, max_power_loss_pct=1.0) (linear, class B, m = 4, "
+          "both torque laws linearised as simulated)")
     print("| v (m/s) | target (%) | k (MN·m per rad/s) | k / law stiffness | promise (%) | G → ∞ (%) | Ω SD (rad/s) | "
           "torque SD (MN·m) | power SD (MW) | mean power (%) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -257,7 +269,7 @@ def torque_design(model):
     print("|---|---|---|---|---|---|---|---|---|---|")
     ros = rosco_scheduled(model)
     tl0 = model.torque_control
-    for v, target in ((7.0, 10.0), (8.0, 20.0), (8.0, 25.0), (9.0, 20.0)):
+    for v, target in ((7.0, 10.0), (8.0, 10.0), (8.0, 20.0), (9.0, 20.0), (10.0, 20.0)):
         try:
             d = qft.design_torque(model, v, target, max_power_loss_pct=1.0)
         except ValueError as e:
@@ -266,16 +278,102 @@ def torque_design(model):
         law = d.torque_law(model.torque_control)
         runs = {}
         for name, tl in (("rosco", model.torque_control), ("design", law)):
-            r = simulate(model, ros, [v], seeds=TORQUE_SEEDS, duration=600.0, torque_control=tl)
+            dels, r = _tower_dels(model, ros, v, tl)
             om = r["gen_speed"][0]
-            runs[name] = (np.array([del_rainflow(x, 4.0, 600.0) for x in r["tower_base_my"][0]]), r["power"][0].mean(axis=1),
-                          om.std(axis=1).mean(), 100 * np.mean(om > tl0.min_speed + 0.005),
+            runs[name] = (dels, r["power"][0].mean(axis=1), om.std(axis=1).mean(), 100 * np.mean(om > tl0.min_speed + 0.005),
                           100 * np.mean(om > 0.97 * tl0.reference_speed))
         ch, se = _paired_change(runs["design"][0], runs["rosco"][0])
         dp = 100 * (runs["design"][1].mean() / runs["rosco"][1].mean() - 1)
         print(f"| {v:g} | {target:g} | {law.kp / 1e6:.1f} | {ch:+.1f} | {se:.1f} | {-d.promise:+.1f} | "
               f"{runs['rosco'][2]:.4f} → {runs['design'][2]:.4f} | {dp:+.2f} | {d.power_change_pct:+.2f} | "
               f"{runs['rosco'][3]:.0f} / {runs['rosco'][4]:.1f} |")
+
+
+class _HeldPitch:
+    """A callable controller (the simulator's slow path): pitch held at the trim, generator torque ``law(Ω)`` (N·m)."""
+
+    def __init__(self, pitch, law):
+        self.pitch, self.law = pitch, law
+
+    def __call__(self, t, y):
+        om = y["gen_speed"]
+        return np.full(om.shape, self.pitch), self.law(om)
+
+
+def torque_gap(model, v=8.0, target=20.0):
+    """The gap between design_torque's promise and rainflow, one change per row (issue 28 item 6)."""
+    d = qft.design_torque(model, v, target, max_power_loss_pct=1.0)
+    op, law0 = model.trim(v), model.torque_control
+    law = d.torque_law(law0)
+    K, om0, tq0, k = law0.k_opt, op.rotor_speed, op.gen_torque, d.gain
+    print(f"\n## The gap at {v:g} m/s, {target:g} % design (k = {k / 1e6:.1f} MN·m per rad/s, kp = {law.kp / 1e6:.1f}), "
+          f"{len(TORQUE_SEEDS)} paired seeds x 600 s: tower-base DEL change vs the row's baseline, one change per row")
+    print("| row | baseline → design (what changes from the row above) | tower DEL change (%) | SE (pp) | linear (%) |")
+    print("|---|---|---|---|---|")
+    # linear rows: the promise as designed, and the general form with linearize's law (K·Ω² on the raw speed) + k·δΩ
+    A, B, C, D = qft.torque_general_form(model, v, d.omega)
+    index = 100 * (del_spectral(d.omega, np.abs((A - B * k) / (C - D * k)) ** 2 * d.wind_psd, 4.0)
+                   / del_spectral(d.omega, np.abs(A) ** 2 * d.wind_psd, 4.0) - 1)
+    print(f"| a | design_torque's promise: ROSCO's law → the mode-3 PI, both linearised as simulated "
+          f"(torque_law_response) | | | {-d.promise:+.1f} |")
+    print(f"| b | the same k on linearize's law: K·Ω² → K·Ω² + k·δΩ, raw speed, no filter, PI or reference | | | {index:+.1f} |")
+    rows = []
+    hold = model.trim(v).pitch
+    clip = (law0.min_torque, min(law0.rated_torque, law0.max_torque))
+    rows.append(("c", "b in the time domain: the linearised turbine (`linear=True`), pitch held, rainflow",
+                 _HeldPitch(hold, lambda om: np.full(om.shape, tq0)), _HeldPitch(hold, lambda om: tq0 + k * (om - om0)),
+                 None, None, True))
+    rows.append(("d", "c on the nonlinear turbine (aerodynamics, K·Ω² curvature)",
+                 _HeldPitch(hold, lambda om: K * om**2), _HeldPitch(hold, lambda om: K * om**2 + k * (om - om0)),
+                 None, None, False))
+    rows.append(("e", f"d with the torque held within [{clip[0]:g}, {clip[1] / 1e6:.2f} MN·m] (ROSCO's limits)",
+                 _HeldPitch(hold, lambda om: np.clip(K * om**2, *clip)),
+                 _HeldPitch(hold, lambda om: np.clip(K * om**2 + k * (om - om0), *clip)), None, None, False))
+    zero = ct.tf([0.0], [1.0])
+    zero.name = "pitch held"
+    ros = rosco_scheduled(model)
+    region2 = {"min_speed": 0.3}  # region 2 throughout (the trim is 0.576 rad/s): no minimum-speed PI
+    bare = region2 | {"filter_corner": 30.0}
+    b_bare = dataclasses.replace(law0, **bare)
+    d_bare = dataclasses.replace(law, **bare, ki=0.0, reference_corner=1e-9, max_rate=1e12)
+    rows.append(("f", ("e as the compiled laws (`simulate(..., torque_control=law)`): mode 1 vs mode 3 with ki = 0, fixed "
+                 "reference, no speed filter (corner 30 rad/s) or rate limit, minimum speed 0.3 rad/s"), zero, zero,
+                 b_bare, d_bare, False))
+    rows.append(("g", "f with ROSCO's pitch PI", ros, ros, b_bare, d_bare, False))
+    rows.append(("h", ("g with the laws as designed (ROSCO's speed filter, the PI's integral, the moving reference, the "
+                 "rate limit)"), ros, ros, dataclasses.replace(law0, **region2), dataclasses.replace(law, **region2), False))
+    rows.append(("i", "h with ROSCO's minimum speed 0.524 rad/s (region 1.5): the nonlinear check above", ros, ros, law0,
+                 law, False))
+    for row, what, c_base, c_design, t_base, t_design, linear in rows:
+        base, _ = _tower_dels(model, c_base, v, t_base, linear)
+        new, _ = _tower_dels(model, c_design, v, t_design, linear)
+        ch, se = _paired_change(new, base)
+        print(f"| {row} | {what} | {ch:+.1f} | {se:.1f} | |")
+    print("\nThe laws linearised as simulated against the nonlinear loop at small amplitude: pitch held, wind "
+          f"{v:g} + 0.02·sin(ω₀t) m/s, first harmonic of the tower-base moment over 600 s after 600 s (the design's law)")
+    print("| ω₀ (rad/s) | |T| nonlinear (MN·m per m/s) | as simulated: amplitude, phase error | linearize's K·Ω² + k·δΩ: "
+          "amplitude, phase error |")
+    print("|---|---|---|---|")
+    w0s = np.array([0.03, 0.1, 0.3, 1.0])
+    A, B, C, D = qft.torque_general_form(model, v, w0s)
+    G = 2 * K * om0 - torque_law_response(model, law, v, w0s)
+    for i, w0 in enumerate(w0s):
+        measured = _small_amplitude(model, zero, law, v, w0)
+        lin, idx = (A[i] + B[i] * G[i]) / (C[i] + D[i] * G[i]), (A[i] - B[i] * k) / (C[i] - D[i] * k)
+        cells = [f"{100 * (abs(x / measured) - 1):+.2f} %, {np.degrees(np.angle(x / measured)):+.2f}°" for x in (lin, idx)]
+        print(f"| {w0:g} | {abs(measured) / 1e6:.2f} | {cells[0]} | {cells[1]} |")
+
+
+def _small_amplitude(model, ctrl, law, v, w0, amp=0.02, settle=600.0):
+    """T_MyT,w(jω₀) of the nonlinear loop: the first harmonic of the tower-base moment (N·m per m/s) under v + amp·sin(ω₀t)."""
+    dur = np.ceil(600.0 / (2 * np.pi / w0)) * 2 * np.pi / w0
+    t = np.arange(0.0, settle + dur + 1.0, 0.1)
+    r = simulate(model, ctrl, [v], wind=(v + amp * np.sin(w0 * t))[None, None], duration=round(dur, 1), transient=settle,
+                 torque_control=law, wind_dt=0.1)
+    tt = r.time + settle
+    c = np.linalg.lstsq(np.column_stack([np.sin(w0 * tt), np.cos(w0 * tt), np.ones_like(tt)]), r["tower_base_my"][0, 0],
+                        rcond=None)[0]
+    return (c[0] + 1j * c[1]) / amp
 
 
 def _merge(a, b, names):
@@ -357,8 +455,8 @@ def held_below_rated(model):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("--part", default="all", choices=["analysis", "designs", "held", "transition", "torque", "torque_design", "bins",
-                                                     "all"])
+    ap.add_argument("--part", default="all", choices=["analysis", "designs", "held", "transition", "torque", "torque_design", "torque_gap",
+                                                     "bins", "all"])
     part = ap.parse_args().part
     m = iea15mw()
     if part in ("analysis", "all"):
@@ -374,5 +472,7 @@ if __name__ == "__main__":
         torque_law_nonlinear(m)
     if part in ("torque_design", "all"):
         torque_design(m)
+    if part in ("torque_gap", "all"):
+        torque_gap(m)
     if part in ("bins", "all"):
         every_bin(m)

@@ -133,7 +133,8 @@ def predictions(model, controllers, kinds, speeds, *, volterra_seeds, duration):
             continue
         raw[name] = {}
         for k, o, m in outs:
-            lin = np.array([linear_prediction(model, c, v, output=o, m=m, omega=prediction_grid(duration)).del_ for v in speeds])
+            lin = np.array([linear_prediction(model, c, v, output=o, m=m, omega=prediction_grid(duration),
+                                             record_length=duration).del_ for v in speeds])
             vol = np.array([volterra_prediction(model, c, v, seeds=volterra_seeds, duration=duration, m=m,
                                                 output=o).del_ for v in speeds])
             raw[name][k] = (lin, vol)

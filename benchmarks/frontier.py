@@ -100,7 +100,7 @@ def main(argv=None):
     lines += ["", "## The frontier: what a pitch controller can promise", "",
               "Per relaxation g of ROSCO's generator-speed map (|T_Ω,w| ≤ 10^(g/20)·|T^ROSCO_Ω,w| on "
               "0.001-10 rad/s; every spectral figure here counts the variance about each 600 s record's mean, "
-              "S_W·(1 − sinc²(ωT/2)), `spec.record_window`, so that it does not depend on where the grid "
+              "S_W·(1 − sinc²(ωT/2)), `wind.record_window`, so that it does not depend on where the grid "
               "starts: tests/test_spectral_band.py), with |S| ≤ 2, integral action (S(0) = 0, as ROSCO's PI) and no more pitch-rate "
               "SD than ROSCO: *achievable* is the "
               "exact (Dirlik, 1 Hz, m = 4) DEL reduction of the convex Youla design "

@@ -132,7 +132,7 @@ def dc_gain_cost(w=100.0, omegas=(0.005, 0.01, 0.02, 0.03)):
 # ----------------------------------------------------------------------------- evaluation
 def _variances(model, c, v):
     """(total, low-band) variance of the linear tower-base moment, |T|²S_W on the prediction grid."""
-    p = validate.linear_prediction(model, c, v, m=M, omega=validate.prediction_grid(DUR))
+    p = validate.linear_prediction(model, c, v, m=M, omega=validate.prediction_grid(DUR), record_length=DUR)
     low = p.omega < LOW_BAND
     return np.trapezoid(p.psd, p.omega), np.trapezoid(p.psd[low], p.omega[low])
 

@@ -110,7 +110,7 @@ def main(argv=None):
         "stability of every case). Pitch only (no ATD).",
         "",
         "Band: every spectral figure of the design step (promise, linear prediction) counts the variance about "
-        "each 600 s record's mean, S_W·(1 − sinc²(ωT/2)) (`spec.record_window`), on 0.001-10 rad/s (400 points, "
+        "each 600 s record's mean, S_W·(1 − sinc²(ωT/2)) (`wind.record_window`), on 0.001-10 rad/s (400 points, "
         "`spec.default_omega`): halving the lowest frequency or doubling the density moves the promise by "
         "< 0.01 pp at 15 and 19 m/s (tests/test_spectral_band.py). Reproducibility: the certificate search counts "
         "a relaxation as reaching the target only by `SEARCH_MARGIN_PP` (0.01 pp), the order is the lowest that "

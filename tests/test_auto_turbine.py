@@ -79,7 +79,7 @@ def test_auto_shaped_controller_reduces_tower_fatigue(model, design, shaped):
     # through the tower spec's bounds, but less than design_qft's 25 % target.
     cl = closedloop.closed_loop(model.linearize(19.0), shaped.controller.tf(), design.atd_controller, warn=False)
     w = design.baseline.omega
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     s_w = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     red = 100 * (1 - closedloop.closed_loop_del(cl, w, s_w, 4.0) / design.baseline.del_1hz)
     assert 10.0 < red <= design.del_reduction + 1.0

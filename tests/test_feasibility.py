@@ -161,7 +161,7 @@ def test_a_specification_for_a_target_promises_it(model, target19):
     from specdesign import spectral, wind
 
     w = np.geomspace(0.001, 10.0, 2000)
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     s_w = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     t_r = closedloop.t_tower_wind(model.linearize(19.0), rosco_baseline(model, 19.0), w)
     red = 100 * (1 - spectral.del_spectral(w, np.abs(target19.tower.response(w)) ** 2 * s_w, 4.0)

@@ -220,7 +220,7 @@ def test_stability_damping_states_and_del(design, model, plant, specs):
 def hinf_wind(model, omega):
     from specdesign import wind
 
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     w = np.asarray(omega, float)
     return wind.rotor_effective_spectrum(omega, V, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
 

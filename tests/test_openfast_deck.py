@@ -3,13 +3,16 @@ case and seed, the TurbSim cache: fast, with fake executables (shell scripts) st
 OpenFAST and TurbSim (tests/test_openfast_run.py runs the real ones)."""
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip("openfast_io")
 
 from specdesign.openfast import (CAMPAIGN_CHANNELS, Deck, OpenFASTInstall, OpenFASTRunError, iea15mw_monopile,
                                  run_case, write_case)
+from specdesign.openfast import wave_seed_for
 from specdesign.openfast.turbsim import turbsim_field
+from specdesign.wind import seed_for
 from specdesign.validate.openfast_campaign import as_discon
 
 
@@ -148,3 +151,22 @@ def test_campaign_controllers_must_be_compiled(tmp_path, library):
     e.parameters = tmp_path / "missing.in"
     with pytest.raises(FileNotFoundError, match="missing.in"):
         as_discon(e)
+
+
+def test_each_run_has_its_own_sea(tmp_path, library):
+    # SeaState's WaveSeed(1) from the (speed, seed) of the run: the wind seed + WAVE_SEED_OFFSET,
+    # distinct from every TurbSim seed (seed_for: 1000·seed + round(10·speed)) and the same for
+    # every controller at that (speed, seed)
+    assert wave_seed_for(19.0, 2) == seed_for(19.0, 2) + 500 == 2690
+    seeds = {seed_for(v, s) for v in np.arange(3.0, 30.5, 0.5) for s in range(1, 9)}
+    assert not seeds & {wave_seed_for(v, s) for v in np.arange(3.0, 30.5, 0.5) for s in range(1, 9)}
+    deck = iea15mw_monopile()
+    case = write_case(deck, tmp_path / "w", tmax=10.0, wind_speed=19.0, library=library, wave_seed=wave_seed_for(19.0, 2))
+    fst = _keys(case.fst)
+    assert _keys(case.folder / fst["SeaStFile"])["WaveSeed(1)"] == "2690"
+    default = write_case(deck, tmp_path / "d", tmax=10.0, wind_speed=19.0, library=library)
+    assert _keys(default.folder / _keys(default.fst)["SeaStFile"])["WaveSeed(1)"] == "123456789"  # the deck's
+    with pytest.raises(TypeError, match="wave_seed"):
+        write_case(deck, tmp_path / "x", tmax=10.0, wind_speed=19.0, library=library, wave_seed=2.5)
+    with pytest.raises(ValueError, match="wave_seed"):
+        write_case(deck, tmp_path / "x", tmax=10.0, wind_speed=19.0, library=library, wave_seed=2**31)

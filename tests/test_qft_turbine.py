@@ -161,7 +161,7 @@ def test_specs_hold_on_a_dense_grid_recomputed_by_interconnect(model, design):
 def test_design_reaches_the_target_and_beats_the_promise(model, design):
     # independent DEL computation: interconnect + Dirlik on |T|² S_W
     w = design.baseline.omega
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     s_w = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     P = model.linearize(19.0)
     new = closedloop.closed_loop(P, design.pitch_controller, design.atd_controller, warn=False)

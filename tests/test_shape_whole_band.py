@@ -94,7 +94,7 @@ def test_the_whole_band_specification_at_25_mps_promises_the_target_and_is_met(m
     # the promise, recomputed independently: Dirlik DEL on |W|²S_W against ROSCO's |T|²S_W
     w = np.geomspace(0.0005, 20.0, 4000)
     t_rosco = np.abs(closedloop.t_tower_wind(model.linearize(25.0), rosco_baseline(model, 25.0), w))
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     psd = wind.rotor_effective_spectrum(w, 25.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     del_w = spectral.del_spectral(w, np.abs(ts.tower.response(w)) ** 2 * psd, 4.0)
     del_r = spectral.del_spectral(w, t_rosco**2 * psd, 4.0)

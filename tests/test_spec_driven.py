@@ -55,7 +55,7 @@ def test_the_specification_promises_the_target_recomputed_independently(model, c
     # Dirlik DEL of |W_MyT|²S_W against ROSCO's |T|²S_W, on another grid, with the wind
     # spectrum and ROSCO's loop built here (not the Baseline's)
     w = np.geomspace(0.001, 10.0, 2000)
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     s_w = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     t_r = closedloop.t_tower_wind(model.linearize(19.0), rosco_baseline(model, 19.0), w)
     red = 100 * (1 - spectral.del_spectral(w, np.abs(ts.tower.response(w)) ** 2 * s_w, 4.0)
@@ -252,7 +252,7 @@ def test_an_element_specification_promises_the_target_and_is_met(model, elements
     w = np.geomspace(0.0005, 20.0, 4000)
     plant = model.linearize(19.0)
     t_rosco = np.abs(closedloop.t_tower_wind(plant, rosco_baseline(model, 19.0), w))
-    # variance about each 600 s record's mean (spec.record_window), written out: 1 − sinc²(ωT/2)
+    # variance about each 600 s record's mean (wind.record_window), written out: 1 − sinc²(ωT/2)
     psd = wind.rotor_effective_spectrum(w, 19.0, model.rotor_radius) * (1 - (np.sin(300.0 * w) / (300.0 * w)) ** 2)
     del_w = spectral.del_spectral(w, np.abs(w_spec.response(w)) ** 2 * psd, 4.0)
     del_r = spectral.del_spectral(w, t_rosco**2 * psd, 4.0)

@@ -629,7 +629,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
     t_speed0 = _response(cl0, omega, "gen_speed")
     speed_excess0 = float(np.max(20 * np.log10(np.abs(t_speed) / np.abs(t_speed0))))
     # windowed as the baseline's (variance about each record's mean): the DELs converge in the grid's lowest ω
-    wind_psd = wind.rotor_effective_spectrum(omega, v, model.rotor_radius) * spec.record_window(omega)
+    wind_psd = wind.rotor_effective_spectrum(omega, v, model.rotor_radius) * wind.record_window(omega)
     t_tower0 = _response(cl0, omega, "tower_base_my")
     del0 = float(spectral.del_spectral(omega, np.abs(t_tower0) ** 2 * wind_psd, m))
     del1 = float(spectral.del_spectral(omega, np.abs(t_tower) ** 2 * wind_psd, m))

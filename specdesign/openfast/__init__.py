@@ -8,7 +8,8 @@
 - :func:`find_openfast`, :func:`build_openfast` (the executables: found, or built from source
   into a cache; :class:`OpenFASTInstall`)
 - :class:`Deck`, :func:`iea15mw_monopile` (the shipped v5.0 deck), :func:`write_case`,
-  :func:`run_case` (case folders written with openfast-io and run in a subprocess)
+  :func:`run_case` (case folders written with openfast-io and run in a subprocess),
+  :func:`wave_seed_for` (each run's sea)
 - :func:`linearize_deck` (a deck → OpenFAST trim-and-linearise runs at several wind speeds →
   :class:`LinearTurbine`; :func:`write_linearization_case` writes one case)
 """
@@ -41,6 +42,7 @@ _LAZY = {
     "write_case": ".deck",
     "run_case": ".deck",
     "CAMPAIGN_CHANNELS": ".deck",
+    "wave_seed_for": ".deck",
     "linearize_deck": ".linearize",
     "write_linearization_case": ".linearize",
     "LinearizationCase": ".linearize",

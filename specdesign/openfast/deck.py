@@ -11,6 +11,7 @@ import contextlib
 import copy
 import io
 import math
+import numbers
 import os
 import resource
 import signal
@@ -22,10 +23,12 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from ..wind import seed_for
 from .install import OpenFASTInstall, check_deck_version, find_openfast
 from .outputs import OpenFASTOutput, read_outputs
 
-__all__ = ["Deck", "Case", "OpenFASTRunError", "iea15mw_monopile", "write_case", "run_case", "CAMPAIGN_CHANNELS"]
+__all__ = ["Deck", "Case", "OpenFASTRunError", "iea15mw_monopile", "write_case", "run_case", "CAMPAIGN_CHANNELS", "wave_seed_for",
+           "WAVE_SEED_OFFSET"]
 
 _SHIPPED = Path(__file__).resolve().parents[1] / "data" / "openfast" / "IEA-15-240-RWT-Monopile" / "IEA-15-240-RWT-Monopile.fst"
 
@@ -185,13 +188,35 @@ def read_deck_cached(fst: str, mtime: float) -> dict:
     return reader.fst_vt
 
 
+#: Offset of a run's wave seed from its wind seed (:func:`specdesign.wind.seed_for`, which is
+#: ``1000·seed + round(10·speed)``): below the next seed's block and above every wind speed's
+#: own offset up to 50 m/s, so no sea shares its seed with any TurbSim field.
+WAVE_SEED_OFFSET = 500
+
+
+def wave_seed_for(wind_speed: float, seed: int) -> int:
+    """SeaState's wave seed of the run at ``wind_speed`` (m/s) and wind ``seed``.
+
+    Each (speed, seed) has its own sea, as it has its own TurbSim field, and every controller
+    of a campaign meets the same sea at the same (speed, seed): runs stay paired while the
+    seed-to-seed spread includes the waves'.
+
+    Examples
+    --------
+    >>> from specdesign.openfast.deck import wave_seed_for
+    >>> wave_seed_for(19.0, 2)
+    2690
+    """
+    return seed_for(wind_speed, seed) + WAVE_SEED_OFFSET
+
+
 def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed: float,
                wind_file: str | os.PathLike | None = None, seed: int | None = None,
                library: str | os.PathLike | None = None, parameters: str | os.PathLike | None = None,
                controller_dt: float | None = None, dt: float | None = None, dt_out: float | None = None,
                channels: Sequence[str] | None = CAMPAIGN_CHANNELS,
                initial_pitch: float | None = None, initial_rotor_speed: float | None = None, hydro: bool = True,
-               name: str | None = None) -> Case:
+               wave_seed: int | None = None, name: str | None = None) -> Case:
     """Write a case folder from a deck with openfast-io (its reader and its writer).
 
     Parameters
@@ -233,6 +258,9 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
         Initial rotor speed (rad/s); default the deck's.
     hydro : bool, default True
         Keep SeaState and HydroDyn on (as the deck has them); False switches both off.
+    wave_seed : int, optional
+        SeaState's first wave seed (``WaveSeed(1)``, a 32-bit signed integer): a sea of its own
+        per run; default the deck's (the same sea in every case).
     name : str, optional
         Case name; default the folder's name.
 
@@ -301,6 +329,12 @@ def write_case(deck: Deck, folder: str | os.PathLike, *, tmax: float, wind_speed
         ed["RotSpeed"] = initial_rotor_speed * 30.0 / math.pi  # rad/s → rpm
     if not hydro:
         fst["CompSeaSt"], fst["CompHydro"] = 0, 0
+    if wave_seed is not None:
+        if isinstance(wave_seed, bool) or not isinstance(wave_seed, numbers.Integral):
+            raise TypeError(f"wave_seed must be an integer (SeaState's WaveSeed(1)), got {type(wave_seed).__name__}")
+        if not -2**31 <= wave_seed < 2**31:
+            raise ValueError(f"wave_seed={wave_seed!r} must lie in [-2**31, 2**31) (SeaState's WaveSeed(1), 32-bit)")
+        vt["SeaState"]["WaveSeed1"] = int(wave_seed)
     if channels is not None:
         _set_outputs(vt, channels)
     from openfast_io.FAST_writer import InputWriter_OpenFAST  # heavy, as in read_deck_cached

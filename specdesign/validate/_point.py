@@ -114,7 +114,8 @@ def campaign_point(model, controllers, v, seeds, duration, dt, record_dt, transi
             omega, p = welch_psd(r[k][0], r.dt, nperseg)
             out["welch"][k].append(p)  # (S, nω) per seed: the campaign averages the cells it assembles
         if predict and has_linear_form(c):
-            pr = linear_prediction(model, c, v, m=m, omega=prediction_grid(duration), turbulence_class=turbulence_class)
+            pr = linear_prediction(model, c, v, m=m, omega=prediction_grid(duration), turbulence_class=turbulence_class,
+                                   record_length=duration)
             out["pred"].append(pr.del_)
             if sw is None:  # the same for every controller at this speed (its disc coherence is costly)
                 sw = wmod.rotor_effective_spectrum(omega, v, radius, turbulence_class=turbulence_class)

@@ -22,7 +22,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..fatigue import TOWER_M
-from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, write_case
+from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
 from ..openfast.series import series_from_openfast
 from ..openfast.turbsim import TURBSIM_GRID, turbsim_field
@@ -210,7 +210,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                 "transient": float(transient), "dt": dt, "record_dt": float(record_dt), "m": float(m),
                 "turbulence_class": turbulence_class, "grid_points": int(grid_points), "grid_size": float(grid_size),
                 "hydro": bool(hydro), "openfast": install.version, "initial_conditions": bool(initial_conditions),
-                "nperseg": None if nperseg is None else int(nperseg)}
+                "nperseg": None if nperseg is None else int(nperseg), "waves": "wave_seed_for(speed, seed)"}
     trim = _trim(deck) if initial_conditions else None
     tmp = None
     if folder is None:
@@ -242,7 +242,8 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         case = write_case(deck, _run_folder(root, run), tmax=transient + duration, wind_speed=v, wind_file=wind.path,
                           seed=s, library=c.library, parameters=c.parameters, controller_dt=c.dt, dt=dt, dt_out=record_dt,
                           channels=CAMPAIGN_CHANNELS, initial_pitch=init[0], initial_rotor_speed=init[1],
-                          hydro=hydro, name=f"{_slug(name)}_{v:g}mps_seed{s}")
+                          hydro=hydro, wave_seed=wave_seed_for(v, s) if hydro else None,
+                          name=f"{_slug(name)}_{v:g}mps_seed{s}")
         out = run_case(case, install, cpu_limit=cpu_limit, timeout=timeout, nice=nice)
         return _post(case, out, settings, meta, keep=s in kept, wind=wind)
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import spectral, wind
+from ..wind import LOWEST_OMEGA, RECORD_LENGTH, record_window
 from .._checks import positive_scalar
 from ..closedloop import local_response, t_output_wind, unstable_message, unstable_poles
 from ..closedloop.maps import state_space_response
@@ -97,13 +98,19 @@ class LinearPrediction:
     sd: float
 
 
-def prediction_grid(duration: float = 600.0, omega_max: float = 30.0, n: int = 3000) -> np.ndarray:
-    """Log-spaced frequency grid for a prediction.
+def prediction_grid(duration: float = RECORD_LENGTH, omega_max: float = 30.0, n: int = 3000) -> np.ndarray:
+    """Log-spaced frequency grid for a prediction over records of ``duration`` seconds.
+
+    The grid starts at :data:`specdesign.wind.LOWEST_OMEGA` scaled to the record (a tenth of its
+    fundamental 2π/duration): with :func:`specdesign.wind.record_window` weighting the wind
+    spectrum, what lies below is negligible, so the prediction is converged in its lowest
+    frequency as the specification's promise is, on the same band (a grid that started sharply
+    at 2π/duration, unwindowed, left the prediction to where the grid happened to stop).
 
     Parameters
     ----------
     duration : float, default 600.0
-        Record length (s): the grid starts at 2π/duration, the longest period it resolves.
+        Record length (s) whose cycles the prediction counts.
     omega_max : float, default 30.0
         Highest frequency (rad/s).
     n : int, default 3000
@@ -122,14 +129,16 @@ def prediction_grid(duration: float = 600.0, omega_max: float = 30.0, n: int = 3
     Examples
     --------
     >>> w = prediction_grid(600.0, 30.0, 5)
-    >>> round(float(w[0]), 6), float(w[-1])
-    (0.010472, 30.0)
+    >>> float(w[0]), float(w[-1])
+    (0.001, 30.0)
     """
-    return np.geomspace(2 * np.pi / positive_scalar(duration, "duration"), positive_scalar(omega_max, "omega_max"), int(n))
+    lo = LOWEST_OMEGA * RECORD_LENGTH / positive_scalar(duration, "duration")
+    return np.geomspace(lo, positive_scalar(omega_max, "omega_max"), int(n))
 
 
 def linear_prediction(model, controller, wind_speed: float, *, output: str = "tower_base_my", m: float = TOWER_M,
-                      omega=None, turbulence_class: str = "B", method: str = "dirlik") -> LinearPrediction:
+                      omega=None, turbulence_class: str = "B", method: str = "dirlik",
+                      record_length: float = RECORD_LENGTH) -> LinearPrediction:
     """|T_{y,w}|²·S_W and its DEL by a spectral method (Dirlik by default) at one wind speed.
 
     Parameters
@@ -146,11 +155,15 @@ def linear_prediction(model, controller, wind_speed: float, *, output: str = "to
     m : float, default 4.0
         Wöhler exponent of the DEL.
     omega : array_like, optional
-        Frequency grid (rad/s); default :func:`prediction_grid` (600 s, 30 rad/s).
+        Frequency grid (rad/s); default :func:`prediction_grid` of ``record_length`` (to 30 rad/s).
     turbulence_class : {"A", "B", "C"}, default "B"
         IEC NTM class of S_W (:func:`specdesign.wind.rotor_effective_spectrum`).
     method : str, default "dirlik"
         Spectral DEL method of :func:`specdesign.spectral.del_spectral`.
+    record_length : float, default 600.0
+        Length (s) of the records whose cycles are predicted: S_W is weighted by
+        :func:`specdesign.wind.record_window` (the variance about each record's mean, as the
+        specification's promise and the rainflow count of each record see it).
 
     Returns
     -------
@@ -166,9 +179,9 @@ def linear_prediction(model, controller, wind_speed: float, *, output: str = "to
     bad = unstable_poles(loop_plant(model), controller, wind_speed)
     if bad.size:
         raise ValueError(unstable_message(controller, wind_speed, bad) + "; a linear prediction of an unstable loop is meaningless")
-    w = prediction_grid() if omega is None else np.asarray(omega, dtype=float)
+    w = prediction_grid(record_length) if omega is None else np.asarray(omega, dtype=float)
     radius = rotor_radius(model)
-    sw = wind.rotor_effective_spectrum(w, wind_speed, radius, turbulence_class=turbulence_class)
+    sw = wind.rotor_effective_spectrum(w, wind_speed, radius, turbulence_class=turbulence_class) * record_window(w, record_length)
     t = closed_loop_response(model, controller, wind_speed, w, output)
     psd = np.abs(t) ** 2 * sw
     return LinearPrediction(omega=w, psd=psd, del_=float(spectral.del_spectral(w, psd, m, method=method)),
