@@ -123,19 +123,18 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
               else lqft.check_grid(dense_omega, "dense_omega"))
     tower_shaping = spec_ratio(target.tower, base.system)
     speed_shaping = spec_ratio(target.speed, sp.speed_specification(model, v).baseline)
+    kappa = target.max_hf_gain_ratio
+    bound = None if kappa is None else (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, 0.0, max_sensitivity, base,
-                         speed_shaping=speed_shaping, response_method="batched")
+                         speed_shaping=speed_shaping, response_method="batched", controller_bound=bound)
     roots = lightly_damped(np.concatenate([spec_roots(target.tower), spec_roots(target.speed)]))
     sharp = np.abs(roots[roots.imag > 0])
     sharp = sharp[(sharp >= wdense[0]) & (sharp <= wdense[-1])]
     if sharp.size:
         prob.set_design(np.unique(np.r_[prob.wd, sharp]))
     wdense = refine_grid(wdense, roots)
-    kappa = target.max_hf_gain_ratio
-    if kappa is not None:
-        # the bound's check includes its band's ends and 3P (hf_check_omega)
+    if kappa is not None:  # the bound's check includes its band's ends and 3P (hf_check_omega)
         wdense = np.union1d(wdense, hf_check_omega(model, wdense))
-        prob.controller_bound = (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     full = ct.ss(target.design.controller(model))
     strict = (np.abs(np.asarray(target.speed.response(wdense))), np.abs(np.asarray(target.tower.response(wdense))))
     cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict,

@@ -183,6 +183,8 @@ class TuningProblem:
             New design frequencies, rad/s (replaces ``wd``, ``Rd``, ``WO``, ``WM``).
         """
         self.wd = np.asarray(omega, float)
+        # the controller's high-frequency gain bound on wd (rad per rad/s; inf outside its band)
+        self._gain_bound = None if self.controller_bound is None else self.controller_bound[0](self.wd)
         self.Rd = plant_responses(self.plants, self.wd, ("gen_speed", "tower_base_my", "tower_top_vel"),
                                   method=self.response_method)
         self.WO, self.WM = self.weights(self.wd)
@@ -200,7 +202,8 @@ class TuningProblem:
         numpy.ndarray
             20·log10(bound/|map|), dB (≥ 0 where met), shape (5, n_omega, n_cases), in the
             order: generator speed, tower load, pitch-loop margin (ATD closed), ATD-loop
-            margin (pitch loop closed), margin at the actuator.
+            margin (pitch loop closed), margin at the actuator; with ``controller_bound`` a
+            sixth row, 20·log10(bound/|C_β|) (the same for every case; 100 dB outside its band).
         """
         nb, db, na, da = controller_polys(x)
         s = 1j * self.wd[:, None]
@@ -212,13 +215,17 @@ class TuningProblem:
         ob, zb = R[("gen_speed", "pitch_cmd")], R[("tower_top_vel", "pitch_cmd")]
         d = 1 + c * ob + k * zb
         with np.errstate(divide="ignore"):
-            return np.stack([
+            rows = [
                 20 * np.log10(self.WO / np.abs(to)),
                 20 * np.log10(self.WM / np.abs(tm)),
                 20 * np.log10(self.ms * np.abs(d) / np.abs(1 + k * zb)),  # pitch loop, ATD closed
                 20 * np.log10(self.ms * np.abs(d) / np.abs(1 + c * ob)),  # ATD loop, pitch closed
                 20 * np.log10(self.ms * np.abs(d)),  # at the actuator
-            ])
+            ]
+            if self._gain_bound is not None:  # finite outside the band too: the SLSQP constraints are numbers
+                gain = np.minimum(20 * np.log10(self._gain_bound[:, None] / np.abs(c)), 100.0)
+                rows.append(np.broadcast_to(gain, to.shape))
+            return np.stack(rows)
 
     def max_real(self, x: ArrayLike) -> np.ndarray:
         """Largest closed-loop pole real part (1/s) per case, full interconnection.
@@ -343,7 +350,7 @@ class TuningProblem:
         Returns
         -------
         numpy.ndarray
-            1-D: the 5·n_omega·n_cases bound margins (dB, less :data:`PERFORMANCE_SAFETY_DB` /
+            1-D: the 5·n_omega·n_cases bound margins (6· with ``controller_bound``; dB, less :data:`PERFORMANCE_SAFETY_DB` /
             :data:`DC_SAFETY_DB` on the performance specs and :data:`STABILITY_SAFETY_DB` on the
             margin specs), the DEL margin (pp) and the n_cases decay margins (1/s).
         """
