@@ -110,8 +110,8 @@ def test_unstable_certificate_near_rated_is_not_a_success(model):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
         with pytest.raises(ValueError, match="no pitch specification promises 20 % at 11 m/s") as err:
-            # without the high-frequency gain bound, as measured above: under it no certificate at
-            # 11 m/s is kept at all (the message then reads "best -inf %"), a refusal as well
+            # without the high-frequency gain bound, as measured above: under it the best stable
+            # certificate at 11 m/s promises −12.0 % (more DEL than ROSCO), a refusal as well
             qft.design_qft(model, 11.0, 20.0, max_hf_gain_ratio=None)
     best = float(re.search(r"best ([0-9.]+) %", str(err.value)).group(1))
     assert 0.0 < best < 20.0
