@@ -119,10 +119,23 @@ def hf_gain_bound(model, wind_speed, omega, max_hf_gain_ratio=HF_GAIN_RATIO, hf_
 
 
 def hf_check_omega(model, omega):
-    """Where the high-frequency gain bound is checked: the points of ``omega`` on
-    [HF_OMEGA, HF_END], both ends and 3P (three times ``model.rated_rotor_speed``, where the
-    model has one), rad/s. A bound relative to ROSCO's fast-falling |C| binds at the band's
-    ends, which a logarithmic grid of the whole band need not hold."""
+    """Where the high-frequency gain bound is checked: ``omega`` on its band, both ends and 3P.
+
+    A bound relative to ROSCO's fast-falling |C| binds at the band's ends, which a logarithmic
+    grid of the whole band need not hold.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel
+        The turbine (3P from its ``rated_rotor_speed``, where it has one).
+    omega : array_like
+        A grid, rad/s.
+
+    Returns
+    -------
+    numpy.ndarray
+        The points of ``omega`` on [HF_OMEGA, HF_END], both ends and 3P, sorted, rad/s.
+    """
     w = np.asarray(omega, float)
     extra = [HF_OMEGA, HF_END]
     three_p = 3.0 * float(getattr(model, "rated_rotor_speed", np.nan))
