@@ -59,6 +59,7 @@ def build_widget(d):
     fig_box = canvas if live else ipw.Output()
     shown = {"idx": None}
     busy = [False]
+    editing = [False]  # an edit made through these controls (they already show it)
 
     def show_figure():
         if not live:  # a static backend: show the re-rendered figure in place of the old one
@@ -81,11 +82,14 @@ def build_widget(d):
         show_figure()
 
     def apply(idx, name, value):
+        editing[0] = True
         try:
             d.set_param(idx, **{name: value})
         except (TypeError, ValueError) as err:
             msg.value = f"<span style='color:#c00'>{name} = {value!r} rejected: {err}</span>"
             return False
+        finally:
+            editing[0] = False
         msg.value = ""
         after_edit()
         return True
@@ -171,18 +175,36 @@ def build_widget(d):
         rows.children = tuple(param_row(idx, name, value) for name, value in e.params.items())
 
     def on_add(_):
-        d.add(kind.value)
+        editing[0] = True
+        try:
+            d.add(kind.value)
+        finally:
+            editing[0] = False
         shown["idx"] = None
         after_edit(select=len(d.controller.elements) - 1)
         build_rows()
 
     def on_remove(_):
         if elements.value is not None and d.controller.elements:
-            d.remove(elements.value)
+            editing[0] = True
+            try:
+                d.remove(elements.value)
+            finally:
+                editing[0] = False
             shown["idx"] = None
             after_edit(select=0)
             build_rows()
 
+    def from_code():
+        # an edit from code (d.set_param in a later cell): the list, the rows and the JSON
+        # follow, so the controls show the controller the figure draws
+        if editing[0]:
+            return
+        shown["idx"] = None
+        after_edit()
+        build_rows()
+
+    d._on_update = from_code
     elements.observe(build_rows, names="value")
     add_btn.on_click(on_add)
     rm_btn.on_click(on_remove)

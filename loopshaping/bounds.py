@@ -191,10 +191,18 @@ class _Part:
 
     def ok(self, fi, L0, rtol=1e-9):
         """Spec met at frequency index fi for nominal loop values L0 (any shape) → bool."""
-        G = L0[..., None] / self.p0[fi]
-        lhs = np.abs(self.A[fi] + self.B[fi] * G) ** 2
-        rhs = self.W[fi] ** 2 * np.abs(self.C[fi] + self.D[fi] * G) ** 2
-        return np.all(lhs <= rhs * (1 + rtol) + 1e-300, axis=-1)
+        return _met(self.A[fi], self.B[fi], self.C[fi], self.D[fi], self.W[fi], L0[..., None] / self.p0[fi], rtol)
+
+    def ok_each(self, L0, rtol=1e-9):
+        """Spec met at each design frequency for the nominal loop L0 there, shape (n_f,) → bool (n_f,)."""
+        return _met(self.A, self.B, self.C, self.D, self.W, (L0 / self.p0)[:, None], rtol)
+
+
+def _met(A, B, C, D, W, G, rtol):
+    """|A + B·G| ≤ W·|C + D·G| for every case (last axis), squared, with a relative tolerance."""
+    lhs = np.abs(A + B * G) ** 2
+    rhs = W**2 * np.abs(C + D * G) ** 2
+    return np.all(lhs <= rhs * (1 + rtol) + 1e-300, axis=-1)
 
 
 def bounds(template: Template, kind: str | Spec, weight: object = None, phases_deg: ArrayLike | None = None, *,

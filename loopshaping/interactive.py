@@ -13,6 +13,7 @@ live in the notebook, otherwise the widget re-displays a static figure after eac
 from __future__ import annotations
 
 import textwrap
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +26,7 @@ from .nichols import draw, loop_nichols, wrap_phase
 from .specs import Spec
 from .templates import Template
 
-__all__ = ["DesignState", "Designer", "closed_loop_poles"]
+__all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles"]
 
 _DEFAULTS = {
     "gain": {"k": 1.0},
@@ -154,6 +155,96 @@ def closed_loop_poles(plant, num, den) -> np.ndarray:
     return np.linalg.eigvals(A).astype(complex)
 
 
+class LiveArtists:
+    """Redraw the few artists an edit changes, blitted on a cached background of the rest.
+
+    On ipympl's canvas a full redraw (``draw_idle``) costs a round trip to the browser and a
+    render of every artist: 0.5 s for the Designer's 77 bound contours, where the loop and
+    its markers take a few ms. The ``artists`` are made animated: every full render of the
+    canvas caches the figure without them as the background and then draws them on top (so a
+    full redraw, a toolbar zoom or a resize still shows them, and ``savefig`` too);
+    :meth:`redraw` restores the background, draws only them and sends the changed pixels.
+    Until the canvas has rendered once and the browser's view of it is connected it asks for
+    a full redraw instead (a blit sent before the browser drew the figure once left it empty).
+    A live figure is not "stale" after a blit or a render (pyplot redraws every stale figure
+    after each message the kernel handles, a slider's included: drawing the artists on top
+    marked it stale again, and notebook 03's kernel rendered without end), and a change of one
+    of its artists asks for no render by itself (pyplot's interactive mode would, on every
+    change); a change made from code is drawn after the cell, as pyplot draws stale figures.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure.
+    artists : sequence of matplotlib.artist.Artist
+        The artists the edits change (lines, collections, texts, a legend), drawn in this order.
+    live : bool, optional
+        Blit (True) or always redraw in full with ``draw_idle`` (False); default: blit on
+        ipympl's canvas (``%matplotlib widget``), full redraws elsewhere (inline and static
+        figures, where a blit shows nothing).
+
+    Attributes
+    ----------
+    live : bool
+        Whether :meth:`redraw` blits.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from loopshaping.interactive import LiveArtists
+    >>> fig, ax = plt.subplots()
+    >>> (line,) = ax.plot([0, 1], [0, 1])
+    >>> live = LiveArtists(fig, [line], live=True)
+    >>> fig.canvas.draw()  # caches the background, draws the line on it
+    >>> line.set_ydata([1, 0]); live.redraw()  # the line alone, on the background
+    >>> plt.close(fig)
+    """
+
+    def __init__(self, figure, artists, live: bool | None = None):
+        self.figure = figure
+        self.artists = list(artists)
+        canvas = figure.canvas
+        self.live = hasattr(canvas, "syncing_data_url") if live is None else bool(live)  # ipympl's Canvas
+        self._background = None
+        if self.live:
+            for a in self.artists:
+                a.set_animated(True)
+            canvas.mpl_connect("draw_event", self._on_draw)
+            # no full render requested by each change (pyplot's draw_idle on "stale" in
+            # interactive mode): the owner redraws, by a blit
+            figure.stale_callback = None
+
+    def _on_draw(self, event):
+        canvas, renderer = event.canvas, event.renderer
+        if canvas.is_saving():  # savefig: the axes draw their animated children then, the figure not
+            for a in self.artists:
+                if getattr(a, "axes", None) is None:
+                    a.draw(renderer)
+            return
+        self._background = canvas.copy_from_bbox(self.figure.bbox)
+        for a in self.artists:
+            a.draw(renderer)
+        self.figure.stale = False  # drawn: their children's updates while drawing are on screen
+
+    @property
+    def ready(self) -> bool:
+        """True when :meth:`redraw` blits: live, a background cached, the browser's view connected."""
+        # ipympl syncs the image as a data URL until its browser view says it is initialised
+        return self.live and self._background is not None and not getattr(self.figure.canvas, "syncing_data_url", False)
+
+    def redraw(self):
+        """Show the artists' new data: blit them when :attr:`ready`, else ask for a full redraw."""
+        canvas = self.figure.canvas
+        if not self.ready:
+            canvas.draw_idle()
+            return
+        canvas.restore_region(self._background)
+        for a in self.artists:
+            self.figure.draw_artist(a)
+        canvas.blit(self.figure.bbox)
+        self.figure.stale = False  # what changed is on screen: no full render after this message
+
+
 def _where(omega):
     """Design frequencies for a title: a short list, or how many and their range."""
     if omega.size <= 3:
@@ -179,6 +270,12 @@ class Designer:
         A bound on the controller's own gain, |G(jω)| ≤ W(ω) on a band
         (:func:`loopshaping.specs.controller_gain`): checked on the dense grid, part of the
         verdict (not saved by :meth:`to_state`; give it again to :meth:`from_state`'s Designer).
+
+    Attributes
+    ----------
+    update_ms : float
+        Wall time of the last :meth:`update` (recompute, artist data and the blit or the
+        redraw request), ms: what an edit costs in the kernel before the browser shows it.
 
     Raises
     ------
@@ -231,6 +328,8 @@ class Designer:
         self.selected = 0
         self.figure = None
         self._artists = {}
+        self.update_ms = float("nan")
+        self._on_update = None  # the widget's controls following an edit made from code
 
     # -- saved state
     def to_state(self) -> dict:
@@ -329,19 +428,21 @@ class Designer:
         G = self.controller.response(self.omega)
         ph, mag = loop_nichols(self._P0 * G, self.omega)
         i = self._design_idx
-        allowed = self.bounds.is_allowed(self.bounds.omega, ph[i], mag[i])
+        L0 = self._P0[i] * G[i]
+        # each spec at all its design frequencies at once (a slider step re-checks them all)
+        allowed = np.ones(i.size, bool)
+        violations = {}
+        for part in self.bounds.parts:
+            k = np.searchsorted(self.bounds.omega, part.omega)
+            met = part.ok_each(L0[k])
+            allowed[k] &= met
+            name = part.spec.name
+            violations[name] = np.union1d(violations.get(name, np.empty(0)), part.omega[~met])
         L = self._P * G[:, None]
         with np.errstate(divide="ignore"):
             T = 20 * np.log10(np.abs(L / (1 + L)).max(axis=1))
             S = 20 * np.log10(np.abs(1 / (1 + L)).max(axis=1))
         stable, rightmost = self._stability()
-        L0 = self._P0[i] * G[i]
-        violations = {}
-        for part in self.bounds.parts:
-            k = np.searchsorted(self.bounds.omega, part.omega)
-            bad = [w for fi, w in enumerate(part.omega) if not part.ok(fi, L0[k[fi]])]
-            name = part.spec.name
-            violations[name] = np.union1d(violations.get(name, np.empty(0)), bad)
         gain_met = True
         if self._gain is not None:
             violations[self._gain[0]] = self.omega[np.abs(G) > self._gain[1]]
@@ -444,12 +545,11 @@ class Designer:
 
         Parameters
         ----------
-        live : bool, default False
-            Redraw edits by blitting (only the loop, markers, title and closed-loop lines are
-            re-rendered on a cached background). Off by default: ipympl's blit of an edit made
-            before the browser drew the figure once left the canvas empty (a broken image), and
-            blitted artists are skipped by ``savefig`` and static inline display; an edit then
-            asks for a full redraw (``draw_idle``), which ipympl coalesces.
+        live : bool, optional
+            Redraw edits by blitting: only the loop, markers, title and closed-loop lines are
+            re-rendered on a cached background of the bounds and axes (:class:`LiveArtists`).
+            Default: on ipympl's canvas (``%matplotlib widget``), where a full redraw of the
+            bounds takes about 0.5 s; off elsewhere (an edit then redraws the figure in full).
 
         Returns
         -------
@@ -458,8 +558,6 @@ class Designer:
         """
         import matplotlib.pyplot as plt
 
-        if live is None:
-            live = False
         # pyplot would also show a figure made with interactive mode on at the end of the cell,
         # beside the one the widget shows: twice
         with plt.ioff():
@@ -508,27 +606,13 @@ class Designer:
         title = fig.suptitle(self._title(st), fontsize=9, color=self._title_colour(st))
         # fixed margins (no layout engine: it would re-run on every redraw); room for the
         # three-line title above the axes
-        fig.subplots_adjust(left=0.08, right=0.98, bottom=0.11, top=0.79, wspace=0.28)
+        fig.subplots_adjust(left=0.08, right=0.98, bottom=0.11, top=0.79, wspace=0.42)
         self.figure = fig
         self._artists = dict(loop=loop, marks=marks, T=t_line, S=s_line, title=title)
-        # Blitting: the bounds and axes are rendered once into a cached background; an edit
-        # redraws only the changing artists on top of it.
-        self._background = None
-        self._live = bool(live)
-        if self._live:
-            for a in self._artists.values():
-                a.set_animated(True)
-            fig.canvas.mpl_connect("draw_event", self._on_draw)
+        # the bounds and axes are rendered once into a cached background; an edit redraws only
+        # the changing artists on top of it
+        self._redraw = LiveArtists(fig, self._artists.values(), live)
         return fig
-
-    def _on_draw(self, event=None):
-        canvas = self.figure.canvas
-        self._background = canvas.copy_from_bbox(self.figure.bbox)
-        self._blit_artists()
-
-    def _blit_artists(self):
-        for a in self._artists.values():
-            self.figure.draw_artist(a)
 
     def update(self, redraw=True) -> DesignState:
         """Recompute and push the new data into the existing artists (no figure rebuild).
@@ -544,6 +628,7 @@ class Designer:
         DesignState
             The numbers behind this redraw (nominal loop, bound check, stability, closed-loop peaks).
         """
+        t0 = time.perf_counter()
         st = self.state()
         if self.figure is not None:
             a = self._artists
@@ -556,15 +641,10 @@ class Designer:
             a["title"].set_text(self._title(st))
             a["title"].set_color(self._title_colour(st))
             if redraw:
-                canvas = self.figure.canvas
-                if not self._live:
-                    canvas.draw_idle()
-                elif self._background is None:
-                    canvas.draw()  # first time: full render, caches the background
-                else:
-                    canvas.restore_region(self._background)
-                    self._blit_artists()
-                    canvas.blit(self.figure.bbox)
+                self._redraw.redraw()
+        self.update_ms = 1e3 * (time.perf_counter() - t0)
+        if self._on_update is not None:
+            self._on_update()
         return st
 
     def _wrapped(self, phase_deg):

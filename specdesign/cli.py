@@ -619,7 +619,8 @@ def run_config(path: str | os.PathLike, out: str | os.PathLike | None = None, *,
 
     The whole file is checked first (:func:`read_config`). Writes into the output folder:
     ``table2.md/.csv``, ``table3.md/.csv`` (with two or more controllers),
-    ``indicators.csv``, ``fig8_<v>mps.png``, ``fig9_<v>mps.png`` and ``fig10.png``.
+    ``indicators.csv``, ``fig8_<v>mps.png``, ``fig9_<v>mps.png`` and ``fig10.png`` (with the
+    promise when the file gives one; :func:`specdesign.plots.validation.save_validation_figures`).
 
     Parameters
     ----------
@@ -664,7 +665,8 @@ def run_config(path: str | os.PathLike, out: str | os.PathLike | None = None, *,
     else:
         say(f"one controller ({camp.controllers[0]}): no Tables 2-3 (they compare a design with a baseline); "
             "the indicators are in indicators.csv")
-    written += _write_figures(camp, folder, designed, baseline if len(camp.controllers) >= 2 else None)
+    acc = acceptance(camp, designed, baseline) if len(camp.controllers) >= 2 else None
+    written += pv.save_validation_figures(camp, folder, acc, promised=c["promised"])
     say(f"\nwrote {len(written)} files to {folder}:")
     for f in written:
         say(f"  {f}")
@@ -680,30 +682,3 @@ def _write_indicators(camp: Campaign, path: Path) -> None:
             for i, v in enumerate(camp.wind_speeds):
                 for s, seed in enumerate(camp.seeds):
                     w.writerow([name, v, int(seed)] + [repr(float(camp.values[k][c, i, s])) for k in INDICATORS])
-
-
-def _write_figures(camp: Campaign, out: Path, designed, baseline) -> list[Path]:
-    """Figs. 8-10 as PNG files (the paths written): figures made without pyplot, so no backend
-    is involved."""
-    from matplotlib.figure import Figure
-
-    written = []
-    for v in camp.wind_speeds:
-        fig = Figure(figsize=(7, 6))
-        axes = fig.subplots(2, 1, sharex=True)
-        pv.plot_spectra(camp, v, "gen_speed", ax=axes[0])
-        pv.plot_spectra(camp, v, "tower_base_my", ax=axes[1])
-        fig.tight_layout()
-        written.append(out / f"fig8_{v:g}mps.png")
-        fig.savefig(written[-1], dpi=120)
-        if camp.series:
-            fig = Figure(figsize=(8, 8))
-            pv.plot_time_series(camp.series, v, seed_index=0, axes=fig.subplots(4, 1, sharex=True))
-            written.append(out / f"fig9_{v:g}mps.png")
-            fig.savefig(written[-1], dpi=120)
-    if baseline is not None:
-        fig = Figure()
-        pv.plot_reductions(acceptance(camp, designed, baseline), ax=fig.subplots())
-        written.append(out / "fig10.png")
-        fig.savefig(written[-1], dpi=120)
-    return written

@@ -31,7 +31,7 @@ from . import feasibility, validate
 from ._checks import del_target, positive_scalar, real_scalar
 from .plots.fatigue import plot_sensitivity
 from .plots.qft import plot_design_bode, plot_design_nichols
-from .plots.validation import plot_lifetime_damage, plot_spectra, plot_time_series
+from .plots.validation import plot_lifetime_damage, save_validation_figures
 from .rosco import rosco_baseline, rosco_scheduled
 from .simulate import scheduled
 from .turbine import iea15mw
@@ -198,7 +198,10 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
 
     Writes ``summary.md``, ``table2.md/.csv``, ``table3.md/.csv``, the designed controllers
     (``controller_qft.json``), a campaign file that reruns the validation (``validate.toml``)
-    and the figures ``1_sensitivity.png`` … ``4_time_series.png``. Figures are drawn on
+    and the figures ``1_sensitivity.png`` … ``3_bode.png`` of the design steps, then the
+    validation's ``fig8_<v>mps.png`` (spectra), ``fig9_<v>mps.png`` (time series) and
+    ``fig10.png`` (DEL reductions with the promise), as ``specdesign validate`` names them
+    (:func:`specdesign.plots.validation.save_validation_figures`). Figures are drawn on
     :class:`matplotlib.figure.Figure`: no pyplot, no backend needed.
 
     Parameters
@@ -321,15 +324,9 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         (out / f"{name}.md").write_text(table.to_markdown())
         table.to_csv(out / f"{name}.csv")
     _say(t3.to_markdown())
-    fig = Figure(figsize=(8, 7))
-    axes = fig.subplots(2, 1)
-    plot_spectra(camp, v, "gen_speed", ax=axes[0])
-    plot_spectra(camp, v, "tower_base_my", ax=axes[1])
-    fig.tight_layout()
-    fig.savefig(out / "4_spectra.png", dpi=120)
-    fig = Figure(figsize=(8, 8))
-    plot_time_series(camp.series, v, axes=fig.subplots(4, 1, sharex=True))
-    fig.savefig(out / "4_time_series.png", dpi=120)
+    # the figures `specdesign validate` writes, by the same function and under the same names:
+    # a validation rerun into this folder replaces them instead of adding copies
+    figures = save_validation_figures(camp, out, acc, promised={v: p.exact_del})
 
     # the designed controllers and a campaign file, so `python -m specdesign validate` can rerun
     # or extend the validation (more seeds, other wind speeds) without redesigning
@@ -380,7 +377,8 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         "",
         t2.to_markdown(),
         t3.to_markdown(),
-        "Figures: 1_sensitivity.png, 2_specification.png, 3_nichols.png, 3_bode.png, 4_spectra.png, 4_time_series.png",
+        ("Figures: 1_sensitivity.png, 2_specification.png, 3_nichols.png, 3_bode.png, "
+         + ", ".join(f.name for f in figures) + " (Welch spectra vs the linear prediction, time series, DEL reductions)"),
         "",
         "Controllers: controller_qft.json; rerun or extend the validation with "
         "`python -m specdesign validate validate.toml` (edit seeds or wind speeds there).",

@@ -3,9 +3,12 @@
 The test starts its own JupyterLab on 127.0.0.1 (a free port, a random token, no browser) over a
 temporary copy of notebooks 03 (the specification explorer) and 04 (the QFT Designer on the
 19 m/s pitch loop), opens each in Debian's Chromium driven by playwright (``executable_path``:
-playwright's own browser downloads are not used), runs all cells, drags a slider, and checks
-from pixels that the live (ipympl) figure changed, then saves the notebook through JupyterLab
-and reads it back to check that every code cell ran and none errored. Screenshots go to
+playwright's own browser downloads are not used), runs all cells, checks that the controls show the state the figure draws, drags a
+slider, and checks from pixels that the live (ipympl) figure changed, then saves the notebook
+through JupyterLab and reads it back to check that every code cell ran and none errored. Each
+drag's redraw time is reported (never asserted) as two numbers: the browser's, from the release
+to the settled figure, and the kernel's, the slider callback alone (``update_ms`` of the
+explorer or the Designer, read from the notebook's kernel through its connection file). Screenshots go to
 ``build/browser-screenshots/`` (kept by CI as artefacts). The server and its kernels are
 stopped in every case (the process group it was started in).
 
@@ -14,6 +17,7 @@ Skipped, with the reason, only when Chromium is not installed (``apt-get install
 """
 from __future__ import annotations
 
+import ast
 import io
 import json
 import os
@@ -78,7 +82,7 @@ def lab(tmp_path_factory):
             if proc.poll() is not None or time.monotonic() > deadline:
                 raise RuntimeError(f"JupyterLab did not start: {(tmp / 'jupyterlab.log').read_text()[-2000:]}")
             time.sleep(0.5)
-        yield url, token, root
+        yield url, token, root, tmp / "runtime"
     finally:
         # the server and the kernels it started share its process group
         try:
@@ -167,6 +171,36 @@ def _drag(page, handle, dx):
     page.mouse.up()
 
 
+def _kernel_value(lab, name, expression):
+    """``expression`` evaluated in the kernel of notebook ``name`` (its repr), beside the browser's session."""
+    from jupyter_client import BlockingKernelClient
+
+    url, token, _, runtime = lab
+    with urllib.request.urlopen(f"{url}/api/sessions?token={token}", timeout=10) as r:
+        kernel = next(s["kernel"]["id"] for s in json.load(r) if s["path"].endswith(name))
+    client = BlockingKernelClient(connection_file=str(runtime / f"kernel-{kernel}.json"))
+    client.load_connection_file()
+    client.start_channels()
+    try:
+        # silent: nothing in the notebook's outputs or its execution count
+        reply = client.execute_interactive("", silent=True, store_history=False,
+                                           user_expressions={"value": expression}, timeout=30)
+    finally:
+        client.stop_channels()
+    value = reply["content"]["user_expressions"]["value"]
+    assert value["status"] == "ok", value
+    return value["data"]["text/plain"]
+
+
+#: In the page: true once JupyterLab's status bar has said the kernel is idle for 2 s on end.
+_IDLE_FOR_2S = """() => {
+  const idle = /\\| Idle/.test(document.querySelector('.jp-StatusBar-Widget')?.innerText || '');
+  if (!idle) { window.__idle_since = null; return false; }
+  window.__idle_since = window.__idle_since ?? performance.now();
+  return performance.now() - window.__idle_since > 2000;
+}"""
+
+
 #: In the page: from the release of a slider handle (pointerup) to the last change of the canvas
 #: it drives, polled every few ms; the time a user waits for the figure to settle. Reported
 #: (build/browser-screenshots/redraw_ms.json), never asserted: speed belongs to benchmarks.
@@ -189,19 +223,38 @@ _WATCH_REDRAW = """([fig]) => {
 }"""
 
 
-def _timed_drag(page, figure, handle, dx, what):
-    """Drag ``handle`` by ``dx`` px and record how long after the release the figure settled (ms)."""
+def _timed_drag(page, lab, name, obj, figure, handle, dx, what):
+    """Drag ``handle`` by ``dx`` px; record how long after the release the figure settled and
+    how long the kernel's last slider callback took (``obj.update_ms`` in the kernel), ms, and
+    whether the callback blitted (``obj._redraw.ready``) or asked for a full redraw.
+
+    The acceptance (issue 30) is ≤ 150 ms on an idle machine; this machine may not be idle, so
+    both numbers are written with the load average beside them
+    (build/browser-screenshots/redraw_ms.json) and not asserted (speed belongs to benchmarks).
+    """
+    # the kernel idle for 2 s first: after Run All the browser asks the kernel to render each
+    # live figure of the notebook once, and a drag queued behind those renders would time them
+    page.evaluate("window.__idle_since = null")
+    page.wait_for_function(_IDLE_FOR_2S, timeout=120_000, polling=100)
     page.evaluate(_WATCH_REDRAW, [figure.element_handle()])
     _drag(page, handle, dx)
     page.wait_for_function("window.__redraw !== null", timeout=60_000)
     ms = float(page.evaluate("window.__redraw"))
     assert ms >= 0, f"{what}: the figure's canvases never changed after the drag"
+    callback_ms = float(_kernel_value(lab, name, f"{obj}.update_ms"))
+    blitted = _kernel_value(lab, name, f"{obj}._redraw.ready") == "True"
+    load = os.getloadavg()[0]
     SHOTS.mkdir(parents=True, exist_ok=True)
     out = SHOTS / "redraw_ms.json"
     times = json.loads(out.read_text()) if out.is_file() else {}
-    times[what] = {"ms": round(ms, 1), "load_1min": os.getloadavg()[0]}
+    times[what] = {"ms": round(ms, 1), "callback_ms": round(callback_ms, 1), "blitted": blitted, "load_1min": load}
     out.write_text(json.dumps(times, indent=1))
-    print(f"{what}: the figure settled {ms:.0f} ms after the release (load {os.getloadavg()[0]:.1f})")
+    print(f"{what}: the figure settled {ms:.0f} ms after the release, the kernel's callback took "
+          f"{callback_ms:.0f} ms, {'blitted' if blitted else 'full redraw'} (load {load:.1f}; acceptance on an "
+          "idle machine: ≤ 150 ms)")
+    # on ipympl's canvas, once the browser showed the figure, a move blits (a full redraw of the
+    # Designer's bounds took 0.5 s of the kernel alone)
+    assert blitted, f"{what}: the slider's redraw was a full redraw, not a blit"
     return ms
 
 
@@ -221,7 +274,7 @@ def _wait_changed(figure, before, timeout_s=40.0):
 
 @pytest.mark.slow
 def test_notebook_03_explorer_slider_redraws_the_figure(lab, browser):
-    url, token, root = lab
+    url, token, root, _ = lab
     SHOTS.mkdir(parents=True, exist_ok=True)
     page = browser.new_page(viewport={"width": 1400, "height": 1000})
     try:
@@ -240,7 +293,14 @@ def test_notebook_03_explorer_slider_redraws_the_figure(lab, browser):
         # after Run All the depth slider shows the notch the figure draws: a later cell set it
         # to 12 dB (explorer.update(1.05, 12.0, 0.2)); it showed 2.80 dB once
         assert float(title_before) == pytest.approx(12.0), title_before
-        _timed_drag(page, figures.first, sliders.nth(1).locator(".noUi-handle"), 60, "notebook 03 depth slider")
+        notch = _kernel_value(lab, "03_specification.ipynb", "(explorer.notch.omega_n, explorer.notch.depth_db, explorer.notch.width)")
+        shown = [float(cell.locator(".widget-readout").nth(i).inner_text()) for i in range(3)]
+        # within half a slider step (the browser rounds a value to its step) and the readout's digits
+        omega_n, depth, width = ast.literal_eval(notch)
+        assert shown[0] == pytest.approx(omega_n, rel=10**0.0025 - 1 + 5e-4), (shown, notch)
+        assert shown[1] == pytest.approx(depth, abs=0.051) and shown[2] == pytest.approx(width, abs=0.0051), (shown, notch)
+        _timed_drag(page, lab, "03_specification.ipynb", "explorer", figures.first,
+                    sliders.nth(1).locator(".noUi-handle"), 60, "notebook 03 depth slider")
         after, changed = _wait_changed(canvas, before)
         cell.screenshot(path=str(SHOTS / "03_explorer_after.png"))
         assert cell.locator(".widget-readout").nth(1).inner_text() != title_before
@@ -254,7 +314,7 @@ def test_notebook_03_explorer_slider_redraws_the_figure(lab, browser):
 
 @pytest.mark.slow
 def test_notebook_04_designer_gain_edit_redraws_the_figure(lab, browser):
-    url, token, root = lab
+    url, token, root, _ = lab
     SHOTS.mkdir(parents=True, exist_ok=True)
     page = browser.new_page(viewport={"width": 1400, "height": 1100})
     try:
@@ -270,7 +330,15 @@ def test_notebook_04_designer_gain_edit_redraws_the_figure(lab, browser):
         gain = cell.locator(".widget-slider").first  # the selected element 0: the gain
         json_box = cell.locator("textarea").first
         k_before = json.loads(json_box.input_value())["elements"][0]["params"]["k"]
-        _timed_drag(page, figures.first, gain.locator(".noUi-handle"), 40, "notebook 04 Designer gain")
+        # after Run All (a later cell set the gain 20 dB high and back, from code) the controls
+        # show the controller the figure draws: the JSON exactly, the slider's readout to its
+        # 4 digits, the exact box exactly
+        assert k_before == float(_kernel_value(lab, "04_qft_design.ipynb", "designer.controller.elements[0].params['k']"))
+        shown = float(gain.locator(".widget-readout").inner_text())  # within half a step (0.0025 decade) and 4 digits
+        assert shown == pytest.approx(abs(k_before), rel=10**0.0025 - 1 + 5e-4), (shown, k_before)
+        assert float(cell.locator(".widget-text input").first.input_value()) == k_before
+        _timed_drag(page, lab, "04_qft_design.ipynb", "designer", figures.first,
+                    gain.locator(".noUi-handle"), 40, "notebook 04 Designer gain")
         after, changed = _wait_changed(canvas, before)
         page.wait_for_function("([el, k]) => JSON.parse(el.value).elements[0].params.k !== k",
                                arg=[json_box.element_handle(), k_before], timeout=20_000)

@@ -29,7 +29,7 @@ def test_demo_writes_every_artefact(demo):
     out, _ = demo
     for name in ("summary.md", "table2.md", "table2.csv", "table3.md", "table3.csv", "controller_qft.json",
                  "validate.toml", "1_sensitivity.png", "2_specification.png", "3_nichols.png", "3_bode.png",
-                 "4_spectra.png", "4_time_series.png"):
+                 "fig8_19mps.png", "fig9_19mps.png", "fig10.png"):
         assert (out / name).is_file() and (out / name).stat().st_size > 0, name
 
 

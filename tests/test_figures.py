@@ -442,3 +442,31 @@ def test_fig10_reads_reductions_against_zero(campaign):
     label = next(t for t in ax.get_legend_handles_labels()[1] if t.startswith("rainflow, nonlinear"))
     assert ("±1 SE" in label) == show_se(acc.n_seeds)
     plt.close("all")
+
+
+def test_the_validation_figures_are_one_file_each_with_the_promise(campaign, tmp_path, monkeypatch):
+    # fig9 duplicated the demo's 4_time_series (and fig8 its 4_spectra) when a validation was
+    # written into the demo's folder: both now write through save_validation_figures, under
+    # one name per figure, so a second writer replaces the first's files
+    from pathlib import Path
+
+    import matplotlib.image
+
+    from specdesign import validate as va
+    from specdesign.plots import validation as pv
+
+    drawn = []
+    plot_reductions = pv.plot_reductions
+    monkeypatch.setattr(pv, "plot_reductions", lambda acc, **kw: drawn.append(kw) or plot_reductions(acc, **kw))
+    acc = va.acceptance(campaign, "ATD", "ROSCO")
+    first = pv.save_validation_figures(campaign, tmp_path, acc, promised={19.0: 12.0})  # the demo
+    again = pv.save_validation_figures(campaign, tmp_path, acc, promised={19.0: 12.0})  # validate --out there
+    assert [f.name for f in first] == [f.name for f in again] == ["fig8_19mps.png", "fig9_19mps.png", "fig10.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f.name for f in first)
+    assert matplotlib.image.imread(first[1]).shape[:2] == (960, 960)  # fig9: the 8 × 8 in time series at 120 dpi
+    assert drawn[0]["promised"] == {19.0: 12.0}  # fig10 with the promise
+    # the demo and the command line draw these figures through it, never a second time
+    root = Path(pv.__file__).parents[1]
+    for name in ("demo.py", "cli.py"):
+        src = (root / name).read_text()
+        assert "save_validation_figures(" in src and "plot_time_series(" not in src and "plot_spectra(" not in src, name

@@ -206,3 +206,99 @@ def test_the_designer_views_cover_the_design_and_key_many_bound_colours():
     lo_k, hi_k = keys[0].get_ylim()
     assert (lo_k, hi_k) == pytest.approx((w.min(), w.max()))
     plt.close("all")
+
+
+def test_the_designer_controls_follow_an_edit_made_from_code(loop):
+    # a later cell's ``designer.set_param`` (notebook 04 sets the gain 20 dB high and back): the
+    # controls show the controller the figure draws, not the one they were built with
+    P, tmpl, b = loop
+    d = Designer(b, tmpl, lc.Controller((lc.gain(-379.0), lc.real_zero(42.0))))
+    ui = d.widget()
+    select, _, rows, json_box, _ = ui.children[0].children
+    d.set_param(0, k=-4321.0)
+    slider, text = rows.children[0].children
+    assert slider.value == 4321.0 and text.value == -4321.0 and slider.description == "k (−)"
+    assert json_box.value == d.controller.to_json()
+    select.value = 1
+    d.set_param(1, omega=7.5)  # the element shown is the one edited
+    slider, text = rows.children[0].children
+    assert slider.value == 7.5 and text.value == 7.5 and select.value == 1
+    assert select.options[1][0] == f"1: {d.controller.elements[1]}"
+    d.remove(1)  # from code: the list shrinks, the selection stays on an element
+    assert len(select.options) == 1 and select.value == 0 and rows.children[0].children[1].value == -4321.0
+
+
+def test_live_redraw_blits_the_changing_artists_and_full_renders_keep_them(loop):
+    # the Designer's redraw on a live canvas: the bounds are a cached background, an edit
+    # redraws the loop alone; a full render (a resize, a toolbar zoom) still draws every artist,
+    # on top as the blit does, and savefig as a figure drawn without blitting (live=False)
+    import io
+
+    from loopshaping.interactive import LiveArtists
+
+    P, tmpl, b = loop
+    G = lc.Controller((lc.gain(379.0), lc.real_zero(42.0), lc.complex_pole(247.0, 0.5)))
+
+    def pixels(fig):
+        fig.canvas.draw()
+        return np.asarray(fig.canvas.buffer_rgba()).copy()
+
+    live, still = Designer(b, tmpl, G), Designer(b, tmpl, G)
+    fig_live, fig_still = live.draw(live=True), still.draw(live=False)
+    assert isinstance(live._redraw, LiveArtists) and live._redraw.live and not still._redraw.live
+    assert all(a.get_animated() for a in live._artists.values())
+    before = pixels(fig_live)  # the first full render caches the background
+    for d in (live, still):
+        d.set_param(0, k=150.0)
+    blitted = np.asarray(fig_live.canvas.buffer_rgba()).copy()  # the blit, no full render since
+    assert not np.array_equal(blitted, before)
+    np.testing.assert_array_equal(blitted, pixels(fig_live))
+    # the same pixels as the still figure's but where the changing artists overlap others
+    assert np.mean(np.any(blitted != pixels(fig_still), axis=-1)) < 0.005
+    saved = [io.BytesIO(), io.BytesIO()]
+    fig_live.savefig(saved[0], format="png")
+    fig_still.savefig(saved[1], format="png")
+    for f in saved:
+        f.seek(0)
+    np.testing.assert_array_equal(plt.imread(saved[0]), plt.imread(saved[1]))
+    assert np.isfinite(live.update_ms) and live.update_ms > 0
+
+
+def test_the_designer_colour_key_leaves_the_closed_loop_panel_its_labels():
+    # notebook 04 in the browser: the key's label "bound frequency ω (rad/s)" was written over
+    # the closed-loop panel's "closed-loop magnitude (dB)"
+    P = ct.tf([1.0], [1.0, 1.4, 1.0])
+    tmpl = qft.Template.from_systems([0.8 * P, P, 1.25 * P], np.geomspace(0.05, 5.0, 24))
+    d = Designer(qft.bounds(tmpl, "stability", 1.3), tmpl, lc.Controller((lc.gain(2.0), lc.integrator())))
+    fig = d.draw()
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    key = next(ax for ax in fig.axes if ax.get_ylabel() == "bound frequency ω (rad/s)")
+    ax_b = fig.axes[1]
+    assert key.get_tightbbox(renderer).x1 < ax_b.get_tightbbox(renderer).x0
+    plt.close(fig)
+
+
+def test_a_live_figure_asks_for_no_full_render_when_an_edit_blits(monkeypatch):
+    # in JupyterLab notebook 03's kernel rendered the explorer without end (busy for minutes):
+    # drawing the legend on top left the figure "stale", and pyplot redraws every stale figure
+    # after each message the kernel handles, the browser's render request included; and
+    # pyplot's interactive mode asked for a full render on every change of the legend's text
+    from specdesign import spec
+    from specdesign.plots.spec import NotchExplorer
+    from specdesign.turbine import iea15mw
+
+    plt.close("all")
+    base = spec.baseline_analysis(iea15mw(), 19.0)
+    with plt.ion():
+        ex = NotchExplorer(base, live=True)
+        ex.fig.canvas.draw()
+        assert not ex.fig.stale  # a render leaves nothing for pyplot's post-execute redraw
+        requests = []
+        monkeypatch.setattr(ex.fig.canvas, "draw_idle", lambda *a, **k: requests.append(1))
+        ex.update(1.1, 9.0, 0.3)  # the line, marker, title and legend text change: one blit
+        assert ex._redraw.ready and requests == [] and not ex.fig.stale
+        assert "9 dB" in ex._legend_text.get_text()
+        ex.fig.axes[0].set_xlim(0.01, 10.0)  # a change from code: drawn after the cell, as pyplot does
+        assert requests == [] and ex.fig.stale
+    plt.close("all")

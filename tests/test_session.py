@@ -67,20 +67,28 @@ def test_a_saved_session_reloads_to_bitwise_the_same_numbers(saved):
     assert data["controllers"]["rosco"].keys() == {"num", "den"}  # the controller-file format of `validate`
 
 
-def test_the_designer_and_the_explorer_start_from_a_saved_session(saved, tmp_path):
+@pytest.fixture
+def small_loop():
+    """A three-case template and its stability bounds for the Designer, on the Agg backend (figures closed after)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from loopshaping import qft
+
+    P = [ct.tf([k], [1, 31, 30]) for k in (1.0, 5.0, 10.0)]
+    tmpl = qft.Template.from_systems(P, np.array([0.1, 5.0, 100.0]))
+    yield tmpl, qft.bounds(tmpl, "stability", 1.2)
+    plt.close("all")
+
+
+def test_the_designer_and_the_explorer_start_from_a_saved_session(saved, small_loop, tmp_path):
     from loopshaping.interactive import Designer
     from specdesign.plots.spec import NotchExplorer
 
     session, base, _ = saved
-    P = [ct.tf([k], [1, 31, 30]) for k in (1.0, 5.0, 10.0)]
-    tmpl = qft.Template.from_systems(P, np.array([0.1, 5.0, 100.0]))
-    b = qft.bounds(tmpl, "stability", 1.2)
+    tmpl, b = small_loop
     d = Designer(b, tmpl, lc.Controller((lc.gain(379.123), lc.real_zero(42.0), lc.complex_pole(247.0, 0.5))))
     d.selected = 2
     s2 = Session(**{**{f: getattr(session, f) for f in ("wind_speeds", "specifications", "spec_context", "controllers")},
@@ -102,7 +110,6 @@ def test_the_designer_and_the_explorer_start_from_a_saved_session(saved, tmp_pat
         NotchExplorer.from_session(back, "speed")
     with pytest.raises(ValueError, match="designer state"):
         Designer.from_session(session, b, tmpl)
-    plt.close("all")
 
 
 def test_a_newer_or_foreign_file_is_refused_with_a_clear_message(saved, tmp_path):
@@ -230,3 +237,26 @@ def test_the_session_of_a_qft_design_reloads_bitwise_and_reopens_the_designer(tm
     import matplotlib.pyplot as plt
 
     plt.close("all")
+
+
+def test_widgets_opened_from_a_saved_session_show_its_state(saved, small_loop, tmp_path):
+    # the controls of a reloaded Designer and explorer show the saved controller and notch
+    # (the figure draws those: test above), exactly (no browser rounds a slider to its step here)
+    from loopshaping.interactive import Designer
+    from specdesign.plots.spec import NotchExplorer
+
+    session, _, _ = saved
+    tmpl, b = small_loop
+    d = Designer(b, tmpl, session.controllers["pitch"])
+    d.selected = 3  # the notch
+    back = load_session(save_session(tmp_path / "s.json", Session(**{
+        **{f: getattr(session, f) for f in ("wind_speeds", "specifications", "spec_context")}, "designer": d.to_state()})))
+    ui = Designer.from_session(back, b, tmpl).widget()
+    select, _, rows, json_box, _ = ui.children[0].children
+    assert select.value == 3 and json_box.value == session.controllers["pitch"].to_json()
+    saved_notch = session.controllers["pitch"].elements[3].params
+    shown = {row.children[0].description: (row.children[0].value, row.children[1].value) for row in rows.children}
+    assert shown == {name: (v, v) for name, v in saved_notch.items()}
+    ex = NotchExplorer.from_session(back, "tower")
+    sliders = ex.widget().children[0].children
+    assert [s.value for s in sliders] == [ex.notch.omega_n, ex.notch.depth_db, ex.notch.width]

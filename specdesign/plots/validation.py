@@ -2,11 +2,15 @@
 predicted vs rainflow DEL reduction (Fig. 10). Results in, axes out; no plt.show()."""
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
 
 from .conventions import SI_UNITS, TIME_SERIES, show_se
 
-__all__ = ["plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage", "plot_comparison"]
+__all__ = ["plot_spectra", "plot_time_series", "plot_reductions", "plot_lifetime_damage", "plot_comparison",
+           "save_validation_figures"]
 
 _NAMES = {"gen_speed": "Generator speed", "tower_base_my": "Tower-base fore-aft moment", "blade_root_my": "Blade-root flapwise moment"}
 
@@ -333,3 +337,55 @@ def plot_comparison(changes, indicators=("tower_del", "blade_del"), *, axes=None
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize="small")
     return axes
+
+
+def save_validation_figures(campaign, folder: str | os.PathLike, acc=None, *, promised=None) -> list[Path]:
+    """Figs. 8-10 of a campaign as PNG files: the demo's step 4 and ``specdesign validate`` both.
+
+    One file per figure and wind speed, so the demo and a validation written into the same
+    folder keep one copy of each: ``fig8_<v>mps.png`` (:func:`plot_spectra`, generator speed
+    and tower-base moment), ``fig9_<v>mps.png`` (:func:`plot_time_series`, the first kept
+    seed; only when the campaign kept series) and, with ``acc``, ``fig10.png``
+    (:func:`plot_reductions`, with the promise). Drawn on :class:`matplotlib.figure.Figure`:
+    no pyplot, no backend needed. ``<v>`` is the wind speed in m/s as ``f"{v:g}"``.
+
+    Parameters
+    ----------
+    campaign : specdesign.validate.Campaign
+        The campaign (:func:`specdesign.validate.run_campaign`).
+    folder : str or os.PathLike
+        An existing folder to write into (files of the same names are replaced).
+    acc : specdesign.validate.Acceptance, optional
+        The design's acceptance against its baseline (:func:`specdesign.validate.acceptance`);
+        without it no fig10.
+    promised : dict of float to float, optional
+        Wind speed (m/s) → the specification's promised DEL reduction (%), drawn on fig10.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, in the order above.
+    """
+    from matplotlib.figure import Figure  # figures only: matplotlib is never loaded by a computation
+
+    out = Path(folder)
+    written = []
+    for v in campaign.wind_speeds:
+        fig = Figure(figsize=(7, 6))
+        axes = fig.subplots(2, 1, sharex=True)
+        plot_spectra(campaign, v, "gen_speed", ax=axes[0])
+        plot_spectra(campaign, v, "tower_base_my", ax=axes[1])
+        fig.tight_layout()
+        written.append(out / f"fig8_{v:g}mps.png")
+        fig.savefig(written[-1], dpi=120)
+        if campaign.series:
+            fig = Figure(figsize=(8, 8))
+            plot_time_series(campaign.series, v, seed_index=0, axes=fig.subplots(4, 1, sharex=True))
+            written.append(out / f"fig9_{v:g}mps.png")
+            fig.savefig(written[-1], dpi=120)
+    if acc is not None:
+        fig = Figure()
+        plot_reductions(acc, promised=promised, ax=fig.subplots())
+        written.append(out / "fig10.png")
+        fig.savefig(written[-1], dpi=120)
+    return written
