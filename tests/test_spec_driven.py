@@ -239,7 +239,7 @@ def test_the_default_design_is_specification_driven(model, chain19):
 def elements19(model):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy accuracy notes on some rungs
-        return fz.element_specification(model, 19.0, 25.0)
+        return fz.element_specification(model, 19.0, 25.0, **NO_HF)
 
 
 @pytest.mark.slow
