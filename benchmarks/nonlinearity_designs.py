@@ -50,9 +50,9 @@ import warnings
 import numpy as np
 
 from specdesign import qft, validate
+from specdesign.closedloop import siso_response
 from specdesign.qft.structure import controller_polys
 from specdesign.qft.tuner import TuningProblem
-from specdesign.closedloop import siso_response
 from specdesign.simulate import scheduled
 from specdesign.turbine import iea15mw, rosco_baseline
 

@@ -23,6 +23,7 @@ from .bounds import Bounds
 from .controller import KINDS, Controller, Element
 from .freqresp import check_grid, evaluate
 from .nichols import draw, loop_nichols, wrap_phase
+from .specs import Spec
 from .templates import Template
 
 __all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles"]
@@ -66,7 +67,10 @@ class DesignState:
         undecided, complex infinity for an ill-posed loop 1 + D_G·D_P = 0).
     spec_violations : dict
         Spec name (:attr:`loopshaping.qft.Bounds.names`) → design frequencies (rad/s) where it
-        fails; an empty array where it is met.
+        fails; an empty array where it is met. A Designer's ``gain_bound`` enters under its
+        name with the dense grid's frequencies where |G| exceeds it.
+    gain_met : bool
+        The controller's gain bound (``gain_bound``) met on the dense grid (True without one).
     """
 
     phase_deg: np.ndarray
@@ -77,6 +81,7 @@ class DesignState:
     stable: np.ndarray
     rightmost_pole: np.ndarray
     spec_violations: dict
+    gain_met: bool = True
 
     @property
     def all_stable(self) -> bool:
@@ -261,6 +266,10 @@ class Designer:
         Starting controller (default: unit gain).
     omega : array_like, optional
         Dense grid, rad/s (default 600 points, design range ×/÷ 100).
+    gain_bound : Spec, optional
+        A bound on the controller's own gain, |G(jω)| ≤ W(ω) on a band
+        (:func:`loopshaping.specs.controller_gain`): checked on the dense grid, part of the
+        verdict (not saved by :meth:`to_state`; give it again to :meth:`from_state`'s Designer).
 
     Attributes
     ----------
@@ -271,7 +280,7 @@ class Designer:
     Raises
     ------
     TypeError
-        If ``bounds`` is not a Bounds.
+        If ``bounds`` is not a Bounds, or ``gain_bound`` not a Spec.
     ValueError
         If the Template has no systems or the grid is bad.
 
@@ -288,9 +297,12 @@ class Designer:
     (False, '+19.29')
     """
 
-    def __init__(self, bounds: Bounds, plant, controller: Controller | None = None, omega=None):
+    def __init__(self, bounds: Bounds, plant, controller: Controller | None = None, omega=None, gain_bound: Spec | None = None):
         if not isinstance(bounds, Bounds):
             raise TypeError(f"bounds must be a loopshaping.qft.Bounds; got {type(bounds).__name__}")
+        if gain_bound is not None and not isinstance(gain_bound, Spec):
+            raise TypeError(f"gain_bound must be a loopshaping Spec (loopshaping.specs.controller_gain); got "
+                            f"{type(gain_bound).__name__}")
         if controller is not None and not isinstance(controller, Controller):
             raise TypeError(f"controller must be a loopshaping Controller (Controller.from_tf converts an LTI); "
                             f"got {type(controller).__name__}")
@@ -309,6 +321,9 @@ class Designer:
         self._P = np.stack([evaluate(p, self.omega, "plant") for p in systems], axis=1)
         self._P0 = self._P[:, nominal]
         self._ss = [_state_space(p) for p in systems]
+        # the gain bound on the dense grid (inf outside its band): |G| is compared with it at every redraw
+        self._gain = None if gain_bound is None else (
+            gain_bound.name, np.where(gain_bound.in_band(self.omega), gain_bound.weights(self.omega, 1)[:, 0], np.inf))
         self.controller = controller if controller is not None else Controller((Element("gain", {"k": 1.0}),))
         self.selected = 0
         self.figure = None
@@ -428,7 +443,11 @@ class Designer:
             T = 20 * np.log10(np.abs(L / (1 + L)).max(axis=1))
             S = 20 * np.log10(np.abs(1 / (1 + L)).max(axis=1))
         stable, rightmost = self._stability()
-        return DesignState(ph, mag, allowed, T, S, stable, rightmost, violations)
+        gain_met = True
+        if self._gain is not None:
+            violations[self._gain[0]] = self.omega[np.abs(G) > self._gain[1]]
+            gain_met = violations[self._gain[0]].size == 0
+        return DesignState(ph, mag, allowed, T, S, stable, rightmost, violations, gain_met)
 
     def _stability(self):
         n = len(self._ss)
@@ -637,7 +656,7 @@ class Designer:
 
     @staticmethod
     def _title_colour(st):
-        return "black" if st.all_stable and st.bounds_met else "tab:red"
+        return "black" if st.all_stable and st.bounds_met and st.gain_met else "tab:red"
 
     def summary(self, state: DesignState | None = None) -> str:
         """What the figure's title says: stability (the unstable case and its pole), bounds, specs, G.
@@ -665,8 +684,10 @@ class Designer:
                     "stability undecided (improper controller or no state-space plant)" if np.isnan(p) else
                     "ill-posed loop (1 + L(∞) = 0)")
             head = f"UNSTABLE: plant case {c} of {n}: {what}" + (f" ({bad.size} unstable cases)" if bad.size > 1 else "")
-        elif st.bounds_met:
+        elif st.bounds_met and st.gain_met:
             head = f"all bounds met, all {n} plant case(s) stable"
+        elif st.bounds_met:
+            head = f"all bounds met, all {n} plant case(s) stable; the controller's gain bound is not"
         else:
             head = f"{n} plant case(s) stable; bounds violated at " + _where(self.bounds.omega[~st.design_allowed])
         specs = "; ".join(f"{name}: " + ("met" if v.size == 0 else "violated at " + _where(v))

@@ -24,7 +24,7 @@ from .bounds import (
     intersect,
 )
 from .freqresp import check_grid, evaluate
-from .specs import KINDS, Spec
+from .specs import KINDS, Spec, controller_gain
 from .templates import Template, tracking_pairs
 
 __all__ = [
@@ -37,6 +37,7 @@ __all__ = [
     "as_specs",
     "bounds",
     "check_grid",
+    "controller_gain",
     "evaluate",
     "intersect",
     "tracking_pairs",

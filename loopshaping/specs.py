@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from .freqresp import evaluate, is_lti
 
-__all__ = ["KINDS", "Spec"]
+__all__ = ["KINDS", "Spec", "controller_gain"]
 
 KINDS = ("stability", "sensitivity", "input_disturbance", "control_effort", "noise", "tracking", "general")
 _KIND_ARGS = {
@@ -278,3 +278,36 @@ def _static_gain(sys):
     if isinstance(sys, ct.StateSpace) and sys.nstates == 0:
         return float(np.real(sys.D[0, 0]))
     return None
+
+
+def controller_gain(bound, band: tuple | None = None, name: str = "controller_gain") -> Spec:
+    """The specification |G(jω)| ≤ bound(ω) on a band: a bound on the controller's own gain.
+
+    The general form with A = 0, B = 1, C = 1, D = 0: the same for every plant case, so a
+    dense check (:func:`loopshaping.check.check`) reports it beside the loop's specifications.
+
+    Parameters
+    ----------
+    bound : float or array_like or control LTI or callable
+        The allowed |G|, linear magnitude (as :class:`Spec`'s ``weight``; np.inf: no constraint).
+    band : tuple of float, optional
+        ``(low, high)`` in rad/s where it applies (everywhere without one).
+    name : str
+        Name in tables and reports.
+
+    Returns
+    -------
+    Spec
+        The specification.
+
+    Examples
+    --------
+    >>> import control as ct
+    >>> from loopshaping.check import check
+    >>> g, w = ct.tf([10], [1, 1]), [0.5, 1.0, 3.0, 10.0]          # |G| = 8.9, 7.1, 3.2, 1.0
+    >>> check([ct.tf([1], [1, 1])], g, controller_gain(5.0, band=(2.0, 10.0)), w).passed
+    True
+    >>> check([ct.tf([1], [1, 1])], g, controller_gain(5.0, band=(1.0, 10.0)), w).passed
+    False
+    """
+    return Spec("general", bound, band=band, name=name, kind_args={"A": 0.0, "B": 1.0, "C": 1.0, "D": 0.0})

@@ -392,24 +392,6 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
     return summary
 
 
-def _held_from(model, speeds, designs) -> int:
-    """Index of the lowest design a schedule may hold below rated: the first, from the lowest
-    speed up, that does not lift the pitch off fine pitch for the speed deficit there
-    (:func:`specdesign.qft.fine_pitch_lift` above the torque law's ``pitch_switch``). A lifting
-    design held below rated leaves fine pitch and ROSCO's torque state machine goes to rated
-    torque: the turbine loses most of its power in low winds (−84 % at 5 m/s, measured with the
-    15 m/s design of a 25 % target). 0 when the model has no torque law or every design lifts."""
-    from .qft import held_lift  # specdesign.qft loads python-control (the lifetime demo's own import)
-
-    law = getattr(model, "torque_control", None)
-    if law is None:
-        return 0
-    for i, d in enumerate(designs):
-        if held_lift(model, d) <= law.pitch_switch:
-            return i
-    return 0
-
-
 def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False, n_seeds: int | None = None,
                       duration: float | None = None, design_speeds=LIFETIME_DESIGN_SPEEDS, bin_width: float = 2.0,
                       cut_in: float = 3.0, cut_out: float = 25.0, k: float | None = None,
@@ -489,12 +471,8 @@ def run_lifetime_demo(out: str | os.PathLike = "specdesign_output", *, fast: boo
     t_start = time.perf_counter()
     _say(f"[1/3] QFT designs meeting the specification for {opts.target_reduction:g} % less tower-base DEL at "
          f"{_list(speeds)} m/s")
+    # the lowest design, held below rated, is made to keep fine pitch there (design_schedule's held_below_rated)
     designs = qft.design_schedule(model, speeds, opts.target_reduction)
-    held = _held_from(model, speeds, designs)
-    if held:
-        _say(f"      the {_list(speeds[:held])} m/s design(s) would lift the pitch off fine pitch below rated "
-             f"(qft.fine_pitch_lift); the schedule holds the {speeds[held]:g} m/s design below {speeds[held]:g} m/s")
-    speeds, designs = speeds[held:], designs[held:]
     pitch = {v: ct.tf(d.pitch_controller) for v, d in zip(speeds, designs)}
     atd = {v: ct.tf(d.atd_controller) for v, d in zip(speeds, designs)}
     controllers = {"ROSCO": rosco_scheduled(model),

@@ -13,7 +13,6 @@ All spectra are one-sided and per rad/s (∫₀^∞ S(ω) dω = variance, (m/s)�
 """
 from __future__ import annotations
 
-
 import functools
 from collections.abc import Callable, Sequence
 

@@ -44,7 +44,9 @@ def test_the_record_window_is_the_variance_about_a_records_mean():
 def test_the_promise_is_converged_in_the_band_and_the_grid(model, v):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy: "solution may be inaccurate" on some rungs
-        target = specification_for_target(model, v, 25.0)
+        # the 25 % pair of before the high-frequency gain bound (refused under its default κ:
+        # docs/feasibility.md); the band's convergence is the same question
+        target = specification_for_target(model, v, 25.0, max_hf_gain_ratio=None)
     w = spec.default_omega()
     assert w[0] == wind.LOWEST_OMEGA
     promise = target.promise.exact_del

@@ -65,6 +65,7 @@ from .stability import (
                            UNSTABLE_CONTROLLER_RATE,
                            ClosedLoopUnstableWarning,
                            closed_loop_matrices,
+                           fine_pitch_lift,
                            hidden_origin_poles,
                            local_response,
                            loop_parts,
@@ -76,6 +77,7 @@ from .stability import (
 
 __all__ = [
     "ClosedLoopUnstableWarning",
+    "fine_pitch_lift",
     "closed_loop",
     "closed_loop_mimo",
     "partial_loop",

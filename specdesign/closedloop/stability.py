@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._checks import positive_scalar
 from ..controller.lti import as_lti, split_integrator
 from ..controller.scheduled import ScheduledController
 from ..turbine.plant import KernelPlant, turbine_plant
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
 
     from ..turbine import TurbineModel
 
-__all__ = ["ClosedLoopUnstableWarning", "loop_parts", "local_response", "closed_loop_matrices", "turbine_loop_poles",
+__all__ = ["ClosedLoopUnstableWarning", "fine_pitch_lift", "loop_parts", "local_response", "closed_loop_matrices", "turbine_loop_poles",
            "hidden_origin_poles", "unstable_poles", "unstable_message", "trim_weights", "ORIGIN_TOL",
            "UNSTABLE_CONTROLLER_RATE", "MAX_SENSITIVITY", "DESIGN_MAX_SENSITIVITY", "CERTIFICATE_MAX_SENSITIVITY",
            "MIN_DECAY_RATE"]
@@ -481,3 +482,59 @@ def _blend(weighted):
         rq, cr = split_integrator(c)
         r, rest = r + wq * rq, rest + wq * control.ss(cr)
     return rest + control.ss(control.tf([r], [1.0, 0.0])) if r != 0 else rest
+
+
+def fine_pitch_lift(controller, deficit: float, duration: float = 60.0, n: int = 6001) -> float:
+    """How far a pitch controller lifts the pitch for a sustained speed deficit (rad; ≤ 0: it does not).
+
+    Below rated the rotor runs ``deficit`` under the pitch controller's speed reference; a
+    controller held there (the lowest design of a schedule) must keep pushing the pitch into
+    fine pitch, where it saturates. Its linear, unsaturated answer β = −C·δΩ_g to the step
+    δΩ_g = −``deficit`` (β in the workbench sign) over ``duration`` seconds: the largest β is
+    the lift. ROSCO's PI answers monotonically (lift 0); a controller whose answer swings up
+    lifts the pitch off fine pitch, and ROSCO's torque state machine then goes to rated torque
+    (docs/below_rated.md).
+
+    Parameters
+    ----------
+    controller : control.LTI
+        C_β, generator speed (rad/s) → pitch (rad), β = −C_β·Ω_g.
+    deficit : float
+        Speed deficit below rated, rad/s (> 0), e.g. the pitch controller's reference minus the
+        torque law's minimum speed.
+    duration : float
+        Time span of the answer, s (> 0).
+    n : int
+        Time samples (≥ 2).
+
+    Returns
+    -------
+    float
+        The largest pitch of the answer, rad (positive: lifted off fine pitch).
+
+    Raises
+    ------
+    ValueError
+        For a non-positive ``deficit`` or ``duration``, fewer than 2 samples, or a controller
+        that is not SISO.
+
+    Examples
+    --------
+    >>> import control
+    >>> from specdesign.closedloop import fine_pitch_lift
+    >>> pi = control.tf([-0.6, -0.08], [1.0, 0.0])  # ROSCO-like PI, β = −C·Ω_g
+    >>> fine_pitch_lift(pi, 0.27) <= 0.0
+    True
+    """
+    import control
+
+    deficit = positive_scalar(deficit, "deficit")
+    duration = positive_scalar(duration, "duration")
+    if int(n) != n or n < 2:
+        raise ValueError(f"n={n!r} must be an integer ≥ 2 (time samples)")
+    sys = control.ss(controller)
+    if sys.ninputs != 1 or sys.noutputs != 1:
+        raise ValueError(f"controller must be SISO (generator speed → pitch), got {sys.noutputs}x{sys.ninputs}")
+    t = np.linspace(0.0, duration, int(n))
+    _, y = control.step_response(sys, t)
+    return float(np.max(deficit * np.squeeze(y)))

@@ -56,14 +56,38 @@ shapes the paper's notches).
 
 Units: ω in rad/s, magnitudes linear (dB only in messages), DEL reductions in %.
 """
-from .achievable import YOULA_PAIRS, YOULA_REAL_POLES, AchievablePitch, YoulaProblem, achievable_pitch
-from .conditions import (PitchChecker, PitchFeasibility, combine, pitch_checkers, pitch_feasibility, pitch_frontier,
-                         sensitivity_disks)
+from .achievable import (
+                         HF_END,
+                         HF_GAIN_RATIO,
+                         MAX_HF_GAIN_RATIO,
+                         HF_OMEGA,
+                         YOULA_PAIRS,
+                         YOULA_REAL_POLES,
+                         AchievablePitch,
+                         YoulaProblem,
+                         achievable_pitch,
+                         hf_check_omega,
+                         hf_gain_bound,
+)
+from .conditions import (
+                         PitchChecker,
+                         PitchFeasibility,
+                         combine,
+                         pitch_checkers,
+                         pitch_feasibility,
+                         pitch_frontier,
+                         sensitivity_disks,
+)
 from .elements import element_specification
 from .shaping import shape_whole_band
-from .target import CertificateSearch, TargetSpecification, recertify, specification_for_target
+from .target import (
+                         CertificateSearch,
+                         TargetSpecification,
+                         recertify,
+                         specification_for_target,
+)
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "AchievablePitch",
            "achievable_pitch", "pitch_frontier", "TargetSpecification", "specification_for_target", "sensitivity_disks",
            "YOULA_REAL_POLES", "YOULA_PAIRS", "YoulaProblem", "recertify", "element_specification", "CertificateSearch",
-           "shape_whole_band"]
+           "shape_whole_band", "HF_GAIN_RATIO", "MAX_HF_GAIN_RATIO", "HF_OMEGA", "HF_END", "hf_check_omega", "hf_gain_bound"]

@@ -17,7 +17,7 @@ from ..closedloop import (
 from ..fatigue import TOWER_M
 from .. import spectral
 from ..spectral import trapezoid_weights
-from .achievable import YoulaProblem
+from .achievable import MAX_HF_GAIN_RATIO, YoulaProblem
 
 __all__ = ["PitchFeasibility", "pitch_feasibility", "PitchChecker", "pitch_checkers", "combine", "pitch_frontier",
            "sensitivity_disks"]
@@ -391,7 +391,7 @@ def _magnitude(spec_like, omega, name):
 
 @on_one_blas_thread
 def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8.0), *, max_sensitivity=MAX_SENSITIVITY,
-                   max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None) -> dict:
+                   max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None, max_hf_gain_ratio=MAX_HF_GAIN_RATIO) -> dict:
     """The largest tower-base DEL reduction a pitch controller can promise, per speed relaxation.
 
     For each relaxation g (dB) of the generator-speed specification W_Ω = 10^(g/20)·|T^ROSCO_{Ω,w}|:
@@ -419,6 +419,10 @@ def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8
         Wöhler exponent of the tower-base S-N curve (-).
     omega : array_like, optional
         Frequency grid, rad/s (default :func:`specdesign.spec.default_omega`).
+    max_hf_gain_ratio : float or None
+        κ of the high-frequency gain bound on the designs (see :func:`achievable_pitch`;
+        default :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO`, None: off; :data:`~specdesign.feasibility.HF_GAIN_RATIO` is the measured κ). The pointwise
+        ``bound`` ignores it (it stays an upper bound).
 
     Returns
     -------
@@ -445,7 +449,8 @@ def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8
     plant = model.linearize(float(wind_speed))
     speed0 = np.abs(spec.speed_specification(model, float(wind_speed)).response(w))
     bound, designs = [], []
-    youla = YoulaProblem(model, wind_speed, max_sensitivity=ms, max_pitch_rate_ratio=max_pitch_rate_ratio, base=base)
+    youla = YoulaProblem(model, wind_speed, max_sensitivity=ms, max_pitch_rate_ratio=max_pitch_rate_ratio, base=base,
+                         max_hf_gain_ratio=max_hf_gain_ratio)
     for gi in g:
         d = sensitivity_disks(plant, w, np.full(w.shape, np.inf), speed0 * 10 ** (gi / 20), ms)
         r = np.minimum(d["r_speed"], d["r_margin"])

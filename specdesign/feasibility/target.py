@@ -14,6 +14,7 @@ from ..closedloop import (
     case_speeds,
     closed_loop,
     closed_map,
+    fine_pitch_lift,
     lightly_damped,
     plant_responses,
     refine_grid,
@@ -21,7 +22,16 @@ from ..closedloop import (
     system_roots,
 )
 from ..fatigue import TOWER_M
-from .achievable import AchievablePitch, YoulaProblem
+from .achievable import (
+    HF_END,
+    MAX_HF_GAIN_RATIO,
+    HF_OMEGA,
+    AchievablePitch,
+    YoulaProblem,
+    hf_check_omega,
+    hf_gain_bound,
+    hf_ratio,
+)
 
 __all__ = ["DEFAULT_CASE_OFFSETS", "DENSE_POINTS_PER_WIDTH", "HOPELESS_DB", "MARGIN_WIDTH", "MAX_RELAX_DB",
            "RELAX_LADDER_DB", "SEARCH_MARGIN_PP", "SLACK_DB", "SPEED_SLACK_DB", "TARGET_REDUCTION", "TOLERANCE_DB", "UNSTABLE_POLE_TOL", "CertificateSearch", "TargetSpecification", "recertify", "specification_for_target"]
@@ -112,6 +122,15 @@ class TargetSpecification:
         its case speed m/s) of the certificate's maps at any plant case over the nominal W itself
         (not the per-case W_i above), on the dense check's grid; > 0 where a plant case exceeds
         the W the user sees (its resonance moved, its gain changed with its operating point).
+    max_hf_gain_ratio : float or None
+        κ of the high-frequency gain bound the certificate meets, |C_β| ≤ κ·|C_ROSCO| on
+        :data:`~specdesign.feasibility.achievable.HF_OMEGA`-:data:`~specdesign.feasibility.achievable.HF_END`
+        rad/s with C_β strictly proper (None: made without it); the design step meets it too.
+    held_lift_limit : tuple or None
+        (speed deficit rad/s, largest lift rad) for a pair made to be held below rated
+        (``held_below_rated``): the certificate's answer to that sustained deficit lifts the
+        pitch off fine pitch by at most the limit (:func:`specdesign.closedloop.fine_pitch_lift`),
+        and the design step's controller too; None: not required.
     """
 
     tower: object
@@ -126,6 +145,8 @@ class TargetSpecification:
     speed_slack_db: float = 0.0
     m: float = TOWER_M
     strict_excess: tuple = ()
+    max_hf_gain_ratio: float | None = None
+    held_lift_limit: tuple | None = None
 
     @property
     def wind_speed(self) -> float:
@@ -150,7 +171,8 @@ def specification_for_target(model, wind_speed, target_reduction=TARGET_REDUCTIO
                              max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0,
                              max_relax_db=MAX_RELAX_DB, tolerance_db=TOLERANCE_DB,
                              m=TOWER_M, omega=None, case_offsets=DEFAULT_CASE_OFFSETS, speed_slack_db=SPEED_SLACK_DB,
-                             dense_omega=None) -> TargetSpecification:
+                             dense_omega=None, max_hf_gain_ratio=MAX_HF_GAIN_RATIO,
+                             held_below_rated=False) -> TargetSpecification:
     """The feasible specification pair that promises ``target_reduction`` with the least speed relaxation.
 
     A ladder (:data:`RELAX_LADDER_DB`) then bisection on the relaxation g of ROSCO's
@@ -204,6 +226,19 @@ def specification_for_target(model, wind_speed, target_reduction=TARGET_REDUCTIO
         Room left above the certificate's speed maps in W_Ω, dB (≥ 0).
     dense_omega : array_like, optional
         Grid of the plant-case check, rad/s (default 600 points, 0.005-20, refined).
+    max_hf_gain_ratio : float or None
+        κ of the high-frequency gain bound on the certificate, |C_β| ≤ κ·|C_ROSCO| on
+        HF_OMEGA-HF_END (2-10 rad/s, 3P inside) with C_β strictly proper (default
+        :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO`, None: off; the κ measured in OpenFAST
+        is :data:`~specdesign.feasibility.HF_GAIN_RATIO`, docs/feasibility.md). Checked on the
+        dense grid too.
+    held_below_rated : bool
+        The pair's design is held below rated by a schedule (its lowest design speed): a
+        certificate counts only if its answer to the torque law's sustained speed deficit
+        (``model.torque_control``: pitch reference minus minimum speed) lifts the pitch off fine
+        pitch by at most the law's ``pitch_switch`` (:func:`specdesign.closedloop.fine_pitch_lift`;
+        above it ROSCO's torque state machine leaves the below-rated law, docs/below_rated.md).
+        Ignored for a model without a torque law.
 
     Returns
     -------
@@ -216,20 +251,22 @@ def specification_for_target(model, wind_speed, target_reduction=TARGET_REDUCTIO
         For a bool or a string where a number is meant (``target_reduction=True`` is not 1 %).
     ValueError
         For a target outside (0, 100), a negative slack, a tolerance ≤ 0, invalid offsets, or when even
-        ``max_relax_db`` does not reach the target (the message gives the promise reached there).
+        ``max_relax_db`` does not reach the target (the message gives the promise reached there and,
+        with the high-frequency gain bound on, names it and its κ).
 
     Examples
     --------
     >>> from specdesign.turbine import iea15mw
-    >>> t = specification_for_target(iea15mw(), 19.0, 25.0)
-    >>> bool(t.promise.exact_del >= 25.0 and t.speed_relax_db < 2.0)
+    >>> t = specification_for_target(iea15mw(), 19.0, 20.0)   # under the default HF gain bound
+    >>> bool(t.promise.exact_del >= 20.0 and t.speed_relax_db < 3.5)
     True
     """
     _check_target(target_reduction, slack_db, speed_slack_db)  # at the door, before the plant cases are built
     search_options(tolerance_db, max_relax_db, speed_relax_db)
     search = CertificateSearch(model, wind_speed, max_sensitivity=max_sensitivity,
                                max_pitch_rate_ratio=max_pitch_rate_ratio, m=m, omega=omega, case_offsets=case_offsets,
-                               dense_omega=dense_omega)
+                               dense_omega=dense_omega, max_hf_gain_ratio=max_hf_gain_ratio,
+                               held_below_rated=held_below_rated)
     return search.for_target(target_reduction, slack_db=slack_db, speed_relax_db=speed_relax_db,
                              max_relax_db=max_relax_db, tolerance_db=tolerance_db, speed_slack_db=speed_slack_db)
 
@@ -255,7 +292,7 @@ class CertificateSearch:
         The turbine.
     wind_speed : float
         Operating point, m/s.
-    max_sensitivity, max_pitch_rate_ratio, m, omega, case_offsets, dense_omega
+    max_sensitivity, max_pitch_rate_ratio, m, omega, case_offsets, dense_omega, max_hf_gain_ratio, held_below_rated
         As in :func:`specification_for_target`.
 
     Raises
@@ -267,13 +304,14 @@ class CertificateSearch:
     --------
     >>> from specdesign.turbine import iea15mw
     >>> search = CertificateSearch(iea15mw(), 19.0)
-    >>> a, b = search.for_target(25.0), search.for_target(28.0)   # the second reuses the first's designs
+    >>> a, b = search.for_target(20.0), search.for_target(22.0)   # the second reuses the first's designs
     >>> bool(b.speed_relax_db >= a.speed_relax_db)
     True
     """
 
     def __init__(self, model, wind_speed, *, max_sensitivity=CERTIFICATE_MAX_SENSITIVITY, max_pitch_rate_ratio=1.0, m=TOWER_M, omega=None,
-                 case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None):
+                 case_offsets=DEFAULT_CASE_OFFSETS, dense_omega=None, max_hf_gain_ratio=MAX_HF_GAIN_RATIO,
+                 held_below_rated=False):
         from .. import spec
         self.model, self.m = model, float(m)
         self.wind_speed = v = model.check_wind_speed(wind_speed)
@@ -282,8 +320,17 @@ class CertificateSearch:
                       else as_omega(dense_omega, "dense_omega", allow_zero=False))
         self.base = spec.baseline_analysis(model, v, m=m, omega=omega)
         self._cases = _Cases(model, self.case_speeds, v)
-        self._youla_options = {"max_sensitivity": max_sensitivity, "max_pitch_rate_ratio": max_pitch_rate_ratio}
+        self.max_hf_gain_ratio = hf_ratio(max_hf_gain_ratio)
+        self._youla_options = {"max_sensitivity": max_sensitivity, "max_pitch_rate_ratio": max_pitch_rate_ratio,
+                               "max_hf_gain_ratio": self.max_hf_gain_ratio}
         self._youla = YoulaProblem(model, v, base=self.base, **self._youla_options)
+        # the bound where the certificate is checked: the dense grid's points in its band, its ends and 3P
+        self._hf_omega = hf_check_omega(model, self.dense)
+        self._hf = hf_gain_bound(model, v, self._hf_omega, self.max_hf_gain_ratio)
+        law = getattr(model, "torque_control", None) if held_below_rated else None
+        # (speed deficit rad/s, largest lift rad): the model's gen_speed output is the rotor-shaft speed
+        self.held_lift_limit = None if law is None else (float(law.pitch_reference_speed - law.min_speed),
+                                                         float(law.pitch_switch))
         self._youla_tower = None  # the same problem with a tower bound, made on first use (for_tower)
         self._designs = {}
 
@@ -302,10 +349,61 @@ class CertificateSearch:
                 # no implementable design: design_qft refuses such a controller (its loop opens
                 # wherever the pitch saturates), so that relaxation counts as one with no design
                 p = np.asarray(control.ss(controller).poles())
-                if not np.any(p.real > UNSTABLE_POLE_TOL * np.maximum(1.0, np.abs(p))):
+                if (not np.any(p.real > UNSTABLE_POLE_TOL * np.maximum(1.0, np.abs(p))) and self.hf_met(controller)
+                        and self.lift_met(controller)):
                     rob = self._cases.excess(controller, self.dense)
             self._designs[g] = (d, rob)
         return self._designs[g]
+
+    def hf_met(self, controller) -> bool:
+        """Whether ``controller`` meets the high-frequency gain bound where it is checked.
+
+        Parameters
+        ----------
+        controller : control.LTI
+            A pitch controller C_β (rad per rad/s), β = −C_β·Ω_g.
+
+        Returns
+        -------
+        bool
+            |C_β| ≤ κ·|C_ROSCO| at the dense grid's points on HF_OMEGA-HF_END, both ends and 3P
+            (:func:`~specdesign.feasibility.achievable.hf_check_omega`); True without a bound.
+        """
+        if self._hf is None:
+            return True
+        return bool(np.all(np.abs(siso_response(controller, self._hf_omega)) <= self._hf))
+
+    def lift_met(self, controller) -> bool:
+        """Whether ``controller``, held below rated, keeps fine pitch.
+
+        Parameters
+        ----------
+        controller : control.LTI
+            A pitch controller C_β (rad per rad/s), β = −C_β·Ω_g.
+
+        Returns
+        -------
+        bool
+            Its lift for the torque law's speed deficit (:func:`specdesign.closedloop.fine_pitch_lift`)
+            at most the law's ``pitch_switch``; True unless made with ``held_below_rated``.
+        """
+        if self.held_lift_limit is None:
+            return True
+        deficit, limit = self.held_lift_limit
+        return fine_pitch_lift(controller, deficit) <= limit
+
+    def _hf_words(self):
+        """How the high-frequency gain bound and the held design's lift limit enter an
+        infeasibility message ('' without either)."""
+        words = ""
+        if self.max_hf_gain_ratio is not None:
+            k = self.max_hf_gain_ratio
+            words += (f" under the high-frequency gain bound |C| ≤ {k:g}·|C_ROSCO| on {HF_OMEGA:g}-{HF_END:g} rad/s "
+                      f"(max_hf_gain_ratio={k:g}; a larger one, or None to switch it off, allows more)")
+        if self.held_lift_limit is not None:
+            words += (f"{' and' if words else ''} keeping fine pitch when held below rated (lift ≤ "
+                      f"{np.degrees(self.held_lift_limit[1]):.2f}° for the torque law's speed deficit: held_below_rated)")
+        return words
 
     def _reached(self, g, slack):
         d, rob = self._design(g)
@@ -344,10 +442,11 @@ class CertificateSearch:
             design, best, rob = self._reached(g, 0.0)
             if design is None or rob is None:
                 raise ValueError(f"no pitch design meets the speed map relaxed by {g:g} dB at {v:g} m/s over the plant "
-                                 f"cases {speeds} m/s")
+                                 f"cases {speeds} m/s" + self._hf_words())
             if best < t + SEARCH_MARGIN_PP:
                 raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s with the speed map relaxed by "
-                                 f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs); relax it more")
+                                 f"{g:g} dB (best {best:.1f} % with no slack over the plant cases' needs)"
+                                 + self._hf_words() + "; relax it more")
             lo_s, hi_s = 0.0, 40.0
             for _ in range(MAX_BISECTIONS):  # bounded: a tolerance below float64's spacing is never reached
                 if hi_s - lo_s <= tolerance_db:
@@ -356,7 +455,8 @@ class CertificateSearch:
                 reaches = _slack_promise(design, base, mid + rob[0]) >= t + SEARCH_MARGIN_PP
                 lo_s, hi_s = (mid, hi_s) if reaches else (lo_s, mid)
             return self._cases.with_strict(_target_result(model, v, design, base, lo_s, rob, g, sslack, speeds, t,
-                                                          self.m), self.dense)
+                                                          self.m, self.max_hf_gain_ratio, self.held_lift_limit),
+                                           self.dense)
         # a ladder first, then bisection inside the first rung that reaches the target: the promise
         # over the plant cases is not monotone in g (bolder designs are less robust), so a bisection
         # over the whole range could step past the smallest relaxation that works
@@ -372,8 +472,8 @@ class CertificateSearch:
         if found is None:
             raise ValueError(f"no pitch specification promises {t:g} % at {v:g} m/s over the plant cases {speeds} m/s "
                              f"with the speed map relaxed up to {max_relax_db:g} dB (best {best_red:.1f} % with "
-                             f"{slack:g} dB slack over the plant cases' needs); lower the target or the slack, or allow "
-                             "more pitch activity")
+                             f"{slack:g} dB slack over the plant cases' needs)" + self._hf_words()
+                             + "; lower the target or the slack, or allow more pitch activity")
         hi_g, best, best_rob = found
         for _ in range(MAX_BISECTIONS):
             if hi_g - lo_g <= tolerance_db:
@@ -385,7 +485,8 @@ class CertificateSearch:
             else:
                 lo_g = mid
         return self._cases.with_strict(_target_result(model, v, best, base, slack, best_rob, hi_g, sslack, speeds, t,
-                                                      self.m), self.dense)
+                                                      self.m, self.max_hf_gain_ratio, self.held_lift_limit),
+                                       self.dense)
 
     def for_tower(self, tower, target_reduction, *, relax_ladder_db=(0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0),
                   max_relax_db=MAX_RELAX_DB, speed_slack_db=SPEED_SLACK_DB, margin_steps=4) -> TargetSpecification:
@@ -437,8 +538,8 @@ class CertificateSearch:
         >>> from specdesign import spec
         >>> from specdesign.turbine import iea15mw
         >>> search = CertificateSearch(iea15mw(), 19.0)
-        >>> t = search.for_target(25.0)
-        >>> deeper = search.for_tower(t.tower.add(spec.Notch(1.0, 2.0, 0.3)), 25.0)  # 2 dB more at the tower mode
+        >>> t = search.for_target(20.0)
+        >>> deeper = search.for_tower(t.tower.add(spec.Notch(1.0, 2.0, 0.3)), 20.0)  # 2 dB more at the tower mode
         >>> bool(deeper.promise.exact_del > t.promise.exact_del and deeper.speed_relax_db >= t.speed_relax_db - 0.5)
         True
         """
@@ -470,6 +571,12 @@ class CertificateSearch:
                     tried.append(f"{g:g} dB: no design")
                     break
                 controller = d.controller(self.model)
+                if not self.hf_met(controller):
+                    tried.append(f"{g:g} dB: over the high-frequency gain bound between grid points")
+                    break
+                if not self.lift_met(controller):
+                    tried.append(f"{g:g} dB: lifts the pitch off fine pitch when held below rated")
+                    break
                 speed_g = spec.speed_specification(self.model, self.wind_speed, margin_db=g)
                 checked = self._cases.spec_excess(controller, tower, speed_g, self.dense)
                 if checked is None:
@@ -483,7 +590,9 @@ class CertificateSearch:
                     # the check just made is that pair's: W_Ω relaxed further only lifts its bound,
                     # and the grid is refined around the same roots (ROSCO's speed map either way)
                     record = TargetSpecification(tower, speed, None, relax, 0.0, d, t, self.case_speeds,
-                                                 float(margin.max()), sslack, self.m)
+                                                 float(margin.max()), sslack, self.m,
+                                                 max_hf_gain_ratio=self.max_hf_gain_ratio,
+                                                 held_lift_limit=self.held_lift_limit)
                     return _checked_record(self.model, record, self._cases, tower, speed, *checked[1:])
                 tried.append(f"{g:g} dB, margin {margin.max():.2f} dB: {x:.2f} dB over W_MyT at {wk:.3g} rad/s "
                              f"({case:g} m/s)")
@@ -500,8 +609,8 @@ class CertificateSearch:
                 margin += np.max(np.where(near, profile[over][None, :] + 0.05, 0.0), axis=1)
             hopeless = hopeless + 1 if rung_hopeless else 0
         raise ValueError(f"no pitch design meets the tower specification at every plant case {self.case_speeds} m/s at "
-                         f"{self.wind_speed:g} m/s with the speed map relaxed up to {max_relax_db:g} dB ("
-                         + "; ".join(tried) + ")")
+                         f"{self.wind_speed:g} m/s with the speed map relaxed up to {max_relax_db:g} dB"
+                         + self._hf_words() + " (" + "; ".join(tried) + ")")
 
 
 class _Cases:
@@ -634,7 +743,7 @@ def _slack_promise(design, base, slack_db):
     return spec.promise_of(10 ** (slack_db / 20) * np.abs(design.t_tower) / np.abs(base.t_response), base).exact_del
 
 
-def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target, m):
+def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, speeds, target, m, kappa_hf, held):
     import control
 
     from .. import spec
@@ -648,7 +757,8 @@ def _target_result(model, wind_speed, design, base, slack, rob, g, speed_slack, 
     relax = max(g, speed_needed) + speed_slack
     speed = spec.speed_specification(model, float(wind_speed), margin_db=relax)
     return TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, total, design, target,
-                               tuple(speeds), robust, speed_slack, float(m))
+                               tuple(speeds), robust, speed_slack, float(m), max_hf_gain_ratio=kappa_hf,
+                               held_lift_limit=held)
 
 
 def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> TargetSpecification:
@@ -693,7 +803,7 @@ def recertify(model, target, *, tower=None, speed=None, dense_omega=None) -> Tar
     >>> from specdesign import spec
     >>> from specdesign.turbine import iea15mw
     >>> model = iea15mw()
-    >>> t = specification_for_target(model, 19.0, 25.0)
+    >>> t = specification_for_target(model, 19.0, 20.0)
     >>> looser = recertify(model, t, tower=t.tower.add(spec.Gain(0.5)))   # 0.5 dB more room
     >>> bool(looser.promise.exact_del < t.promise.exact_del)
     True
@@ -740,5 +850,6 @@ def _checked_record(model, target, cases, tower, speed, w, t0, rs0):
     relax = float(20 * np.log10(np.min(np.abs(np.asarray(speed.response(w))) / rs0)))
     record = TargetSpecification(tower, speed, spec.promise_of(tower, base), relax, margin, design,
                                  target.target_reduction, cases.speeds, target.robustness_db, target.speed_slack_db,
-                                 target.m)
+                                 target.m, max_hf_gain_ratio=target.max_hf_gain_ratio,
+                                 held_lift_limit=target.held_lift_limit)
     return cases.with_strict(record, w)

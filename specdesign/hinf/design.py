@@ -27,6 +27,7 @@ from .._checks import finite_system, spec_made_at
 from ..closedloop import MIN_DECAY_RATE, closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
 from ..fatigue import TOWER_M
+from ..feasibility import MAX_HF_GAIN_RATIO
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from ..feasibility.target import TARGET_REDUCTION
@@ -242,6 +243,7 @@ def design_hinf(
     min_damping: float = DEFAULT_MIN_DAMPING,
     decay_rate: float = DEFAULT_DECAY_RATE,
     integral_corner: float | None = None,
+    max_hf_gain_ratio: float | None = MAX_HF_GAIN_RATIO,
     **plant_options: Any,
 ) -> HinfDesign:
     """Design, reduce and assess an H∞ pitch (and optional ATD) controller at one wind speed.
@@ -310,6 +312,14 @@ def design_hinf(
         Corner ω_i (rad/s) of the integrator F(s) = (1 + s/ω_i)/s built into the plant
         (:func:`generalized_plant`). Default: 0.1 rad/s when ``decay_rate`` > 0 (without it
         the shift would move the controller's integral action to −α), none otherwise.
+    max_hf_gain_ratio : float or None
+        κ of the high-frequency gain bound with ``spec="target"``: the pair is made under it
+        (``specification_for_target(max_hf_gain_ratio=...)``, which refuses a target it makes
+        infeasible, naming it), and the multi-model step holds |C_β| ≤ κ·|C_ROSCO| on
+        HF_OMEGA-HF_END (2-10 rad/s, 3P included) with C_β strictly proper (``case_check``'s
+        ``hf_excess_db`` and ``proper``). A TargetSpecification carries its own. Default
+        :data:`specdesign.feasibility.MAX_HF_GAIN_RATIO` (None: off); the measured κ is
+        :data:`specdesign.feasibility.HF_GAIN_RATIO`.
     **plant_options
         ``noise``, ``noise_band``, ``rolloff``, ``shift`` for :func:`generalized_plant`.
 
@@ -367,7 +377,7 @@ def design_hinf(
     # baseline analysis or SLICOT meet it ("SVD did not converge")
     finite_system(model.linearize(v), f"the plant linearised at {v:g} m/s")
     if spec is None:  # design_qft's default: the feasible (certified) pair for the DEL target, then meet it
-        spec = spec_for_target(model, v, target_reduction, m=m)
+        spec = spec_for_target(model, v, target_reduction, m=m, max_hf_gain_ratio=max_hf_gain_ratio)
     elif not isinstance(spec, HinfSpecification):
         raise TypeError(f"spec must be a hinf.HinfSpecification, got {spec!r}: make it with hinf.spec_for_target, "
                         "spec_from_certified (a feasibility.TargetSpecification), spec_from_pair (W_MyT, W_Ω), "
@@ -494,7 +504,9 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
                   f"tower load by {case_check.tower_excess_db[i]:+.2f} dB at {case_check.tower_omega[i]:.3g} rad/s "
                   f"({case_check.case_speeds[i]:g} m/s), generator speed by {case_check.speed_excess_db[j]:+.2f} dB at "
                   f"{case_check.speed_omega[j]:.3g} rad/s ({case_check.case_speeds[j]:g} m/s), closed-loop decay "
-                  f"{case_check.decay_rate:.3g} 1/s; raise order, or qft.design_qft(spec=...) meets it")
+                  f"{case_check.decay_rate:.3g} 1/s, high-frequency gain bound by {case_check.hf_excess_db:+.2f} dB"
+                  f"{'' if case_check.proper else ' (not strictly proper)'}; raise order, or qft.design_qft(spec=...) "
+                  "meets it")
         notes = notes + (missed,)
         warnings.warn(missed, RuntimeWarning, stacklevel=3)
     elif case_check is None and label in ("given", "target") and (speed_excess > 0 or tower_ratio.max() > 0):

@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from .. import spec as sp
 from ..fatigue import TOWER_M
-from ..feasibility import TargetSpecification, specification_for_target
+from ..feasibility import MAX_HF_GAIN_RATIO, TargetSpecification, specification_for_target
 from ..feasibility.target import TARGET_REDUCTION
 from ..qft.design import SPEED_RELAX_DB
 
@@ -137,7 +137,7 @@ def spec_from_certified(target: TargetSpecification, *, kind: str = "given") -> 
 
 
 def spec_for_target(model: TurbineModel, wind_speed: float, target_reduction: float = TARGET_REDUCTION, *,
-                    m: float = TOWER_M) -> HinfSpecification:
+                    m: float = TOWER_M, max_hf_gain_ratio: float | None = MAX_HF_GAIN_RATIO) -> HinfSpecification:
     """The certified pair for a tower-base DEL target, as :func:`specdesign.qft.design_qft` makes it.
 
     :func:`specdesign.feasibility.specification_for_target` (certified over the plant cases
@@ -151,6 +151,9 @@ def spec_for_target(model: TurbineModel, wind_speed: float, target_reduction: fl
         The DEL target: tower-base DEL reduction (1 Hz, m = ``m``) vs ROSCO, % (0-100).
     m : float
         Wöhler exponent of the tower-base S-N curve on ranges (-).
+    max_hf_gain_ratio : float or None
+        κ of the certificate's high-frequency gain bound (:func:`specification_for_target`);
+        None: no bound.
 
     Returns
     -------
@@ -174,7 +177,8 @@ def spec_for_target(model: TurbineModel, wind_speed: float, target_reduction: fl
         reduction = float("nan")
     if not 0 < reduction < 100:
         raise ValueError(f"target_reduction={target_reduction!r} must be a DEL reduction in % (0-100)")
-    return spec_from_certified(specification_for_target(model, wind_speed, reduction, m=m), kind="target")
+    return spec_from_certified(specification_for_target(model, wind_speed, reduction, m=m,
+                                                        max_hf_gain_ratio=max_hf_gain_ratio), kind="target")
 
 
 def spec_from_pair(tower: Specification | ct.LTI, speed: Specification | ct.LTI, *,

@@ -17,6 +17,7 @@ from loopshaping import qft as lqft
 from loopshaping.freqresp import is_zero
 
 from .. import closedloop
+from ..feasibility import HF_END, HF_OMEGA, hf_gain_bound
 from ..turbine import iea15mw
 
 if TYPE_CHECKING:
@@ -58,20 +59,33 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
     omega : array_like, optional
         Frequency grid, rad/s (default 800 log-spaced points, 0.01-10 rad/s).
     axes : sequence of matplotlib.axes.Axes, optional
-        Two stacked axes (generator speed, tower-base moment); default a new figure.
+        Two stacked axes (generator speed, tower-base moment), or three (and the pitch
+        controller's gain); default a new figure with three for a design made under the
+        high-frequency gain bound, two otherwise.
 
     Returns
     -------
     matplotlib.figure.Figure
-        The figure (two stacked axes, shared ω axis in rad/s): |T| in dB re 1 (rad/s)/(m/s)
-        and re 1 N·m/(m/s).
+        The figure (stacked axes, shared ω axis in rad/s): |T| in dB re 1 (rad/s)/(m/s) and
+        re 1 N·m/(m/s); a third axes holds |C_β| and ROSCO's |C| in dB re 1 rad/(rad/s) with
+        the bound κ·|C_ROSCO| on HF_OMEGA-HF_END (legend "high-frequency gain bound").
+
+    Raises
+    ------
+    ValueError
+        If ``axes`` holds neither two nor three axes.
     """
     w = np.logspace(-2, 1, 800) if omega is None else np.asarray(omega, dtype=float)
+    kappa = design.options.get("max_hf_gain_ratio")
     if axes is None:
         import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(2, 1, figsize=(9, 7.5), sharex=True)
+        n = 2 if kappa is None else 3
+        fig, axes = plt.subplots(n, 1, figsize=(9, 3.75 * n), sharex=True)
     else:
+        if len(axes) not in (2, 3):
+            raise ValueError(f"axes holds {len(axes)} axes; give two (generator speed, tower-base moment) or three "
+                             "(and the pitch controller's gain)")
         fig = axes[0].figure
     if model is None:
         model = iea15mw()
@@ -124,9 +138,29 @@ def plot_design_bode(design: QFTDesign, model: TurbineModel | None = None, omega
     axes[0].set_title(f"Wind → generator speed, {design.wind_speed:g} m/s (dense check, every plant case: "
                       f"{design.message})", fontsize=10)
     axes[1].set_title(f"Wind → tower-base fore-aft moment, {design.wind_speed:g} m/s")
-    axes[1].set_xlabel("frequency ω (rad/s)")
+    if len(axes) == 3:
+        _draw_gain(axes[2], design, model, w, kappa)
+    axes[-1].set_xlabel("frequency ω (rad/s)")
     fig.tight_layout()
     return fig
+
+
+def _draw_gain(ax, design, model, w, kappa):
+    """|C_β| and ROSCO's |C| (dB re 1 rad per rad/s) and the high-frequency gain bound on ``ax``."""
+    def db(x):
+        return 20 * np.log10(np.abs(x))
+
+    ax.semilogx(w, db(closedloop.siso_response(design.baseline_controller, w)), "C0", label="ROSCO $|C|$")
+    ax.semilogx(w, db(closedloop.siso_response(design.pitch_controller, w)), "C1", lw=2, label="design $|C_\\beta|$")
+    if kappa is not None:
+        band = w[(w >= HF_OMEGA) & (w <= HF_END)]
+        ax.semilogx(band, db(hf_gain_bound(model, design.wind_speed, band, kappa)), "k--", lw=1.5,
+                    label=f"high-frequency gain bound $|C_\\beta| \\leq {kappa:g}\\,|C_{{ROSCO}}|$ "
+                          f"({HF_OMEGA:g}-{HF_END:g} rad/s)")
+    ax.set_ylabel("|C| (dB re 1 rad/(rad/s))")
+    ax.set_title(f"Pitch controller gain, {design.wind_speed:g} m/s", fontsize=10)
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=7)
 
 
 def _bounds_at(bounds, template, picks):
@@ -140,7 +174,7 @@ def _bounds_at(bounds, template, picks):
 
 
 def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05, 0.1, 0.3, 0.6, 1.0, 1.5, 3.0),
-                        axes: Sequence[Axes] | None = None) -> Figure:
+                        axes: Sequence[Axes] | None = None, model: TurbineModel | None = None) -> Figure:
     """Nichols charts of the QFT loops with their bounds: the paper's Figs. 5-6 analogue.
 
     The pitch loop C_β·P'_{Ω,β} (with the ATD loop closed, where the design has one) and, for
@@ -157,6 +191,10 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
         Frequencies, rad/s, whose nearest template frequencies get their bounds drawn.
     axes : sequence of matplotlib.axes.Axes, optional
         One axes per loop drawn (two with ATD, one without); default a new figure.
+    model : specdesign.turbine.TurbineModel, optional
+        The turbine the design was made on (default the embedded IEA 15 MW), for ROSCO's |C|
+        in the high-frequency gain bound of a design made under it: drawn on the pitch loop's
+        chart as |L| ≤ κ·|C_ROSCO|·|P| at the loop's phase (legend "high-frequency gain bound").
 
     Returns
     -------
@@ -185,9 +223,22 @@ def plot_design_nichols(design: QFTDesign, picks: Sequence[float] = (0.01, 0.05,
                          f"({'pitch and ATD' if with_atd else 'pitch only'}): give one axes per loop")
     fig = axes[0].figure
     w = np.logspace(-3, 1.5, 3000)
-    for ax, (bounds, template, c, ylim, title) in zip(axes, loops):
+    kappa = design.options.get("max_hf_gain_ratio")
+    for i, (ax, (bounds, template, c, ylim, title)) in enumerate(zip(axes, loops)):
         plant = template.systems[template.nominal]
         nichols.draw(_bounds_at(bounds, template, picks), loop=c * plant, ax=ax, omega=w, ylim=ylim)
+        if i == 0 and kappa is not None:
+            # |C_β| ≤ B(ω) is |L| ≤ B(ω)·|P| at the loop's own phase, frequency by frequency: the
+            # highest the nominal loop may lie on its band
+            band = w[(w >= HF_OMEGA) & (w <= HF_END)]
+            p = closedloop.siso_response(plant, band, "plant")
+            loop = closedloop.siso_response(c, band) * p
+            phase, mag = nichols.wrap_phase(np.degrees(np.unwrap(np.angle(loop))),
+                                            20 * np.log10(hf_gain_bound(iea15mw() if model is None else model,
+                                                                        design.wind_speed, band, kappa) * np.abs(p)))
+            ax.plot(phase, mag, "k--", lw=1.5, label=f"high-frequency gain bound $|C_\\beta| \\leq {kappa:g}\\,"
+                    f"|C_{{ROSCO}}|$ ({HF_OMEGA:g}-{HF_END:g} rad/s), at the loop's phase")
+            ax.legend(fontsize=7)
         ax.set_title(f"{title}, {design.wind_speed:g} m/s")
     fig.tight_layout()
     return fig

@@ -80,7 +80,15 @@ from __future__ import annotations
 
 from ..closedloop import general_form, partial_loop
 from .checks import fine_pitch_lift
-from .design import SPEED_RELAX_DB, check_design_speed, design_qft, design_schedule, design_table, format_table, held_lift
+from .design import (
+    SPEED_RELAX_DB,
+    check_design_speed,
+    design_qft,
+    design_schedule,
+    design_table,
+    format_table,
+    held_lift,
+)
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 

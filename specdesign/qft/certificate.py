@@ -29,12 +29,19 @@ from ..closedloop import (
     MIN_DECAY_RATE,
     closed_loop,
     closed_map,
+    fine_pitch_lift,
     lightly_damped,
     plant_responses,
     refine_grid,
     siso_response,
 )
-from ..feasibility import TargetSpecification
+from ..feasibility import (
+    HF_END,
+    HF_OMEGA,
+    TargetSpecification,
+    hf_check_omega,
+    hf_gain_bound,
+)
 from .checks import spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, assemble_design
 from .tuner import TuningProblem
@@ -85,7 +92,11 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
         exact DEL promise. Every plant case meets its own W_i = T^ROSCO_i·W/T^ROSCO (the
         specification at that case's speed); ``options["strict_excess_db"]`` gives the largest
         excess of any case over the nominal W_MyT and W_Ω themselves (dB, the pair read strictly:
-        > 0 where a case exceeds the W the user sees).
+        > 0 where a case exceeds the W the user sees). With the high-frequency gain bound of
+        ``target.max_hf_gain_ratio`` the controller also meets |C_β| ≤ κ·|C_ROSCO| on
+        HF_OMEGA-HF_END (the dense grid's points there and 3P) with the order margin and is
+        strictly proper (its certificate is, and balanced truncation keeps D = 0); the check
+        "hf_gain" of ``pitch_check`` says so, and ``options["max_hf_gain_ratio"]`` records κ.
 
     Raises
     ------
@@ -113,17 +124,22 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
               else lqft.check_grid(dense_omega, "dense_omega"))
     tower_shaping = spec_ratio(target.tower, base.system)
     speed_shaping = spec_ratio(target.speed, sp.speed_specification(model, v).baseline)
+    kappa = target.max_hf_gain_ratio
+    bound = None if kappa is None else (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, 0.0, max_sensitivity, base,
-                         speed_shaping=speed_shaping, response_method="batched")
+                         speed_shaping=speed_shaping, response_method="batched", controller_bound=bound)
     roots = lightly_damped(np.concatenate([spec_roots(target.tower), spec_roots(target.speed)]))
     sharp = np.abs(roots[roots.imag > 0])
     sharp = sharp[(sharp >= wdense[0]) & (sharp <= wdense[-1])]
     if sharp.size:
         prob.set_design(np.unique(np.r_[prob.wd, sharp]))
     wdense = refine_grid(wdense, roots)
+    if kappa is not None:  # the bound's check includes its band's ends and 3P (hf_check_omega)
+        wdense = np.union1d(wdense, hf_check_omega(model, wdense))
     full = ct.ss(target.design.controller(model))
     strict = (np.abs(np.asarray(target.speed.response(wdense))), np.abs(np.asarray(target.tower.response(wdense))))
-    cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict)
+    cb, order, strict_excess = _lowest_order(prob, full, wdense, int(min_order), max_sensitivity, min_decay, strict,
+                                             target.held_lift_limit)
     ca = ct.tf([0.0], [1.0])
     c = siso_response(cb, base.omega)[:, None]
     performance = prob.performance_of(c, np.zeros_like(c))
@@ -134,15 +150,17 @@ def design_from_certificate(model, target, *, max_sensitivity: float = DESIGN_MA
                            parameters={"order": float(order)},
                            options=dict(structure="certificate", template_offsets=target.template_offsets,
                                         speed_relax_db=target.speed_relax_db, tower_slack_db=target.slack_db,
-                                        strict_excess_db=strict_excess,
+                                        strict_excess_db=strict_excess, max_hf_gain_ratio=kappa,
+                                        held_lift_limit=target.held_lift_limit,
                                         max_sensitivity=max_sensitivity, min_decay=min_decay))
 
 
-def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
+def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict, held=None):
     """The lowest-order balanced truncation of ``full`` (its stable part; poles within
     :data:`ORDER_AXIS_TOL` of the axis kept) that meets every specification on ``omega`` at every
-    plant case, keeps |S| ≤ ``ms`` and is stable with decay ≥ ``min_decay``, each with the margin
-    :data:`ORDER_MARGIN_DB`; else ``full``. Each case meets its own W_i (ROSCO's map at its speed
+    plant case, keeps |S| ≤ ``ms``, meets ``prob.controller_bound`` (if any) strictly proper, keeps
+    its fine-pitch lift within ``held`` = (deficit rad/s, limit rad) if given, and is stable with
+    decay ≥ ``min_decay``, each with the margin :data:`ORDER_MARGIN_DB`; else ``full``. Each case meets its own W_i (ROSCO's map at its speed
     times the nominal ratio). Returns (controller, order, (largest excess over the nominal W_MyT,
     over the nominal W_Ω) dB at any case: the pair read strictly, ``strict`` = (|W_Ω|, |W_MyT|) on
     ``omega``, reported beside it))."""
@@ -150,6 +168,7 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
     w_speed, w_tower = prob.weights(omega)
     ob = R[("gen_speed", "pitch_cmd")]
     shrink = 10 ** (-ORDER_MARGIN_DB / 20)
+    hf = None if prob.controller_bound is None else prob.controller_bound[0](omega)
     for n in range(min_order, full.nstates + 1):
         if n < full.nstates:
             try:
@@ -161,12 +180,13 @@ def _lowest_order(prob, full, omega, min_order, ms, min_decay, strict):
         c = siso_response(cand, omega)[:, None]
         if (np.any(np.abs(closed_map(R, c, 0.0, "tower_base_my")) > shrink * w_tower)
                 or np.any(np.abs(closed_map(R, c, 0.0, "gen_speed")) > shrink * w_speed)
-                or np.any(np.abs(1 / (1 + c * ob)) > shrink * ms)):
+                or np.any(np.abs(1 / (1 + c * ob)) > shrink * ms)
+                or (hf is not None and (np.any(np.abs(c[:, 0]) > shrink * hf) or np.any(np.asarray(ct.ss(cand).D) != 0)))):
             continue
         with warnings.catch_warnings():  # python-control's notes on the interconnections (unused signals)
             warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
             decay = min(-np.max(np.real(closed_loop(p, cand, warn=False).poles())) for p in prob.plants)
-        if decay >= min_decay / shrink:
+        if decay >= min_decay / shrink and (held is None or fine_pitch_lift(cand, held[0]) <= held[1]):
             return cand, n, _strict_excess(R, cand, omega, strict)
     return full, full.nstates, _strict_excess(R, full, omega, strict)
 

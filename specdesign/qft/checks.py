@@ -11,10 +11,11 @@ import numpy as np
 
 from loopshaping import qft as lqft
 from loopshaping.check import check as lcheck
+from loopshaping.specs import controller_gain
 
-from .._checks import positive_scalar
-from ..closedloop import (
+from ..closedloop import (  # fine_pitch_lift: the qft checks' name for it (design_schedule's)
     close_responses,
+    fine_pitch_lift,
     general_coefficients,
     partial_loop,
     plant_responses,
@@ -50,6 +51,8 @@ def loop_checks(prob, cb, ca, wdense):
         (pitch_check, atd_check, pitch_template, atd_template, pitch_specs, atd_specs): the
         :class:`loopshaping.check.CheckResult` of each loop, its
         :class:`loopshaping.templates.Template` and its list of :class:`loopshaping.qft.Spec`.
+        With ``prob.controller_bound`` the pitch loop's check includes "hf_gain", |C_β| ≤ the
+        bound on its band (wdense's points there); the specs returned are the loops' own.
     """
     plants, nom = prob.plants, prob.nom
 
@@ -100,7 +103,11 @@ def loop_checks(prob, cb, ca, wdense):
     atd_plants = [partial_loop(P, cb, "gen_speed")["tower_top_vel", "pitch_cmd"] for P in plants]
     pitch_t = lqft.Template.from_systems(pitch_plants, prob.wd, nom)
     atd_t = lqft.Template.from_systems(atd_plants, prob.wd, nom)
-    pitch_check = lcheck(pitch_t, cb, pitch_specs, wdense)
+    # the controller's own high-frequency gain bound is checked with the pitch loop's specifications
+    # (not a QFT bound of the loop: it is the same for every case)
+    gain = [] if prob.controller_bound is None else [controller_gain(prob.controller_bound[0], prob.controller_bound[1],
+                                                                     name="hf_gain")]
+    pitch_check = lcheck(pitch_t, cb, pitch_specs + gain, wdense)
     atd_check = lcheck(atd_t, ca, atd_specs, wdense)
     return pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs
 
@@ -185,59 +192,3 @@ def spec_roots(spec_like) -> np.ndarray:
         out += [np.asarray(t.poles(), complex), np.asarray(t.zeros(), complex)]
     r = np.concatenate(out)
     return r[np.isfinite(r)]
-
-
-def fine_pitch_lift(controller, deficit: float, duration: float = 60.0, n: int = 6001) -> float:
-    """How far a pitch controller lifts the pitch for a sustained speed deficit (rad; ≤ 0: it does not).
-
-    Below rated the rotor runs ``deficit`` under the pitch controller's speed reference; a
-    controller held there (the lowest design of a schedule) must keep pushing the pitch into
-    fine pitch, where it saturates. Its linear, unsaturated answer β = −C·δΩ_g to the step
-    δΩ_g = −``deficit`` (β in the workbench sign) over ``duration`` seconds: the largest β is
-    the lift. ROSCO's PI answers monotonically (lift 0); a controller whose answer swings up
-    lifts the pitch off fine pitch, and ROSCO's torque state machine then goes to rated torque
-    (docs/below_rated.md).
-
-    Parameters
-    ----------
-    controller : control.LTI
-        C_β, generator speed (rad/s) → pitch (rad), β = −C_β·Ω_g.
-    deficit : float
-        Speed deficit below rated, rad/s (> 0), e.g. the pitch controller's reference minus the
-        torque law's minimum speed.
-    duration : float
-        Time span of the answer, s (> 0).
-    n : int
-        Time samples (≥ 2).
-
-    Returns
-    -------
-    float
-        The largest pitch of the answer, rad (positive: lifted off fine pitch).
-
-    Raises
-    ------
-    ValueError
-        For a non-positive ``deficit`` or ``duration``, fewer than 2 samples, or a controller
-        that is not SISO.
-
-    Examples
-    --------
-    >>> import control
-    >>> from specdesign.qft import fine_pitch_lift
-    >>> pi = control.tf([-0.6, -0.08], [1.0, 0.0])  # ROSCO-like PI, β = −C·Ω_g
-    >>> fine_pitch_lift(pi, 0.27) <= 0.0
-    True
-    """
-    import control
-
-    deficit = positive_scalar(deficit, "deficit")
-    duration = positive_scalar(duration, "duration")
-    if int(n) != n or n < 2:
-        raise ValueError(f"n={n!r} must be an integer ≥ 2 (time samples)")
-    sys = control.ss(controller)
-    if sys.ninputs != 1 or sys.noutputs != 1:
-        raise ValueError(f"controller must be SISO (generator speed → pitch), got {sys.noutputs}x{sys.ninputs}")
-    t = np.linspace(0.0, duration, int(n))
-    _, y = control.step_response(sys, t)
-    return float(np.max(deficit * np.squeeze(y)))

@@ -27,7 +27,16 @@ from ..closedloop import (
     lightly_damped,
     refine_grid,
 )
-from ..feasibility import TargetSpecification, specification_for_target
+from ..feasibility import (
+    HF_END,
+    MAX_HF_GAIN_RATIO,
+    HF_OMEGA,
+    TargetSpecification,
+    hf_check_omega,
+    hf_gain_bound,
+    specification_for_target,
+)
+from ..feasibility.achievable import hf_ratio
 from ..feasibility.target import TARGET_REDUCTION
 from ..spec import KEEP_BELOW, SPEC_REDUCTION, TOWER_RELAX_DB, TOWER_RELAX_OMEGA
 from .certificate import design_from_certificate
@@ -142,6 +151,20 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             Required closed-loop decay rate, 1/s (poles left of −min_decay).
         keep_below : float, default 0.6
             Protected band of the notch specification, rad/s (power regulation).
+        max_hf_gain_ratio : float or None, default :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO` (None: off)
+            κ of the high-frequency gain bound, |C_β(jω)| ≤ κ·|C_ROSCO(jω)| on HF_OMEGA-HF_END
+            (2-10 rad/s, 3P inside) with C_β strictly proper; None switches it off. With
+            ``spec="target"`` the certificate is made under it
+            (``specification_for_target(max_hf_gain_ratio=...)``, which refuses a target the bound
+            makes infeasible, naming it) and the design meets it with its order margin; a
+            TargetSpecification carries its own. The fixed structures are checked against it
+            (dense check "hf_gain").
+        held_below_rated : bool, default False
+            Only with ``spec="target"``: the design is held below rated by a schedule (its
+            lowest design speed): the certificate, and the controller reduced from it, lift the
+            pitch off fine pitch for the torque law's speed deficit by at most its
+            ``pitch_switch`` (``specification_for_target(held_below_rated=True)``;
+            :func:`held_lift`). :func:`design_schedule` sets it for its lowest speed.
         refine : int, default 2
             Rounds adding the dense check's failing frequencies to the design set.
         maxfev : int, default 3000
@@ -187,8 +210,10 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     if isinstance(spec, str) and spec == "target":
         # the plant cases the pair is certified on are the ones the design must meet it on
         offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
+        # the certificate meets the high-frequency gain bound, and so does the design reduced from it
+        hf = {k: kwargs.pop(k) for k in ("max_hf_gain_ratio", "held_below_rated") if structure != "fixed" and k in kwargs}
         spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction,
-                                        **({} if offsets is None else {"case_offsets": offsets}))
+                                        **({} if offsets is None else {"case_offsets": offsets}), **hf)
     elif isinstance(spec, str):  # "notch"
         spec = None
     if structure == "certificate" and not isinstance(spec, TargetSpecification):
@@ -200,6 +225,11 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             raise TypeError("design_qft(spec=TargetSpecification) meets the pair on the plant cases it was certified on "
                             "(spec.case_speeds): make the specification with specification_for_target(..., "
                             "case_offsets=...) instead of passing template_offsets=")
+        for k in ("max_hf_gain_ratio", "held_below_rated"):
+            if k in kwargs:
+                raise TypeError(f"design_qft(spec=TargetSpecification) meets the {k} its certificate was made with "
+                                f"(spec.max_hf_gain_ratio, spec.held_lift_limit): make the specification with "
+                                f"specification_for_target(..., {k}=...) instead of passing it here")
         if set(kwargs) - allowed:
             raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
                             f"got {sorted(set(kwargs) - allowed)}")
@@ -225,7 +255,7 @@ def _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs)
     model, the wind speed, ``spec``, options of the other design, the relaxation ladder,
     ``structure``): the ladder of speed relaxations (dB, increasing)."""
     options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
-    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db"})
+    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db", "held_below_rated"})
     if unknown:  # named here, not as a TypeError of an internal function
         raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
     if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
@@ -235,12 +265,17 @@ def _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs)
     if isinstance(spec, str) and spec not in ("target", "notch"):
         raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
                          "(tower, speed)")
-    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets"}
+    fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets",
+                                "max_hf_gain_ratio", "held_below_rated"}
     if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
         named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
         raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
                         "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
-                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets")
+                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets, "
+                        "max_hf_gain_ratio")
+    if "held_below_rated" in kwargs and not (isinstance(spec, str) and spec == "target" and structure != "fixed"):
+        raise TypeError("design_qft's held_below_rated belongs to the specification-driven design (spec='target'): "
+                        "the certificate is made to keep fine pitch below rated")
     if speed_relax_db is None:
         speed_relax_db = SPEED_RELAX_DB
     ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
@@ -318,7 +353,8 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
                    template_offsets=(-1.0, -0.5, 0.5, 1.0),
                    design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=TOWER_RELAX_DB,
                    tower_relax_omega=TOWER_RELAX_OMEGA,
-                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=MIN_DECAY_RATE, keep_below=KEEP_BELOW, refine=2, maxfev=3000) -> QFTDesign:
+                   max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=MIN_DECAY_RATE, keep_below=KEEP_BELOW, refine=2, maxfev=3000,
+                   max_hf_gain_ratio=MAX_HF_GAIN_RATIO) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
     from .. import spec as sp
 
@@ -354,8 +390,12 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
     if t is None:
         t = float(promise.exact_del)  # the target the specification carries
 
+    kappa = hf_ratio(max_hf_gain_ratio)
+    bound = None if kappa is None else (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
+    if bound is not None:  # the bound's check includes its band's ends and 3P
+        wdense = np.union1d(wdense, hf_check_omega(model, wdense))
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, speed_relax_db, max_sensitivity, base,
-                         speed_shaping=speed_shaping)
+                         speed_shaping=speed_shaping, controller_bound=bound)
     # Sharp features of the specs (the lightly damped tower-mode poles and zeros of every case's
     # ROSCO loop) are design frequencies and dense-check points too: a bound that holds on
     # both sides of a narrow dip of W can still fail inside it.
@@ -395,7 +435,7 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
                            options=dict(spec_reduction=spec_reduction, template_offsets=tuple(offsets),
                                         speed_relax_db=speed_relax_db, tower_relax_db=tower_relax_db,
                                         tower_relax_omega=tower_relax_omega, max_sensitivity=max_sensitivity,
-                                        min_decay=min_decay, refine_rounds=rounds),
+                                        min_decay=min_decay, refine_rounds=rounds, max_hf_gain_ratio=kappa),
                            checks=(pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs))
 
 
@@ -443,7 +483,10 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         As :func:`design_qft`, for each wind speed whose design does not meet every spec; and
         for a model with a torque law when the lowest design, which a schedule holds below
         rated, lifts the pitch off fine pitch for the speed deficit there
-        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``).
+        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``). With
+        ``"target"`` that design is made with ``held_below_rated=True`` (its certificate and
+        its reduction keep the lift within ``pitch_switch``), so the warning is for the notch
+        designs or a target that cannot be met so.
 
     Examples
     --------
@@ -468,10 +511,14 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
                         enumerate(target_reduction if per_speed else [target_reduction] * vs.size)])
 
     out = []
-    for v, tr in tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)", unit="speed",
-                      disable=not progress):
-        out.append(design_qft(model, float(v), float(tr), spec=specification, **kwargs))
-    _warn_held_design(model, out[int(np.argmin(vs))])
+    lowest = int(np.argmin(vs))
+    held = specification == "target" and getattr(model, "torque_control", None) is not None
+    for i, (v, tr) in enumerate(tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)",
+                                     unit="speed", disable=not progress)):
+        # the lowest design is held below rated: made to keep fine pitch for the speed deficit there
+        extra = {"held_below_rated": True} if held and i == lowest else {}
+        out.append(design_qft(model, float(v), float(tr), spec=specification, **kwargs, **extra))
+    _warn_held_design(model, out[lowest])
     return tuple(out)
 
 

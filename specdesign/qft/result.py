@@ -331,6 +331,9 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
         problems.append("dense check of the ATD loop failed: " + atd_check.summary().replace("\n", "; "))
     if not all_stable:
         problems.append(f"unstable closed loops at {[speeds[i] for i, s_ in enumerate(stable) if not s_]} m/s")
+    if prob.controller_bound is not None and np.any(np.asarray(ct.ss(cb).D) != 0):
+        problems.append(f"the pitch controller has a direct term ({float(np.asarray(ct.ss(cb).D).ravel()[0]):.3g} rad per "
+                        "rad/s): under the high-frequency gain bound it must be strictly proper (roll off)")
     rhp = np.concatenate([ct.poles(cb), ct.poles(ca)])
     rhp = rhp[rhp.real > UNSTABLE_CONTROLLER_RATE]
     if rhp.size:

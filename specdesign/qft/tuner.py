@@ -75,6 +75,10 @@ class TuningProblem:
         How the plant cases are evaluated (:func:`specdesign.closedloop.plant_responses`); the
         fixed-structure design keeps python-control's round-off, the certificate design the
         fast batched solve.
+    controller_bound : tuple, optional
+        (ω → allowed |C_β(jω)| in rad per rad/s, (low, high) band in rad/s): the high-frequency
+        gain bound the pitch controller must meet (:func:`specdesign.feasibility.hf_gain_bound`),
+        checked on the dense grid with the loops' specifications; None: none.
 
     Attributes
     ----------
@@ -112,7 +116,7 @@ class TuningProblem:
     def __init__(self, model: TurbineModel, v: float, speeds: Sequence[float], nominal: int, design_omega: ArrayLike,
                  tower_shaping: Callable[[np.ndarray], np.ndarray], speed_relax_db: float, max_sensitivity: float,
                  base: Baseline, speed_shaping: Callable[[np.ndarray], np.ndarray] | None = None,
-                 response_method: str = "python-control") -> None:
+                 response_method: str = "python-control", controller_bound: tuple | None = None) -> None:
         from ..spec import baseline_controllers
 
         self.v, self.speeds, self.nom = v, speeds, nominal
@@ -123,6 +127,7 @@ class TuningProblem:
         self.speed_gain = 10 ** (speed_relax_db / 20)
         self.speed_shaping = speed_shaping  # callable ω → W_Ω/T^ROSCO_{Ω,w} (nominal), or None: speed_gain
         self.ms = max_sensitivity
+        self.controller_bound = controller_bound
         self.base = base
         self.wf, self.S = base.omega, base.wind_psd
         self.Rf = plant_responses(self.plants, self.wf, method=response_method)
@@ -178,6 +183,8 @@ class TuningProblem:
             New design frequencies, rad/s (replaces ``wd``, ``Rd``, ``WO``, ``WM``).
         """
         self.wd = np.asarray(omega, float)
+        # the controller's high-frequency gain bound on wd (rad per rad/s; inf outside its band)
+        self._gain_bound = None if self.controller_bound is None else self.controller_bound[0](self.wd)
         self.Rd = plant_responses(self.plants, self.wd, ("gen_speed", "tower_base_my", "tower_top_vel"),
                                   method=self.response_method)
         self.WO, self.WM = self.weights(self.wd)
@@ -195,7 +202,8 @@ class TuningProblem:
         numpy.ndarray
             20·log10(bound/|map|), dB (≥ 0 where met), shape (5, n_omega, n_cases), in the
             order: generator speed, tower load, pitch-loop margin (ATD closed), ATD-loop
-            margin (pitch loop closed), margin at the actuator.
+            margin (pitch loop closed), margin at the actuator; with ``controller_bound`` a
+            sixth row, 20·log10(bound/|C_β|) (the same for every case; 100 dB outside its band).
         """
         nb, db, na, da = controller_polys(x)
         s = 1j * self.wd[:, None]
@@ -207,13 +215,17 @@ class TuningProblem:
         ob, zb = R[("gen_speed", "pitch_cmd")], R[("tower_top_vel", "pitch_cmd")]
         d = 1 + c * ob + k * zb
         with np.errstate(divide="ignore"):
-            return np.stack([
+            rows = [
                 20 * np.log10(self.WO / np.abs(to)),
                 20 * np.log10(self.WM / np.abs(tm)),
                 20 * np.log10(self.ms * np.abs(d) / np.abs(1 + k * zb)),  # pitch loop, ATD closed
                 20 * np.log10(self.ms * np.abs(d) / np.abs(1 + c * ob)),  # ATD loop, pitch closed
                 20 * np.log10(self.ms * np.abs(d)),  # at the actuator
-            ])
+            ]
+            if self._gain_bound is not None:  # finite outside the band too: the SLSQP constraints are numbers
+                gain = np.minimum(20 * np.log10(self._gain_bound[:, None] / np.abs(c)), 100.0)
+                rows.append(np.broadcast_to(gain, to.shape))
+            return np.stack(rows)
 
     def max_real(self, x: ArrayLike) -> np.ndarray:
         """Largest closed-loop pole real part (1/s) per case, full interconnection.
@@ -338,7 +350,7 @@ class TuningProblem:
         Returns
         -------
         numpy.ndarray
-            1-D: the 5·n_omega·n_cases bound margins (dB, less :data:`PERFORMANCE_SAFETY_DB` /
+            1-D: the 5·n_omega·n_cases bound margins (6· with ``controller_bound``; dB, less :data:`PERFORMANCE_SAFETY_DB` /
             :data:`DC_SAFETY_DB` on the performance specs and :data:`STABILITY_SAFETY_DB` on the
             margin specs), the DEL margin (pp) and the n_cases decay margins (1/s).
         """
