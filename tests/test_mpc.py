@@ -12,10 +12,29 @@ import pytest
 import scipy.optimize
 
 from specdesign.fatigue import VarianceDamageFit, fit_variance_damage
-from specdesign.mpc import (ClonedController, CloningRegressor, ColletMPC, DiscreteTurbine, EconomicMPC, FatigueTerm,
-                            OpenLoopPlayback, PreviewClone, QuadraticMPC, clone, collet_qp, demonstrations,
-                            discretize_turbine, economic_open_loop, economic_problem, fit_fatigue_terms,
-                            pitch_wind_estimate, preview_demonstrations, quadratic_qp, surrogate_cost, tune_rho)
+from specdesign.mpc import (
+    ClonedController,
+    CloningRegressor,
+    ColletMPC,
+    DiscreteTurbine,
+    EconomicMPC,
+    FatigueTerm,
+    OpenLoopPlayback,
+    PreviewClone,
+    QuadraticMPC,
+    clone,
+    collet_qp,
+    demonstrations,
+    discretize_turbine,
+    economic_open_loop,
+    economic_problem,
+    fit_fatigue_terms,
+    pitch_wind_estimate,
+    preview_demonstrations,
+    quadratic_qp,
+    surrogate_cost,
+    tune_rho,
+)
 from specdesign.simulate import simulate
 from specdesign.turbine import iea15mw, rosco_baseline
 from specdesign.wind import wind_series
@@ -344,7 +363,7 @@ def test_estimated_operating_point_reads_no_mean_wind_and_tracks_it(model):
             for g, run in enumerate(runs):
                 est[int(run)].append((t, v + xhat[g, -1]))
     for run in (0, 1):
-        t_est, v_est = np.array(est[run]).T
+        _, v_est = np.array(est[run]).T
         assert abs(np.mean(v_est) - r["wind"][run, 0].mean()) < 0.3
     with pytest.raises(ValueError, match="operating_point"):
         QuadraticMPC(model, operating_point="mean wind")

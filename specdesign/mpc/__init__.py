@@ -23,14 +23,54 @@ Layout
 """
 from __future__ import annotations
 
-from .base import (MEASURED, OPERATING_POINTS, DiscreteTurbine, discretize_turbine, kalman_gain, pitch_wind_estimate,
-                   prediction_matrices)
-from .collet import (COLLET_OUTPUTS, ColletMPC, PreviewClone, RhoTuning, collet_qp, fatigue_cost,
-                     preview_demonstrations, preview_features, tune_rho)
-from .cloning import ClonedController, CloningRegressor, Demonstrations, OpenLoopPlayback, clone, demonstrations
-from .economic import (WOHLER, EconomicMPC, FatigueTerm, OpenLoopResult, economic_open_loop, economic_problem,
-                       fit_fatigue_terms, solve_cone, surrogate_cost)
-from .health import HEALTH_OSQP, REF_MARGIN, HealthMPC, health_aware_mpc, health_move, health_qp, health_scale
+from .base import (
+                   MEASURED,
+                   OPERATING_POINTS,
+                   DiscreteTurbine,
+                   discretize_turbine,
+                   kalman_gain,
+                   pitch_wind_estimate,
+                   prediction_matrices,
+)
+from .cloning import (
+                   ClonedController,
+                   CloningRegressor,
+                   Demonstrations,
+                   OpenLoopPlayback,
+                   clone,
+                   demonstrations,
+)
+from .collet import (
+                   COLLET_OUTPUTS,
+                   ColletMPC,
+                   PreviewClone,
+                   RhoTuning,
+                   collet_qp,
+                   fatigue_cost,
+                   preview_demonstrations,
+                   preview_features,
+                   tune_rho,
+)
+from .economic import (
+                   WOHLER,
+                   EconomicMPC,
+                   FatigueTerm,
+                   OpenLoopResult,
+                   economic_open_loop,
+                   economic_problem,
+                   fit_fatigue_terms,
+                   solve_cone,
+                   surrogate_cost,
+)
+from .health import (
+                   HEALTH_OSQP,
+                   REF_MARGIN,
+                   HealthMPC,
+                   health_aware_mpc,
+                   health_move,
+                   health_qp,
+                   health_scale,
+)
 from .health_report import TradeoffPoint, health_tradeoff, plot_tradeoff
 from .lpv import PREDICTED, LPVObserver, LPVTurbine, lpv_observer, lpv_turbine
 from .quadratic import QuadraticMPC, quadratic_qp

@@ -49,12 +49,11 @@ from .._checks import positive_scalar
 from .._docs import docstring_of
 from ..fatigue import rainflow
 from ..simulate import simulate
-from .base import DiscreteTurbine, discretize_turbine, prediction_matrices
+from .base import MEASURED, DiscreteTurbine, discretize_turbine, prediction_matrices
 from .cloning import CloningRegressor, Demonstrations
 from .economic import economic_open_loop, economic_problem
 from .quadratic import QuadraticMPC, preview_matrix
 from .sampled import SampledController
-from .base import MEASURED
 
 __all__ = ["COLLET_OUTPUTS", "collet_qp", "ColletMPC", "fatigue_cost", "RhoTuning", "tune_rho",
            "preview_features", "preview_demonstrations", "PreviewClone"]

@@ -59,8 +59,8 @@ from .._checks import bad_measurements, positive_scalar
 from ..fatigue import SNCurve
 from ..fatigue_online import StreamingDamage
 from .base import MEASURED
-from .sampled import SampledController
 from .lpv import LPVTurbine, lpv_turbine
+from .sampled import SampledController
 
 __all__ = ["HealthMPC", "health_aware_mpc", "health_qp", "health_move", "health_scale", "HEALTH_OSQP", "REF_MARGIN"]
 

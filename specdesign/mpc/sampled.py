@@ -9,8 +9,15 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import bad_measurements, positive_scalar
-from .base import (MEASURED, OPERATING_POINTS, discretize_turbine, kalman_gain, operating_wind_speed,
-                   pitch_wind_estimate)
+from .base import (
+    MEASURED,
+    OPERATING_POINTS,
+    DiscreteTurbine,
+    discretize_turbine,
+    kalman_gain,
+    operating_wind_speed,
+    pitch_wind_estimate,
+)
 from .lpv import check_speeds, lpv_observer, vertex_pair
 
 __all__ = ["SampledController"]
