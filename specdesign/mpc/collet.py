@@ -380,8 +380,6 @@ def preview_demonstrations(model, design_speed: float, terms, wind, wind_dt: flo
         Features of :func:`preview_features`, targets the optimal setpoint deviations (rad),
         ``seeds`` the record's index, ``cpu_time`` one entry per optimum.
     """
-    from .base import discretize_turbine
-
     rng = np.random.default_rng(seed)
     dm = discretize_turbine(model, design_speed, ts)
     every = int(round(ts / wind_dt))
