@@ -55,7 +55,7 @@ import numpy as np
 from .._checks import positive_scalar
 
 __all__ = ["DiscreteTurbine", "discretize_turbine", "kalman_gain", "operating_wind_speed", "pitch_wind_estimate",
-           "prediction_matrices", "MEASURED", "MEASUREMENT_STD", "OPERATING_POINTS"]
+           "prediction_matrices", "within_limits", "MEASURED", "MEASUREMENT_STD", "OPERATING_POINTS"]
 
 #: Values of ``operating_point``: the estimate scheduled online (default), the trim of the
 #: run's initial pitch held, or a fixed design point given by the user (module docstring).
@@ -361,3 +361,35 @@ def pitch_wind_estimate(model, pitch: float) -> float:
         return hi
     v = scipy.optimize.brentq(lambda s: model.trim(s).pitch - pitch, lo, hi, xtol=1e-6)
     return round(float(v), 3)
+
+
+def within_limits(model, ts: float, u: np.ndarray, uprev: np.ndarray, pitch0: float) -> np.ndarray:
+    """Commands cut to the pitch actuator's rate and position limits over one sample.
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine (``pitch_rate_limit`` rad/s, ``pitch_min``, ``pitch_max`` rad).
+    ts : float
+        Sample time (s).
+    u, uprev : numpy.ndarray
+        (G,) wanted and previous commands (rad, deviations from ``pitch0``).
+    pitch0 : float
+        The trim pitch the deviations are about (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        (G,) the commands within |u − u_prev| ≤ β̇_max T_s and β_min ≤ pitch0 + u ≤ β_max.
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> m = iea15mw()
+    >>> float(within_limits(m, 0.1, np.array([1.0]), np.array([0.0]), 0.3)[0]) == m.pitch_rate_limit * 0.1
+    True
+    """
+    step = float(model.pitch_rate_limit) * ts
+    lo = np.maximum(uprev - step, float(model.pitch_min) - pitch0)
+    hi = np.minimum(uprev + step, float(model.pitch_max) - pitch0)
+    return np.minimum(np.maximum(u, lo), hi)

@@ -36,7 +36,7 @@ from threadpoolctl import ThreadpoolController
 from .._checks import positive_scalar
 from .._docs import docstring_of
 from ..simulate import SimulationDivergedError, simulate
-from .base import MEASURED, discretize_turbine
+from .base import MEASURED, discretize_turbine, within_limits
 from .economic import economic_problem, solve_cone
 from .quadratic import QuadraticMPC
 from .sampled import SampledController
@@ -446,10 +446,7 @@ class ClonedController(SampledController):
         dm = pt["model"]
         X = np.column_stack([xhat, uprev, np.full(uprev.size, dm.wind_speed)])
         u = pt["regressor"].predict(X)
-        step = float(self.model.pitch_rate_limit) * self.ts
-        lo = np.maximum(uprev - step, float(self.model.pitch_min) - dm.pitch0)
-        hi = np.minimum(uprev + step, float(self.model.pitch_max) - dm.pitch0)
-        out = np.minimum(np.maximum(u, lo), hi)
+        out = within_limits(self.model, self.ts, u, uprev, dm.pitch0)
         self.saturated += int(np.count_nonzero(out != u))
         self.solve_times.extend([(time.process_time() - t0) / max(uprev.size, 1)] * uprev.size)
         return out

@@ -49,7 +49,13 @@ from .._checks import positive_scalar
 from .._docs import docstring_of
 from ..fatigue import rainflow
 from ..simulate import simulate
-from .base import MEASURED, DiscreteTurbine, discretize_turbine, prediction_matrices
+from .base import (
+    MEASURED,
+    DiscreteTurbine,
+    discretize_turbine,
+    prediction_matrices,
+    within_limits,
+)
 from .cloning import CloningRegressor, Demonstrations
 from .economic import economic_open_loop, economic_problem
 from .quadratic import QuadraticMPC, preview_matrix
@@ -189,10 +195,7 @@ class ColletMPC(QuadraticMPC):
         t0 = time.process_time()
         dw = self._horizon_wind(pt["model"], xhat)
         u = np.einsum("j,gj->g", pt["qp"]["K"][0], np.hstack([xhat[:, :-1], dw]))
-        dm, step = pt["model"], float(self.model.pitch_rate_limit) * self.ts
-        lo = np.maximum(uprev - step, float(self.model.pitch_min) - dm.pitch0)
-        hi = np.minimum(uprev + step, float(self.model.pitch_max) - dm.pitch0)
-        out = np.minimum(np.maximum(u, lo), hi)
+        out = within_limits(self.model, self.ts, u, uprev, pt["model"].pitch0)
         self.saturated += int(np.count_nonzero(out != u))
         self.solve_times.extend([(time.process_time() - t0) / max(uprev.size, 1)] * uprev.size)
         return out
@@ -514,11 +517,7 @@ class PreviewClone:
         self._y = np.concatenate([self._y[:, 1:], yk[:, None]], axis=1)
         X = np.hstack([self._y.reshape(len(yk), -1), self._u, d])
         u = self.regressor.predict(X)
-        step = float(self.model.pitch_rate_limit) * self.ts
-        uprev = self._cmd - dm.pitch0
-        lo = np.maximum(uprev - step, float(self.model.pitch_min) - dm.pitch0)
-        hi = np.minimum(uprev + step, float(self.model.pitch_max) - dm.pitch0)
-        out = np.minimum(np.maximum(u, lo), hi)
+        out = within_limits(self.model, self.ts, u, self._cmd - dm.pitch0, dm.pitch0)
         self.saturated += int(np.count_nonzero(out != u))
         self._u = np.concatenate([self._u[:, 1:], out[:, None]], axis=1)
         self._cmd = dm.pitch0 + out
