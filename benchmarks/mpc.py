@@ -89,12 +89,16 @@ def open_loop_table(model, terms, terms_mpc, bc, seeds, horizon=100.0, v=19.0):
     held = np.repeat(w[:, :n], int(round(TS / dt)), axis=1)
     held = np.concatenate([held, held[:, -1:]], axis=1)[None]
     kw = dict(wind=held, wind_dt=dt, duration=horizon, transient=0.0, linear=True, dt=dt, record_dt=0.1)
+    # the plant here is the linearisation at v, which the open-loop optimum also knows: the
+    # closed loops get the same model and operating point (operating_point="initial pitch"),
+    # so the comparison is of the controllers, not of their model error
+    known = dict(operating_point="initial pitch")
     ctrls = {"ROSCO": turbine.rosco_baseline(model, v), "open-loop optimum (preview)":
              mpc.OpenLoopPlayback(np.stack([o.pitch_cmd for o in opt]), TS),
-             "quadratic MPC": mpc.QuadraticMPC(model),
-             "quadratic MPC (preview)": mpc.QuadraticMPC(model, preview=(held, dt)),
-             "economic MPC": mpc.EconomicMPC(model, terms_mpc, ts=TS),
-             "behavioural cloning": bc}
+             "quadratic MPC": mpc.QuadraticMPC(model, **known),
+             "quadratic MPC (preview)": mpc.QuadraticMPC(model, preview=(held, dt), **known),
+             "economic MPC": mpc.EconomicMPC(model, terms_mpc, ts=TS, **known),
+             "behavioural cloning": mpc.ClonedController(model, bc.regressors, TS, **known)}
     res = {}
     for name, c in ctrls.items():
         r = simulate(model, c, [v], **kw)

@@ -15,7 +15,7 @@ from numpy.testing import assert_allclose
 from specdesign.fatigue import SNCurve, del_rainflow, miner_damage, rainflow
 from specdesign.fatigue_online import StreamingDamage, accumulated_damage
 from specdesign.mpc.base import DiscreteTurbine, prediction_matrices
-from specdesign.mpc.health import HealthMPC, health_move, health_scale
+from specdesign.mpc.health import HealthMPC, health_aware_mpc, health_move, health_scale
 from specdesign.mpc.lpv import PREDICTED, LPVTurbine, lpv_turbine
 from specdesign.simulate import simulate
 from specdesign.turbine import iea15mw
@@ -247,3 +247,20 @@ def test_health_weight_follows_the_damage_budget(model):
             factors[budget] = health_scale(mpc.blade_damage[0], 140.0, 10.0, 10.0)
     assert factors[1e6] > 2.0
     assert dels[1e6] < 0.9 * dels[None]
+
+
+def test_names_and_the_papers_health_aware_term_derates(model):
+    # the default label names the workbench's excursion penalty; Boutrous et al.'s controller
+    # is health_aware_mpc: the accumulated-moment term alone, which derates (their Table 2:
+    # power falls as the weight grows); the reference is the same MPC without the term
+    assert HealthMPC(model).name == "excursion MPC"
+    ha = health_aware_mpc(model)
+    assert ha.name == "health-aware MPC" and ha.weights[3:] == (0.0, 30.0)
+    kw = dict(seeds=[1], duration=60.0, transient=40.0)
+    p0 = simulate(model, HealthMPC(model), [13.0], **kw)["power"].mean()
+    p1 = simulate(model, ha, [13.0], **kw)["power"].mean()
+    assert p1 < 0.99 * p0
+    with pytest.raises(ValueError, match="health_weight"):
+        health_aware_mpc(model, health_weight=1.0)
+    with pytest.raises(ValueError, match="stress_weight"):
+        health_aware_mpc(model, stress_weight=0.0)

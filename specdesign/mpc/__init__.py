@@ -13,6 +13,9 @@ Layout
   :func:`economic_open_loop`, :class:`EconomicMPC`.
 - :mod:`specdesign.mpc.cloning`: :func:`demonstrations`, :class:`CloningRegressor`,
   :class:`ClonedController`, :class:`OpenLoopPlayback`.
+- :mod:`specdesign.mpc.collet`: Collet et al.'s methods as the paper defines them (collective):
+  :class:`ColletMPC`, :func:`tune_rho` (Eq. 13), :class:`PreviewClone` of the preview optimum.
+- :mod:`specdesign.mpc.sampled`: the sampled loop and its online operating point.
 - :mod:`specdesign.mpc.lpv`: the wind-scheduled LPV prediction model and observer (after Boutrous, Nejjari and Puig, health-aware LPV MPC).
 - :mod:`specdesign.mpc.health`: :class:`HealthMPC`, the health-aware MPC trading speed tracking
   against blade damage growth (docs/health_mpc.md); :mod:`specdesign.mpc.health_report`: its
@@ -20,16 +23,69 @@ Layout
 """
 from __future__ import annotations
 
-from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine, kalman_gain, prediction_matrices
-from .cloning import ClonedController, CloningRegressor, Demonstrations, OpenLoopPlayback, clone, demonstrations
-from .economic import (WOHLER, EconomicMPC, FatigueTerm, OpenLoopResult, economic_open_loop, economic_problem,
-                       fit_fatigue_terms, solve_cone, surrogate_cost)
-from .health import HEALTH_OSQP, REF_MARGIN, HealthMPC, health_move, health_qp, health_scale
+from .base import (
+                   MEASURED,
+                   OPERATING_POINTS,
+                   DiscreteTurbine,
+                   discretize_turbine,
+                   kalman_gain,
+                   pitch_wind_estimate,
+                   prediction_matrices,
+)
+from .cloning import (
+                   ClonedController,
+                   CloningRegressor,
+                   Demonstrations,
+                   OpenLoopPlayback,
+                   clone,
+                   demonstrations,
+)
+from .collet import (
+                   COLLET_OUTPUTS,
+                   ColletMPC,
+                   PreviewClone,
+                   RhoTuning,
+                   collet_qp,
+                   fatigue_cost,
+                   preview_demonstrations,
+                   preview_features,
+                   tune_rho,
+)
+from .economic import (
+                   WOHLER,
+                   EconomicMPC,
+                   FatigueTerm,
+                   OpenLoopResult,
+                   economic_open_loop,
+                   economic_problem,
+                   fit_fatigue_terms,
+                   solve_cone,
+                   surrogate_cost,
+)
+from .health import (
+                   HEALTH_OSQP,
+                   REF_MARGIN,
+                   HealthMPC,
+                   health_aware_mpc,
+                   health_move,
+                   health_qp,
+                   health_scale,
+)
 from .health_report import TradeoffPoint, health_tradeoff, plot_tradeoff
 from .lpv import PREDICTED, LPVObserver, LPVTurbine, lpv_observer, lpv_turbine
 from .quadratic import QuadraticMPC, quadratic_qp
+from .sampled import SampledController
 
 __all__ = [
+    "COLLET_OUTPUTS",
+    "ColletMPC",
+    "PreviewClone",
+    "RhoTuning",
+    "collet_qp",
+    "fatigue_cost",
+    "preview_demonstrations",
+    "preview_features",
+    "tune_rho",
     "QuadraticMPC",
     "quadratic_qp",
     "EconomicMPC",
@@ -47,13 +103,16 @@ __all__ = [
     "ClonedController",
     "OpenLoopPlayback",
     "DiscreteTurbine",
-    "SampledController",
     "discretize_turbine",
     "kalman_gain",
     "prediction_matrices",
     "MEASURED",
     "WOHLER",
     "HealthMPC",
+    "health_aware_mpc",
+    "SampledController",
+    "OPERATING_POINTS",
+    "pitch_wind_estimate",
     "health_qp",
     "health_move",
     "health_scale",

@@ -1,7 +1,8 @@
 """What every controller of :mod:`specdesign.mpc` shares: the linearised turbine discretised at
 the controller's sample time, a steady-state Kalman filter that estimates its states and the
 rotor-effective wind from the measured outputs, and the sampled loop that runs them as a
-callable controller of :func:`specdesign.simulate.simulate`.
+callable controller of :func:`specdesign.simulate.simulate` (the loop is
+:class:`specdesign.mpc.sampled.SampledController`; this module holds its parts).
 
 Discrete model (deviations from the trim at the run's mean wind speed v, zero-order hold of
 both the pitch command u and the wind deviation d over the sample time T_s)::
@@ -21,9 +22,29 @@ L from the discrete algebraic Riccati equation of (A_a, C_a) with process noise
 Q = diag(q_x, q_w T_s) and measurement noise R = diag(σ²). The wind estimate d̂ is what the
 controllers use in place of a wind measurement (no preview).
 
-The operating point of each run is found at ``start`` from its initial pitch (the simulator
-starts every run at the trim of its mean wind speed, and the trim pitch is monotone in the wind
-speed above rated), so one controller object serves every wind speed of a campaign.
+Operating point (``operating_point="estimated"``, the default): no controller is told the
+run's mean wind. Each run's operating point is the controller's own estimate of the
+rotor-effective wind, v̂, from the LPV Kalman filter of :mod:`specdesign.mpc.lpv` (the filter
+above, on the linearisations of the model every 1 m/s, blended by α(v̂) and scheduled by its
+own wind estimate: an extended-Kalman-like estimator of the kind ROSCO's wind-speed estimator
+is, with the wind a random-walk state it infers from the generator speed, the pitch and the
+tower-top acceleration through the model's aerodynamic tables). At every sample the policy
+is evaluated at the two grid points v_i ≤ v̂ < v_{i+1} (each with its own discretised model,
+filter states in deviations about its trim and compiled problem) and the absolute commands
+are blended, β = Σ α_i(v̂) (β̄_i + u_i): a gain-scheduled controller whose internal linear
+model follows the estimate. Both vertex commands respect the pitch rate and position limits,
+and so does their convex blend. The filter starts at the steady state whose trim pitch is the
+pitch measured at t = 0 (:func:`pitch_wind_estimate`, the trim table inverted), which is all
+it reads at ``start``; the wind sample the simulator passes to ``start`` is not used.
+
+``operating_point="initial pitch"`` keeps the former behaviour: one fixed linearisation per
+run at the wind speed whose trim is the run's initial pitch (in this simulator, the run's mean
+wind, :func:`operating_wind_speed`) and its time-invariant filter. It is the model-equal-plant
+setting of Collet et al. (the system and its operating point known), kept for the
+open-loop-vs-closed-loop comparison of ``benchmarks/mpc.py`` on the *linearised* turbine at
+the mean wind, where that model is the plant. ``operating_point="design point"`` holds the
+linearisation at a wind speed the user gives (``design_speed``), as a fixed-gain controller is
+designed at one point: Collet et al.'s setting (:mod:`specdesign.mpc.collet`).
 """
 from __future__ import annotations
 
@@ -31,10 +52,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import bad_measurements, positive_scalar
+from .._checks import positive_scalar
 
-__all__ = ["DiscreteTurbine", "discretize_turbine", "kalman_gain", "operating_wind_speed", "prediction_matrices",
-           "SampledController", "MEASURED", "MEASUREMENT_STD"]
+__all__ = ["DiscreteTurbine", "discretize_turbine", "kalman_gain", "operating_wind_speed", "pitch_wind_estimate",
+           "prediction_matrices", "within_limits", "MEASURED", "MEASUREMENT_STD", "OPERATING_POINTS"]
+
+#: Values of ``operating_point``: the estimate scheduled online (default), the trim of the
+#: run's initial pitch held, or a fixed design point given by the user (module docstring).
+OPERATING_POINTS = ("estimated", "initial pitch", "design point")
 
 #: Outputs the observer reads by default: generator speed (rad/s), tower-top fore-aft
 #: acceleration (m/s², an accelerometer in the nacelle) and the pitch (rad).
@@ -299,229 +324,72 @@ def operating_wind_speed(model, pitch: float, wind: float) -> float:
     return round(float(v), 3)
 
 
-class SampledController:
-    """A discrete controller on the estimated state, run as a callable of :func:`~specdesign.simulate.simulate`.
+def pitch_wind_estimate(model, pitch: float) -> float:
+    """Steady-state wind speed (m/s) whose trim pitch is the measured ``pitch``.
 
-    Base of :class:`~specdesign.mpc.QuadraticMPC`, :class:`~specdesign.mpc.EconomicMPC` and
-    :class:`~specdesign.mpc.ClonedController`: every ``ts`` it updates the Kalman filter of
-    :func:`kalman_gain` with the measurements, asks the subclass's ``policy`` for the command
-    deviation of each run, and holds the command until the next sample (zero-order hold, as the
-    discrete model assumes). Picklable: the per-operating-point caches and timings are rebuilt,
-    not pickled.
+    The trim table inverted: above rated the trim pitch grows with the wind speed. At or below
+    the pitch of the lowest wind speed of ``model.wind_range`` the pitch carries no information
+    and the lowest speed is returned (the filter then finds the wind from the speed and the
+    tower); above the highest, the highest.
 
     Parameters
     ----------
     model : TurbineModel
-        The turbine the controller is designed on (and runs on).
-    ts : float
-        Sample time (s), a whole multiple of the simulation step.
-    measured : sequence of str, optional
-        Outputs the observer reads (default :data:`MEASURED`).
-    name : str, optional
-        Label in campaign tables.
+        The turbine.
+    pitch : float
+        Measured pitch (rad).
 
-    Attributes
-    ----------
-    solve_times : list of float
-        CPU time (s) of the policy per run and sample, since construction or unpickling.
-    trace : list or None
-        What the policy saw at every sample of the last run, after :meth:`record`.
+    Returns
+    -------
+    float
+        The wind speed (m/s), rounded to 1 mm/s.
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> m = iea15mw()
+    >>> pitch_wind_estimate(m, m.trim(19.0).pitch)
+    19.0
     """
+    import scipy.optimize
 
-    def __init__(self, model, ts: float, measured=MEASURED, name: str = "controller"):
-        self.model = model
-        self.ts = positive_scalar(ts, "ts")
-        self.measured = tuple(measured)
-        if not self.measured or not all(isinstance(m, str) for m in self.measured):
-            raise TypeError(f"measured must be a non-empty sequence of output names, got {measured!r}")
-        self.__name__ = self.name = str(name)
-        self._reset_caches()
+    lo, hi = (float(x) for x in model.wind_range)
+    p_lo, p_hi = model.trim(lo).pitch, model.trim(hi).pitch
+    if pitch <= p_lo:
+        return lo
+    if pitch >= p_hi:
+        return hi
+    v = scipy.optimize.brentq(lambda s: model.trim(s).pitch - pitch, lo, hi, xtol=1e-6)
+    return round(float(v), 3)
 
-    def _reset_caches(self):
-        self._points = {}
-        self.solve_times = []
-        self.trace = None
 
-    def record(self, on: bool = True) -> None:
-        """Record, from the next :meth:`start`, what the policy sees at every sample.
+def within_limits(model, ts: float, u: np.ndarray, uprev: np.ndarray, pitch0: float) -> np.ndarray:
+    """Commands cut to the pitch actuator's rate and position limits over one sample.
 
-        Parameters
-        ----------
-        on : bool, default True
-            Record (True) or stop (False).
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine (``pitch_rate_limit`` rad/s, ``pitch_min``, ``pitch_max`` rad).
+    ts : float
+        Sample time (s).
+    u, uprev : numpy.ndarray
+        (G,) wanted and previous commands (rad, deviations from ``pitch0``).
+    pitch0 : float
+        The trim pitch the deviations are about (rad).
 
-        Notes
-        -----
-        The record is :attr:`trace`: a list of ``(t, v, xhat, uprev)`` per sample and
-        operating point, ``xhat`` (G, n+1) the filtered states and wind estimate and ``uprev``
-        (G,) the previous command deviations; behavioural cloning labels these states.
-        """
-        self._recording = bool(on)
+    Returns
+    -------
+    numpy.ndarray
+        (G,) the commands within |u − u_prev| ≤ β̇_max T_s and β_min ≤ pitch0 + u ≤ β_max.
 
-    def __getstate__(self):
-        state = dict(self.__dict__)
-        for k in ("_points", "solve_times", "_run", "trace", "_recording"):
-            state.pop(k, None)
-        return state
-
-    def __setstate__(self, state):
-        self.__dict__.update(state)
-        self._reset_caches()
-
-    def point(self, wind_speed: float) -> dict:
-        """The per-operating-point data at ``wind_speed`` (built once, then cached).
-
-        Parameters
-        ----------
-        wind_speed : float
-            Mean wind speed (m/s).
-
-        Returns
-        -------
-        dict
-            ``"model"`` (:class:`DiscreteTurbine`), ``"kf"`` (:func:`kalman_gain`'s tuple) and
-            whatever the subclass's ``build`` adds.
-        """
-        key = round(float(wind_speed), 3)
-        if key not in self._points:
-            dm = discretize_turbine(self.model, key, self.ts)
-            pt = {"model": dm, "kf": kalman_gain(dm, self.measured)}
-            pt.update(self.build(dm))
-            self._points[key] = pt
-        return self._points[key]
-
-    def build(self, dm: DiscreteTurbine) -> dict:
-        """Subclass hook: what ``policy`` needs at one operating point.
-
-        Parameters
-        ----------
-        dm : DiscreteTurbine
-            The discrete model there.
-
-        Returns
-        -------
-        dict
-            Extra entries of :meth:`point` (none here).
-        """
-        return {}
-
-    def policy(self, pt: dict, xhat: np.ndarray, uprev: np.ndarray) -> np.ndarray:
-        """Subclass hook: command deviations (rad) of the runs at one operating point.
-
-        Each controller defines it (the QP's first move, the economic problem's first move, the
-        regressor's command within the actuator limits); they share this docstring.
-
-        Parameters
-        ----------
-        pt : dict
-            :meth:`point` of their operating point.
-        xhat : numpy.ndarray
-            (G, n+1) filtered states and wind deviation (last column, m/s).
-        uprev : numpy.ndarray
-            (G,) previous command deviations (rad).
-
-        Returns
-        -------
-        numpy.ndarray
-            (G,) new command deviations (rad).
-
-        Raises
-        ------
-        RuntimeError
-            If the controller's solver fails.
-        """
-        raise NotImplementedError
-
-    def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
-        """Initialise every run at its trim (called by the simulator before the first step).
-
-        Parameters
-        ----------
-        dt : float
-            Simulation step (s); ``ts`` must be a whole multiple of it.
-        wind : numpy.ndarray
-            (R,) wind at t = 0 (m/s).
-        pitch : numpy.ndarray
-            (R,) initial pitch (rad): the trim pitch of each run's mean wind speed.
-        torque : numpy.ndarray
-            (R,) generator torque (N·m).
-
-        Raises
-        ------
-        ValueError
-            If ``ts`` is not a whole multiple of ``dt``.
-        """
-        every = int(round(self.ts / dt))
-        if every < 1 or abs(every * dt - self.ts) > 1e-9 * self.ts:
-            raise ValueError(f"ts={self.ts} s must be a whole multiple of the simulation step dt={dt} s")
-        pitch = np.asarray(pitch, float)
-        speeds = np.array([operating_wind_speed(self.model, float(b), float(w)) for b, w in zip(pitch, wind)])
-        groups = {}
-        for r, v in enumerate(speeds):
-            groups.setdefault(float(v), []).append(r)
-        groups = {v: np.array(idx) for v, idx in groups.items()}
-        pts = {v: self.point(v) for v in groups}
-        n1 = next(iter(pts.values()))["kf"][0].shape[0]
-        beta0 = np.empty(pitch.size)
-        y0 = {}
-        for v, idx in groups.items():
-            beta0[idx] = pts[v]["model"].pitch0
-            y0[v] = pts[v]["model"].y0[pts[v]["model"].rows(self.measured)]
-        self.trace = [] if getattr(self, "_recording", False) else None
-        self._run = {"every": every, "k": 0, "groups": groups, "points": pts, "beta0": beta0, "y0": y0,
-                     "xprior": np.zeros((pitch.size, n1)), "u": pitch - beta0, "cmd": pitch.copy(), "warned": set()}
-
-    def __call__(self, t: float, y: dict) -> np.ndarray:
-        """Pitch command of every run at time ``t`` (the simulator's callable contract).
-
-        Parameters
-        ----------
-        t : float
-            Time (s).
-        y : dict
-            Output name → (R,) measured outputs (SI).
-
-        Returns
-        -------
-        numpy.ndarray
-            (R,) absolute pitch command (rad), held between samples.
-
-        Raises
-        ------
-        RuntimeError
-            If called before :meth:`start`.
-
-        Warns
-        -----
-        RuntimeWarning
-            Once per signal, for a NaN or inf measurement: that run holds its last command and
-            its state estimate until the signal is finite again
-            (:func:`specdesign._checks.bad_measurements`, the convention of every controller).
-        """
-        run = getattr(self, "_run", None)
-        if run is None:
-            raise RuntimeError(f"{type(self).__name__}.start(dt, wind, pitch, torque) must be called first "
-                               "(specdesign.simulate.simulate does it)")
-        k = run["k"]
-        run["k"] = k + 1
-        if k % run["every"]:
-            return run["cmd"]
-        # a run with a NaN/inf sample holds its command and its estimate (bad_measurements)
-        bad = bad_measurements(y, self.measured, t, run["warned"], self.name)
-        ym = np.stack([np.asarray(y[n], float) for n in self.measured], axis=1)
-        for v, idx in run["groups"].items():
-            idx = idx[~bad[idx]]
-            if not idx.size:
-                continue
-            pt = run["points"][v]
-            Aa, Ba, Ca, L = pt["kf"]
-            xp = run["xprior"][idx]
-            xf = xp + (ym[idx] - run["y0"][v] - xp @ Ca.T) @ L.T
-            if self.trace is not None:
-                self.trace.append((t, v, xf.copy(), run["u"][idx].copy()))
-            run["now"] = (t, idx)  # for a policy that reads per-run data (a wind preview)
-            u = np.asarray(self.policy(pt, xf, run["u"][idx]), float)
-            run["u"][idx] = u
-            run["xprior"][idx] = xf @ Aa.T + u[:, None] * Ba
-        run["cmd"] = run["beta0"] + run["u"]
-        return run["cmd"]
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> m = iea15mw()
+    >>> float(within_limits(m, 0.1, np.array([1.0]), np.array([0.0]), 0.3)[0]) == m.pitch_rate_limit * 0.1
+    True
+    """
+    step = float(model.pitch_rate_limit) * ts
+    lo = np.maximum(uprev - step, float(model.pitch_min) - pitch0)
+    hi = np.minimum(uprev + step, float(model.pitch_max) - pitch0)
+    return np.minimum(np.maximum(u, lo), hi)

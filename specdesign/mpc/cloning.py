@@ -36,9 +36,10 @@ from threadpoolctl import ThreadpoolController
 from .._checks import positive_scalar
 from .._docs import docstring_of
 from ..simulate import SimulationDivergedError, simulate
-from .base import MEASURED, SampledController, discretize_turbine
+from .base import MEASURED, discretize_turbine, within_limits
 from .economic import economic_problem, solve_cone
 from .quadratic import QuadraticMPC
+from .sampled import SampledController
 
 __all__ = ["Demonstrations", "demonstrations", "CloningRegressor", "ClonedController", "OpenLoopPlayback", "clone",
            "UPREV"]
@@ -150,19 +151,24 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
         raise ValueError(f"behaviour must be a SampledController (an MPC or a clone) at ts={ts} s")
     N = int(round(horizon / ts))
     behaviour.record(True)
-    feats, targs, sd, cpu = [], [], [], []
+    feats, targs, sd, cpu, experts = [], [], [], [], {}
     try:
         for v in np.atleast_1d(np.asarray(wind_speeds, float)):
             try:
                 simulate(model, behaviour, [float(v)], seeds=list(seeds), duration=duration, transient=transient)
             except SimulationDivergedError:
                 pass  # an early clone may lose the rotor: the states it visited on the way are the lesson
-            trace = [rec for i, rec in enumerate(behaviour.trace) if rec[0] >= transient and i % stride == 0]
-            dm = discretize_turbine(model, float(v), ts)
-            pb = economic_problem(dm, terms, N, speed_weight=speed_weight, activity_weight=activity_weight,
-                                  rated_speed=float(model.rated_rotor_speed), rate_limit=float(model.pitch_rate_limit),
-                                  pitch_limits=(float(model.pitch_min), float(model.pitch_max)))
-            for _, vv, xhat, uprev in trace:
+            # every ``stride``-th sample after the transient (a sample may carry two records:
+            # the two grid points of its wind estimate)
+            trace = [rec for rec in behaviour.trace if rec[0] >= transient and int(round(rec[0] / ts)) % stride == 0]
+            for _, vv, xhat, uprev, runs in trace:
+                if vv not in experts:  # the expert at the record's operating point, compiled once
+                    experts[vv] = economic_problem(
+                        discretize_turbine(model, float(vv), ts), terms, N, speed_weight=speed_weight,
+                        activity_weight=activity_weight, rated_speed=float(model.rated_rotor_speed),
+                        rate_limit=float(model.pitch_rate_limit),
+                        pitch_limits=(float(model.pitch_min), float(model.pitch_max)))
+                pb = experts[vv]
                 for g in range(uprev.size):
                     t0 = time.process_time()
                     pb["x0"].value, pb["d"].value = xhat[g, :-1], np.full(N, xhat[g, -1])
@@ -173,7 +179,7 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
                         continue  # an unlabelled state is left out, not guessed
                     feats.append(np.concatenate([xhat[g], [uprev[g], vv]]))
                     targs.append(float(pb["v"].value[0]) * pb["step"])
-                    sd.append(int(list(seeds)[g % len(seeds)]))
+                    sd.append(int(list(seeds)[runs[g] % len(seeds)]))
     finally:
         behaviour.record(False)
     return Demonstrations(np.array(feats), np.array(targs), np.array(sd), ts, np.array(cpu))
@@ -253,10 +259,13 @@ class CloningRegressor:
         Most boosting iterations; early stopping on a 10 % validation split ends sooner.
     random_state : int, default 0
         Seed of the validation split.
+    uprev_column : int, default :data:`UPREV`
+        Column of the features holding the previous command: the stages learn the move from it.
     """
 
-    def __init__(self, max_depth: int = 6, max_iter: int = 200, random_state: int = 0):
+    def __init__(self, max_depth: int = 6, max_iter: int = 200, random_state: int = 0, uprev_column: int = UPREV):
         self.max_depth, self.max_iter, self.random_state = int(max_depth), int(max_iter), int(random_state)
+        self.uprev_column = int(uprev_column)
         self.linear = self.trees = None
 
     def fit(self, demos: Demonstrations) -> CloningRegressor:
@@ -286,7 +295,7 @@ class CloningRegressor:
             raise ImportError('behavioural cloning needs scikit-learn: pip install "specdesign[mpc]"') from e
         if demos.targets.size < 20:
             raise ValueError(f"demos has {demos.targets.size} rows; fit needs at least 20")
-        move = demos.targets - demos.features[:, UPREV]
+        move = demos.targets - demos.features[:, self.uprev_column]
         self.linear = LinearRegression().fit(demos.features, move)
         res = move - self.linear.predict(demos.features)
         self.trees = HistGradientBoostingRegressor(max_depth=self.max_depth, max_iter=self.max_iter,
@@ -318,7 +327,7 @@ class CloningRegressor:
         # one thread: for the few rows of a control step, OpenMP's thread start-up costs ~50×
         # the prediction itself (45 ms against 0.6 ms of CPU for 4 rows)
         with _threadpools().limit(limits=1, user_api="openmp"):
-            return features[:, UPREV] + self.linear.predict(features) + self.trees.predict(features)
+            return features[:, self.uprev_column] + self.linear.predict(features) + self.trees.predict(features)
 
     def score(self, demos: Demonstrations, *, moves: bool = True) -> float:
         """R² of the predictions on demonstrations (1 − SS_res/SS_tot).
@@ -337,7 +346,7 @@ class CloningRegressor:
         """
         y, p = demos.targets, self.predict(demos.features)
         if moves:
-            y, p = y - demos.features[:, UPREV], p - demos.features[:, UPREV]
+            y, p = y - demos.features[:, self.uprev_column], p - demos.features[:, self.uprev_column]
         return float(1.0 - np.sum((y - p) ** 2) / np.sum((y - y.mean()) ** 2))
 
 
@@ -355,11 +364,17 @@ class ClonedController(SampledController):
         Sample time (s), that of the demonstrations.
     measured : sequence of str, optional
         Outputs the Kalman filter reads.
-    max_gap : float, default 1.0
-        Largest distance (m/s) from a run's wind speed to the nearest trained speed: a clone
-        knows only the operating points it was shown.
+    max_gap : float, default 5.0
+        Largest distance (m/s) from an operating point of the schedule to the nearest trained
+        speed: a clone knows only the operating points it was shown (a rollout at v visits
+        the grid points its wind estimate crosses: in class-B turbulence at 19 m/s, 15-23 m/s).
     name : str, default "behavioural cloning"
         Label.
+    operating_point : {"estimated", "initial pitch"}, default "estimated"
+        The model scheduled on the run's own wind estimate, or held at the trim of its initial
+        pitch (:class:`~specdesign.mpc.sampled.SampledController`).
+    wind_speeds : array_like, optional
+        Grid of the schedule (m/s); default every 1 m/s over ``model.wind_range``.
 
     Attributes
     ----------
@@ -370,8 +385,8 @@ class ClonedController(SampledController):
         their time is shared).
     """
 
-    def __init__(self, model, regressor, ts: float = 0.2, measured=MEASURED, max_gap: float = 1.0,
-                 name: str = "behavioural cloning"):
+    def __init__(self, model, regressor, ts: float = 0.2, measured=MEASURED, max_gap: float = 5.0,
+                 name: str = "behavioural cloning", operating_point: str = "estimated", wind_speeds=None):
         regs = regressor if isinstance(regressor, dict) else {None: regressor}
         if not regs or not all(isinstance(r, CloningRegressor) and r.linear is not None for r in regs.values()):
             raise TypeError("regressor must be a fitted CloningRegressor (CloningRegressor().fit(demos)) "
@@ -379,7 +394,7 @@ class ClonedController(SampledController):
         self.regressors = {None if k is None else float(k): r for k, r in regs.items()}
         self.max_gap = positive_scalar(max_gap, "max_gap")
         self.saturated = 0
-        super().__init__(model, ts, measured, name)
+        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds)
 
     def build(self, dm) -> dict:
         """The regressor of the operating point.
@@ -431,10 +446,7 @@ class ClonedController(SampledController):
         dm = pt["model"]
         X = np.column_stack([xhat, uprev, np.full(uprev.size, dm.wind_speed)])
         u = pt["regressor"].predict(X)
-        step = float(self.model.pitch_rate_limit) * self.ts
-        lo = np.maximum(uprev - step, float(self.model.pitch_min) - dm.pitch0)
-        hi = np.minimum(uprev + step, float(self.model.pitch_max) - dm.pitch0)
-        out = np.minimum(np.maximum(u, lo), hi)
+        out = within_limits(self.model, self.ts, u, uprev, dm.pitch0)
         self.saturated += int(np.count_nonzero(out != u))
         self.solve_times.extend([(time.process_time() - t0) / max(uprev.size, 1)] * uprev.size)
         return out

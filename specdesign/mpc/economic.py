@@ -42,13 +42,15 @@ from ..fatigue import (
 )
 from ..simulate import simulate
 from ..turbine import rosco_baseline
-from .base import MEASURED, DiscreteTurbine, SampledController, discretize_turbine
+from .base import MEASURED, DiscreteTurbine, discretize_turbine
+from .sampled import SampledController
 
 __all__ = ["solve_cone", "FatigueTerm", "fit_fatigue_terms", "surrogate_cost", "economic_problem",
            "economic_open_loop", "OpenLoopResult", "EconomicMPC", "WOHLER"]
 
-#: Wöhler exponents of the priced components: steel tower, glass-fibre blade root.
-WOHLER = {"tower_base_my": TOWER_M, "blade_root_my": BLADE_M}
+#: Wöhler exponents of the priced components: steel tower, glass-fibre blade root, and the
+#: pitch angle (the pitch actuator's fatigue, m = 4 in Collet et al.'s Table 1).
+WOHLER = {"tower_base_my": TOWER_M, "blade_root_my": BLADE_M, "pitch": 4.0}
 
 
 def solve_cone(problem) -> bool:
@@ -68,7 +70,9 @@ def solve_cone(problem) -> bool:
 
     for solver, opts in (("CLARABEL", {}), ("SCS", {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iters": 20000})):
         try:
-            problem.solve(solver=solver, **opts)
+            # the SciPy canonicalisation backend: cvxpy 1.9's COO backend, which it picks for
+            # long horizons (the open-loop optimum over a whole record), fails on a Parameter divided by a constant
+            problem.solve(solver=solver, canon_backend="SCIPY", **opts)
         except cp.error.SolverError:
             continue  # Clarabel's rare numerical breakdowns on a far-off state: the first-order solver still converges
         if problem.status in ("optimal", "optimal_inaccurate"):
@@ -99,7 +103,8 @@ class FatigueTerm:
 
 
 def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3), prices: dict | None = None,
-                      ultimate: dict | None = None, classes=("A", "B", "C"), duration: float = 600.0) -> tuple:
+                      ultimate: dict | None = None, classes=("A", "B", "C"), duration: float = 600.0,
+                      outputs=None) -> tuple:
     """Fit the variance-damage surrogate of each priced load on simulated histories of this turbine.
 
     ROSCO's PI (:func:`specdesign.turbine.rosco_baseline`) runs at ``wind_speed`` on the IEC
@@ -130,6 +135,9 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
         IEC turbulence classes (spread of variances for the fit).
     duration : float, optional
         Simulated time per run (s).
+    outputs : sequence of str, optional
+        The outputs to price relatively (π = 1/D_ref each) when ``prices`` is not given; default
+        the tower base and the blade root.
 
     Returns
     -------
@@ -149,7 +157,8 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
     names = tuple(model.output_names)
     relative = prices is None
     if relative:
-        prices = {o: 1.0 for o in ("tower_base_my", "blade_root_my") if o in names}
+        prices = {o: 1.0 for o in (("tower_base_my", "blade_root_my") if outputs is None else outputs)
+                  if o in names or outputs is not None}
     for out in prices:
         if out not in names:
             raise ValueError(f"priced output {out!r} is not an output of the model {names}")
@@ -235,7 +244,9 @@ def economic_problem(dm: DiscreteTurbine, terms, horizon: int, *, speed_weight: 
     dict
         ``problem``; parameters ``x0`` (n,), ``d`` (N,) wind deviations (m/s) and ``uprev``
         (1,); variables ``v`` (N,) commands in units of the largest move ``step`` (rad) and ``x``
-        (n, N+1) states; ``scale`` (J̃_ref) and ``step``.
+        (n, N+1) states; ``scale`` (J̃_ref) and ``step``; ``parts`` the objective's three terms
+        (``"fatigue"`` J̃_fat/J̃_ref, ``"speed"``, ``"activity"``: cvxpy expressions whose values
+        after a solve are the terms' shares, :attr:`EconomicMPC.term_values`).
 
     Raises
     ------
@@ -276,9 +287,11 @@ def economic_problem(dm: DiscreteTurbine, terms, horizon: int, *, speed_weight: 
         fatigue = fatigue + weight * cp.sum(cp.power(var, t.fit.a, approx=False))
     w = dm.rows(["gen_speed"])[0]
     speed = cp.sum_squares((dm.C[w] @ x[:, 1:]) / rated_speed) / N
-    cost = fatigue + float(speed_weight) * speed + float(activity_weight) * cp.sum_squares(dv) / N
-    problem = cp.Problem(cp.Minimize(cost), cons)
-    return {"problem": problem, "x0": x0, "d": d, "uprev": uprev, "v": v, "x": x, "scale": scale, "step": step}
+    parts = {"fatigue": fatigue, "speed": float(speed_weight) * speed,
+             "activity": float(activity_weight) * cp.sum_squares(dv) / N}
+    problem = cp.Problem(cp.Minimize(parts["fatigue"] + parts["speed"] + parts["activity"]), cons)
+    return {"problem": problem, "x0": x0, "d": d, "uprev": uprev, "v": v, "x": x, "scale": scale, "step": step,
+            "parts": parts}
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
@@ -412,15 +425,24 @@ class EconomicMPC(SampledController):
         Outputs the Kalman filter reads.
     name : str, default "economic MPC"
         Label.
+    operating_point : {"estimated", "initial pitch"}, default "estimated"
+        The model scheduled on the run's own wind estimate, or held at the trim of its initial
+        pitch (:class:`~specdesign.mpc.sampled.SampledController`).
+    wind_speeds : array_like, optional
+        Grid of the schedule (m/s); default every 1 m/s over ``model.wind_range``.
 
     Attributes
     ----------
     solve_times : list of float
         CPU time (s) per solve.
+    term_values : list of tuple
+        (fatigue, speed, activity) values of the objective's terms at every solve's optimum
+        (module docstring), since the last pickle: how much of the objective is Eq. 4's term.
     """
 
     def __init__(self, model, terms, ts: float = 0.2, horizon: int = 50, *, speed_weight: float = 100.0,
-                 activity_weight: float = 1.0, measured=MEASURED, name: str = "economic MPC"):
+                 activity_weight: float = 1.0, measured=MEASURED, name: str = "economic MPC",
+                 operating_point: str = "estimated", wind_speeds=None):
         self.terms = tuple(terms)
         if not self.terms or not all(isinstance(t, FatigueTerm) for t in self.terms):
             raise TypeError("terms must be a non-empty sequence of FatigueTerm (fit_fatigue_terms)")
@@ -428,7 +450,16 @@ class EconomicMPC(SampledController):
             raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 2")
         self.horizon = int(horizon)
         self.speed_weight, self.activity_weight = float(speed_weight), float(activity_weight)
-        super().__init__(model, ts, measured, name)
+        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds)
+
+    def _reset_caches(self):
+        super()._reset_caches()
+        self.term_values = []
+
+    def __getstate__(self):
+        state = super().__getstate__()
+        state.pop("term_values", None)
+        return state
 
     def build(self, dm: DiscreteTurbine) -> dict:
         """The compiled problem at one operating point.
@@ -466,4 +497,5 @@ class EconomicMPC(SampledController):
             # the first one, within the actuator's limits to rounding
             out[g] = min(max(float(pb["v"].value[0]) * step, uprev[g] - step), uprev[g] + step)
             self.solve_times.append(time.process_time() - t0)
+            self.term_values.append(tuple(float(pb["parts"][k].value) for k in ("fatigue", "speed", "activity")))
         return out

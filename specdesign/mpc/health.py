@@ -58,10 +58,11 @@ import numpy as np
 from .._checks import bad_measurements, positive_scalar
 from ..fatigue import BLADE_M, SNCurve
 from ..fatigue_online import StreamingDamage
-from .base import MEASURED, SampledController
-from .lpv import LPVTurbine, lpv_observer, lpv_turbine
+from .base import MEASURED
+from .lpv import LPVTurbine, lpv_turbine
+from .sampled import SampledController
 
-__all__ = ["HealthMPC", "health_qp", "health_move", "health_scale", "HEALTH_OSQP", "REF_MARGIN"]
+__all__ = ["HealthMPC", "health_aware_mpc", "health_qp", "health_move", "health_scale", "HEALTH_OSQP", "REF_MARGIN"]
 
 #: OSQP settings of the constrained QP (tight tolerances, polishing for exact active sets).
 HEALTH_OSQP = {"eps_abs": 1e-9, "eps_rel": 1e-9, "polishing": True, "max_iter": 20000}
@@ -263,16 +264,21 @@ class HealthMPC(SampledController):
         the correction does not undo the derating asked for. None: off.
     lpv : bool, default True
         Schedule the prediction and the observer on the estimated wind (LPV,
-        :class:`~specdesign.mpc.lpv.LPVObserver`); False: the linearisation at the run's mean
-        wind speed and its fixed Kalman filter only.
+        :class:`~specdesign.mpc.lpv.LPVObserver`); False: the linearisation at the run's
+        starting operating point (``operating_point``) and its fixed Kalman filter only.
     wind_speeds : array_like, optional
         LPV vertices (m/s); default every 1 m/s over the model's range.
     measured : sequence of str, optional
         Outputs the Kalman filter reads.
     solver : str, default "OSQP"
         cvxpy solver when a constraint is active.
-    name : str, default "health MPC"
-        Label.
+    name : str, default "excursion MPC"
+        Label (the default names the excursion penalty, this workbench's term; Boutrous et
+        al.'s controller is :func:`health_aware_mpc`, "health-aware MPC").
+    operating_point : {"estimated", "initial pitch"}, default "estimated"
+        Start the observer at the trim of the pitch measured at t = 0 (default; from then on
+        the LPV observer schedules on its own wind estimate), or at the trim of the run's
+        mean wind (:class:`~specdesign.mpc.sampled.SampledController`).
 
     Attributes
     ----------
@@ -295,7 +301,7 @@ class HealthMPC(SampledController):
                  stress_weight: float = 0.0, blade_m: float = BLADE_M, del_budget: float | None = None,
                  budget_prior: float = 60.0, mean_time: float = 60.0, speed_integral_time: float | None = 30.0,
                  lpv: bool = True, wind_speeds=None, measured=MEASURED,
-                 solver: str = "OSQP", name: str = "health MPC"):
+                 solver: str = "OSQP", name: str = "excursion MPC", operating_point: str = "estimated"):
         if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 1")
         self.horizon = int(horizon)
@@ -313,20 +319,18 @@ class HealthMPC(SampledController):
         self.speed_integral_time = (None if speed_integral_time is None
                                     else positive_scalar(speed_integral_time, "speed_integral_time"))
         self.lpv = bool(lpv)
-        self.wind_speeds = None if wind_speeds is None else tuple(float(v) for v in np.atleast_1d(wind_speeds))
         self.solver = str(solver)
-        super().__init__(model, ts, measured, name)
+        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds)
         positive_scalar(model.pitch_rate_limit, "model.pitch_rate_limit")
 
     def _reset_caches(self):
         super()._reset_caches()
         self._lpv = None
-        self._obs = None
         self._qp = None
 
     def __getstate__(self):
         state = super().__getstate__()
-        for k in ("_lpv", "_obs", "_qp"):
+        for k in ("_lpv", "_qp"):
             state.pop(k, None)
         return state
 
@@ -378,9 +382,7 @@ class HealthMPC(SampledController):
         self._run["mean_moment"] = mean
         self._run["speed_ref"] = np.full(mean.size, float(self.model.rated_rotor_speed))
         if self.lpv:
-            if self._obs is None:
-                self._obs = lpv_observer(self.model, self.ts, self.measured, wind_speeds=self.wind_speeds)
-            z = np.empty((mean.size, self._obs.z_trim.shape[1]))
+            z = np.empty((mean.size, self.observer().z_trim.shape[1]))
             for v, idx in self._run["groups"].items():
                 z[idx] = np.append(self._run["points"][v]["x_trim"], v)
             self._run["zprior"] = z
@@ -457,7 +459,7 @@ class HealthMPC(SampledController):
             pt = run["points"][v]
             Aa, Ba, Ca, L = pt["kf"]
             if self.lpv:  # the LPV observer, absolute (states, wind)
-                zf = np.stack([self._obs.update(run["zprior"][r], ym[r]) for r in idx])
+                zf = np.stack([self.observer().update(run["zprior"][r], ym[r]) for r in idx])
                 xs, winds = zf[:, :-1], zf[:, -1]
             else:  # the fixed-point filter of SampledController, deviations from the run's trim
                 xf = run["xprior"][idx] + (ym[idx] - run["y0"][v] - run["xprior"][idx] @ Ca.T) @ L.T
@@ -481,8 +483,42 @@ class HealthMPC(SampledController):
             run["u"][idx] = u
             if self.lpv:
                 for g, r in enumerate(idx):
-                    run["zprior"][r] = self._obs.predict(zf[g], pt["model"].pitch0 + u[g])
+                    run["zprior"][r] = self.observer().predict(zf[g], pt["model"].pitch0 + u[g])
             else:
                 run["xprior"][idx] = xf @ Aa.T + u[:, None] * Ba
         run["cmd"] = run["beta0"] + run["u"]
         return run["cmd"]
+
+
+def health_aware_mpc(model, stress_weight: float = 30.0, **kw) -> HealthMPC:
+    """Boutrous et al.'s health-aware LPV MPC: the accumulated-blade-moment term alone.
+
+    The linear cost ψ_acc·Σ_j M_j/(N M_s) on the predicted blade moment (their Ψ_mb·M_b,acc,
+    Eqs. 16-18) with the excursion penalty off (``health_weight`` = 0): the controller pitches
+    more and derates, trading power for accumulated blade stress as the paper's Table 2 does
+    (docs/health_mpc.md).
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine.
+    stress_weight : float, default 30
+        ψ_acc (dimensionless, > 0); 30 at 13 m/s derates 15.00 → 14.54 MW (docs/health_mpc.md).
+    **kw
+        Other options of :class:`HealthMPC` (not ``health_weight``).
+
+    Returns
+    -------
+    HealthMPC
+        Named "health-aware MPC" unless ``name`` is given.
+
+    Raises
+    ------
+    ValueError
+        For a ``stress_weight`` that is not > 0, or a ``health_weight`` given.
+    """
+    if "health_weight" in kw:
+        raise ValueError("health_aware_mpc has no excursion penalty: use HealthMPC(health_weight=...) for it")
+    stress_weight = positive_scalar(stress_weight, "stress_weight")
+    kw.setdefault("name", "health-aware MPC")
+    return HealthMPC(model, stress_weight=stress_weight, **kw)

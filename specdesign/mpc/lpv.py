@@ -31,7 +31,7 @@ import numpy as np
 from .._checks import positive_scalar
 from .base import discretize_turbine, kalman_gain, prediction_matrices
 
-__all__ = ["LPVTurbine", "lpv_turbine", "LPVObserver", "lpv_observer", "PREDICTED"]
+__all__ = ["LPVTurbine", "lpv_turbine", "LPVObserver", "lpv_observer", "PREDICTED", "vertex_pair", "check_speeds"]
 
 #: Outputs the health-aware MPC predicts: generator speed (rad/s), blade-root flapwise moment
 #: (N·m) and tower-top fore-aft velocity (m/s).
@@ -116,7 +116,7 @@ class LPVTurbine:
         a : float
             Weight of vertex i + 1, in [0, 1] (held at the end vertices outside the grid).
         """
-        return _alphas(self.wind_speeds, wind)
+        return vertex_pair(self.wind_speeds, wind)
 
     def affine(self, x: np.ndarray, wind: float, pitch_ref: float) -> tuple[np.ndarray, np.ndarray]:
         """Prediction as an affine map of the commands: z = z₀ + Γ(α)·(U − β_ref).
@@ -181,14 +181,51 @@ class LPVTurbine:
         return (z0 + G @ u).reshape(self.horizon, len(self.output_names))
 
 
-def _alphas(v, wind):
+def vertex_pair(v, wind) -> tuple[int, float]:
+    """The vertex pair of ``wind`` on the grid ``v`` and its weight (:meth:`LPVTurbine.alphas`).
+
+    Parameters
+    ----------
+    v : numpy.ndarray
+        (K,) increasing vertex wind speeds (m/s).
+    wind : float
+        Scheduling wind speed (m/s).
+
+    Returns
+    -------
+    i : int
+        Index of the lower vertex.
+    a : float
+        Weight of vertex i + 1 in [0, 1] (α_i = 1 − a), held at the ends of the grid.
+    """
     if v.size == 1:
         return 0, 0.0
-    i = int(np.clip(np.searchsorted(v, wind, side="right") - 1, 0, v.size - 2))
-    return i, float(np.clip((wind - v[i]) / (v[i + 1] - v[i]), 0.0, 1.0))
+    # plain floats: called per run and sample, where numpy's scalar clip costs more than the rest
+    i = min(max(int(np.searchsorted(v, wind, side="right")) - 1, 0), v.size - 2)
+    lo, hi = float(v[i]), float(v[i + 1])
+    return i, min(max((float(wind) - lo) / (hi - lo), 0.0), 1.0)
 
 
-def _check_speeds(model, wind_speeds):
+def check_speeds(model, wind_speeds) -> np.ndarray:
+    """The vertex wind speeds (m/s): ``wind_speeds`` checked, or every 1 m/s over ``model.wind_range``.
+
+    Parameters
+    ----------
+    model : TurbineModel
+        The turbine.
+    wind_speeds : array_like or None
+        Increasing wind speeds within the model's range (m/s).
+
+    Returns
+    -------
+    numpy.ndarray
+        (K,) vertex wind speeds.
+
+    Raises
+    ------
+    ValueError
+        For speeds that are not increasing or outside the model's range.
+    """
     lo, hi = (float(v) for v in model.wind_range)
     if wind_speeds is None:
         wind_speeds = np.arange(np.ceil(lo), np.floor(hi) + 0.5, 1.0)
@@ -242,7 +279,7 @@ class LPVObserver:
     L: np.ndarray = field(repr=False)
 
     def _pairs(self, wind):
-        i, a = _alphas(self.wind_speeds, wind)
+        i, a = vertex_pair(self.wind_speeds, wind)
         return [(j, w) for j, w in ((i, 1.0 - a), (min(i + 1, self.wind_speeds.size - 1), a)) if w > 0.0]
 
     def update(self, z: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -313,7 +350,7 @@ def lpv_observer(model, ts: float, measured, *, wind_speeds=None) -> LPVObserver
         As :func:`lpv_turbine`, or for an unknown measured output.
     """
     ts = positive_scalar(ts, "ts")
-    v = _check_speeds(model, wind_speeds)
+    v = check_speeds(model, wind_speeds)
     measured = tuple(measured)
     parts = {k: [] for k in ("z", "b", "y", "A", "B", "C", "L")}
     for s in v:
@@ -356,7 +393,7 @@ def lpv_turbine(model, ts: float, horizon: int, *, wind_speeds=None, outputs=PRE
         ``ts`` or a horizon < 1.
     """
     ts = positive_scalar(ts, "ts")
-    v = _check_speeds(model, wind_speeds)
+    v = check_speeds(model, wind_speeds)
     outputs = tuple(outputs)
     mats, xs, bs, ys, cs, ds = [], [], [], [], [], []
     for s in v:

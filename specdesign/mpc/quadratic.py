@@ -30,13 +30,43 @@ import numpy as np
 
 from .._checks import positive_scalar
 from .._docs import docstring_of
-from .base import MEASURED, DiscreteTurbine, SampledController, prediction_matrices
+from .base import MEASURED, DiscreteTurbine, prediction_matrices
+from .sampled import SampledController
 
-__all__ = ["QuadraticMPC", "quadratic_qp", "OSQP_OPTIONS"]
+__all__ = ["QuadraticMPC", "quadratic_qp", "preview_matrix", "OSQP_OPTIONS"]
 
 #: OSQP settings of the constrained QP: tolerances well under the 1e-6 relative accuracy the
 #: first move needs, and solution polishing (an active-set refinement: exact active constraints).
 OSQP_OPTIONS = {"eps_abs": 1e-9, "eps_rel": 1e-9, "polishing": True, "max_iter": 20000}
+
+
+def preview_matrix(dm: DiscreteTurbine, outputs, horizon: int) -> np.ndarray:
+    """Condensed response of ``outputs`` to a previewed wind sequence: z = … + Ψ [d₀ … d_{N−1}].
+
+    The wind enters as the command does, through B_w (the same condensed matrix), plus the
+    outputs' wind feedthrough D_w with the wind of the output's own step (the last held for
+    the last step).
+
+    Parameters
+    ----------
+    dm : DiscreteTurbine
+        The discrete model.
+    outputs : sequence of str
+        The q outputs.
+    horizon : int
+        N steps.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N·q, N) step-major as :func:`~specdesign.mpc.base.prediction_matrices`.
+    """
+    N = int(horizon)
+    _, Psi, _ = prediction_matrices(dataclasses.replace(dm, Bu=dm.Bw), outputs, N)
+    Dw, q = dm.Dw[dm.rows(outputs)], len(outputs)
+    for j in range(N):  # feedthrough of the output at step j+1: the wind of that step
+        Psi[j * q:(j + 1) * q, min(j + 1, N - 1)] += Dw
+    return Psi
 
 
 def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float, float], rated_speed: float,
@@ -85,11 +115,7 @@ def quadratic_qp(dm: DiscreteTurbine, horizon: int, weights: tuple[float, float,
     Phi, Gam, Psi = prediction_matrices(dm, names, N)
     Psi = Psi[:, None]
     if preview:
-        # the wind enters as the command does, through B_w: the same condensed matrix
-        _, Psi, _ = prediction_matrices(dataclasses.replace(dm, Bu=dm.Bw), names, N)
-        Dw, q = dm.Dw[dm.rows(names)], len(names)
-        for j in range(N):  # feedthrough of the output at step j+1: the wind of that step
-            Psi[j * q:(j + 1) * q, min(j + 1, N - 1)] += Dw
+        Psi = preview_matrix(dm, names, N)
     step = float(rate_limit) * dm.ts
     wz = np.tile([np.sqrt(qw) / rated_speed, np.sqrt(qt)], N)  # row scaling of z
     Dm = np.eye(N) - np.eye(N, k=-1)  # Δu = Dm u − e₁ u₋₁
@@ -152,6 +178,13 @@ class QuadraticMPC(SampledController):
         record's end) instead of the estimate d̂ held. Default None: no preview.
     name : str, default "quadratic MPC"
         Label.
+    operating_point : {"estimated", "initial pitch"}, default "estimated"
+        The model scheduled on the run's own wind estimate, or held at the trim of its initial
+        pitch (:class:`~specdesign.mpc.sampled.SampledController`).
+    wind_speeds : array_like, optional
+        Grid of the schedule (m/s); default every 1 m/s over ``model.wind_range``.
+    design_speed : float, optional
+        The fixed operating point (m/s) of ``operating_point="design point"``.
 
     Attributes
     ----------
@@ -170,7 +203,8 @@ class QuadraticMPC(SampledController):
 
     def __init__(self, model, ts: float = 0.1, horizon: int = 50, *, speed_weight: float = 100.0,
                  tower_weight: float = 100.0, activity_weight: float = 0.1, measured=MEASURED, shortcut: bool = True,
-                 solver: str = "OSQP", preview=None, name: str = "quadratic MPC"):
+                 solver: str = "OSQP", preview=None, name: str = "quadratic MPC", operating_point: str = "estimated",
+                 wind_speeds=None, design_speed: float | None = None):
         if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 1")
         self.horizon = int(horizon)
@@ -191,7 +225,8 @@ class QuadraticMPC(SampledController):
                 raise ValueError(f"preview wind must be a finite (R, n_w) or (W, S, n_w) array in m/s, got shape "
                                  f"{np.shape(preview[0])}")
             self.preview = (w, positive_scalar(preview[1], "preview wind_dt"))
-        super().__init__(model, ts, measured, name)
+        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds,
+                         design_speed=design_speed)
         positive_scalar(model.pitch_rate_limit, "model.pitch_rate_limit")
 
     def build(self, dm: DiscreteTurbine) -> dict:
