@@ -154,7 +154,15 @@ def _saved_errors(page, root, name):
     while path.stat().st_mtime_ns == before and time.monotonic() < deadline:
         time.sleep(0.3)
     assert path.stat().st_mtime_ns != before, f"JupyterLab did not save {name}"
-    nb = json.loads(path.read_text())
+    # the file's time moves when JupyterLab starts writing it: read it once the write is complete
+    while True:
+        try:
+            nb = json.loads(path.read_text())
+            break
+        except json.JSONDecodeError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.3)
     code = [c for c in nb["cells"] if c["cell_type"] == "code"]
     not_run = [i for i, c in enumerate(code) if c.get("execution_count") is None]
     errors = [(o.get("ename"), o.get("evalue")) for c in code for o in c.get("outputs", []) if o.get("output_type") == "error"]
