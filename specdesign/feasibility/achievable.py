@@ -12,7 +12,7 @@ from ..closedloop import MAX_SENSITIVITY, frequency_response, siso_response
 from ..fatigue import TOWER_M
 from ..spectral import trapezoid_weights
 
-__all__ = ["HF_END", "HF_GAIN_RATIO", "HF_OMEGA", "MAX_HF_GAIN_RATIO", "SOLVER_FALLBACK_OPTIONS", "SOLVER_OPTIONS", "YOULA_REAL_POLES",
+__all__ = ["HF_END", "HF_GAIN_RATIO", "HF_GRID_MARGIN", "HF_OMEGA", "MAX_HF_GAIN_RATIO", "SOLVER_FALLBACK_OPTIONS", "SOLVER_OPTIONS", "YOULA_REAL_POLES",
            "YOULA_PAIRS", "AchievablePitch", "achievable_pitch", "hf_check_omega", "hf_gain_bound", "YoulaProblem"]
 
 

@@ -246,7 +246,7 @@ def economic_problem(dm: DiscreteTurbine, terms, horizon: int, *, speed_weight: 
         (1,); variables ``v`` (N,) commands in units of the largest move ``step`` (rad) and ``x``
         (n, N+1) states; ``scale`` (J̃_ref) and ``step``; ``parts`` the objective's three terms
         (``"fatigue"`` J̃_fat/J̃_ref, ``"speed"``, ``"activity"``: cvxpy expressions whose values
-        after a solve are the terms' shares, :attr:`EconomicMPC.term_values`).
+        after a solve are the terms' shares, ``EconomicMPC.term_values``).
 
     Raises
     ------

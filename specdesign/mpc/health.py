@@ -229,7 +229,7 @@ class HealthMPC(SampledController):
     """Health-aware LPV MPC (after Boutrous et al.), a callable controller for ``simulate`` and ``run_campaign``.
 
     See the module docstring for the problem; the observer and sampling are those of
-    :class:`specdesign.mpc.base.SampledController`. The generator torque stays at its trim.
+    :class:`specdesign.mpc.sampled.SampledController`. The generator torque stays at its trim.
 
     Parameters
     ----------
