@@ -172,20 +172,9 @@ class ColletMPC(QuadraticMPC):
         return {"qp": collet_qp(dm, self.horizon, self.rho, speed_weight=self.speed_weight,
                                 rated_speed=float(self.model.rated_rotor_speed))}
 
+    @docstring_of(SampledController)
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
-        """Initialise the runs (:meth:`QuadraticMPC.start`: the preview checked) and the cut count.
-
-        Parameters
-        ----------
-        dt : float
-            Simulation step (s).
-        wind : numpy.ndarray
-            (R,) wind at t = 0 (m/s).
-        pitch : numpy.ndarray
-            (R,) initial pitch (rad).
-        torque : numpy.ndarray
-            (R,) generator torque (N·m).
-        """
+        # QuadraticMPC.start checks the preview's runs; the count of commands cut at the limits restarts
         self.saturated = 0
         super().start(dt, wind, pitch, torque)
 
