@@ -22,6 +22,14 @@ controller, each timed, all on the same (wind speed, seed) winds, so the runs ar
   lies between two grid points): on a documented subset of speeds and seeds, with the shares of
   its objective's terms at the optimum (Eq. 4 term vs the quadratic speed and move terms).
 
+Sensors: every controller reads the plant through the same measurement model
+(``controller.noise.IEA15MW_SENSORS``, docs/sensors.md: white noise on the generator speed,
+tower-top acceleration and velocity and blade-root moment, the 3P line on the speed), drawn per
+(wind speed, seed) and so the same for every controller on the same wind (``run_campaign(noise=)``);
+``--noise none`` runs them on the exact outputs instead, and ``--exact-rows`` adds the noise-free
+campaigns of every controller but the economic MPC as rows "… (exact sensors)" against ROSCO on
+exact sensors.
+
 No controller is told the run's mean wind: the MPCs and the clone estimate their operating point
 online (``operating_point="estimated"``, docs/mpc.md). Collet et al.'s own quadratic MPC and
 clone of the preview optimum need the future wind (a perfect LiDAR) and run on their paper's
@@ -38,7 +46,8 @@ Writes the tables between the result markers of docs/comparison.md (the prose ar
 kept) and the figure docs/figures/comparison.png.
 
 Run: python benchmarks/comparison.py [--quick --out /tmp/comparison.md --figure /tmp/comparison.png]
-     [--speeds 15 21 --seeds 4 --duration 600 --econ-speeds 21 --econ-seeds 1]
+     [--speeds 15 21 --seeds 4 --duration 600 --econ-speeds 21 --econ-seeds 1 --clone-rounds 1
+      --noise {iea15mw,none} --exact-rows --volterra-seeds 40]
 (full size about 25 minutes on 2 shared cores; --quick: 2 speeds × 2 seeds × 60 s, about 1.5 min)
 """
 from __future__ import annotations
@@ -51,6 +60,8 @@ import numpy as np
 
 SPEEDS = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
 INDS = ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "pitch_travel")
+#: Suffix of the noise-free rows (``--exact-rows``); their baseline is ROSCO on exact sensors too.
+EXACT = " (exact sensors)"
 LABELS = {"tower_del": "tower DEL", "blade_del": "blade DEL", "gen_speed_sd": "speed SD",
           "mean_power": "mean power", "pitch_sd": "pitch SD", "pitch_rate_sd": "pitch-rate SD",
           "pitch_travel": "pitch travel"}
@@ -69,7 +80,7 @@ def actuator_table(camps):
 
 
 def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101, 102, 103), quick=False,
-                      say=print):
+                      clone_rounds=2, say=print):
     """The controllers of the comparison (name → controller) and their kinds ("lti"/"mpc")."""
     import control as ct
 
@@ -93,7 +104,7 @@ def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101
     t0 = time.perf_counter()
     terms = mpc.fit_fatigue_terms(model, 19.0, 10.0, seeds=(1, 2))
     cs = list(speeds if clone_speeds is None else clone_speeds)
-    bc, demos = mpc.clone(model, cs, list(clone_seeds), terms, rounds=1 if quick else 2, horizon=10.0,
+    bc, demos = mpc.clone(model, cs, list(clone_seeds), terms, rounds=1 if quick else clone_rounds, horizon=10.0,
                           duration=20.0 if quick else 60.0)
     say(f"clone: {demos.targets.size} demonstrations at {cs} m/s, {time.perf_counter() - t0:.0f} s")
     out["behavioural cloning"] = bc
@@ -105,38 +116,48 @@ def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101
     return out, kinds
 
 
-def run_all(model, controllers, speeds, seeds, duration, *, econ_speeds, econ_seeds, transient=30.0, say=print):
-    """One timed campaign per controller; the economic MPC on its subset (and ROSCO on it too)."""
+def run_all(model, controllers, speeds, seeds, duration, *, econ_speeds, econ_seeds, transient=30.0, noise=None,
+            suffix="", say=print):
+    """One timed campaign per controller (named ``name + suffix``), all through the sensors ``noise``
+    (a ``SensorNoise`` or None: exact outputs); the economic MPC on its subset (and ROSCO on it too).
+
+    Returns the campaigns, the campaign CPU (s), wall (s) and the mean CPU per policy call of the
+    MPCs (s; NaN for an LTI controller), each keyed by the row name."""
     from specdesign.validate import run_campaign
 
-    camps, cpu, wall = {}, {}, {}
+    camps, cpu, wall, solve = {}, {}, {}, {}
     for name, c in controllers.items():
         vs, ss = (econ_speeds, econ_seeds) if name == "economic MPC" else (speeds, seeds)
         if not len(vs):
             continue
         if hasattr(c, "solve_times"):
             c.solve_times.clear()
+        row = name + suffix
         t0, p0 = time.perf_counter(), time.process_time()
-        camps[name] = run_campaign({name: c}, list(vs), list(ss), model=model, duration=duration, transient=transient,
-                                   predict=False, progress=False)
-        wall[name], cpu[name] = time.perf_counter() - t0, time.process_time() - p0
-        say(f"{name}: {len(vs)} speeds × {len(ss)} seeds × {duration:g} s in {wall[name]:.0f} s wall")
-    if "economic MPC" in controllers:  # the baseline on the subset: the same winds, so paired
-        camps["ROSCO (subset)"] = run_campaign({"ROSCO": controllers["ROSCO"]}, list(econ_speeds), list(econ_seeds),
-                                               model=model, duration=duration, transient=transient, predict=False,
-                                               progress=False)
-    return camps, cpu, wall
+        camps[row] = run_campaign({name: c}, list(vs), list(ss), model=model, duration=duration, transient=transient,
+                                  predict=False, progress=False, noise=noise)
+        wall[row], cpu[row] = time.perf_counter() - t0, time.process_time() - p0
+        st = getattr(c, "solve_times", None)
+        solve[row] = float(np.mean(st)) if st else float("nan")
+        say(f"{row}: {len(vs)} speeds × {len(ss)} seeds × {duration:g} s in {wall[row]:.0f} s wall", flush=True)
+    if "economic MPC" in controllers:  # the baseline on the subset: the same winds and sensors, so paired
+        camps["ROSCO (subset)" + suffix] = run_campaign(
+            {"ROSCO": controllers["ROSCO"]}, list(econ_speeds), list(econ_seeds), model=model, duration=duration,
+            transient=transient, predict=False, progress=False, noise=noise)
+    return camps, cpu, wall, solve
 
 
 def changes(camps, baseline="ROSCO"):
-    """Per controller and indicator: (change (W,), SE (W,)) vs the baseline on the same seeds (%)."""
+    """Per controller and indicator: (change (W,), SE (W,)) vs the baseline on the same seeds and
+    sensors (%): a row "… (exact sensors)" against the baseline's row of that name."""
     from specdesign.validate import paired_change
 
     res = {}
     for name, c in camps.items():
         if name.startswith("ROSCO"):
             continue
-        b = camps["ROSCO (subset)"] if name == "economic MPC" else camps[baseline]
+        tail = EXACT if name.endswith(EXACT) else ""
+        b = camps["ROSCO (subset)" + tail] if name.startswith("economic MPC") else camps[baseline + tail]
         res[name] = {k: paired_change(c.values[k][0], b.values[k][0], k, m=c.m, wind_speeds=c.wind_speeds)
                      for k in INDS}
     return res
@@ -166,16 +187,14 @@ def predictions(model, controllers, kinds, speeds, *, volterra_seeds, duration):
             for n, r in raw.items() if n != "ROSCO"}
 
 
-def cpu_per_step(camps, controllers, cpu, duration, transient, dt=0.02):
-    """(ms of campaign CPU per simulated step, ms per control step of the MPC's own solve_times or NaN)."""
+def cpu_per_step(camps, cpu, solve, duration, transient, dt=0.02):
+    """(ms of campaign CPU per simulated step, ms per control step of the MPC's own solve_times or NaN)
+    for every timed row of ``cpu``."""
     out = {}
-    for name, c in controllers.items():
-        if name not in camps:
-            continue
+    for name in cpu:
         camp = camps[name]
         steps = camp.wind_speeds.size * camp.seeds.size * (duration + transient) / dt
-        st = getattr(c, "solve_times", None)
-        out[name] = (1e3 * cpu[name] / steps, 1e3 * float(np.mean(st)) if st else float("nan"))
+        out[name] = (1e3 * cpu[name] / steps, 1e3 * solve[name])
     return out
 
 
@@ -184,12 +203,13 @@ def fmt(x, se):
     return "–" if not np.isfinite(x) else (f"{x:+.1f} ± {se:.1f}" if np.isfinite(se) else f"{x:+.1f}")
 
 
-def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took, camps=None):
-    """The tables of docs/comparison.md (with ``camps``, the actuator's cost of each controller too)."""
+def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took, camps=None, sensors="exact"):
+    """The tables of docs/comparison.md (with ``camps``, the actuator's cost of each controller too);
+    ``sensors`` names what the rows without the suffix :data:`EXACT` read."""
     lines = []
-    lines.append("| controller | " + " | ".join(f"{LABELS[k]} Δ% ± SE" for k in INDS)
+    lines.append("| controller | sensors | " + " | ".join(f"{LABELS[k]} Δ% ± SE" for k in INDS)
                  + " | CPU/step: campaign (ms) | CPU/step: controller solve (ms) |")
-    lines.append("|---" * (len(INDS) + 3) + "|")
+    lines.append("|---" * (len(INDS) + 4) + "|")
     for name, r in res.items():
         cells = []
         for k in INDS:
@@ -197,32 +217,35 @@ def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took, camps=None)
             # mean over the speeds of the change; SE of the mean from the per-speed SEs (independent speeds)
             cells.append(fmt(float(np.mean(ch.change)), float(np.sqrt(np.sum(ch.se**2))) / ch.change.size))
         per, solve = cpu[name]
-        tag = " (subset)" if name == "economic MPC" else ""
+        tag = " (subset)" if name.startswith("economic MPC") else ""
         sv = "compiled loop" if not np.isfinite(solve) else f"{solve:.2f}"
-        lines.append(f"| {name}{tag} | " + " | ".join(cells) + f" | {per:.3f} | {sv} |")
-    per_speed = ["", "Per wind speed (change vs ROSCO, %, ± paired-seed SE):", ""]
+        sens = "exact" if name.endswith(EXACT) else sensors
+        lines.append(f"| {name}{tag} | {sens} | " + " | ".join(cells) + f" | {per:.3f} | {sv} |")
+    per_speed = ["", f"Per wind speed (change vs ROSCO, %, ± paired-seed SE; sensors: {sensors}):", ""]
     per_speed.append("| controller | indicator | " + " | ".join(f"{v:g} m/s" for v in speeds) + " |")
     per_speed.append("|---|---|" + "---|" * len(speeds))
     for name, r in res.items():
+        if name.endswith(EXACT):
+            continue
         for k in ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd"):
             ch = r[k]
             cells = {float(v): fmt(c, s) for v, c, s in zip(ch.wind_speeds, ch.change, ch.se)}
             per_speed.append(f"| {name} | {LABELS[k]} | " + " | ".join(cells.get(float(v), "") for v in speeds) + " |")
-    pred = ["", "Predictions of the DEL changes vs ROSCO (LTI controllers; %, per wind speed), beside the rainflow result:",
-            ""]
+    pred = ["", "Predictions of the DEL changes vs ROSCO (LTI controllers; %, per wind speed; both predictions are "
+            "noise-free), beside the rainflow result (on exact sensors where those rows were run):", ""]
     pred.append("| controller | DEL | source | " + " | ".join(f"{v:g} m/s" for v in speeds) + " |")
     pred.append("|---|---|---|" + "---|" * len(speeds))
     for name, p in preds.items():
         for k in ("tower_del", "blade_del"):
             lin, vol = p[k]
-            sim = res[name][k]
+            sim = res.get(name + EXACT, res[name])[k]
             pred.append(f"| {name} | {LABELS[k]} | linear (Dirlik) | " + " | ".join(f"{x:+.1f}" for x in lin) + " |")
             pred.append(f"| {name} | {LABELS[k]} | Volterra (order 3) | " + " | ".join(f"{x:+.1f}" for x in vol) + " |")
             pred.append(f"| {name} | {LABELS[k]} | rainflow (simulated) | "
                         + " | ".join(fmt(c, s) for c, s in zip(sim.change, sim.se)) + " |")
     act = [] if camps is None else ["", "The pitch actuator's cost (absolute; mean over the speeds and seeds; pitch "
                                     "travel Σ|Δβ| per hour on the 0.1 s records, the rate limit the model's "
-                                    "2 deg/s):", ""] + actuator_table(camps)
+                                    f"2 deg/s; sensors {sensors} unless the row says exact):", ""] + actuator_table(camps)
     return "\n".join(lines + act + per_speed + pred)
 
 
@@ -261,6 +284,12 @@ def main():
     ap.add_argument("--duration", type=float, default=600.0)
     ap.add_argument("--econ-speeds", type=float, nargs="+", default=[15.0, 21.0])
     ap.add_argument("--econ-seeds", type=int, default=4)
+    ap.add_argument("--clone-rounds", type=int, default=2, help="rounds of the clone's training (1: no DAgger round)")
+    ap.add_argument("--noise", choices=("iea15mw", "none"), default="iea15mw",
+                    help="the sensors every controller reads: IEA15MW_SENSORS (docs/sensors.md) or the exact outputs")
+    ap.add_argument("--exact-rows", action="store_true",
+                    help="also run every controller but the economic MPC on exact sensors (rows '… (exact sensors)')")
+    ap.add_argument("--volterra-seeds", type=int, default=40, help="synthetic records of the Volterra prediction")
     ap.add_argument("--out", default="docs/comparison.md", help="Markdown page; the results go between its markers")
     ap.add_argument("--figure", default="docs/figures/comparison.png")
     a = ap.parse_args()
@@ -271,24 +300,43 @@ def main():
     else:
         speeds, seeds, duration = tuple(a.speeds), list(range(a.seeds)), a.duration
         econ_speeds, econ_seeds = tuple(a.econ_speeds), list(range(a.econ_seeds))
+    from specdesign.controller.noise import IEA15MW_SENSORS
+
+    noise = IEA15MW_SENSORS if a.noise == "iea15mw" else None
+    sensors = "IEA15MW_SENSORS" if noise is not None else "exact"
     load = os.getloadavg()
     t_all = time.perf_counter()
     model = turbine.iea15mw()
-    ctrls, kinds = build_controllers(model, speeds, quick=a.quick)
+    ctrls, kinds = build_controllers(model, speeds, quick=a.quick, clone_rounds=a.clone_rounds)
     econ = {"economic MPC": ctrls.pop("economic MPC")}
-    camps, cpu, wall = run_all(model, ctrls, speeds, seeds, duration, econ_speeds=econ_speeds, econ_seeds=econ_seeds)
+    camps, cpu, wall, solve = run_all(model, ctrls, speeds, seeds, duration, econ_speeds=econ_speeds,
+                                      econ_seeds=econ_seeds, noise=noise)
+    if a.exact_rows and noise is not None:
+        for part, got in zip((camps, cpu, wall, solve), run_all(model, ctrls, speeds, seeds, duration, econ_speeds=(),
+                                                                 econ_seeds=(), suffix=EXACT)):
+            part.update(got)
     t0 = time.perf_counter()
-    preds = predictions(model, ctrls, kinds, speeds, volterra_seeds=range(1000, 1000 + (4 if a.quick else 40)),
+    preds = predictions(model, ctrls, kinds, speeds, volterra_seeds=range(1000, 1000 + (4 if a.quick else a.volterra_seeds)),
                         duration=duration)
     print(f"predictions: {time.perf_counter() - t0:.0f} s")
+    cmd = "python benchmarks/comparison.py" + (" --quick" if a.quick else "".join(
+        f" {k} {v}" for k, v in (("--speeds", " ".join(f"{x:g}" for x in speeds)), ("--seeds", len(seeds)),
+                                  ("--duration", f"{duration:g}"), ("--econ-speeds", " ".join(f"{x:g}" for x in econ_speeds)),
+                                  ("--econ-seeds", len(econ_seeds)), ("--clone-rounds", a.clone_rounds),
+                                  ("--noise", a.noise), ("--volterra-seeds", a.volterra_seeds)))) \
+        + (" --exact-rows" if a.exact_rows else "")
 
     def write(done_econ):
         took = time.perf_counter() - t_all
         load_end = os.getloadavg()
-        allc = {**ctrls, **econ} if done_econ else ctrls
-        head = (f"Command: `python benchmarks/comparison.py{' --quick' if a.quick else ''}`; {len(speeds)} speeds "
+        head = (f"Command: `{cmd}`; {len(speeds)} speeds "
                 f"({', '.join(f'{v:g}' for v in speeds)} m/s) × {len(seeds)} paired seeds × {duration:g} s (after "
-                f"30 s of transient); baseline ROSCO with tower damping off; economic MPC on {', '.join(f'{v:g}' for v in econ_speeds)} m/s × "
+                f"30 s of transient); sensors: **{sensors}** for every controller"
+                + (" (docs/sensors.md; the same noise for every controller on the same (wind speed, seed))"
+                   if noise is not None else "")
+                + (f", and every controller but the economic MPC again on exact sensors (rows \"{EXACT.strip()}\", "
+                   "against ROSCO on exact sensors)" if a.exact_rows and noise is not None else "")
+                + f"; baseline ROSCO with tower damping off; economic MPC on {', '.join(f'{v:g}' for v in econ_speeds)} m/s × "
                 f"{len(econ_seeds)} seeds (vs ROSCO on the same subset)"
                 + ("" if done_econ else " NOT YET RUN (this file was written before its campaign)")
                 + f". Took {took:.0f} s wall; load average {load[0]:.1f} at the start, {load_end[0]:.1f} at the end "
@@ -299,21 +347,20 @@ def main():
             frac = p / p.sum(axis=1, keepdims=True)
             head += (f" Economic MPC objective at its optima ({len(p)} solves): Eq. 4 term {100 * frac[:, 0].mean():.0f} %, "
                      f"speed term {100 * frac[:, 1].mean():.0f} %, move term {100 * frac[:, 2].mean():.0f} % (mean shares).")
-        text = head + "\n\n" + markdown(changes(camps), preds, cpu_per_step(camps, allc, cpu, duration, 30.0), speeds,
-                                        econ_speeds, a, load, took, camps=camps)
+        res = changes(camps)
+        text = head + "\n\n" + markdown(res, preds, cpu_per_step(camps, cpu, solve, duration, 30.0), speeds,
+                                        econ_speeds, a, load, took, camps=camps, sensors=sensors)
         print(text)
         splice(a.out, text)
-        figure(changes(camps), a.figure)
+        figure({n: r for n, r in res.items() if not n.endswith(EXACT)}, a.figure)
         print(f"wrote {a.out}, {a.figure}")
 
     write(False)
-    c2, cpu2, wall2 = run_all(model, {"ROSCO": ctrls["ROSCO"], **econ}, (), (), duration, econ_speeds=econ_speeds,
-                              econ_seeds=econ_seeds)
-    camps.update({k: v for k, v in c2.items() if k != "ROSCO"})
-    cpu.update({k: v for k, v in cpu2.items() if k != "ROSCO"})
-    wall.update({k: v for k, v in wall2.items() if k != "ROSCO"})
+    got = run_all(model, {"ROSCO": ctrls["ROSCO"], **econ}, (), (), duration, econ_speeds=econ_speeds,
+                  econ_seeds=econ_seeds, noise=noise)
+    for part, more in zip((camps, cpu, wall, solve), got):
+        part.update({k: v for k, v in more.items() if k != "ROSCO"})
     write(True)
-
 
 if __name__ == "__main__":
     main()

@@ -6,7 +6,9 @@ fore-aft mode a damping ratio of 0.2 at every whole m/s of 12-25 m/s on the line
 ROSCO's PI), run by ``rosco_scheduled(model, tower_damper=...)`` on the same speeds, paired seeds
 and durations as ``benchmarks/comparison.py``, beside ROSCO as shipped (tower damping off), QFT,
 H∞ and (unless ``--no-mpc``) the quadratic MPC and the excursion MPC (``HealthMPC(health_weight=10)``). Every change is given against
-both baselines, with the paired-seed jackknife SE (``validate.paired_change``).
+both baselines, with the paired-seed jackknife SE (``validate.paired_change``). Every controller
+reads the plant through the same sensors as in ``comparison.py`` (``IEA15MW_SENSORS`` by default,
+``--noise none`` for the exact outputs), the same noise on the same (wind speed, seed).
 
 Writes its tables between the markers ``<!-- tower_damper.py results: start/end -->`` of
 docs/comparison.md (written once after the LTI controllers, again after the MPCs).
@@ -15,6 +17,7 @@ docs/comparison.md (written once after the LTI controllers, again after the MPCs
 the damper gain's trade-off between tower DEL and pitch activity.
 
 Run: python benchmarks/tower_damper.py [--no-mpc] [--quick --out /tmp/td.md] [--sweep 0.2 0.3 0.4 0.5]
+     [--speeds 15 19 23 --seeds 8 --duration 600 --noise {iea15mw,none}]
 """
 from __future__ import annotations
 
@@ -48,12 +51,13 @@ def table(camps, baseline):
     return lines, per
 
 
-def sweep(model, speeds, seeds, duration, ratios):
+def sweep(model, speeds, seeds, duration, ratios, noise=None):
     """Print ROSCO + TD against ROSCO (TD off) for each target damping ratio of the rule."""
     from specdesign.rosco import rosco_scheduled, tune_tower_damper
     from specdesign.validate import run_campaign
 
-    kw = {"model": model, "duration": duration, "transient": 30.0, "predict": False, "progress": False}
+    kw = {"model": model, "duration": duration, "transient": 30.0, "predict": False, "progress": False,
+          "noise": noise}
     camps = {"ROSCO (TD off)": run_campaign({"R": rosco_scheduled(model)}, list(speeds), seeds, **kw)}
     for z in ratios:
         td = tune_tower_damper(model, z)
@@ -69,19 +73,28 @@ def main():
     ap.add_argument("--damping-ratio", type=float, default=0.2)
     ap.add_argument("--out", default="docs/comparison.md")
     ap.add_argument("--sweep", type=float, nargs="+", help="target damping ratios: print ROSCO + TD vs ROSCO for each")
+    ap.add_argument("--speeds", type=float, nargs="+", default=list(SPEEDS))
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--duration", type=float, default=600.0)
+    ap.add_argument("--noise", choices=("iea15mw", "none"), default="iea15mw",
+                    help="the sensors every controller reads: IEA15MW_SENSORS (docs/sensors.md) or the exact outputs")
     a = ap.parse_args()
     import control as ct
 
     from specdesign import hinf, mpc, qft, turbine
+    from specdesign.controller.noise import IEA15MW_SENSORS
     from specdesign.rosco import rosco_scheduled, tower_mode_damping, tune_tower_damper
     from specdesign.simulate import scheduled
     from specdesign.validate import run_campaign
 
-    speeds, seeds, duration = ((17.0, 21.0), [0, 1], 60.0) if a.quick else (SPEEDS, list(range(20)), 600.0)
+    speeds, seeds, duration = ((17.0, 21.0), [0, 1], 60.0) if a.quick else (tuple(a.speeds), list(range(a.seeds)),
+                                                                           a.duration)
+    noise = IEA15MW_SENSORS if a.noise == "iea15mw" else None
+    sensors = "IEA15MW_SENSORS" if noise is not None else "exact"
     load, t_all = os.getloadavg(), time.perf_counter()
     model = turbine.iea15mw()
     if a.sweep:
-        sweep(model, speeds, seeds, duration, a.sweep)
+        sweep(model, speeds, seeds, duration, a.sweep, noise)
         return
     td = tune_tower_damper(model, a.damping_ratio)
     zeta = {v: (tower_mode_damping(model, v, None), tower_mode_damping(model, v, td)) for v in speeds}
@@ -102,14 +115,17 @@ def main():
         for name, c in group.items():
             t0 = time.perf_counter()
             camps[name] = run_campaign({name: c}, list(speeds), seeds, model=model, duration=duration, transient=30.0,
-                                       predict=False, progress=False)
+                                       predict=False, progress=False, noise=noise)
             wall[name] = time.perf_counter() - t0
             print(f"{name}: {wall[name]:.0f} s wall", flush=True)
 
     def write(mpc_done):
-        cmd = "python benchmarks/tower_damper.py" + (" --quick" if a.quick else "") + (" --no-mpc" if a.no_mpc else "")
+        cmd = "python benchmarks/tower_damper.py" + (" --quick" if a.quick else (
+            f" --speeds {' '.join(f'{v:g}' for v in speeds)} --seeds {len(seeds)} --duration {duration:g}"
+            f" --noise {a.noise}")) + (" --no-mpc" if a.no_mpc else "")
         head = [f"Command: `{cmd}`; {len(speeds)} speeds ({', '.join(f'{v:g}' for v in speeds)} m/s) × {len(seeds)} "
-                f"paired seeds × {duration:g} s (after 30 s of transient), the same winds as `comparison.py`. "
+                f"paired seeds × {duration:g} s (after 30 s of transient), the same winds as `comparison.py`; "
+                f"sensors: **{sensors}** for every controller (the same noise on the same (wind speed, seed)). "
                 f"Took {time.perf_counter() - t_all:.0f} s wall; load average {load[0]:.1f} at the start, "
                 f"{os.getloadavg()[0]:.1f} at the end (2 cores, shared). Campaign wall times: "
                 + ", ".join(f"{n} {t:.0f} s" for n, t in wall.items()) + "."

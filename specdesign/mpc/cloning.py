@@ -13,7 +13,11 @@ held at d̂_k over the horizon, and the previous command u_{k−1}. Demonstratio
 at the states a closed loop visits: rollouts of a behaviour controller on the nonlinear
 turbine (:class:`~specdesign.mpc.QuadraticMPC` first), then, with ``rounds`` > 1, of the clone
 itself (DAgger: the clone's own state distribution, labelled by the expert, is added and the
-clone refitted). Cloning the paper's perfect-preview open-loop optimum instead
+clone refitted). Each visited state is also labelled in ``perturbed`` copies moved by Gaussian
+draws of the features' own spread: along a closed loop's trajectory the features are nearly
+collinear, and fitted on the visited states alone the regressor's gains are not identified (a
+clone with the operating point estimated took a tower-velocity gain of the wrong sign and
+shook the tower; docs/mpc.md). Cloning the paper's perfect-preview open-loop optimum instead
 (:func:`~specdesign.mpc.economic_open_loop`) gives a policy without enough speed feedback: its
 demonstrations never leave the optimal trajectory, and the clone lets the rotor run away in
 closed loop (docs/mpc.md). That optimum stays the reference the controllers are compared with.
@@ -100,8 +104,8 @@ class Demonstrations:
 def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon: float = 20.0, ts: float = 0.2,
                    duration: float = 100.0, every: float = 0.6, transient: float = 20.0,
                    speed_weight: float = 100.0, activity_weight: float = 1.0,
-                   turbulence_class: str = "B") -> Demonstrations:
-    """Roll out a behaviour controller, then label the states it visits with the expert's move.
+                   turbulence_class: str = "B", perturbed: int = 1, perturb_seed: int = 0) -> Demonstrations:
+    """Roll out a behaviour controller, then label the states it visits, and perturbed copies, with the expert's move.
 
     Parameters
     ----------
@@ -130,17 +134,28 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
         The expert's q_Ω and q_Δ (:func:`~specdesign.mpc.economic_problem`).
     turbulence_class : str, default "B"
         IEC class of the wind.
+    perturbed : int, default 1
+        Perturbed copies of every visited state, labelled too: each of the features x̂, d̂ and
+        u_prev moved by an independent Gaussian draw whose SD is that feature's SD over the
+        visited states (the grid point v kept). Without them the features are nearly collinear
+        (the pitch follows the command, the tower velocity follows the wind estimate along a
+        closed loop's trajectory) and the regressor's gains on them are not identified: a clone
+        fitted on the visited states alone took a tower-velocity gain of the wrong sign and
+        shook the tower (docs/mpc.md, "The causal clone with the operating point estimated").
+        0 labels the visited states only.
+    perturb_seed : int, default 0
+        Seed of the perturbations' generator.
 
     Returns
     -------
     Demonstrations
-        One row per labelled state.
+        One row per labelled state (the visited states first, then their perturbed copies).
 
     Raises
     ------
     ValueError
-        For ``every`` not a whole multiple of ``ts``, or a behaviour controller at another
-        sample time.
+        For ``every`` not a whole multiple of ``ts``, a behaviour controller at another sample
+        time, or ``perturbed`` not an integer >= 0.
     """
     horizon, ts, every = positive_scalar(horizon, "horizon"), positive_scalar(ts, "ts"), positive_scalar(every, "every")
     stride = int(round(every / ts))
@@ -149,40 +164,56 @@ def demonstrations(model, wind_speeds, seeds, terms, *, behaviour=None, horizon:
     behaviour = QuadraticMPC(model, ts=ts) if behaviour is None else behaviour
     if not isinstance(behaviour, SampledController) or abs(behaviour.ts - ts) > 1e-12:
         raise ValueError(f"behaviour must be a SampledController (an MPC or a clone) at ts={ts} s")
+    if isinstance(perturbed, bool) or not isinstance(perturbed, (int, np.integer)) or perturbed < 0:
+        raise ValueError(f"perturbed={perturbed!r} must be an integer >= 0 (perturbed copies per visited state)")
     N = int(round(horizon / ts))
+    seeds = list(seeds)
     behaviour.record(True)
-    feats, targs, sd, cpu, experts = [], [], [], [], {}
+    visited, seed_of = [], []  # feature rows [x̂, d̂, u_prev, v] of the visited states, their wind seeds
     try:
         for v in np.atleast_1d(np.asarray(wind_speeds, float)):
             try:
-                simulate(model, behaviour, [float(v)], seeds=list(seeds), duration=duration, transient=transient)
+                simulate(model, behaviour, [float(v)], seeds=seeds, duration=duration, transient=transient)
             except SimulationDivergedError:
                 pass  # an early clone may lose the rotor: the states it visited on the way are the lesson
             # every ``stride``-th sample after the transient (a sample may carry two records:
             # the two grid points of its wind estimate)
             trace = [rec for rec in behaviour.trace if rec[0] >= transient and int(round(rec[0] / ts)) % stride == 0]
             for _, vv, xhat, uprev, runs in trace:
-                if vv not in experts:  # the expert at the record's operating point, compiled once
-                    experts[vv] = economic_problem(
-                        discretize_turbine(model, float(vv), ts), terms, N, speed_weight=speed_weight,
-                        activity_weight=activity_weight, rated_speed=float(model.rated_rotor_speed),
-                        rate_limit=float(model.pitch_rate_limit),
-                        pitch_limits=(float(model.pitch_min), float(model.pitch_max)))
-                pb = experts[vv]
-                for g in range(uprev.size):
-                    t0 = time.process_time()
-                    pb["x0"].value, pb["d"].value = xhat[g, :-1], np.full(N, xhat[g, -1])
-                    pb["uprev"].value = uprev[g:g + 1]
-                    ok = solve_cone(pb["problem"])
-                    cpu.append(time.process_time() - t0)
-                    if not ok:
-                        continue  # an unlabelled state is left out, not guessed
-                    feats.append(np.concatenate([xhat[g], [uprev[g], vv]]))
-                    targs.append(float(pb["v"].value[0]) * pb["step"])
-                    sd.append(int(list(seeds)[runs[g] % len(seeds)]))
+                visited.extend(np.column_stack([xhat, uprev, np.full(uprev.size, vv)]))
+                seed_of.extend(seeds[r % len(seeds)] for r in runs)
     finally:
         behaviour.record(False)
-    return Demonstrations(np.array(feats), np.array(targs), np.array(sd), ts, np.array(cpu))
+    rows, seed_of = np.array(visited).reshape(-1, UPREV + 2), np.array(seed_of, int)
+    if perturbed and rows.shape[0] > 1:
+        # every feature but the grid point v, spread by its own SD over the visited states
+        spread = np.append(rows[:, :-1].std(axis=0), 0.0)
+        rng = np.random.default_rng(perturb_seed)
+        copies = np.repeat(rows, perturbed, axis=0)
+        rows = np.vstack([rows, copies + rng.standard_normal(copies.shape) * spread])
+        seed_of = np.concatenate([seed_of, np.repeat(seed_of, perturbed)])
+    feats, targs, sd, cpu, experts = [], [], [], [], {}
+    for f, s in zip(rows, seed_of):
+        vv = float(f[-1])
+        if vv not in experts:  # the expert at the row's operating point, compiled once
+            experts[vv] = economic_problem(
+                discretize_turbine(model, vv, ts), terms, N, speed_weight=speed_weight,
+                activity_weight=activity_weight, rated_speed=float(model.rated_rotor_speed),
+                rate_limit=float(model.pitch_rate_limit),
+                pitch_limits=(float(model.pitch_min), float(model.pitch_max)))
+        pb = experts[vv]
+        t0 = time.process_time()
+        pb["x0"].value, pb["d"].value = f[:UPREV - 1], np.full(N, f[UPREV - 1])
+        pb["uprev"].value = f[UPREV:UPREV + 1]
+        ok = solve_cone(pb["problem"])
+        cpu.append(time.process_time() - t0)
+        if not ok:
+            continue  # an unlabelled state is left out, not guessed
+        feats.append(f)
+        targs.append(float(pb["v"].value[0]) * pb["step"])
+        sd.append(int(s))
+    return Demonstrations(np.array(feats).reshape(-1, UPREV + 2), np.array(targs), np.array(sd, int), ts,
+                          np.array(cpu))
 
 
 _POOLS = []
