@@ -26,7 +26,8 @@ import os
 import time
 
 import numpy as np
-from comparison import INDS, LABELS, SPEEDS, actuator_table, fmt, splice
+
+from comparison import INDS, LABELS, SPEEDS, actuator_table, fmt, qft_schedule, splice
 
 START, END = "<!-- tower_damper.py results: start -->", "<!-- tower_damper.py results: end -->"
 
@@ -80,8 +81,7 @@ def main():
                     help="the sensors every controller reads: IEA15MW_SENSORS (docs/sensors.md) or the exact outputs")
     a = ap.parse_args()
     import control as ct
-
-    from specdesign import hinf, mpc, qft, turbine
+    from specdesign import hinf, mpc, turbine
     from specdesign.controller.noise import IEA15MW_SENSORS
     from specdesign.rosco import rosco_scheduled, tower_mode_damping, tune_tower_damper
     from specdesign.simulate import scheduled
@@ -100,7 +100,7 @@ def main():
     zeta = {v: (tower_mode_damping(model, v, None), tower_mode_damping(model, v, td)) for v in speeds}
     ctrls = {"ROSCO (TD off)": rosco_scheduled(model),
              "ROSCO + TD": rosco_scheduled(model, tower_damper=td, name="ROSCO + TD")}
-    designs = qft.design_schedule(model, list(speeds))
+    designs, qft_targets = qft_schedule(model, speeds)
     ctrls["QFT"] = scheduled(model, {d.wind_speed: d.pitch_controller for d in designs},
                              atd={d.wind_speed: d.atd_controller for d in designs}, name="QFT")
     hd = {v: hinf.design_hinf(model, v) for v in speeds}
@@ -125,7 +125,8 @@ def main():
             f" --noise {a.noise}")) + (" --no-mpc" if a.no_mpc else "")
         head = [f"Command: `{cmd}`; {len(speeds)} speeds ({', '.join(f'{v:g}' for v in speeds)} m/s) × {len(seeds)} "
                 f"paired seeds × {duration:g} s (after 30 s of transient), the same winds as `comparison.py`; "
-                f"sensors: **{sensors}** for every controller (the same noise on the same (wind speed, seed)). "
+                f"sensors: **{sensors}** for every controller (the same noise on the same (wind speed, seed)); "
+                "QFT's DEL targets " + ", ".join(f"{t:g} % at {v:g} m/s" for v, t in zip(speeds, qft_targets)) + ". "
                 f"Took {time.perf_counter() - t_all:.0f} s wall; load average {load[0]:.1f} at the start, "
                 f"{os.getloadavg()[0]:.1f} at the end (2 cores, shared). Campaign wall times: "
                 + ", ".join(f"{n} {t:.0f} s" for n, t in wall.items()) + "."
