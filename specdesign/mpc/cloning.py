@@ -247,7 +247,7 @@ def clone(model, wind_speeds, seeds, terms, *, rounds: int = 2, ts: float = 0.2,
         Sample time (s).
     **kw
         Options of :func:`demonstrations` (``horizon``, ``duration``, ``every``, ``transient``,
-        the weights, ``turbulence_class``).
+        the weights, ``turbulence_class``, ``perturbed``, ``perturb_seed``).
 
     Returns
     -------
