@@ -101,6 +101,7 @@ def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101
     """The controllers of the comparison (name → controller), their kinds ("lti"/"mpc") and QFT's DEL
     targets (%, one per speed)."""
     import control as ct
+
     from specdesign import hinf, mpc
     from specdesign.rosco import rosco_scheduled
     from specdesign.simulate import scheduled
