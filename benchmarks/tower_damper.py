@@ -28,7 +28,16 @@ import os
 import time
 
 import numpy as np
-from comparison import INDS, LABELS, SPEEDS, actuator_table, fmt, qft_schedule, splice
+from comparison import (
+    INDS,
+    LABELS,
+    ROOT,
+    SPEEDS,
+    actuator_table,
+    fmt,
+    qft_schedule,
+    splice,
+)
 
 START, END = "<!-- tower_damper.py results: start -->", "<!-- tower_damper.py results: end -->"
 
@@ -73,7 +82,7 @@ def main():
     ap.add_argument("--quick", action="store_true", help="smoke test: 2 speeds, 2 seeds, 60 s")
     ap.add_argument("--no-mpc", action="store_true", help="LTI controllers only (seconds instead of minutes)")
     ap.add_argument("--damping-ratio", type=float, default=0.2)
-    ap.add_argument("--out", default="docs/comparison.md")
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "comparison.md"))
     ap.add_argument("--sweep", type=float, nargs="+", help="target damping ratios: print ROSCO + TD vs ROSCO for each")
     ap.add_argument("--speeds", type=float, nargs="+", default=list(SPEEDS))
     ap.add_argument("--seeds", type=int, default=20)
