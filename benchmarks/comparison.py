@@ -265,7 +265,7 @@ def markdown(res, preds, cpu, speeds, econ_speeds, args, load, took, camps=None,
     act = [] if camps is None else ["", ("The pitch actuator's cost (absolute; mean over the speeds and seeds; pitch "
                                          "travel Σ|Δβ| per hour on the 0.1 s records, the rate limit the model's "
                                          f"2 deg/s; sensors {sensors} unless the row says exact):"), ""] + actuator_table(camps)
-    return "\n".join(lines + act + per_speed + pred)
+    return "\n".join(lines + act + per_speed + (pred if preds else []))
 
 
 START, END = "<!-- comparison.py results: start -->", "<!-- comparison.py results: end -->"
