@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._designer_widget import build_widget
+from ._textcache import CachedTextRenderer
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
 from .freqresp import check_grid, evaluate
@@ -163,7 +164,10 @@ class LiveArtists:
     its markers take a few ms. The ``artists`` are made animated: every full render of the
     canvas caches the figure without them as the background and then draws them on top (so a
     full redraw, a toolbar zoom or a resize still shows them, and ``savefig`` too);
-    :meth:`redraw` restores the background, draws only them and sends the changed pixels.
+    :meth:`redraw` restores the background, draws only them and sends the changed pixels; a line
+    of text that meets the pixels it met before is written from a cache instead of rasterised
+    again (:class:`loopshaping._textcache.CachedTextRenderer`: pixel-identical, and a multi-line
+    title whose one line changed costs that line).
     Until the canvas has rendered once and the browser's view of it is connected it asks for
     a full redraw instead (a blit sent before the browser drew the figure once left it empty).
     A live figure is not "stale" after a blit or a render (pyplot redraws every stale figure
@@ -206,6 +210,7 @@ class LiveArtists:
         canvas = figure.canvas
         self.live = hasattr(canvas, "syncing_data_url") if live is None else bool(live)  # ipympl's Canvas
         self._background = None
+        self._text = None  # the canvas's renderer drawing unchanged lines of text from a cache
         if self.live:
             for a in self.artists:
                 a.set_animated(True)
@@ -239,8 +244,11 @@ class LiveArtists:
             canvas.draw_idle()
             return
         canvas.restore_region(self._background)
+        renderer = canvas.get_renderer()
+        if self._text is None or self._text.renderer is not renderer:  # a new canvas size or dpi
+            self._text = CachedTextRenderer(renderer)
         for a in self.artists:
-            self.figure.draw_artist(a)
+            a.draw(self._text)
         canvas.blit(self.figure.bbox)
         self.figure.stale = False  # what changed is on screen: no full render after this message
 
@@ -452,9 +460,9 @@ class Designer:
     def _stability(self):
         n = len(self._ss)
         stable, rightmost = np.zeros(n, bool), np.full(n, complex(np.nan, np.nan))
-        if not self.controller.is_proper:
+        num, den = self.controller.polys()  # once: Controller.is_proper would multiply them out again
+        if len(np.trim_zeros(num, "f")) > len(np.trim_zeros(den, "f")):  # improper: undecided
             return stable, rightmost
-        num, den = self.controller.polys()
         for c, ss in enumerate(self._ss):
             if ss is None:
                 continue

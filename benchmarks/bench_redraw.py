@@ -1,0 +1,120 @@
+"""The live figures' slider callbacks, in the kernel, as JupyterLab runs them (ipympl's canvas).
+
+Run: python benchmarks/bench_redraw.py
+Target (issue 30): a slider step redraws in ≤ 150 ms in the browser on an idle machine; the
+kernel's share, the callback (``update_ms``), ≤ 40 ms.
+
+Notebook 03's notch explorer (with the pitch and QFT-bounds checkers, a sweep of the depth
+slider) and notebook 04's Designer on the 19 m/s pitch loop of ``design_qft(spec="notch")``
+(a sweep of the gain, ±0.15 decade) are built on ipympl's canvas as in JupyterLab, the
+browser's end replaced by a no-op (``send``): the callback then computes, sets the artists'
+data, blits them and encodes the changed pixels as PNG, as it does in a notebook. Printed: the
+median callback, and its parts measured apart (compute alone, the blit of the artists,
+ipympl's diff image). The browser's time on top is measured by tests/test_browser.py.
+"""
+from __future__ import annotations
+
+import os
+import time
+
+import matplotlib
+
+matplotlib.use("module://ipympl.backend_nbagg")
+
+import numpy as np  # noqa: E402
+
+from loopshaping.controller import Controller  # noqa: E402
+from loopshaping.interactive import Designer  # noqa: E402
+from specdesign import feasibility, qft, spec  # noqa: E402
+from specdesign.plots.spec import NotchExplorer  # noqa: E402
+from specdesign.qft.boundscheck import bounds_checker  # noqa: E402
+from specdesign.turbine import iea15mw  # noqa: E402
+
+
+def _as_in_the_browser(fig):
+    """ipympl's canvas as once the browser has drawn the figure (blits, not data URLs), sending nowhere."""
+    canvas = fig.canvas
+    canvas.syncing_data_url = False  # the browser's view said it is initialised
+    canvas.send = lambda *args, **kwargs: None  # the comm to the browser
+    canvas.draw()  # the first full render caches the background
+    return canvas
+
+
+def _median_ms(fn, args):
+    times = []
+    for a in args:
+        t0 = time.perf_counter()
+        fn(a)
+        times.append(time.perf_counter() - t0)
+    return 1e3 * float(np.median(times))
+
+
+def _parts(canvas, redraw, update, args):
+    """Median ms of: the callback; compute alone; the blit of the artists; ipympl's diff image."""
+    callback = _median_ms(update, args)
+    compute = _median_ms(lambda a: update(a, redraw=False), args)
+    blit, diff = [], []
+    for a in args:
+        update(a, redraw=False)
+        t0 = time.perf_counter()
+        canvas.restore_region(redraw._background)
+        for artist in redraw.artists:
+            artist.draw(redraw._text if redraw._text is not None else canvas.get_renderer())
+        t1 = time.perf_counter()
+        canvas._png_is_old = True
+        canvas.get_diff_image()
+        t2 = time.perf_counter()
+        blit.append(t1 - t0)
+        diff.append(t2 - t1)
+    return callback, compute, 1e3 * float(np.median(blit)), 1e3 * float(np.median(diff))
+
+
+def _report(what, canvas, parts):
+    callback, compute, blit, diff = parts
+    w, h = canvas.get_width_height(physical=True)
+    print(f"{what} ({w}x{h} px)")
+    print(f"  callback (update_ms)          {callback:7.1f} ms   target ≤ 40 ms")
+    print(f"    compute (verdicts, data)    {compute:7.1f} ms")
+    print(f"    blit of the changed artists {blit:7.1f} ms")
+    print(f"    ipympl's PNG diff image     {diff:7.1f} ms")
+
+
+def main():
+    print(f"slider callbacks on ipympl's canvas (median over a sweep; load {os.getloadavg()[0]:.1f})")
+    model = iea15mw()
+    base = spec.baseline_analysis(model, 19.0, output="tower_base_my", m=4.0)
+    notch = spec.shape_to_target(base, 15.0, keep_below=0.6).notches[0]
+    checker = feasibility.pitch_checkers(model, 19.0, spec.speed_specification(model, 19.0, margin_db=3.0),
+                                         max_sensitivity=None)[0]
+    t0 = time.perf_counter()
+    qc = bounds_checker(model, 19.0)
+    t_build = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    qc.precompute()
+    t_pre = time.perf_counter() - t0
+    explorer = NotchExplorer(base, notch, checker=checker, bounds_checker=qc)
+    canvas = _as_in_the_browser(explorer.fig)
+    depths = np.linspace(notch.depth_db - 3.0, notch.depth_db + 3.0, 31)
+
+    def move(depth, redraw=True):
+        explorer.update(notch.omega_n, depth, notch.width, redraw=redraw)
+
+    _report("notebook 03: the notch explorer's depth slider", canvas, _parts(canvas, explorer._redraw, move, depths))
+    print(f"    (bounds checker: built in {t_build * 1e3:.0f} ms, precomputed in {t_pre * 1e3:.0f} ms, once)")
+
+    d = qft.design_qft(model, 19.0, target_reduction=25.0, spec="notch")
+    designer = Designer(d.pitch_bounds, d.pitch_template, Controller.from_tf(d.pitch_controller))
+    canvas = _as_in_the_browser(designer.draw())
+    k0 = designer.controller.elements[0].params["k"]
+    gains = k0 * np.logspace(-0.15, 0.15, 31)
+
+    def gain(k, redraw=True):
+        designer.controller = designer.controller.set(0, k=k)
+        designer.update(redraw=redraw)
+
+    _report(f"notebook 04: the Designer's gain ({len(d.pitch_template.systems)} plant cases, "
+            f"{designer.omega.size} frequencies)", canvas, _parts(canvas, designer._redraw, gain, gains))
+
+
+if __name__ == "__main__":
+    main()
