@@ -106,6 +106,11 @@ class BoundsChecker:
             both = lqft.intersect(self.fixed, lqft.bounds(self.template, spec))
         return np.asarray(both.empty, bool)
 
+    @property
+    def precomputed(self) -> bool:
+        """True once :meth:`precompute` has bracketed some frequency (checks then compare)."""
+        return bool(np.isfinite(self._empty_up_to).any() or np.isfinite(self._feasible_from).any())
+
     def precompute(self, lowest: float = 1e-3, highest: float = 10.0, halvings: int = 14) -> "BoundsChecker":
         """Bracket the ratio W/W^ROSCO where each frequency's bound turns empty, for fast checks.
 
