@@ -45,8 +45,16 @@ class CachedTextRenderer:
         self._lines = OrderedDict()  # key (inputs and the underlay's bytes) → the box's pixels after drawing
         self._metrics = OrderedDict()  # (text, font, math) → (width, height, descent), px
 
+    _OWN = frozenset({"renderer", "size", "hits", "misses", "_lines", "_metrics"})
+
     def __getattr__(self, name):  # everything but draw_text: the canvas's renderer
         return getattr(self.renderer, name)
+
+    def __setattr__(self, name, value):  # the renderer's state (e.g. its rasterisation depth) stays its own
+        if name in self._OWN:
+            object.__setattr__(self, name, value)
+        else:
+            setattr(self.renderer, name, value)
 
     def _extent(self, s, prop, ismath):
         key = (s, prop, ismath)
@@ -64,11 +72,15 @@ class CachedTextRenderer:
         if angle or ismath == "TeX" or clip_path is not None or not (math.isfinite(x) and math.isfinite(y)):
             return r.draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
         w, h, d = self._extent(s, prop, ismath)
-        # the ink lies within the metrics box from the pen position (x, baseline y); a margin for
-        # side bearings and antialiasing (a quarter of the font size across, a pixel up and down)
+        # the ink lies within the metrics box from the pen position (x, baseline y), rounded out
+        # to whole pixels; a margin across for side bearings (a quarter of the font size), and up
+        # and down only for mathtext, whose box can miss a pixel row of ink (a margin there would
+        # take in the line above or below, and an unchanged line under a changed one would be
+        # drawn again); tests/test_fast_redraw.py compares the pixels with drawing every line
         pad = int(math.ceil(0.25 * prop.get_size_in_points() * r.dpi / 72.0)) + 1
+        m = 1 if ismath else 0
         buf = np.asarray(r.buffer_rgba())
-        rows = slice(max(int(math.floor(y - (h - d))) - 1, 0), min(int(math.ceil(y + d)) + 2, buf.shape[0]))
+        rows = slice(max(int(math.floor(y - (h - d))) - m, 0), min(int(math.ceil(y + d)) + 1 + m, buf.shape[0]))
         cols = slice(max(int(math.floor(x)) - pad, 0), min(int(math.ceil(x + w)) + pad, buf.shape[1]))
         box = buf[rows, cols]
         clip = gc.get_clip_rectangle()

@@ -103,13 +103,18 @@ def _uncached_blit(live):
     return np.asarray(canvas.buffer_rgba()).copy()
 
 
-def test_cached_text_lines_blit_the_same_pixels_as_drawing_them(base):
-    # the explorer's title (three lines, the first changing) and legend, blitted with the text
-    # cache, pixel for pixel the same as drawn without it; revisited values come from the cache
+@pytest.mark.parametrize("dpi", [100, 163])  # matplotlib's default; a high-density screen's (ipympl scales)
+def test_cached_text_lines_blit_the_same_pixels_as_drawing_them(base, dpi):
+    # the explorer's title (three lines, the first changing) and legend (plain text and
+    # mathtext), blitted with the text cache, pixel for pixel the same as drawn without it;
+    # revisited values come from the cache
     ex = NotchExplorer(base, live=True)
     try:
+        ex.fig.set_dpi(dpi)
         ex.fig.canvas.draw()
-        for n in [(1.05, d, 0.2) for d in (3.0, 6.0, 3.0, 9.0, 6.0)] + [(w, 6.0, 0.2) for w in (0.5, 1.0, 0.5)]:
+        moves = [(1.05, d, 0.2) for d in (3.0, 6.0, 3.0, 9.0, 6.0, 17.3, 29.9)] + [(w, 6.0, z) for w in (0.5, 1.0, 0.5)
+                                                                                  for z in (0.02, 0.47)]
+        for n in moves:
             ex.update(*n)
             cached = np.asarray(ex.fig.canvas.buffer_rgba()).copy()
             np.testing.assert_array_equal(cached, _uncached_blit(ex._redraw), err_msg=str(n))
