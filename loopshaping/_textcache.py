@@ -77,11 +77,11 @@ class CachedTextRenderer:
         # and down only for mathtext, whose box can miss a pixel row of ink (a margin there would
         # take in the line above or below, and an unchanged line under a changed one would be
         # drawn again); tests/test_fast_redraw.py compares the pixels with drawing every line
-        pad = int(math.ceil(0.25 * prop.get_size_in_points() * r.dpi / 72.0)) + 1
+        pad = math.ceil(0.25 * prop.get_size_in_points() * r.dpi / 72.0) + 1
         m = 1 if ismath else 0
         buf = np.asarray(r.buffer_rgba())
-        rows = slice(max(int(math.floor(y - (h - d))) - m, 0), min(int(math.ceil(y + d)) + 1 + m, buf.shape[0]))
-        cols = slice(max(int(math.floor(x)) - pad, 0), min(int(math.ceil(x + w)) + pad, buf.shape[1]))
+        rows = slice(max(math.floor(y - (h - d)) - m, 0), min(math.ceil(y + d) + 1 + m, buf.shape[0]))
+        cols = slice(max(math.floor(x) - pad, 0), min(math.ceil(x + w) + pad, buf.shape[1]))
         box = buf[rows, cols]
         clip = gc.get_clip_rectangle()
         key = (s, prop, ismath, x, y, tuple(gc.get_rgb()), gc.get_alpha(), gc.get_forced_alpha(),

@@ -72,10 +72,9 @@ def test_a_ratio_inside_a_bracket_or_outside_the_seeds_is_computed_exactly(check
         exact.precompute(halvings=-1)
 
 
-def test_the_explorer_draws_and_says_what_the_exact_checks_give(base, checkers, model):
+def test_the_explorer_draws_and_says_what_the_exact_checks_give(base, model):
     # the explorer precomputes its checker; the reference explorer keeps an exact one (its
     # precompute a no-op): verdicts, line, marker, title and legend equal along the sweep
-    _, exact = checkers
     exact_only = boundscheck.bounds_checker(model, 19.0)
     exact_only.precompute = lambda: exact_only
     fast_ex = NotchExplorer(base, bounds_checker=boundscheck.bounds_checker(model, 19.0), live=False)

@@ -111,7 +111,7 @@ class BoundsChecker:
         """True once :meth:`precompute` has bracketed some frequency (checks then compare)."""
         return bool(np.isfinite(self._empty_up_to).any() or np.isfinite(self._feasible_from).any())
 
-    def precompute(self, lowest: float = 1e-3, highest: float = 10.0, halvings: int = 14) -> "BoundsChecker":
+    def precompute(self, lowest: float = 1e-3, highest: float = 10.0, halvings: int = 14) -> BoundsChecker:
         """Bracket the ratio W/W^ROSCO where each frequency's bound turns empty, for fast checks.
 
         The tower spec |T_{MyT,w}| ≤ W allows a set of loop values that only grows with W, so at
@@ -147,7 +147,7 @@ class BoundsChecker:
         if int(halvings) != halvings or halvings < 0:
             raise ValueError(f"halvings={halvings!r} must be an integer ≥ 0")
         n = self.template.omega.size
-        seeds = np.geomspace(lowest, highest, max(2, int(round(np.log10(highest / lowest))) + 1))
+        seeds = np.geomspace(lowest, highest, max(2, round(np.log10(highest / lowest)) + 1))
         empty = np.stack([self._empty(np.full(n, r)) for r in seeds])  # (n_seeds, n)
         # monotone: empty at the low seeds, not empty from some seed on
         monotone = np.all(empty[1:] <= empty[:-1], axis=0)
