@@ -98,8 +98,8 @@ class NotchExplorer:
         The pitch loop's QFT problem at the same speed (:func:`specdesign.qft.boundscheck.bounds_checker`):
         every update also says whether the QFT bounds of ROSCO's map × the notch are empty
         anywhere (:attr:`bounds_verdict`). The explorer calls its
-        :meth:`~specdesign.qft.boundscheck.BoundsChecker.precompute` (about 0.5 s, once), so
-        a move decides the verdict by comparisons instead of a bound computation (25-50 ms).
+        :meth:`~specdesign.qft.boundscheck.BoundsChecker.precompute` (about 1 s, once), so
+        a move decides the verdict by comparisons instead of a bound computation (35-70 ms).
     live : bool, optional
         Redraw a move by blitting the line, marker, title and legend on a cached background
         (:class:`loopshaping.interactive.LiveArtists`); default: on ipympl's canvas

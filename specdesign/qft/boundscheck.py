@@ -9,7 +9,7 @@ nominal ratio W/T^ROSCO (as :func:`specdesign.qft.design_qft` uses them). An *em
 closing this loop meets the specifications there: the designer sees it before loop shaping.
 
 :func:`bounds_checker` precomputes everything but the tower weight; :meth:`BoundsChecker.check`
-then costs one exact bound computation (25-50 ms on 47 frequencies). For a slider,
+then costs one exact bound computation (35-70 ms on 47 frequencies). For a slider,
 :meth:`BoundsChecker.precompute` brackets, per design frequency, the ratio W/W^ROSCO at which the
 bound turns empty (the allowed set only grows with W), so a check is a comparison, with the exact
 computation only for a ratio inside a bracket.
@@ -119,7 +119,7 @@ class BoundsChecker:
         map and not above it. This brackets r* between a ratio computed empty and one computed
         not empty: seeds at every decade from ``lowest`` to ``highest``, then ``halvings`` halvings
         of the bracket's log width (2⁻¹⁴ decade: a bracket 0.014 % wide), every frequency in
-        one bound computation per step (about 0.5 s). Afterwards :meth:`check` decides each
+        one bound computation per step (19 in all, about 1 s). Afterwards :meth:`check` decides each
         frequency by comparison and runs the exact computation only when a ratio falls inside a
         bracket or outside the seeded range; the verdict is the exact one either way. A frequency
         whose seeds are not monotone in the ratio keeps no bracket (always computed exactly).
