@@ -8,7 +8,8 @@ slider, and checks from pixels that the live (ipympl) figure changed, then saves
 through JupyterLab and reads it back to check that every code cell ran and none errored. Each
 drag's redraw time is reported (never asserted) as two numbers: the browser's, from the release
 to the settled figure, and the kernel's, the slider callback alone (``update_ms`` of the
-explorer or the Designer, read from the notebook's kernel through its connection file). Screenshots go to
+explorer or the Designer, read from the notebook's kernel through its connection file), beside the
+lines of text its blits took from the text cache and drew. Screenshots go to
 ``build/browser-screenshots/`` (kept by CI as artefacts). The server and its kernels are
 stopped in every case (the process group it was started in).
 
