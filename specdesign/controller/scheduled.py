@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 from .lti import as_lti, split_integrator, split_slow, tustin_matrices
+from .peak_shaving import PeakShaving
 
 __all__ = ["SCHEDULE_FILTER_OMEGA", "FORMS", "ScheduledController", "schedule_filter_coefficients", "controller_bank"]
 
@@ -74,6 +75,10 @@ class ScheduledController:
         ``filter_omega``, discretised exactly. A damping ratio ζ: second order,
         ω_f²/(s² + 2ζω_f s + ω_f²), discretised by Tustin, as ROSCO filters its scheduling
         pitch (``Filters.f90``: ω_f = 0.25·F_LPFCornerFreq, ζ = 0.7).
+    peak_shaving : PeakShaving or None, optional
+        ROSCO's peak shaving (``form="gains"`` only): the PI's lower limit lifted every step
+        to the minimum pitch at ROSCO's filtered wind-speed estimate (see
+        :mod:`specdesign.controller.peak_shaving`). None (default): the limits alone.
 
     Raises
     ------
@@ -94,6 +99,7 @@ class ScheduledController:
     error_filter: object = field(default=None, repr=False)
     pitch_limits: tuple | None = None
     filter_damping: float | None = None
+    peak_shaving: PeakShaving | None = None
 
     def __post_init__(self):
         b = np.atleast_1d(np.asarray(self.schedule_pitch, dtype=float))
@@ -110,8 +116,9 @@ class ScheduledController:
         if self.form not in FORMS:
             raise ValueError(f"form must be one of {FORMS}, got {self.form!r}")
         if self.form == "output":
-            if self.kp is not None or self.ki is not None or self.error_filter is not None or self.pitch_limits is not None:
-                raise ValueError("kp, ki, error_filter and pitch_limits are for form='gains' only")
+            if (self.kp is not None or self.ki is not None or self.error_filter is not None
+                    or self.pitch_limits is not None or self.peak_shaving is not None):
+                raise ValueError("kp, ki, error_filter, pitch_limits and peak_shaving are for form='gains' only")
             return
         if self.pitch_limits is not None:
             lim = tuple(float(x) for x in self.pitch_limits)
@@ -126,6 +133,9 @@ class ScheduledController:
             gains.append(a)
         object.__setattr__(self, "kp", gains[0])
         object.__setattr__(self, "ki", gains[1])
+        if self.peak_shaving is not None and not isinstance(self.peak_shaving, PeakShaving):
+            raise TypeError(f"peak_shaving must be a PeakShaving (peak_shaving_from_discon) or None, "
+                            f"got {type(self.peak_shaving).__name__}")
         f = as_lti(self.error_filter, "error_filter")
         object.__setattr__(self, "error_filter", f)
         # The local controllers must be the frozen-gain PIs, or the linear prediction (which

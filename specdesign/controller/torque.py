@@ -522,7 +522,7 @@ def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):
 
 @njit(cache=True)
 def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitch: float, dt: float,
-                first: bool) -> tuple[float, float]:
+                first: bool, pitch_min: float = math.nan) -> tuple[float, float]:
     """One step of ROSCO's torque controller (compiled; :mod:`specdesign.controller.torque`).
 
     Parameters
@@ -542,6 +542,11 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         Step (s).
     first : bool
         The first call (filters and integrators start at their inputs, as ROSCO's do).
+    pitch_min : float, optional
+        The pitch controller's lower limit of the previous step (rad), ROSCO's ``PC_MinPit``:
+        NaN (default) for the law's ``fine_pitch`` (``tq[T_PITCH_MIN]``), or the peak-shaving limit
+        (:func:`specdesign.controller.peak_shaving.peak_shaving_step`). Region 3 starts
+        ``PC_Switch`` above it, and the setpoint smoother measures the pitch from it.
 
     Returns
     -------
@@ -552,6 +557,8 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     """
     mode = int(tq[T_MODE])
     c = tq[T_FILT_CORNER]
+    if math.isnan(pitch_min):
+        pitch_min = tq[T_PITCH_MIN]
     if first:
         st[S_WF] = omega
         st[S_WF2] = omega
@@ -593,7 +600,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     min_om = k * tq[T_MIN_SPEED] ** 2
     max_om = k * tq[T_VS_REF] ** 2
     # state machine, on the previous step's PI outputs (StateMachine)
-    rgn3 = tq[T_PITCH_MIN] + tq[T_PC_SWITCH]
+    rgn3 = pitch_min + tq[T_PC_SWITCH]
     if first:
         state = 4 if pitch >= rgn3 else 2
     elif pitch >= rgn3:
@@ -609,7 +616,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     st[S_STATE] = state
     # setpoint smoother (SetpointSmoother), on the measured pitch and the last step's power
     if tq[T_SS_MODE] != 0.0:
-        d = ((pitch - tq[T_PITCH_MIN]) / 0.524 * tq[T_SS_VS]
+        d = ((pitch - pitch_min) / 0.524 * tq[T_SS_VS]
              - (tq[T_RATED_POWER] - st[S_PLAST]) / tq[T_RATED_POWER] * tq[T_SS_PC]) * tq[T_PC_REF]
         st[S_SSF] = _lpf1(st, S_SSF, S_SS_U, d, tq[T_SS_CORNER], dt, first)
     last = st[S_TQ]

@@ -233,8 +233,9 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     kind, run_batch, step_all, outputs_all = compiled_for(rhs, outfn)
     ny = len(plant.output_names)
     lim_names = tuple(plant.output_limits)
+    peak_shaving = getattr(controller, "peak_shaving", None) is not None
     setup = LoopSetup(kind, wind_dt, times.dt, times.nsteps, times.rec_every, ny, plant.index("gen_speed"),
-                      plant.index("tower_top_vel"), *_torque_outputs(plant, TQ),
+                      plant.index("tower_top_vel"), *_torque_outputs(plant, TQ, peak_shaving),
                       np.array([plant.index(n) for n in lim_names], dtype=np.int64),
                       np.array([float(plant.output_limits[n]) for n in lim_names]))
     Y = np.empty((runs.X0.shape[0], ny + 1, (times.nsteps + times.rec_every - 1) // times.rec_every))
@@ -388,6 +389,7 @@ def _bank_records(controller, plant, dt):
     same = _same_locals(Ad, Bd, Cd, Dd, Rq, Ns)
     sfilt = schedule_filter_coefficients(fw, getattr(controller, "filter_damping", None), dt)
     cmd_lim = np.array((-np.inf, np.inf) if plant.pitch_limits is None else plant.pitch_limits, dtype=float)
+    ps = np.zeros(0)
     if pi is None:
         pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
         Af, Bf, Cf, Df, lim = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1), np.array([-np.inf, np.inf])
@@ -396,8 +398,10 @@ def _bank_records(controller, plant, dt):
         # the PI's integrator never holds more than the command can reach: its own limits
         # narrowed to the plant's (the plant's alone when it has none), so it cannot wind up
         lim = np.array([max(lim[0], cmd_lim[0]), min(lim[1], cmd_lim[1])])
+        if controller.peak_shaving is not None:  # ROSCO's minimum pitch from its wind estimate (form="gains")
+            ps = controller.peak_shaving.params()
     bank = Bank(Ad, Bd, Cd, Dd, Rq, Ns, same, np.ascontiguousarray(sched_pitch), sfilt, cmd_lim)
-    gpi = GainsPI(pi_on, *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim)))
+    gpi = GainsPI(pi_on, *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim, ps)))
     return bank, gpi
 
 
@@ -455,7 +459,10 @@ def _torque_params(plant, torque_control, vs, S, linear):
     return TQ, above
 
 
-def _torque_outputs(plant, TQ):
+def _torque_outputs(plant, TQ, peak_shaving=False):
+    """Indices of the power and the pitch, which the torque law and peak shaving read (0 for unread)."""
+    if peak_shaving and not TQ[:, 0].any():
+        return 0, plant.index("pitch")
     if not TQ[:, 0].any():
         return 0, 0
     return plant.index("power"), plant.index("pitch")
