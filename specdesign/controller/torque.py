@@ -29,8 +29,10 @@ raises the pitch controller's. Torque is then limited to [``VS_MinTq``, min(``VS
 ``VS_MaxRat``. PIs are ROSCO's: forward Euler integrator
 saturated at the output limits. Filters are ROSCO's Tustin forms, reset to their input on
 the first call. Peak shaving (``PS_Mode``, a minimum pitch ``PS_BldPitchMin`` interpolated at
-the wind speed estimated by ROSCO's extended Kalman filter) is not modelled, the estimator being
-outside the workbench: the pitch limit is the model's, and :func:`torque_law_from_discon` warns.
+the wind speed estimated by ROSCO's extended Kalman filter) belongs to the pitch controller
+(:mod:`specdesign.controller.peak_shaving`, run by :func:`specdesign.rosco.rosco_scheduled`); its
+limit reaches this law as ``pitch_min`` of :func:`torque_step` (the smoother and the state
+machine measure the pitch from it), the law's ``fine_pitch`` without it.
 
 All quantities here are on the rotor (low-speed) shaft in SI: a DISCON.IN's generator-side
 speeds are divided by its gearbox ratio N, torques multiplied by it (K by N³, PI gains by N²).
@@ -38,7 +40,6 @@ speeds are divided by its gearbox ratio N, torques multiplied by it (K by N³, P
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -298,19 +299,15 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
         :data:`TORQUE_MODES` (mode 2: pass ``mode=3``), ``VS_ConstPower`` not 0 or 1, or
         ``VS_FBP`` or ``PRC_Mode`` not 0 (laws the workbench does not run).
 
-    Warns
+    Notes
     -----
-    UserWarning
-        For ``PS_Mode`` not 0, naming the file, line and key: peak shaving is not modelled (the
-        pitch limit is the model's).
+    A file's peak shaving (``PS_Mode = 1``) is the pitch controller's, not this law's:
+    :func:`specdesign.rosco.rosco_scheduled` runs it with the file's schedule.
 
     Examples
     --------
-    >>> import warnings
     >>> from specdesign.rosco import iea15mw_discon
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore", UserWarning)  # its PS_Mode = 1: peak shaving not modelled
-    ...     law = torque_law_from_discon(iea15mw_discon(), mode=1)
+    >>> law = torque_law_from_discon(iea15mw_discon(), mode=1)
     >>> law.mode, round(law.min_speed, 4)
     (1, 0.5236)
     """
@@ -335,13 +332,6 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
     if const_power not in (0, 1):
         raise ValueError(f"{p}: line {entries['VS_ConstPower'].line}: VS_ConstPower = {const_power} must be 0 "
                          "(constant torque above rated) or 1 (constant power)")
-    if "PS_Mode" in entries and int(f("PS_Mode")) != 0:
-        warnings.warn(f"{p}: line {entries['PS_Mode'].line}: PS_Mode = {int(f('PS_Mode'))}: peak shaving (ROSCO's "
-                      "minimum pitch PS_BldPitchMin at its wind-speed estimate WE_Vw_F, an extended Kalman filter the "
-                      "workbench does not model) is not modelled; the pitch limit is the model's. Where the pitch "
-                      "dips to that table it matters (the NREL 5 MW's deck: 6 % in tower DEL at 19 m/s, "
-                      "docs/turbines.md); compare with the compiled DISCON on write_discon(path, out, PS_Mode=0)",
-                      UserWarning, stacklevel=2)
     n = f("WE_GearboxRatio")
     if not n > 0:
         raise ValueError(f"{p}: line {entries['WE_GearboxRatio'].line}: WE_GearboxRatio must be positive")
