@@ -20,6 +20,7 @@ from specdesign.controller.peak_shaving import (
     peak_shaving_from_discon,
     peak_shaving_step,
 )
+from specdesign.export import export_discon
 from specdesign.rosco import Discon, from_discon, iea15mw_discon, rosco_scheduled, rosco_test_cases, write_discon
 from specdesign.simulate import ScheduledController, simulate
 from specdesign.turbine import from_openfast, iea15mw
@@ -144,3 +145,9 @@ def test_peak_shaving_holds_the_pitch_in_a_lull(nrel):
     assert np.degrees(b["pitch_cmd"].min()) < 0.01
     assert np.degrees(a["pitch_cmd"].min()) > 1.5
     assert a["pitch_cmd"].min() >= on.peak_shaving.min_pitch.min()
+
+
+def test_export_refuses_peak_shaving(tmp_path):
+    sc = rosco_scheduled(iea15mw(), schedule=from_discon(iea15mw_discon()))
+    with pytest.raises(ValueError, match=r"peak shaving .*peak_shaving=None"):
+        export_discon(sc, tmp_path)

@@ -414,17 +414,11 @@ def peak_shaving_step(ps: np.ndarray, st: np.ndarray, omega: float, pitch: float
         vh, vm, vt, om = st[S_VH], st[S_VM], st[S_VT], st[S_OM]
         a_op = _interp1(ps, i_fv, i_fa, n_fo, vh)
         cp_op = max(0.0, _cp(ps, i_t, i_p, i_c, nt, npt, max(w_in, _EPS) * R / vh, b_in))
+        # ROSCO's Jacobian F (rows: rotor speed, turbulent wind, mean wind) and process noise Q
         f12 = 1.0 / (2.0 * J) * ps[H_RHO] * math.pi * R * R * (1.0 / om) * 3.0 * cp_op * vh * vh
-        F = np.zeros((3, 3))
-        F[0, 0] = a_op
-        F[0, 1] = f12
-        F[0, 2] = f12
-        F[1, 1] = -math.pi * vm / (2.0 * L)
-        F[1, 2] = -math.pi * vt / (2.0 * L)
-        Q = np.zeros((3, 3))
-        Q[0, 0] = 0.00001
-        Q[1, 1] = math.pi * vm ** 3 * ti * ti / L
-        Q[2, 2] = 4.0 / 600.0
+        f11 = -math.pi * vm / (2.0 * L)
+        f21 = -math.pi * vt / (2.0 * L)
+        q0, q1, q2 = 0.00001, math.pi * vm ** 3 * ti * ti / L, 4.0 / 600.0
         # AeroDynTorque at the last estimate
         vw = max(st[S_VW], _EPS)
         cp_t = _cp(ps, i_t, i_p, i_c, nt, npt, w_in * R / vw, b_in)
@@ -432,23 +426,34 @@ def peak_shaving_step(ps: np.ndarray, st: np.ndarray, omega: float, pitch: float
         a = math.pi * vm / (2.0 * L)
         st[S_X0] += dt * (1.0 / J * (tau - t_in))
         st[S_X1] += dt * (-a * vt)
-        P = np.empty((3, 3))
-        K = np.array([st[S_K0], st[S_K1], st[S_K2]])
-        for i in range(3):
-            for j in range(3):
-                P[i, j] = st[S_P + 3 * i + j]
-        P = P + dt * (F @ P + P @ F.T + Q - np.outer(K * r_m, K))
-        s = P[0, 0] + r_m
-        K = P[:, 0] / s
+        # P += dt·(F·P + P·Fᵀ + Q − K·R·Kᵀ), written out (F's last row is zero): no array per step
+        k0, k1, k2 = st[S_K0], st[S_K1], st[S_K2]
+        p00, p01, p02 = st[S_P], st[S_P + 1], st[S_P + 2]
+        p10, p11, p12 = st[S_P + 3], st[S_P + 4], st[S_P + 5]
+        p20, p21, p22 = st[S_P + 6], st[S_P + 7], st[S_P + 8]
+        st[S_P] = p00 + dt * (((a_op * p00 + f12 * p10 + f12 * p20) + (p00 * a_op + p01 * f12 + p02 * f12) + q0)
+                              - k0 * r_m * k0)
+        st[S_P + 1] = p01 + dt * (((a_op * p01 + f12 * p11 + f12 * p21) + (p01 * f11 + p02 * f21)) - k0 * r_m * k1)
+        st[S_P + 2] = p02 + dt * ((a_op * p02 + f12 * p12 + f12 * p22) - k0 * r_m * k2)
+        st[S_P + 3] = p10 + dt * (((f11 * p10 + f21 * p20) + (p10 * a_op + p11 * f12 + p12 * f12)) - k1 * r_m * k0)
+        st[S_P + 4] = p11 + dt * (((f11 * p11 + f21 * p21) + (p11 * f11 + p12 * f21) + q1) - k1 * r_m * k1)
+        st[S_P + 5] = p12 + dt * ((f11 * p12 + f21 * p22) - k1 * r_m * k2)
+        st[S_P + 6] = p20 + dt * ((p20 * a_op + p21 * f12 + p22 * f12) - k2 * r_m * k0)
+        st[S_P + 7] = p21 + dt * ((p21 * f11 + p22 * f21) - k2 * r_m * k1)
+        st[S_P + 8] = p22 + dt * (q2 - k2 * r_m * k2)
+        # measurement update on the rotor speed: K = P·Hᵀ/(H·P·Hᵀ + R), x += K·(ω − ω̂), P = (I − K·H)·P
+        s = st[S_P] + r_m
+        k0, k1, k2 = st[S_P] / s, st[S_P + 3] / s, st[S_P + 6] / s
         innov = w_in - om
-        st[S_X0] += K[0] * innov
-        st[S_X1] += K[1] * innov
-        st[S_X2] += K[2] * innov
-        P = P - np.outer(K, P[0, :])
-        for i in range(3):
-            for j in range(3):
-                st[S_P + 3 * i + j] = P[i, j]
-        st[S_K0], st[S_K1], st[S_K2] = K[0], K[1], K[2]
+        st[S_X0] += k0 * innov
+        st[S_X1] += k1 * innov
+        st[S_X2] += k2 * innov
+        h = (st[S_P], st[S_P + 1], st[S_P + 2])  # H·P, the first row
+        for j in range(3):
+            st[S_P + j] -= k0 * h[j]
+            st[S_P + 3 + j] -= k1 * h[j]
+            st[S_P + 6 + j] -= k2 * h[j]
+        st[S_K0], st[S_K1], st[S_K2] = k0, k1, k2
         st[S_OM] = max(st[S_X0], _EPS)
         st[S_VT] = st[S_X1]
         st[S_VM] = st[S_X2]
