@@ -32,6 +32,16 @@ SCHEDULE_FILTER_OMEGA = 0.1
 FORMS = ("output", "gains")
 
 
+def _check_peak_shaving(ps, form):
+    """ScheduledController's ``peak_shaving``: a PeakShaving, with ROSCO's form of the PI only, or None."""
+    if ps is None:
+        return
+    if not isinstance(ps, PeakShaving):
+        raise TypeError(f"peak_shaving must be a PeakShaving (peak_shaving_from_discon) or None, got {type(ps).__name__}")
+    if form != "gains":
+        raise ValueError("peak_shaving is for form='gains' only (it lifts the lower limit of ROSCO's PI)")
+
+
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
 class ScheduledController:
     """Local pitch (and optional ATD) controllers scheduled on filtered pitch.
@@ -115,10 +125,10 @@ class ScheduledController:
             object.__setattr__(self, "filter_damping", positive_scalar(self.filter_damping, "filter_damping"))
         if self.form not in FORMS:
             raise ValueError(f"form must be one of {FORMS}, got {self.form!r}")
+        _check_peak_shaving(self.peak_shaving, self.form)
         if self.form == "output":
-            if (self.kp is not None or self.ki is not None or self.error_filter is not None
-                    or self.pitch_limits is not None or self.peak_shaving is not None):
-                raise ValueError("kp, ki, error_filter, pitch_limits and peak_shaving are for form='gains' only")
+            if self.kp is not None or self.ki is not None or self.error_filter is not None or self.pitch_limits is not None:
+                raise ValueError("kp, ki, error_filter and pitch_limits are for form='gains' only")
             return
         if self.pitch_limits is not None:
             lim = tuple(float(x) for x in self.pitch_limits)
@@ -133,9 +143,6 @@ class ScheduledController:
             gains.append(a)
         object.__setattr__(self, "kp", gains[0])
         object.__setattr__(self, "ki", gains[1])
-        if self.peak_shaving is not None and not isinstance(self.peak_shaving, PeakShaving):
-            raise TypeError(f"peak_shaving must be a PeakShaving (peak_shaving_from_discon) or None, "
-                            f"got {type(self.peak_shaving).__name__}")
         f = as_lti(self.error_filter, "error_filter")
         object.__setattr__(self, "error_filter", f)
         # The local controllers must be the frozen-gain PIs, or the linear prediction (which
