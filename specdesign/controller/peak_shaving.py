@@ -38,6 +38,7 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from .discon_file import read_discon
+from .torque import rosco_lpf1
 
 __all__ = ["WE_MODES", "PeakShaving", "peak_shaving_from_discon", "peak_shaving_step", "PEAK_SHAVING_STATES"]
 
@@ -270,18 +271,6 @@ def peak_shaving_from_discon(path: str | Path, tsr_grid: ArrayLike, pitch_grid: 
 
 # ----------------------------------------------------------------------------- compiled step
 @njit(cache=True)
-def _lpf1(st, iy, iu, u, corner, dt, reset, init):
-    # ROSCO's LPFilter (Tustin), reset to ``init``
-    if reset:
-        st[iy] = init
-        st[iu] = init
-    y = (-(corner * dt - 2.0) * st[iy] + corner * dt * u + corner * dt * st[iu]) / (2.0 + corner * dt)
-    st[iy] = y
-    st[iu] = u
-    return y
-
-
-@njit(cache=True)
 def _lpf2(st, iy, iy2, iu1, iu2, u, corner, damp, dt, reset):
     # ROSCO's SecLPFilter (Tustin), reset to its input
     if reset:
@@ -378,11 +367,11 @@ def peak_shaving_step(ps: np.ndarray, st: np.ndarray, omega: float, pitch: float
         st[S_OP] = 1.0
     # PreFilterMeasuredSignals: the rotor speed as the generator speed, the last torque, the last estimate
     if ps[H_FILT_TYPE] == 1.0:
-        wf = _lpf1(st, S_WF, S_WU1, omega, c, dt, first, omega)
+        wf = rosco_lpf1(st, S_WF, S_WU1, omega, c, dt, first)
     else:
         wf = _lpf2(st, S_WF, S_WF2, S_WU1, S_WU2, omega, c, ps[H_FILT_DAMP], dt, first)
     tf = _lpf2(st, S_TF, S_TF2, S_TU1, S_TU2, torque, c, 0.7, dt, first)
-    vw_f = _lpf1(st, S_VF, S_VU, st[S_VW], ps[H_WE_CORNER], dt, first, st[S_VW])
+    vw_f = rosco_lpf1(st, S_VF, S_VU, st[S_VW], ps[H_WE_CORNER], dt, first)
     # WindSpeedEstimator: inputs held in the estimator's range, which it leaves when one is held
     lo_speed = 0.25 * ps[H_MIN_SPEED]
     w_in = lo_speed + _EPS if wf < lo_speed else wf
@@ -393,7 +382,10 @@ def peak_shaving_step(ps: np.ndarray, st: np.ndarray, omega: float, pitch: float
     op = 0.0 if (b_in != pitch or t_in != tf or w_in != wf) else 1.0
     st[S_OP] = op
     restart = first or (op == 0.0 and op_last == 1.0) or (op == 1.0 and op_last == 0.0)
-    hw_f = _lpf1(st, S_HF, S_HU, hub_wind, ps[H_WE_CORNER] / 10.0, dt, restart, st[S_VW])
+    if restart:  # ROSCO restarts the hub-height wind's filter at the estimate
+        st[S_HF] = st[S_VW]
+        st[S_HU] = st[S_VW]
+    hw_f = rosco_lpf1(st, S_HF, S_HU, hub_wind, ps[H_WE_CORNER] / 10.0, dt, False)
     if op == 0.0:
         st[S_VW] = hw_f
     elif restart:

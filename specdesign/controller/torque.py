@@ -53,7 +53,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
 
 __all__ = ["TORQUE_MODES", "TORQUE_PARAMS", "TORQUE_STATES", "TORQUE_REGIONS", "TRIM_TOL", "TorqueLaw", "torque_law",
-           "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step"]
+           "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step", "rosco_lpf1"]
 
 #: Regions of a trim (:attr:`specdesign.turbine.OperatingPoint.region`): "1.5" minimum speed held
 #: by the PI, "2" K·Ω², "2.5" the torque controller's rated speed held by the PI, "2.5s" its PI
@@ -486,8 +486,30 @@ def close_torque_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray
 
 # ----------------------------------------------------------------------------- compiled step
 @njit(cache=True)
-def _lpf1(st, iy, iu, u, corner, dt, first):
-    # ROSCO's LPFilter (Tustin), reset to its input on the first call
+def rosco_lpf1(st: np.ndarray, iy: int, iu: int, u: float, corner: float, dt: float, first: bool) -> float:
+    """One step of ROSCO's first-order low-pass ``LPFilter`` (``Filters.f90``: Tustin of ω_c/(s + ω_c)).
+
+    Parameters
+    ----------
+    st : numpy.ndarray
+        State array holding the filter's last output at ``iy`` and last input at ``iu``, updated.
+    iy, iu : int
+        Their indices.
+    u : float
+        Input.
+    corner : float
+        Corner ω_c (rad/s).
+    dt : float
+        Step (s).
+    first : bool
+        Reset to the input first, as ROSCO does on its first call (set ``st[iy]`` and ``st[iu]``
+        and pass False to reset to another value).
+
+    Returns
+    -------
+    float
+        Output.
+    """
     if first:
         st[iy] = u
         st[iu] = u
@@ -557,7 +579,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         st[S_SSF] = 0.0
         st[S_PLAST] = power
     if tq[T_FILT_TYPE] == 1.0:
-        wf = _lpf1(st, S_WF, S_U1, omega, c, dt, False)
+        wf = rosco_lpf1(st, S_WF, S_U1, omega, c, dt, False)
     else:
         h2 = dt * dt * c * c
         z = tq[T_FILT_DAMP]
@@ -580,7 +602,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     else:
         ref = tq[T_VS_REF]
     if tq[T_REF_CORNER] > 0.0:
-        ref = _lpf1(st, S_REF, S_REF_U, ref, tq[T_REF_CORNER], dt, first)
+        ref = rosco_lpf1(st, S_REF, S_REF_U, ref, tq[T_REF_CORNER], dt, first)
     vs_ref = min(max(ref, tq[T_MIN_SPEED]), tq[T_VS_REF])
     if ssf > 0.0:
         vs_ref -= ssf
@@ -608,7 +630,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     if tq[T_SS_MODE] != 0.0:
         d = ((pitch - pitch_min) / 0.524 * tq[T_SS_VS]
              - (tq[T_RATED_POWER] - st[S_PLAST]) / tq[T_RATED_POWER] * tq[T_SS_PC]) * tq[T_PC_REF]
-        st[S_SSF] = _lpf1(st, S_SSF, S_SS_U, d, tq[T_SS_CORNER], dt, first)
+        st[S_SSF] = rosco_lpf1(st, S_SSF, S_SS_U, d, tq[T_SS_CORNER], dt, first)
     last = st[S_TQ]
     # VS_ConstPower: the rated power on the filtered speed above rated, and as every mode's ceiling
     const_power = tq[T_CONST_POWER] != 0.0
