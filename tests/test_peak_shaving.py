@@ -16,12 +16,20 @@ import pytest
 import specdesign.rosco.discon as discon_module
 from specdesign.controller.peak_shaving import (
     PEAK_SHAVING_STATES,
+    S_VW,
     PeakShaving,
     peak_shaving_from_discon,
     peak_shaving_step,
 )
 from specdesign.export import export_discon
-from specdesign.rosco import Discon, from_discon, iea15mw_discon, rosco_scheduled, rosco_test_cases, write_discon
+from specdesign.rosco import (
+    Discon,
+    from_discon,
+    iea15mw_discon,
+    rosco_scheduled,
+    rosco_test_cases,
+    write_discon,
+)
 from specdesign.simulate import ScheduledController, simulate
 from specdesign.turbine import from_openfast, iea15mw
 
@@ -116,7 +124,7 @@ def test_estimator_and_limit_match_roscos_own(nrel, monkeypatch, tmp_path):
     lim, vw = np.empty(om.size), np.empty(om.size)
     for k in range(om.size):
         lim[k] = peak_shaving_step(p, st, om[k], cmd[k], torque[k], r["wind"][0, 0, 0], dt, k == 0)
-        vw[k] = st[12]  # the estimate WE_Vw (S_VW)
+        vw[k] = st[S_VW]  # the estimate WE_Vw
     n = min(dbg.shape[0], om.size)
     assert n > 2500
     np.testing.assert_allclose(dbg[:n, 0], np.arange(n) * dt, atol=1e-4)  # the same steps
@@ -128,7 +136,7 @@ def test_estimator_and_limit_match_roscos_own(nrel, monkeypatch, tmp_path):
     st2, vw2 = np.zeros(PEAK_SHAVING_STATES), np.empty(n)
     for k in range(n):
         peak_shaving_step(p, st2, om[k], r["pitch"][0, 0, k], torque[k], r["wind"][0, 0, 0], dt, k == 0)
-        vw2[k] = st2[12]
+        vw2[k] = st2[S_VW]
     assert np.abs(vw2 - we).max() > 0.05
 
 
@@ -140,7 +148,7 @@ def test_peak_shaving_holds_the_pitch_in_a_lull(nrel):
         warnings.simplefilter("error")
         on = rosco_scheduled(model, schedule=from_discon(path), scheduling_filter="rosco")
     off = dataclasses.replace(on, peak_shaving=None)
-    kw = dict(seeds=[1], duration=300.0)
+    kw = {"seeds": [1], "duration": 300.0}
     a, b = simulate(model, on, [15.0], **kw), simulate(model, off, [15.0], **kw)
     assert np.degrees(b["pitch_cmd"].min()) < 0.01
     assert np.degrees(a["pitch_cmd"].min()) > 1.5

@@ -377,7 +377,7 @@ def peak_shaving_step(ps: np.ndarray, st: np.ndarray, omega: float, pitch: float
     w_in = lo_speed + _EPS if wf < lo_speed else wf
     b_in = min(max(pitch, ps[H_MIN_PITCH]), ps[i_p + npt - 1])
     t_floor = 1e-4 * ps[H_RATED_TQ]
-    t_in = t_floor if tf < t_floor else tf
+    t_in = max(tf, t_floor)
     op_last = st[S_OP]
     op = 0.0 if (b_in != pitch or t_in != tf or w_in != wf) else 1.0
     st[S_OP] = op
