@@ -40,7 +40,8 @@ from numpy.typing import ArrayLike
 from .discon_file import read_discon
 from .torque import rosco_lpf1
 
-__all__ = ["WE_MODES", "PeakShaving", "peak_shaving_from_discon", "peak_shaving_step", "PEAK_SHAVING_STATES"]
+__all__ = ["WE_MODES", "PeakShaving", "peak_shaving_from_discon", "peak_shaving_step", "tsr_reference",
+           "PEAK_SHAVING_STATES"]
 
 #: ROSCO wind-speed estimators :class:`PeakShaving` runs (``WE_Mode``): 2, the extended Kalman filter.
 WE_MODES = (2,)
@@ -49,8 +50,8 @@ WE_MODES = (2,)
 # PS wind speeds and minimum pitches (n_ps each), the estimator's pole table (n_fo speeds, n_fo
 # poles), the Cp grid (n_tsr tip-speed ratios, n_pitch pitches in rad) and Cp (n_tsr × n_pitch, C order).
 (H_N_PS, H_N_FO, H_N_TSR, H_N_PITCH, H_WE_CORNER, H_FINE_PITCH, H_MIN_PITCH, H_RADIUS, H_INERTIA, H_RHO,
- H_MIN_SPEED, H_RATED_TQ, H_FILT_TYPE, H_FILT_CORNER, H_FILT_DAMP) = range(15)
-_HEADER = 15
+ H_MIN_SPEED, H_RATED_TQ, H_FILT_TYPE, H_FILT_CORNER, H_FILT_DAMP, H_TSR) = range(16)
+_HEADER = 16
 # Layout of the state array of peak_shaving_step.
 (S_WF, S_WF2, S_WU1, S_WU2, S_TF, S_TF2, S_TU1, S_TU2, S_VF, S_VU, S_HF, S_HU, S_VW, S_OM, S_VT, S_VM, S_VH,
  S_X0, S_X1, S_X2, S_K0, S_K1, S_K2, S_OP) = range(24)
@@ -99,6 +100,10 @@ class PeakShaving:
         ``F_LPFCornerFreq`` (rad/s), also the corner of the torque's second-order low-pass.
     filter_damping : float, optional
         ``F_LPFDamping`` (-), second-order speed filter only.
+    tsr : float, optional
+        ``VS_TSRopt`` (-) of a file in ``VS_ControlMode = 2``, or 0 (default): ROSCO's torque
+        controller then tracks the speed TSR·WE_Vw/R on this estimate, and the simulator hands
+        it to the torque law (mode 3 in the workbench) as its reference (:func:`tsr_reference`).
     name : str, optional
         Label (the file it was read from).
     """
@@ -121,6 +126,7 @@ class PeakShaving:
     filter_type: int = 2
     filter_corner: float = 1.0081
     filter_damping: float = 0.7
+    tsr: float = 0.0
     name: str = "ROSCO peak shaving"
 
     def __post_init__(self):
@@ -150,6 +156,8 @@ class PeakShaving:
                 raise ValueError(f"{k}={getattr(self, k)!r} must be a positive finite number (SI, rotor shaft)")
         if self.filter_type not in (1, 2):
             raise ValueError(f"filter_type={self.filter_type!r} must be 1 or 2 (ROSCO F_LPFType)")
+        if not (math.isfinite(self.tsr) and self.tsr >= 0):
+            raise ValueError(f"tsr={self.tsr!r} must be a finite tip-speed ratio >= 0 (0: no TSR tracking)")
 
     def limit(self, wind_speed: ArrayLike) -> np.ndarray:
         """The pitch controller's lower limit at a filtered wind estimate, max(PS_BldPitchMin(v), PC_FinePit) (rad).
@@ -176,10 +184,10 @@ class PeakShaving:
         """
         head = np.zeros(_HEADER)
         head[[H_N_PS, H_N_FO, H_N_TSR, H_N_PITCH, H_WE_CORNER, H_FINE_PITCH, H_MIN_PITCH, H_RADIUS, H_INERTIA, H_RHO,
-              H_MIN_SPEED, H_RATED_TQ, H_FILT_TYPE, H_FILT_CORNER, H_FILT_DAMP]] = [
+              H_MIN_SPEED, H_RATED_TQ, H_FILT_TYPE, H_FILT_CORNER, H_FILT_DAMP, H_TSR]] = [
             self.wind_speeds.size, self.poles.size, self.tsr_grid.size, self.pitch_grid.size, self.we_corner,
             self.fine_pitch, self.pitch_min, self.rotor_radius, self.inertia, self.air_density, self.min_speed,
-            self.rated_torque, self.filter_type, self.filter_corner, self.filter_damping]
+            self.rated_torque, self.filter_type, self.filter_corner, self.filter_damping, self.tsr]
         return np.concatenate([head, self.wind_speeds, self.min_pitch, self.pole_speeds, self.poles, self.tsr_grid,
                                self.pitch_grid, self.cp_table.ravel()])
 
@@ -264,7 +272,8 @@ def peak_shaving_from_discon(path: str | Path, tsr_grid: ArrayLike, pitch_grid: 
             min_speed=one("VS_MinOMSpd") / n, rated_torque=one("VS_RtTq") * n, pole_speeds=numbers("WE_FOPoles_v"),
             poles=numbers("WE_FOPoles"), tsr_grid=tsr_grid, pitch_grid=pitch_grid, cp_table=cp_table,
             filter_type=int(one("F_LPFType")), filter_corner=one("F_LPFCornerFreq"),
-            filter_damping=one("F_LPFDamping"), name=f"ROSCO peak shaving ({Path(p).name})")
+            filter_damping=one("F_LPFDamping"), name=f"ROSCO peak shaving ({Path(p).name})",
+            tsr=one("VS_TSRopt") if int(one("VS_ControlMode")) == 2 else 0.0)
     except ValueError as err:
         raise ValueError(f"{p}: peak shaving (PS_Mode = 1): {err}") from None
 
@@ -459,3 +468,24 @@ def peak_shaving_step(ps: np.ndarray, st: np.ndarray, omega: float, pitch: float
             st[S_VW] = hub_wind
     # PitchSaturation on the filtered estimate, never below fine pitch
     return max(_interp1(ps, i_ws, i_pm, n_ps, vw_f), ps[H_FINE_PITCH])
+
+
+@njit(cache=True)
+def tsr_reference(ps: np.ndarray, st: np.ndarray) -> float:
+    """ROSCO's ``VS_ControlMode = 2`` speed reference, TSR·WE_Vw/R, on this step's estimate (compiled).
+
+    Parameters
+    ----------
+    ps : numpy.ndarray
+        :meth:`PeakShaving.params`.
+    st : numpy.ndarray
+        The state of :func:`peak_shaving_step` after this step's call.
+
+    Returns
+    -------
+    float
+        The reference rotor speed (rad/s), or NaN for a file in another torque mode (``tsr`` 0).
+    """
+    if ps[H_TSR] == 0.0:
+        return math.nan
+    return ps[H_TSR] * st[S_VW] / ps[H_RADIUS]

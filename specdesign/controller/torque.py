@@ -534,7 +534,7 @@ def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):
 
 @njit(cache=True)
 def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitch: float, dt: float,
-                first: bool, pitch_min: float = math.nan) -> tuple[float, float]:
+                first: bool, pitch_min: float = math.nan, reference: float = math.nan) -> tuple[float, float]:
     """One step of ROSCO's torque controller (compiled; :mod:`specdesign.controller.torque`).
 
     Parameters
@@ -559,6 +559,10 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         NaN (default) for the law's ``fine_pitch`` (``tq[T_PITCH_MIN]``), or the peak-shaving limit
         (:func:`specdesign.controller.peak_shaving.peak_shaving_step`). Region 3 starts
         ``PC_Switch`` above it, and the setpoint smoother measures the pitch from it.
+    reference : float, optional
+        Modes 3 and 4: the tracking reference (rad/s) to use instead of theirs, ROSCO's
+        ``VS_ControlMode = 2`` reference TSR·WE_Vw/R on a wind estimate
+        (:func:`specdesign.controller.peak_shaving.tsr_reference`); NaN (default): their own.
 
     Returns
     -------
@@ -601,6 +605,8 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         ref = math.sqrt(max(st[S_TQ], 0.0) / k)
     else:
         ref = tq[T_VS_REF]
+    if mode != 1 and not math.isnan(reference):
+        ref = reference
     if tq[T_REF_CORNER] > 0.0:
         ref = rosco_lpf1(st, S_REF, S_REF_U, ref, tq[T_REF_CORNER], dt, first)
     vs_ref = min(max(ref, tq[T_MIN_SPEED]), tq[T_VS_REF])

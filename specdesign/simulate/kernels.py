@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:  # pragma: no cover
     import control
 
-from ..controller.peak_shaving import PEAK_SHAVING_STATES, peak_shaving_step
+from ..controller.peak_shaving import PEAK_SHAVING_STATES, peak_shaving_step, tsr_reference
 from ..controller.torque import S_TQ, T_MODE, T_PC_REF, TORQUE_STATES, torque_step
 from ..turbine import aero_loads as _turbine_aero
 from ..turbine import mechanics as _turbine_mechanics
@@ -472,7 +472,8 @@ def _run_one(setup, bank, gpi, p, x, w, beta0, omega_ref, torque, tq, noise, Yr)
                 ps_last = ps_min
         if tq_on:  # ROSCO's torque law; its setpoint smoother moves the pitch reference
             if ps_on:
-                torque, wref = torque_step(tq, tst, speed, y[i_power], bcmd, dt, k == 0, ps_last)
+                torque, wref = torque_step(tq, tst, speed, y[i_power], bcmd, dt, k == 0, ps_last,
+                                           tsr_reference(ps, pst))
                 # ROSCO filters the speed, not its reference: the smoother's shift, which peak
                 # shaving turns negative at the limit, enters the PI's error unfiltered (below)
                 e = -(speed - tq[T_PC_REF])
