@@ -126,15 +126,15 @@ def _metrics(r):
     return np.stack([r["gen_speed"].std(axis=2).mean(1), r["pitch"].std(axis=2).mean(1), dels.mean(1)])
 
 
-def _relative(model, discon_in, *controllers, **kw):
-    """Each controller's metrics relative to the compiled DISCON's on the same wind (19, 23 m/s, 4 × 600 s)."""
+def _relative(model, discon_in, *controllers, vs=_VS):
+    """Each controller's metrics relative to the compiled DISCON's on the same wind (4 × 600 s at ``vs``)."""
     d = Discon(discon_in)
     try:
-        ref = _metrics(simulate(model, d, _VS, seeds=_SEEDS, duration=600.0))
+        ref = _metrics(simulate(model, d, vs, seeds=_SEEDS, duration=600.0))
     finally:
         d.close()
     assert math.isfinite(ref.sum())
-    return [_metrics(simulate(model, c, _VS, seeds=_SEEDS, duration=600.0, **k)) / ref - 1 for c, k in controllers]
+    return [_metrics(simulate(model, c, vs, seeds=_SEEDS, duration=600.0, **k)) / ref - 1 for c, k in controllers]
 
 
 @pytest.mark.slow
@@ -165,18 +165,20 @@ def test_nrel5mw_deck_as_shipped_agrees_with_rosco_scheduled(nrel_discon):
     """Issue 27 item 4, the deck as shipped (VS_ConstPower = 1 and PS_Mode = 1): rosco_scheduled
     with the file's peak shaving (its minimum pitch at ROSCO's extended-Kalman-filter wind
     estimate, ported: tests/test_peak_shaving.py) against the compiled DISCON on the same wind,
-    4 seeds × 600 s at 19 and 23 m/s: tower-base DEL (m = 4) within 0.5 %, speed and pitch SD
-    within 1 %. Measured: DEL +0.17 % and +0.22 % (without peak shaving +6.1 % and +0.9 %);
-    docs/turbines.md has the table and 15 m/s."""
+    4 seeds × 600 s at 19 and 23 m/s (the issue's acceptance) and 15 m/s (where peak shaving
+    acts most, and the file's VS_ControlMode = 2 tracks the TSR on the same estimate): tower-base
+    DEL (m = 4) within 0.5 %, speed and pitch SD within 1 %. Measured: DEL −0.27 %, +0.17 %,
+    +0.22 % (without peak shaving +11.1 %, +6.1 %, +0.9 %); docs/turbines.md has the table."""
     t0 = time.perf_counter()
     model = from_openfast(nrel_discon.parent / "NREL-5MW.fst")
     assert model.torque_control.const_power
     c = rosco_scheduled(model, schedule=from_discon(nrel_discon), scheduling_filter="rosco")
     assert c.peak_shaving is not None
-    rel, off = _relative(model, nrel_discon, (c, {}), (dataclasses.replace(c, peak_shaving=None), {}))
-    print(f"relative to DISCON (speed SD, pitch SD, DEL) x (19, 23 m/s):\n{np.round(100 * rel, 2)}\n"
+    rel, off = _relative(model, nrel_discon, (c, {}), (dataclasses.replace(c, peak_shaving=None), {}),
+                         vs=[15.0, 19.0, 23.0])
+    print(f"relative to DISCON (speed SD, pitch SD, DEL) x (15, 19, 23 m/s):\n{np.round(100 * rel, 2)}\n"
           f"without peak shaving: {np.round(100 * off, 2)}\n{time.perf_counter() - t0:.1f} s")
     assert np.all(np.abs(rel[2]) < 0.005), rel
     assert np.all(np.abs(rel[:2]) < 0.01), rel
-    # the oracle can fail: without peak shaving the DEL at 19 m/s is 6 % off
-    assert abs(off[2, 0]) > 0.03, off
+    # the oracle can fail: without peak shaving the DEL at 15 and 19 m/s is 11 % and 6 % off
+    assert np.all(np.abs(off[2, :2]) > 0.03), off
