@@ -24,6 +24,10 @@ file. The hub-height wind ROSCO falls back on when an input leaves the estimator
 (pitch below ``PC_MinPit`` or past the table, torque or speed near zero) is the run's wind at
 t = 0, as the workbench's harness of the compiled library gives it (:class:`specdesign.rosco.Discon`).
 
+A file in ``VS_ControlMode = 2`` tracks the tip-speed ratio ``VS_TSRopt`` on the same estimate;
+:func:`tsr_reference` gives that reference, TSR·WE_Vw/R, which the simulator hands to the
+torque law (run as mode 3, the same PI) in place of mode 3's power-based one.
+
 Quantities on the rotor (low-speed) shaft, SI: a DISCON.IN's generator-side speed and torque
 are converted by ``WE_GearboxRatio``.
 """

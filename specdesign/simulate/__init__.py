@@ -82,9 +82,11 @@ estimator (its extended Kalman filter, ported) on the measured rotor speed, the 
 command and the last torque command, and lifts the PI's lower limit to ``PS_BldPitchMin`` at
 the filtered estimate (the integrator at the last step's limit, the command at this one's, as
 ROSCO). As in ROSCO, the torque law then reads the last pitch command as the measured pitch and
-that limit as the minimum pitch (smoother, state machine), and the smoother's shift of the
-speed reference enters the PI's error unfiltered. A controller without it runs bit for bit
-as before.
+that limit as the minimum pitch (smoother, state machine), the smoother's shift of the
+speed reference enters the PI's error unfiltered, and a file in ``VS_ControlMode = 2`` gives
+the torque law its reference TSR·WE_Vw/R on the estimate
+(:func:`specdesign.controller.peak_shaving.tsr_reference`). A controller without it runs bit
+for bit as before.
 The pitch loop's stability check (:func:`warn_unstable`) covers the speeds at or above rated
 only: below rated the pitch loop is open.
 
