@@ -20,6 +20,7 @@ from specdesign.controller.peak_shaving import (
     PeakShaving,
     peak_shaving_from_discon,
     peak_shaving_step,
+    tsr_reference,
 )
 from specdesign.export import export_discon
 from specdesign.rosco import (
@@ -159,3 +160,16 @@ def test_export_refuses_peak_shaving(tmp_path):
     sc = rosco_scheduled(iea15mw(), schedule=from_discon(iea15mw_discon()))
     with pytest.raises(ValueError, match=r"peak shaving .*peak_shaving=None"):
         export_discon(sc, tmp_path)
+
+
+def test_mode_2_reference_is_the_tsr_on_the_estimate(nrel, tmp_path):
+    # ROSCO's VS_ControlMode = 2 (ComputeVariablesSetpoints): VS_TSRopt·WE_Vw/WE_BladeRadius
+    path, model = nrel
+    grids = (model.tsr_grid, model.pitch_grid, model.cp_table)
+    ps = peak_shaving_from_discon(path, *grids)
+    assert ps.tsr == 7.5 and ps.rotor_radius == 63.0  # the file's VS_TSRopt and WE_BladeRadius
+    st = np.zeros(PEAK_SHAVING_STATES)
+    st[S_VW] = 20.0
+    assert tsr_reference(ps.params(), st) == pytest.approx(7.5 * 20.0 / 63.0, rel=1e-15)
+    mode3 = peak_shaving_from_discon(write_discon(path, tmp_path / "m3.IN", VS_ControlMode=3), *grids)
+    assert mode3.tsr == 0.0 and np.isnan(tsr_reference(mode3.params(), st))
