@@ -151,9 +151,8 @@ def test_simulate_synthesises_the_wind_for_the_models_rotor(nrel5mw):
 # ----------------------------------------------------------------------------- below rated
 def test_torque_law_of_the_discon_is_attached_and_trims_from_cut_in(cases, tmp_path):
     # the NREL 5 MW's own DISCON.IN runs constant power above rated (VS_ConstPower = 1): its law
-    # is attached with it; its peak shaving (PS_Mode = 1) is not modelled, and a warning says so
-    with pytest.warns(UserWarning, match="PS_Mode = 1: peak shaving"):
-        plain = from_openfast(cases / "NREL-5MW/NREL-5MW.fst")
+    # is attached with it (its peak shaving, PS_Mode = 1, is the pitch controller's: rosco_scheduled)
+    plain = from_openfast(cases / "NREL-5MW/NREL-5MW.fst")
     assert plain.torque_control is not None and plain.torque_control.const_power
     assert plain.trim(7.0).region == "2"
     # the same DISCON.IN with constant torque above rated and no peak shaving: its law
