@@ -42,6 +42,7 @@ from ..fatigue import (
 )
 from ..simulate import simulate
 from ..turbine import rosco_baseline
+from ..wind import RECORD_LENGTH
 from .base import MEASURED, DiscreteTurbine, discretize_turbine
 from .sampled import SampledController
 
@@ -103,7 +104,7 @@ class FatigueTerm:
 
 
 def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3), prices: dict | None = None,
-                      ultimate: dict | None = None, classes=("A", "B", "C"), duration: float = 600.0,
+                      ultimate: dict | None = None, classes=("A", "B", "C"), duration: float = RECORD_LENGTH,
                       outputs=None) -> tuple:
     """Fit the variance-damage surrogate of each priced load on simulated histories of this turbine.
 
