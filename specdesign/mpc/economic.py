@@ -426,11 +426,10 @@ class EconomicMPC(SampledController):
         Outputs the Kalman filter reads.
     name : str, default "economic MPC"
         Label.
-    operating_point : {"estimated", "initial pitch"}, default "estimated"
-        The model scheduled on the run's own wind estimate, or held at the trim of its initial
-        pitch (:class:`~specdesign.mpc.sampled.SampledController`).
-    wind_speeds : array_like, optional
-        Grid of the schedule (m/s); default every 1 m/s over ``model.wind_range``.
+    operating_point, wind_speeds : str, array_like
+        Where the model is linearised, as :class:`~specdesign.mpc.sampled.SampledController`
+        takes them (default: scheduled on the run's own wind estimate, every 1 m/s over
+        ``model.wind_range``; or ``"initial pitch"``).
 
     Attributes
     ----------
@@ -462,19 +461,8 @@ class EconomicMPC(SampledController):
         state.pop("term_values", None)
         return state
 
+    @docstring_of(SampledController, note='Here the compiled problem of :func:`economic_problem`, under ``"problem"``.')
     def build(self, dm: DiscreteTurbine) -> dict:
-        """The compiled problem at one operating point.
-
-        Parameters
-        ----------
-        dm : DiscreteTurbine
-            The discrete model.
-
-        Returns
-        -------
-        dict
-            ``{"problem": ...}`` (:func:`economic_problem`).
-        """
         return {"problem": economic_problem(dm, self.terms, self.horizon, speed_weight=self.speed_weight,
                                             activity_weight=self.activity_weight,
                                             rated_speed=float(self.model.rated_rotor_speed),

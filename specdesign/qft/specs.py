@@ -143,10 +143,13 @@ def spec_from_pair(tower: Specification, speed: Specification, *, wind_speed: fl
 
     Examples
     --------
+    A tower specification 3 dB above ROSCO's map everywhere, with the notch design's speed spec:
+
     >>> from specdesign import qft, spec, turbine
     >>> ds = spec.design_specifications(turbine.iea15mw(), 19.0)
-    >>> qft.spec_from_pair(ds.tower, ds.speed, wind_speed=19.0).kind
-    'pair'
+    >>> s = qft.spec_from_pair(spec.Specification(ds.base.system, (spec.Gain(3.0),)), ds.speed, wind_speed=19.0)
+    >>> s.kind, s.tower.elements
+    ('pair', (Gain(gain_db=3.0),))
     """
     for name, w in (("tower", tower), ("speed", speed)):
         if not hasattr(w, "response"):
