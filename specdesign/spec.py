@@ -445,17 +445,17 @@ class Specification:
         return siso_response(self.baseline, omega, "baseline", method="batched") * self.shaping(omega)
 
     def magnitude(self, omega: ArrayLike) -> np.ndarray:
-        """|W_y(jω)| on a frequency grid.
+        """|W_y(jω)|, output units per m/s (linear, not dB): the modulus of :meth:`response`.
 
         Parameters
         ----------
         omega : array_like
-            Frequencies, rad/s.
+            As :meth:`response`'s (rad/s).
 
         Returns
         -------
         numpy.ndarray
-            |W_y(jω)|, output units per m/s (linear, not dB).
+            Real, shaped like ``omega``.
         """
         return np.abs(self.response(omega))
 
