@@ -308,14 +308,10 @@ def t_tower_wind(P: PlantLike, C: ElementLike, omega: ArrayLike, **atd: Any) -> 
 
     Parameters
     ----------
-    P : control.LTI or Mapping
-        Named plant LTI or its responses (as in :func:`t_output_wind`).
-    C : control.LTI, float, array_like or None
-        Pitch controller C_β (rad per rad/s) or its response on ``omega``.
-    omega : array_like
-        Frequencies, rad/s.
-    **atd : dict, optional
-        ``atd_controller`` and ``atd_measurement`` of :func:`t_output_wind`.
+    P, C, omega, **atd
+        As :func:`t_gen_speed_wind` and :func:`t_output_wind` take them: the named plant (or its
+        responses), the pitch controller C_β (rad per rad/s, or its response), the frequencies
+        (rad/s) and the ATD's ``atd_controller`` and ``atd_measurement``.
 
     Returns
     -------

@@ -20,7 +20,7 @@ from ..controller.scheduled import ScheduledController, controller_bank, schedul
 from ..controller.torque import TORQUE_PARAMS, TorqueLaw
 from ..turbine import iea15mw
 from ..turbine.plant import KernelPlant, turbine_plant
-from ..wind import wind_series
+from ..wind import RECORD_LENGTH, wind_series
 from .checks import check_step, warn_unstable
 from .kernels import (NONFINITE, Bank, GainsPI, LoopSetup, Runs, compiled_for, linear_outputs, linear_plant_params,
                       linear_rhs, run_callable)
@@ -100,7 +100,7 @@ class SimulationResult:
 
 
 def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds: ArrayLike, *,
-             seeds: ArrayLike | None = None, wind: ArrayLike | None = None, duration: float = 600.0, dt: float = 0.02,
+             seeds: ArrayLike | None = None, wind: ArrayLike | None = None, duration: float = RECORD_LENGTH, dt: float = 0.02,
              record_dt: float = 0.1, transient: float = 60.0, wind_dt: float | None = None,
              turbulence_class: str = "B", linear: bool = False, wind_rotor_radius: float | None = None,
              wind_mean_tol: float = WIND_MEAN_TOLERANCE, torque_control: object = "auto",

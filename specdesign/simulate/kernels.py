@@ -94,16 +94,9 @@ def linear_outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: flo
 
     Parameters
     ----------
-    x : numpy.ndarray
-        Deviation state of the linear model, float64[nx].
-    wind : float
-        Rotor-effective wind speed (m/s), absolute.
-    pitch_cmd : float
-        Pitch command (rad), absolute.
-    gen_torque : float
-        Generator torque (N·m), absolute.
-    p : numpy.ndarray
-        Flat parameters from :func:`linear_plant_params`.
+    x, wind, pitch_cmd, gen_torque, p
+        The deviation state (float64[nx]), the absolute wind (m/s), pitch command (rad) and
+        generator torque (N·m), and the flat parameters, as :func:`linear_rhs` takes them.
     y : numpy.ndarray
         Output: float64[ny], the absolute outputs (written).
     """

@@ -364,16 +364,9 @@ def outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: 
 
     Parameters
     ----------
-    x : numpy.ndarray
-        State, float64[5] (:data:`STATE_NAMES`, SI).
-    wind : float
-        Rotor-effective wind speed (m/s).
-    pitch_cmd : float
-        Collective pitch demand (rad).
-    gen_torque : float
-        Generator torque on the rotor shaft (N·m).
-    p : numpy.ndarray
-        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    x, wind, pitch_cmd, gen_torque, p
+        The state (float64[5], SI), wind (m/s), pitch demand (rad), generator torque (N·m) and
+        parameter array, as :func:`rhs` takes them.
     y : numpy.ndarray
         Output: float64[7], written: gen_speed (rad/s), tower_base_my (N·m), tower_top_acc
         (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical), blade_root_my (N·m).
