@@ -154,12 +154,50 @@ def test_the_notch_design_climbs_its_ladder(model, steps):
 
 
 def test_a_schedule_of_notch_designs_gives_each_speed_its_target(model, steps, monkeypatch):
+    # was design_schedule(model, speeds, (20, 30), specification="notch"): the same calls, from
+    # one notch specification per speed
     single, *_ = steps
     monkeypatch.setattr(qdesign, "_warn_held_design", lambda model, design: None)  # the stand-ins have no controller
     with pytest.warns(RuntimeWarning):  # no rung of the stand-ins succeeds: each speed climbs the whole ladder
-        qft.design_schedule(model, (19.0, 21.0), (20.0, 30.0), specification="notch", progress=False)
+        qft.design_schedule(model, (19.0, 21.0), spec=[qft.spec_notch(20.0), qft.spec_notch(30.0)], progress=False)
     assert [(c[0][1:], c[1]["speed_relax_db"]) for c in single.calls] == [
         ((v, t), r) for v, t in ((19.0, 20.0), (21.0, 30.0)) for r in qft.SPEED_RELAX_DB]
+
+
+def test_one_notch_specification_is_applied_at_every_speed(model, steps, monkeypatch):
+    # was design_schedule(model, speeds, 20, specification="notch"): its target and its ladder at each speed
+    single, certificate, made, _ = steps
+    monkeypatch.setattr(qdesign, "_warn_held_design", lambda model, design: None)  # the stand-ins have no controller
+    single.outcomes = [True, False, True]
+    designs = qft.design_schedule(model, (19.0, 21.0), spec=qft.spec_notch(20.0, speed_relax_db=(3.0, 6.0)),
+                                  progress=False, maxfev=5)
+    assert [d.success for d in designs] == [True, True]
+    assert single.calls == [((model, 19.0, 20.0), {"speed_relax_db": 3.0, "maxfev": 5}),
+                            ((model, 21.0, 20.0), {"speed_relax_db": 3.0, "maxfev": 5}),
+                            ((model, 21.0, 20.0), {"speed_relax_db": 6.0, "maxfev": 5})]
+    assert not certificate.calls and not made.calls
+
+
+def test_a_schedule_without_spec_makes_the_certified_pair_at_each_speed(model, steps, monkeypatch):
+    # was design_schedule(model, speeds, 20) with specification="target", the default: the pair for
+    # the target made at each speed, the lowest design held below rated (a model with a torque law)
+    single, certificate, made, fake = steps
+    monkeypatch.setattr(qdesign, "_warn_held_design", lambda model, design: None)  # the stand-ins have no controller
+    qft.design_schedule(model, (21.0, 19.0), 20.0, progress=False)
+    assert [c[0][1:] for c in made.calls] == [(21.0, 20.0), (19.0, 20.0)]
+    held = [c[1].get("held_below_rated", False) for c in made.calls]
+    assert held == [False, model.torque_control is not None]
+    assert len(certificate.calls) == 2 and not single.calls
+
+
+def test_a_schedule_refuses_a_specification_made_at_one_speed(model, pair):
+    for spec in (qft.spec_from_pair(*pair, wind_speed=19.0), "notch"):
+        with pytest.raises(TypeError, match="spec_notch.*spec_from_certified or qft.spec_from_pair"):
+            qft.design_schedule(model, (19.0, 21.0), spec=spec, progress=False)
+    with pytest.raises(TypeError, match="target_reduction or spec, not both"):
+        qft.design_schedule(model, (19.0,), 20.0, spec=qft.spec_notch(20.0), progress=False)
+    with pytest.raises(ValueError, match="1 specifications for 2 wind speeds"):
+        qft.design_schedule(model, (19.0, 21.0), spec=[qft.spec_notch()], progress=False)
 
 
 def test_options_of_the_other_design_are_refused_with_the_way_to_them(model, pair, steps):

@@ -176,8 +176,8 @@ def test_a_specification_driven_schedule(model):
     (d,) = design_schedule(model, (25.0,), progress=False, **NO_HF)  # specification-driven by default
     assert d.success and d.promise.exact_del >= 24.5 and d.del_reduction >= d.promise.exact_del - 0.1
     assert d.options["structure"] == "certificate"
-    with pytest.raises(ValueError, match="specification"):
-        design_schedule(model, (25.0,), specification="youla")
+    with pytest.raises(TypeError, match="spec_notch"):
+        design_schedule(model, (25.0,), spec="youla")
 
 
 def test_the_figures_say_which_specification_the_design_meets(model, chain19):

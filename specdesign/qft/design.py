@@ -41,7 +41,7 @@ from ..spec import KEEP_BELOW, SPEC_REDUCTION, TOWER_RELAX_DB, TOWER_RELAX_OMEGA
 from .certificate import design_from_certificate
 from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign, assemble_design
-from .specs import SPEED_RELAX_DB, QFTSpecification, spec_from_certified, spec_notch
+from .specs import SPEED_RELAX_DB, QFTSpecification, spec_from_certified
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
 
@@ -433,8 +433,9 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
 
 
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
-                    target_reduction: float | Sequence[float] = TARGET_REDUCTION, *, specification: str = "target",
-                    progress: bool = True, **kwargs: Any) -> tuple[QFTDesign, ...]:
+                    target_reduction: float | Sequence[float] | None = None, *,
+                    spec: QFTSpecification | Sequence[QFTSpecification] | None = None, progress: bool = True,
+                    **kwargs: Any) -> tuple[QFTDesign, ...]:
     """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
 
     Parameters
@@ -443,13 +444,17 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         The turbine.
     wind_speeds : sequence of float
         Operating points, m/s.
-    target_reduction : float or sequence of float
-        Tower-base DEL reduction to reach, %: one number, or one value per wind speed.
-    specification : {"target", "notch"}
-        ``"target"`` (default): specification-driven, the specification for the target first
-        (:func:`specdesign.feasibility.specification_for_target`), then the design that meets
-        it (:func:`design_qft`'s default). ``"notch"``: the fixed-structure design against the
-        notch specification and a DEL target (``design_qft(spec=spec_notch(target))``).
+    target_reduction : float or sequence of float, optional
+        Without ``spec``: the tower-base DEL reduction to reach, %: one number, or one value per
+        wind speed (default :data:`specdesign.feasibility.target.TARGET_REDUCTION`). With
+        ``spec`` it is not given: a notch specification carries its own target.
+    spec : QFTSpecification or sequence of QFTSpecification, optional
+        None (default): specification-driven, at each speed the certified pair for the target
+        first (:func:`specdesign.feasibility.specification_for_target`), then the design that
+        meets it (:func:`design_qft`'s default). A :func:`spec_notch` specification (it does not
+        depend on the speed): the fixed-structure design against the notch specification made at
+        each speed, with its DEL target and relaxation ladder; or one per wind speed. A certified
+        pair or a given pair is made at one speed: design it with :func:`design_qft`.
     progress : bool
         Show a progress bar over the wind speeds (tqdm.auto: a widget in Jupyter).
     **kwargs
@@ -465,10 +470,12 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     ValueError
         If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` is not one
         DEL reduction in (0, 100) % or one per wind speed (every one checked before the first
-        design), ``specification`` is unknown, or :func:`design_qft` (or, with
-        ``"target"``, :func:`specdesign.feasibility.specification_for_target`) raises.
+        design), ``spec`` is a sequence of another length than ``wind_speeds``, or
+        :func:`design_qft` (or, without ``spec``,
+        :func:`specdesign.feasibility.specification_for_target`) raises.
     TypeError
-        As :func:`design_qft`; for a bool or a string as a target.
+        As :func:`design_qft`; for a bool or a string as a target; for a ``spec`` that is not a
+        :func:`spec_notch` specification, or one given with ``target_reduction``.
 
     Warns
     -----
@@ -476,8 +483,8 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         As :func:`design_qft`, for each wind speed whose design does not meet every spec; and
         for a model with a torque law when the lowest design, which a schedule holds below
         rated, lifts the pitch off fine pitch for the speed deficit there
-        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``). With
-        ``"target"`` that design is made with ``held_below_rated=True`` (its certificate and
+        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``). Without
+        ``spec`` that design is made with ``held_below_rated=True`` (its certificate and
         its reduction keep the lift within ``pitch_switch``), so the warning is for the notch
         designs or a target that cannot be met so.
 
@@ -487,14 +494,19 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     >>> from specdesign.qft import design_schedule, design_table, format_table
     >>> designs = design_schedule(turbine.iea15mw(), (15, 19, 23))  # doctest: +SKIP
     >>> print(format_table(design_table(designs)))  # doctest: +SKIP
+    >>> from specdesign.qft import spec_notch
+    >>> notch = design_schedule(turbine.iea15mw(), (15, 19, 23), spec=spec_notch(25.0))  # doctest: +SKIP
     """
     vs = np.atleast_1d(np.asarray(wind_speeds, float))
     if vs.ndim != 1 or vs.size == 0:
         raise ValueError("wind_speeds must be a non-empty 1-D sequence of wind speeds in m/s")
-    if specification not in ("notch", "target"):
-        raise ValueError(f"specification={specification!r} must be 'notch' or 'target'")
+    specs = _schedule_specs(spec, target_reduction, vs.size)
     for v in vs:  # before any design: a speed below the design range is refused with its reason
         check_design_speed(model, float(v))
+    if specs is not None:  # each notch specification carries its target (design_qft does not read the argument)
+        target_reduction = [x.target_reduction for x in specs]
+    elif target_reduction is None:
+        target_reduction = TARGET_REDUCTION
     # every target too (a bool or a string is no target), before the first design
     per_speed = np.ndim(target_reduction) != 0
     if per_speed and np.shape(target_reduction) != vs.shape:
@@ -505,15 +517,37 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
 
     out = []
     lowest = int(np.argmin(vs))
-    held = specification == "target" and getattr(model, "torque_control", None) is not None
-    for i, (v, tr) in enumerate(tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)",
+    held = specs is None and getattr(model, "torque_control", None) is not None
+    kind = "target" if specs is None else "notch"
+    for i, (v, tr) in enumerate(tqdm(list(zip(vs, targets)), desc=f"QFT designs ({kind} specification)",
                                      unit="speed", disable=not progress)):
         # the lowest design is held below rated: made to keep fine pitch for the speed deficit there
         extra = {"held_below_rated": True} if held and i == lowest else {}
-        spec = spec_notch(float(tr)) if specification == "notch" else None
-        out.append(design_qft(model, float(v), float(tr), spec=spec, **kwargs, **extra))
+        out.append(design_qft(model, float(v), float(tr), spec=None if specs is None else specs[i], **kwargs, **extra))
     _warn_held_design(model, out[lowest])
     return tuple(out)
+
+
+def _schedule_specs(spec, target_reduction, n) -> tuple[QFTSpecification, ...] | None:
+    """:func:`design_schedule`'s ``spec`` as one notch specification per wind speed (None without
+    one), refusing the kinds made at one speed and a target given beside a specification."""
+    if spec is None:
+        return None
+    many = isinstance(spec, Sequence) and not isinstance(spec, str)
+    specs = tuple(spec) if many else (spec,) * n
+    for s in specs:
+        if not isinstance(s, QFTSpecification) or s.kind != "notch":
+            got = f"a {s.kind!r} specification" if isinstance(s, QFTSpecification) else repr(s)
+            raise TypeError(f"design_schedule's spec must be qft.spec_notch(target_reduction) (applied at every wind "
+                            f"speed) or one per wind speed, got {got}: a qft.spec_from_certified or qft.spec_from_pair "
+                            "specification is made at one speed (design it with qft.design_qft); without spec each "
+                            "speed gets the certified pair for target_reduction")
+    if len(specs) != n:
+        raise ValueError(f"spec has {len(specs)} specifications for {n} wind speeds; give one or one per wind speed")
+    if target_reduction is not None:
+        raise TypeError("design_schedule: give target_reduction or spec, not both: a notch specification carries its "
+                        "DEL target (qft.spec_notch(target_reduction))")
+    return specs
 
 
 def held_lift(model, design) -> float | None:
