@@ -213,14 +213,9 @@ def checked_loop(plant: KernelPlant, controller: object, wind_speed: float, dt: 
 
     Parameters
     ----------
-    plant : KernelPlant
-        The plant, with a linearisation.
-    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
-        The controller.
-    wind_speed : float
-        Mean wind speed (m/s) of the linearisation.
-    dt : float
-        Simulation step (s).
+    plant, controller, wind_speed, dt
+        The loop, as :func:`sampled_loop_radius` takes them (a KernelPlant; wind speed in m/s, step
+        in s).
 
     Returns
     -------
