@@ -364,12 +364,9 @@ def closed_loop_del(sys: control.LTI, omega: ArrayLike, wind_psd: ArrayLike, m: 
 
     Parameters
     ----------
-    sys : control.LTI
-        Closed-loop (or open-loop) named LTI system.
-    omega : array_like
-        Frequencies, rad/s: 1-D, increasing, non-negative.
-    wind_psd : array_like
-        One-sided wind PSD S_W on ``omega``, (m/s)² per rad/s.
+    sys, omega, wind_psd, input
+        The system, the grid (rad/s), the wind PSD ((m/s)² per rad/s) and the disturbance input,
+        as :func:`output_psd` takes them.
     m : float
         Wöhler exponent (-), > 0.
     output : str
@@ -377,8 +374,6 @@ def closed_loop_del(sys: control.LTI, omega: ArrayLike, wind_psd: ArrayLike, m: 
     method : str
         One of :func:`specdesign.spectral.damage_rate`'s methods ("dirlik", "narrowband",
         "tovo_benasciutti", ...).
-    input : str
-        Name of the disturbance input (``wind`` by default).
 
     Returns
     -------
