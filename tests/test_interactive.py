@@ -379,26 +379,33 @@ def test_the_explorers_changing_text_moves_to_a_readout_beside_a_live_figure(ipy
     # oracle: an explorer drawn live=False at the same notch); the legend names the
     # specification only and is part of the background; a saved figure's title says it all
     from loopshaping.interactive import readout_html
-    from specdesign import spec
+    from specdesign import feasibility, spec
     from specdesign.plots.spec import NotchExplorer
     from specdesign.turbine import iea15mw
 
-    base = spec.baseline_analysis(iea15mw(), 19.0)
-    ex = NotchExplorer(base)
+    model = iea15mw()
+    base = spec.baseline_analysis(model, 19.0)
+    # with the pitch checker: its verdict names where a notch is infeasible (notebook 03's)
+    checker = feasibility.pitch_checkers(model, 19.0, spec.speed_specification(model, 19.0, margin_db=3.0),
+                                         max_sensitivity=None)[0]
+    ex = NotchExplorer(base, checker=checker)
     ui = ex.widget()
     sliders, readout, fig_box = ui.children
     assert fig_box is ex.fig.canvas
     canvas = ipympl_canvas(ex.fig)
     assert ex._redraw.artists == [ex.line, ex.marker]  # the data alone is blitted
-    static = NotchExplorer(base, live=False)
-    for n in ((1.05, 12.0, 0.2), (0.8, 3.3, 0.5)):
+    static = NotchExplorer(base, checker=checker, live=False)
+    infeasible = []
+    for n in ((1.05, 12.0, 0.2), (1.08, 30.0, 0.02), (0.8, 3.3, 0.5)):
         ex.update(*n)
         static.update(*n, redraw=False)
         where, *verdict = ex.readout.split("\n")
         assert static.line.get_label() == f"specification $|W_y|$: {where}"
         assert verdict == static.ax_mag.get_title().split("\n")
         assert readout.value == readout_html(ex.readout)
+        infeasible.append("INFEASIBLE" in ex.readout)
         assert ex._legend_text.get_text() == "specification $|W_y|$ with the notch"
+    assert any(infeasible) and not all(infeasible)  # the sweep met both verdicts (the deep notches infeasible)
     assert ex.ax_mag.get_title() == ex.readout  # drawn into a saved figure
     renderer = canvas.get_renderer()
     assert not _ink_in(canvas.buffer_rgba(), ex.ax_mag.title, renderer) and _ink_in(_saved(ex.fig), ex.ax_mag.title, renderer)

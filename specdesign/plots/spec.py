@@ -202,9 +202,9 @@ class NotchExplorer:
         """
         t0 = time.perf_counter()
         self.notch = Notch(float(omega_n), float(depth_db), float(width))
-        where = f"notch at {self.notch.omega_n:.3g} rad/s, {self.notch.depth_db:.3g} dB, ζ_p = {self.notch.width:.3g}"
+        at = f"notch at {self.notch.omega_n:.3g} rad/s, {self.notch.depth_db:.3g} dB, ζ_p = {self.notch.width:.3g}"
         if self._readout_widget is None:  # the figure says it (the readout widget does beside a live one)
-            self.line.set_label(f"specification $|W_y|$: {where}")
+            self.line.set_label(f"specification $|W_y|$: {at}")
             self._legend_text.set_text(self.line.get_label())
         shaping = self.notch.response(self.base.omega)
         self.promise = promise_of(shaping, self.base)
@@ -225,7 +225,7 @@ class NotchExplorer:
             b = self.bounds_checker
             self.bounds_verdict = b.check(b.rosco_nominal * self.notch.response(b.template.omega))
             title += "\n" + self.bounds_verdict.summary()
-        self.readout = f"{where}\n{title}"
+        self.readout = f"{at}\n{title}"
         if self._readout_widget is None:
             self.ax_mag.set_title(title, fontsize=9)
         else:  # drawn into a saved figure only, which says where the notch is in its title then
