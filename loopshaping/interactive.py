@@ -605,7 +605,8 @@ class Designer:
         ----------
         live : bool, optional
             Redraw edits by blitting: only the loop, markers, title and closed-loop lines are
-            re-rendered on a cached background of the bounds and axes (:class:`LiveArtists`).
+            re-rendered on a cached background of the bounds and axes (:class:`LiveArtists`;
+            the title not once :meth:`widget` shows the verdict in a readout above the figure).
             Default: on ipympl's canvas (``%matplotlib widget``), where a full redraw of the
             bounds takes about 0.5 s; off elsewhere (an edit then redraws the figure in full).
 
