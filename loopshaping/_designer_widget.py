@@ -40,11 +40,11 @@ def readout_html(text: str, colour: str = "black") -> str:
     --------
     >>> from loopshaping.interactive import readout_html
     >>> readout_html("a < b\\nmet")
-    '<div style="font-size:12px;line-height:1.35;white-space:pre-wrap;color:#000000">a &lt; b\\nmet</div>'
+    '<div style="font-size:12px;line-height:1.35;white-space:pre-wrap;padding-left:3px;color:#000000">a &lt; b\\nmet</div>'
     """
     from matplotlib.colors import to_hex  # loopshaping loads matplotlib only to draw (here: a live figure's)
 
-    return (f'<div style="font-size:12px;line-height:1.35;white-space:pre-wrap;color:{to_hex(colour)}">'
+    return (f'<div style="font-size:12px;line-height:1.35;white-space:pre-wrap;padding-left:3px;color:{to_hex(colour)}">'
             f"{html.escape(text, quote=False)}</div>")
 
 
