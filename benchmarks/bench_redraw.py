@@ -11,8 +11,10 @@ browser's end replaced by a no-op (``send``): the callback then computes, sets t
 data, blits them and encodes the changed pixels as PNG, as it does in a notebook. Printed: the
 median callback, and its parts measured apart (compute alone, the blit of the artists,
 ipympl's diff image), beside what the shortcuts replace (the explorer's exact QFT bounds check,
-the blit with every line of text rasterised). The browser's time on top is measured by
-tests/test_browser.py.
+the blit with every line of text rasterised). Each figure twice, back to back: on its own, its
+changing text (the Designer's verdict, the explorer's title and legend label) drawn on the
+canvas at each step; and as its ``widget()`` shows it, that text in an ipywidgets readout above
+the figure. The browser's time on top is measured by tests/test_browser.py.
 """
 from __future__ import annotations
 
@@ -92,6 +94,25 @@ def _report(what, canvas, parts, replaced):
     print(f"    ipympl's PNG diff image          {diff:7.1f} ms")
 
 
+def _explorer(base, notch, checker, qc, readout):
+    explorer = NotchExplorer(base, notch, checker=checker, bounds_checker=qc)
+    if readout:
+        explorer.widget()  # the changing lines leave the canvas for the widget's readout
+    return explorer, _as_in_the_browser(explorer.fig)
+
+
+def _designer(d, readout):
+    designer = Designer(d.pitch_bounds, d.pitch_template, Controller.from_tf(d.pitch_controller))
+    designer.draw()
+    if readout:
+        designer.widget()  # the verdict lines leave the canvas for the widget's readout
+    return designer, _as_in_the_browser(designer.figure)
+
+
+MODES = {False: "the changing text drawn on the canvas (no widget: a figure on its own)",
+         True: "the changing text in the widget's readout (as widget() shows it)"}
+
+
 def main():
     print(f"slider callbacks on ipympl's canvas (median over a sweep; load {os.getloadavg()[0]:.1f})")
     model = iea15mw()
@@ -105,33 +126,34 @@ def main():
     t0 = time.perf_counter()
     qc.precompute()
     t_pre = time.perf_counter() - t0
-    explorer = NotchExplorer(base, notch, checker=checker, bounds_checker=qc)
-    canvas = _as_in_the_browser(explorer.fig)
     depths = np.linspace(notch.depth_db - 3.0, notch.depth_db + 3.0, 31)
-
-    def move(depth, redraw=True):
-        explorer.update(notch.omega_n, depth, notch.width, redraw=redraw)
-
-    parts = _parts(canvas, explorer._redraw, move, depths)
     exact = bounds_checker(model, 19.0)  # not precomputed: one exact bound computation per check
     t_exact = _median_ms(lambda dep: exact.check(exact.rosco_nominal * spec.Notch(notch.omega_n, dep, notch.width)
                                                  .response(exact.template.omega)), depths[::3])
-    _report("notebook 03: the notch explorer's depth slider", canvas, parts,
-            f"(its QFT verdict computed exactly: +{t_exact:.1f} ms)")
+    for readout, mode in MODES.items():
+        explorer, canvas = _explorer(base, notch, checker, qc, readout)
+
+        def move(depth, redraw=True):
+            explorer.update(notch.omega_n, depth, notch.width, redraw=redraw)
+
+        parts = _parts(canvas, explorer._redraw, move, depths)
+        _report(f"notebook 03: the notch explorer's depth slider, {mode}", canvas, parts,
+                f"(its QFT verdict computed exactly: +{t_exact:.1f} ms)")
     print(f"    (bounds checker: built in {t_build * 1e3:.0f} ms, precomputed in {t_pre * 1e3:.0f} ms, once)")
 
     d = qft.design_qft(model, 19.0, target_reduction=25.0, spec="notch")
-    designer = Designer(d.pitch_bounds, d.pitch_template, Controller.from_tf(d.pitch_controller))
-    canvas = _as_in_the_browser(designer.draw())
-    k0 = designer.controller.elements[0].params["k"]
-    gains = k0 * np.logspace(-0.15, 0.15, 31)
+    for readout, mode in MODES.items():
+        designer, canvas = _designer(d, readout)
+        k0 = designer.controller.elements[0].params["k"]
+        gains = k0 * np.logspace(-0.15, 0.15, 31)
 
-    def gain(k, redraw=True):
-        designer.controller = designer.controller.set(0, k=k)
-        designer.update(redraw=redraw)
+        def gain(k, redraw=True):
+            designer.controller = designer.controller.set(0, k=k)
+            designer.update(redraw=redraw)
 
-    _report(f"notebook 04: the Designer's gain ({len(d.pitch_template.systems)} plant cases, "
-            f"{designer.omega.size} frequencies)", canvas, _parts(canvas, designer._redraw, gain, gains), "")
+        _report(f"notebook 04: the Designer's gain ({len(d.pitch_template.systems)} plant cases, "
+                f"{designer.omega.size} frequencies), {mode}", canvas,
+                _parts(canvas, designer._redraw, gain, gains), "")
 
 
 if __name__ == "__main__":

@@ -304,6 +304,8 @@ def test_notebook_03_explorer_slider_redraws_the_figure(lab, browser):
         page.screenshot(path=str(SHOTS / "03_explorer_before.png"), full_page=False)
         before = _pixels(canvas.screenshot())
         title_before = cell.locator(".widget-readout").nth(1).inner_text()
+        readout_before = cell.locator(".widget-html").last.inner_text().strip()
+        assert readout_before.startswith("notch at "), readout_before
         # after Run All the depth slider shows the notch the figure draws: a later cell set it
         # to 12 dB (explorer.update(1.05, 12.0, 0.2)); it showed 2.80 dB once
         assert float(title_before) == pytest.approx(12.0), title_before
@@ -320,6 +322,10 @@ def test_notebook_03_explorer_slider_redraws_the_figure(lab, browser):
         after, changed = _wait_changed(canvas, before)
         cell.screenshot(path=str(SHOTS / "03_explorer_after.png"))
         assert cell.locator(".widget-readout").nth(1).inner_text() != title_before
+        # the notch and its verdicts in the readout above the figure, as the kernel has them
+        readout = cell.locator(".widget-html").last.inner_text().strip()
+        assert readout == ast.literal_eval(_kernel_value(lab, "03_specification.ipynb", "explorer.readout")), readout
+        assert readout_before != readout
         assert changed > 0.001, f"the figure did not change after the depth slider moved ({changed:.4%} of pixels)"
         not_run, errors = _saved_errors(page, root, "03_specification.ipynb")
         assert not not_run and not errors, (not_run, errors)
@@ -359,6 +365,10 @@ def test_notebook_04_designer_gain_edit_redraws_the_figure(lab, browser):
         page.wait_for_function("([el, k]) => JSON.parse(el.value).elements[0].params.k !== k",
                                arg=[json_box.element_handle(), k_before], timeout=20_000)
         k_after = json.loads(json_box.input_value())["elements"][0]["params"]["k"]
+        # the verdict in the readout above the figure, as the kernel has it (summary())
+        readout = cell.locator(".widget-html").last.inner_text().strip()
+        assert readout == ast.literal_eval(_kernel_value(lab, "04_qft_design.ipynb", "designer.readout")), readout
+        assert f"G = gain(k={k_after:.6g})" in readout, (readout, k_after)  # the dragged gain
         # a 40-pixel drag is a fraction of a decade, in the gain's sign (not three decades)
         assert k_after * k_before > 0 and 0.02 < abs(np.log10(k_after / k_before)) < 0.6, (k_before, k_after)
         cell.screenshot(path=str(SHOTS / "04_designer_after_drag.png"))
