@@ -235,8 +235,8 @@ def specification_for_target(model, wind_speed, target_reduction=TARGET_REDUCTIO
     max_hf_gain_ratio : float or None
         κ of the high-frequency gain bound on the certificate, |C_β| ≤ κ·|C_ROSCO| on
         HF_OMEGA-HF_END (2-10 rad/s, 3P inside) with C_β strictly proper (default
-        :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO`, None: off; the κ measured in OpenFAST
-        is :data:`~specdesign.feasibility.HF_GAIN_RATIO`, docs/feasibility.md). Checked on the
+        :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO`, the κ measured in OpenFAST,
+        :data:`~specdesign.feasibility.HF_GAIN_RATIO`, docs/feasibility.md; None: off). Checked on the
         dense grid too.
     held_below_rated : bool
         The pair's design is held below rated by a schedule (its lowest design speed): a
@@ -248,11 +248,11 @@ def specification_for_target(model, wind_speed, target_reduction=TARGET_REDUCTIO
     margin_bumps : int
         Most bumps of the plant cases' margin in W_MyT
         (:func:`specdesign.feasibility.margin.case_margin`, 0 to
-        :data:`~specdesign.feasibility.margin.MARGIN_BUMPS`): 0 (default,
-        :data:`~specdesign.feasibility.margin.DEFAULT_MARGIN_BUMPS`) raises the certificate's map
-        by the cases' largest excess everywhere; more follows their excess where it lies (near
-        the tower mode, in the wind band), which the 25 % target under the measured
-        high-frequency gain bound needs at 15-25 m/s (docs/feasibility.md).
+        :data:`~specdesign.feasibility.margin.MARGIN_BUMPS`, the default
+        :data:`~specdesign.feasibility.margin.DEFAULT_MARGIN_BUMPS`): bumps follow the cases'
+        excess where it lies (near the tower mode, in the wind band), which the 25 % target under
+        the measured high-frequency gain bound needs at 15-25 m/s (docs/feasibility.md); 0 raises
+        the certificate's map by the cases' largest excess everywhere.
 
     Returns
     -------

@@ -318,8 +318,8 @@ def design_hinf(
         infeasible, naming it), and the multi-model step holds |C_β| ≤ κ·|C_ROSCO| on
         HF_OMEGA-HF_END (2-10 rad/s, 3P included) with C_β strictly proper (``case_check``'s
         ``hf_excess_db`` and ``proper``). A TargetSpecification carries its own. Default
-        :data:`specdesign.feasibility.MAX_HF_GAIN_RATIO` (None: off); the measured κ is
-        :data:`specdesign.feasibility.HF_GAIN_RATIO`.
+        :data:`specdesign.feasibility.MAX_HF_GAIN_RATIO`, the measured κ
+        (:data:`specdesign.feasibility.HF_GAIN_RATIO`); None switches it off.
     **plant_options
         ``noise``, ``noise_band``, ``rolloff``, ``shift`` for :func:`generalized_plant`.
 
