@@ -23,6 +23,8 @@ from loopshaping.specs import controller_gain
 from specdesign import closedloop, spec
 from specdesign import feasibility as fz
 from specdesign.feasibility import HF_END, HF_GAIN_RATIO, HF_OMEGA, YoulaProblem
+from specdesign.feasibility.margin import MARGIN_BUMPS
+from specdesign.feasibility.target import SEARCH_MARGIN_PP, TARGET_REDUCTION
 from specdesign.turbine import iea15mw
 
 matplotlib.use("Agg")
@@ -154,7 +156,7 @@ def test_design_qft_meets_the_bound_and_promises_the_target(model, qft_designs, 
     assert gain_ratio(model, v, d.pitch_controller, HF_GAIN_RATIO) <= 1.0
     assert direct_term(d.pitch_controller) == 0.0
     assert "hf_gain" in d.pitch_check.names and d.pitch_check.spec_passed[d.pitch_check.names.index("hf_gain")]
-    assert d.promise.exact_del >= fz.TARGET_REDUCTION + fz.SEARCH_MARGIN_PP
+    assert d.promise.exact_del >= TARGET_REDUCTION + SEARCH_MARGIN_PP
 
 
 @pytest.mark.slow
@@ -167,7 +169,7 @@ def test_design_hinf_meets_the_bound_and_is_strictly_proper(model, v):
     assert d.case_check.hf_excess_db <= 0.0
     assert gain_ratio(model, v, d.pitch_controller, HF_GAIN_RATIO) <= 1.0
     assert direct_term(d.pitch_controller) == 0.0
-    assert d.promised_del_reduction >= fz.TARGET_REDUCTION
+    assert d.promised_del_reduction >= TARGET_REDUCTION
 
 
 def test_the_25_percent_target_needs_the_cases_margin_where_their_excess_lies(model):
@@ -178,15 +180,15 @@ def test_the_25_percent_target_needs_the_cases_margin_where_their_excess_lies(mo
     # on recertify's own dense grid (refined around the bumps' roots)
     search = fz.CertificateSearch(model, 19.0, margin_bumps=0)
     with pytest.raises(ValueError, match=rf"high-frequency gain bound \|C\| ≤ {HF_GAIN_RATIO:g}"):
-        search.for_target(fz.TARGET_REDUCTION)
+        search.for_target(TARGET_REDUCTION)
     ts = fz.specification_for_target(model, 19.0)
-    assert ts.max_hf_gain_ratio == HF_GAIN_RATIO and ts.promise.exact_del >= fz.TARGET_REDUCTION + fz.SEARCH_MARGIN_PP
+    assert ts.max_hf_gain_ratio == HF_GAIN_RATIO and ts.promise.exact_del >= TARGET_REDUCTION + SEARCH_MARGIN_PP
     bumps = [e for e in ts.tower.elements if isinstance(e, spec.Notch)]
     assert bumps and all(e.depth_db < 0 for e in bumps)  # bumps: W_MyT only rises above the certificate's map
     again = fz.recertify(model, ts)
     assert again.promise.exact_del == pytest.approx(ts.promise.exact_del, abs=1e-9)
     with pytest.raises(ValueError, match="margin_bumps"):
-        fz.CertificateSearch(model, 19.0, margin_bumps=fz.margin.MARGIN_BUMPS + 1)
+        fz.CertificateSearch(model, 19.0, margin_bumps=MARGIN_BUMPS + 1)
 
 
 def test_the_cases_margin_lies_above_their_excess_and_promises_no_less_than_a_uniform_one():
