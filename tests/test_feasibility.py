@@ -196,8 +196,9 @@ def test_a_fixed_speed_relaxation_gives_the_largest_slack(model):
     base = spec.baseline_analysis(model, 19.0)
     # the certificate meets the 6 dB map; W_Ω covers what it needs at the other plant cases too
     assert t.design.speed_relax_db == 6.0 and t.speed_relax_db >= 6.0 and t.promise.exact_del >= 25.0
-    ratio = np.abs(t.design.t_tower) / np.abs(base.t_response)
-    over = spec.promise_of(10 ** ((t.slack_db + 0.1) / 20) * ratio, base).exact_del
+    # 0.1 dB more slack (twice the bisection's tolerance) on top of the pair's, the cases' margin
+    # (gain and bumps) kept
+    over = spec.promise_of(t.tower.add(spec.Gain(0.1)), base).exact_del
     assert over < 25.0 < t.promise.exact_del < 25.0 + 1.0
 
 
