@@ -15,10 +15,9 @@ from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw
 
 
-#: These tests check the certificate machinery on the 25 % pair as it was made before the
-#: high-frequency gain bound became a default (issue 28 item 1): under the bound's default
-#: κ = fz.HF_GAIN_RATIO the 25 % target is refused at 15-25 m/s (best certified promise
-#: 19.8-24.8 %, docs/feasibility.md), and tests/test_hf_bound.py checks the bounded designs.
+#: These tests check the certificate machinery on the 25 % pair without the high-frequency gain
+#: bound (issue 28 item 1), whose certificates reach further; tests/test_hf_bound.py checks the
+#: default designs, under the bound's κ = fz.HF_GAIN_RATIO.
 NO_HF = {"max_hf_gain_ratio": None}
 
 
