@@ -180,7 +180,20 @@ def case_margin(omega, excess_db, weight_omega, weight, promise, max_bumps=MARGI
 
 
 def shaping_db(elements, omega):
-    """|Π elements(jω)| in dB on ``omega`` (rad/s)."""
+    """The magnitude of a product of shaping elements, in dB.
+
+    Parameters
+    ----------
+    elements : sequence
+        :mod:`specdesign.spec` shaping elements (e.g. :func:`case_margin`'s).
+    omega : array_like
+        Frequencies, rad/s.
+
+    Returns
+    -------
+    numpy.ndarray
+        20·log10 |Π elements(jω)|, dB, shaped like ``omega``.
+    """
     out = np.zeros(np.shape(omega))
     for e in elements:
         out += 20 * np.log10(np.abs(e.response(omega)))

@@ -566,7 +566,7 @@ class CertificateSearch:
         >>> from specdesign.turbine import iea15mw
         >>> search = CertificateSearch(iea15mw(), 19.0)
         >>> t = search.for_target(20.0)
-        >>> deeper = search.for_tower(t.tower.add(spec.Notch(1.0, 2.0, 0.3)), 20.0)  # 2 dB more at the tower mode
+        >>> deeper = search.for_tower(t.tower.add(spec.Notch(1.0, 1.0, 0.3)), 20.0)  # 1 dB more at the tower mode
         >>> bool(deeper.promise.exact_del > t.promise.exact_del and deeper.speed_relax_db >= t.speed_relax_db - 0.5)
         True
         """
