@@ -41,8 +41,8 @@ MARGIN_SEED_SPACING = np.log(2.0)
 #: Bounds of a bump's pole damping ratio ζ_p (-): 0.005 follows a case's resonance moved by
 #: 1 % of its frequency, 1.5 a hump over a decade.
 MARGIN_ZETA_BOUNDS = (0.005, 1.5)
-#: The bumps' depth bounds, dB (the Notch's depth is minus this), and the starting ζ_p.
-_HEIGHT_BOUNDS_DB, _ZETA_START = (0.0, 20.0), 0.1
+#: Bounds of a bump's height, dB (the Notch's depth is minus it).
+_HEIGHT_BOUNDS_DB = (0.0, 20.0)
 #: Floor of the fit's ΔD% weight, as a fraction of its peak (the shape still follows p where
 #: ΔD% is nil, a little), as in :mod:`specdesign.feasibility.elements`.
 _WEIGHT_FLOOR = 0.05

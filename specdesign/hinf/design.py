@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
+from itertools import pairwise
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -400,7 +401,7 @@ def design_hinf(
     for k, ((wt, ws), relax) in enumerate(zip(spec.pairs, spec.speed_relax_db)):
         last = k == len(spec.pairs) - 1
         try:
-            design = _lowest_order(orders, lambda o: _design_once(
+            design = _lowest_order(orders, lambda o, wt=wt, ws=ws, relax=relax: _design_once(
                 model, v, base, wt, ws, spec.notch, spec.kind, relax, spec.target, measurements=measurements, order=o,
                 w_pitch=w_pitch, m=m, suboptimality=suboptimality, reduction_method=reduction_method, dt=dt,
                 min_damping=min_damping, decay_rate=decay_rate, integral_corner=integral_corner, **plant_options))
@@ -427,7 +428,7 @@ def _orders(order):
     except (TypeError, ValueError):
         raise TypeError(f"order={order!r} must be a whole number of states or a sequence of them") from None
     if not out or any(o < 1 or o != x or isinstance(x, (bool, np.bool_)) for o, x in zip(out, orders)) \
-            or any(b <= a for a, b in zip(out, out[1:])):
+            or any(b <= a for a, b in pairwise(out)):
         raise ValueError(f"order={order!r} must be whole numbers of states ≥ 1, increasing")
     return out
 
