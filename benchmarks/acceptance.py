@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from specdesign import validate
-from specdesign.qft import design_schedule
+from specdesign.qft import design_schedule, spec_notch
 from specdesign.simulate import rosco_scheduled, scheduled
 from specdesign.turbine import iea15mw, rosco_baseline
 
@@ -76,7 +76,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     model = iea15mw()
-    designs = design_schedule(model, args.speeds, specification="notch")
+    designs = design_schedule(model, args.speeds, spec=spec_notch())
     t_design = time.perf_counter() - t0
     seeds = np.arange(args.seeds)
     points, independent = [], []

@@ -8,20 +8,11 @@ Needs the rosco package (pip install 'specdesign[rosco]').
 """
 from __future__ import annotations
 
-import time
+from timing import best_of
 
 from specdesign.rosco import Discon, from_discon, rosco_scheduled, rosco_test_cases
 from specdesign.simulate import simulate
 from specdesign.turbine import iea15mw
-
-
-def best_of(fn, n=3):
-    times = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main():

@@ -8,22 +8,13 @@ ratios reference/ours. numba compile time is excluded: every specdesign kernel i
 """
 from __future__ import annotations
 
-import time
 import warnings
 
 import numpy as np
+from timing import best_of
 
 from specdesign import spectral as sp
 from specdesign.fatigue import rainflow
-
-
-def best_of(f, n):
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        f()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 def row(label, t_ref, t_ours, note=""):

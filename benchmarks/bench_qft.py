@@ -19,19 +19,11 @@ matplotlib.use("Agg")
 
 import control as ct  # noqa: E402
 import numpy as np  # noqa: E402
+from timing import timed  # noqa: E402
 
 from loopshaping import qft  # noqa: E402
 from loopshaping.controller import Controller  # noqa: E402
 from loopshaping.interactive import Designer  # noqa: E402
-
-
-def best_of(fn, n=3):
-    times = []
-    for _ in range(n):
-        t = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t)
-    return min(times), out
 
 
 def brute_force(bounds, mags_db):
@@ -86,7 +78,7 @@ def main():
         return qft.intersect(qft.bounds(tmpl, "stability", 1.2), qft.bounds(tmpl, "sensitivity", w_sens),
                              qft.bounds(tmpl, "input_disturbance", 0.01))
 
-    t_exact, B = best_of(exact)
+    t_exact, B = timed(exact)
     sub_w = omegas[[13]]
     sub = qft.intersect(*(qft.bounds(tmpl.at(sub_w), kind, wt) for kind, wt in
                           (("stability", 1.2), ("sensitivity", w_sens), ("input_disturbance", 0.01))))

@@ -5,26 +5,16 @@ Target: the slider callback (notch response, Eq. 10, exact Dirlik, line update) 
 """
 from __future__ import annotations
 
-import time
-
 import matplotlib
 
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+from timing import best_of
 
 from specdesign import spec  # noqa: E402
 from specdesign.plots.spec import NotchExplorer  # noqa: E402
 from specdesign.turbine import iea15mw  # noqa: E402
-
-
-def best_of(fn, n=20):
-    times = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main():

@@ -15,21 +15,14 @@ from __future__ import annotations
 
 import argparse
 import os
-import time
 import warnings
 
-from specdesign import feasibility as fz, spec
-from specdesign.qft import design_qft
+from timing import timed
+
+from specdesign import feasibility as fz
+from specdesign import spec
+from specdesign.qft import design_qft, spec_from_certified, spec_notch
 from specdesign.turbine import iea15mw
-
-
-def best_of(fn, n):
-    times, out = [], None
-    for _ in range(n):
-        t = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t)
-    return min(times), out
 
 
 def main(argv=None):
@@ -41,11 +34,11 @@ def main(argv=None):
     model, v = iea15mw(), args.speed
     warnings.simplefilter("ignore", UserWarning)  # cvxpy's "solution may be inaccurate" on some rungs
     fz.achievable_pitch(model, v, 1.5)  # imports and first compilations out of the timings
-    t_spec, ts = best_of(lambda: fz.specification_for_target(model, v, 25.0), args.repeat)
-    t_check, res = best_of(lambda: fz.pitch_feasibility(model, v, ts.tower, ts.speed), args.repeat)
-    t_design, d = best_of(lambda: design_qft(model, v, spec=ts), args.repeat)
+    t_spec, ts = timed(lambda: fz.specification_for_target(model, v, 25.0), args.repeat)
+    t_check, res = timed(lambda: fz.pitch_feasibility(model, v, ts.tower, ts.speed), args.repeat)
+    t_design, d = timed(lambda: design_qft(model, v, spec=spec_from_certified(ts)), args.repeat)
     base = spec.baseline_analysis(model, v)
-    t_whole, whole = best_of(lambda: fz.shape_whole_band(base, 25.0), args.repeat)
+    t_whole, whole = timed(lambda: fz.shape_whole_band(base, 25.0), args.repeat)
     print(f"{'step at ' + format(v, 'g') + ' m/s':<52}{'time':>9}{'target':>9}{'ratio':>8}   (load {os.getloadavg()[0]:.1f})")
     for name, t, target in (("pitch_feasibility (check of the pair)", t_check, None),
                             ("specification_for_target (25 %, 5 plant cases)", t_spec, None),
@@ -61,7 +54,7 @@ def main(argv=None):
     if args.fixed:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            t_fixed, _ = best_of(lambda: design_qft(model, v, spec="notch"), 1)
+            t_fixed, _ = timed(lambda: design_qft(model, v, spec=spec_notch()), 1)
         print(f"{'design_qft (fixed structure, DEL target)':<52}{t_fixed:8.2f}s")
 
 

@@ -4,7 +4,7 @@ For each wind speed: ``feasibility.shape_whole_band(base, target)``, the
 user's entry point to ``feasibility.element_specification(model, v, target)`` (ROSCO's map ×
 gain, lag, lead and notches/bumps that follow a certificate's envelope, then certified
 themselves by a Youla design that meets them at every plant case), its elements, promise and speed relaxation beside those
-of ``specification_for_target`` (the certificate's own map), then ``qft.design_qft(spec=...)`` on
+of ``specification_for_target`` (the certificate's own map), then ``qft.design_qft(spec=qft.spec_from_certified(...))`` on
 it: success, order and predicted DEL reduction; seconds per speed (total, in the certificates, in
 ``recertify``, the shaping itself) with the load average; and the same shaping and design at
 v ± 1e-9 m/s beside it (a result must not move with its input by a rounding error). Wall times on
@@ -24,7 +24,7 @@ import numpy as np
 
 from specdesign import closedloop, feasibility, spec, spectral, wind
 from specdesign.feasibility import elements, target
-from specdesign.qft import design_qft
+from specdesign.qft import design_qft, spec_from_certified
 from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw
 
@@ -72,7 +72,7 @@ Every step is a continuous function of the input (a convex design, a converged s
 monotone root), so a rounding error in v moves the result by a rounding error (second table).
 The result carries a `TargetSpecification` like any other (`res.certified`), editable
 (`res.certified.tower.add(spec.Notch(...))`, then `feasibility.recertify`), and
-`qft.design_qft(spec=res.certified)` meets it.
+`qft.design_qft(spec=qft.spec_from_certified(res.certified))` meets it.
 
 Which shaper when: `feasibility.shape_whole_band(base, t)` (a DEL target by default) is the
 specification to hand to a design; `spec.shape_to_target(base, t)` (a damage target by
@@ -235,11 +235,11 @@ def main():
                 continue
             ts = res.certified
             tf = feasibility.specification_for_target(model, v, args.target)
-            d = design_qft(model, v, spec=ts)
+            d = design_qft(model, v, spec=spec_from_certified(ts))
             ind = _independent(model, v, ts, d)
             try:
                 res2, sec2 = _shape(model, v2, args.target, clock)
-                d2 = design_qft(model, v2, spec=res2.certified)
+                d2 = design_qft(model, v2, spec=spec_from_certified(res2.certified))
                 p2, k2 = res2.certified.promise.exact_del, d2.del_reduction
                 ind2 = _independent(model, v2, res2.certified, d2)
                 near = (f"| {v:g} | {v2!r} | {ts.promise.exact_del:.3f}, {p2:.3f} | {d.del_reduction:.3f}, {k2:.3f} "

@@ -240,6 +240,8 @@ def _design_key(model, v) -> str:
             versions.append(f"{lib} {md.version(lib)}")
         except md.PackageNotFoundError:
             versions.append(f"{lib} -")
+    # the key names the notch design as it was called when the cache was made (spec='notch', now
+    # spec=spec_notch(): the same design), so that the cached designs stay valid
     h.update(f"design_qft(model, {float(v)!r}, spec='notch') {'; '.join(versions)}".encode())
     return h.hexdigest()
 
@@ -249,14 +251,14 @@ def _design_file(model, v):
 
 
 def designs_for(model, v):
-    """(C_β, C_atd) of design_qft(model, v), cached as JSON transfer functions under
+    """(C_β, C_atd) of design_qft(model, v, spec=spec_notch()), cached as JSON transfer functions under
     build/cache, keyed by the design code, the model, v and the library versions
     (:func:`_design_key`); an unreadable cache file is designed again and replaced."""
     import os
 
     import control
 
-    from specdesign.qft import design_qft
+    from specdesign.qft import design_qft, spec_notch
 
     f = _design_file(model, v)
     if f.exists():
@@ -265,7 +267,7 @@ def designs_for(model, v):
             return tuple(control.tf(data[k]["num"], data[k]["den"]) for k in ("pitch", "atd"))
         except (ValueError, KeyError, TypeError) as e:
             print(f"cache file {f} is unreadable ({e}); designing again")
-    d = design_qft(model, v, spec="notch")
+    d = design_qft(model, v, spec=spec_notch())
     out = (d.pitch_controller, d.atd_controller)
     f.parent.mkdir(parents=True, exist_ok=True)
     tmp = f.with_name(f"{f.name}.{os.getpid()}.tmp")  # written whole, then renamed: no half-written cache file

@@ -212,7 +212,7 @@ def main():
         done.add((name, v, target))
         t0 = time.time()
         with extra_cost(term) if term is not None else contextlib.nullcontext():
-            d = qft.design_qft(model, v, target, spec="notch")
+            d = qft.design_qft(model, v, spec=qft.spec_notch(target))
         t1 = time.time()
         r = evaluate(model, d, seeds)
         results.append((name, r))

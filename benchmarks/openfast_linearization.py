@@ -120,7 +120,7 @@ def gap(lt, model, v, target=25.0):
             ladder.append(f"{g:g} dB: {'none' if d is None or rob is None else f'{red:.1f} %'}")
         lines.append(f"{label}, {v:g} m/s only: certificate promise per speed-map relaxation: " + ", ".join(ladder))
         pair = specification_for_target(m, v, target)
-        made[label] = q = design_qft(m, v, spec=pair)
+        made[label] = q = design_qft(m, v, spec=spec_from_certified(pair))
         b = q.baseline
         w, S = b.omega, b.wind_psd
         t0 = b.t_response

@@ -38,7 +38,7 @@ def designs(model, speeds, target) -> dict:
     for v in speeds:
         t = time.monotonic()
         pair = feasibility.specification_for_target(model, v, target)
-        d = qft.design_qft(model, v, spec=pair)
+        d = qft.design_qft(model, v, spec=qft.spec_from_certified(pair))
         res[v] = {"design": d, "promise": float(pair.promise.exact_del)}
         print(f"design at {v:g} m/s: {time.monotonic() - t:.0f} s; {d.summary()}", file=sys.stderr, flush=True)
     return res

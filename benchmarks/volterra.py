@@ -23,7 +23,7 @@ from specdesign import simulate as sm
 from specdesign import turbine
 from specdesign import validate as va
 from specdesign.fatigue import del_rainflow
-from specdesign.qft import design_schedule
+from specdesign.qft import design_schedule, spec_notch
 
 TRANSIENT, DURATION, WDT = 60.0, 600.0, 0.1
 
@@ -58,7 +58,7 @@ def convergence(model, seeds):
 
 def by_order(model, speeds, seeds):
     t0 = time.perf_counter()
-    designs = design_schedule(model, speeds, specification="notch")
+    designs = design_schedule(model, speeds, spec=spec_notch())
     print(f"\n(b) QFT vs ROSCO, {len(seeds)} paired seeds × {DURATION:g} s (designs {time.perf_counter() - t0:.0f} s)")
     print("| wind speed (m/s) | linear prediction | rainflow, nonlinear | rainflow, linearised | Volterra order 1 "
           "| order 2 | order 3 | nonlinear part (pp) | order 2 part | order 3 part |")

@@ -4,11 +4,12 @@ Kept apart so that the designer's numbers and figure import no widget library.
 """
 from __future__ import annotations
 
+import html
 import math
 
 from .controller import KINDS
 
-__all__ = ["build_widget", "LOG_STEP", "LOG_SPAN"]
+__all__ = ["build_widget", "readout_html", "LOG_STEP", "LOG_SPAN"]
 
 LOG_STEP = 0.005  # decades per slider step: 1.2 %, fine enough to place a corner frequency
 LOG_SPAN = 1.0  # decades either side of the value the slider was built around (re-centred on a typed value)
@@ -17,6 +18,34 @@ LOG_SPAN = 1.0  # decades either side of the value the slider was built around (
 def _log_range(value):
     c = math.log10(abs(value))
     return c - LOG_SPAN, c + LOG_SPAN
+
+
+def readout_html(text: str, colour: str = "black") -> str:
+    """Lines of text as the HTML of an ``ipywidgets.HTML`` readout beside a live figure.
+
+    Parameters
+    ----------
+    text : str
+        The lines (``\\n`` between them); shown as they are (escaped, white space kept).
+    colour : str
+        The text's colour, any matplotlib colour (``"tab:red"``), written as its hex value.
+
+    Returns
+    -------
+    str
+        HTML: one ``<div>``, the lines in a small font, wrapped where the widget is narrower
+        than a line.
+
+    Examples
+    --------
+    >>> from loopshaping.interactive import readout_html
+    >>> readout_html("a < b\\nmet")
+    '<div style="font-size:12px;line-height:1.35;white-space:pre-wrap;padding-left:3px;color:#000000">a &lt; b\\nmet</div>'
+    """
+    from matplotlib.colors import to_hex  # loopshaping loads matplotlib only to draw (here: a live figure's)
+
+    return (f'<div style="font-size:12px;line-height:1.35;white-space:pre-wrap;padding-left:3px;color:{to_hex(colour)}">'
+            f"{html.escape(text, quote=False)}</div>")
 
 
 def build_widget(d):
@@ -30,7 +59,9 @@ def build_widget(d):
     Returns
     -------
     ipywidgets.VBox
-        ``VBox([controls, figure])``; ``controls`` holds the element list, the add/remove
+        ``VBox([controls, figure])``, on a live (ipympl) canvas ``VBox([controls, readout,
+        figure])`` with the verdict lines in ``readout`` (an ``ipywidgets.HTML``, no longer
+        drawn on the canvas); ``controls`` holds the element list, the add/remove
         row, the selected element's parameter rows (slider + exact text box each), the
         controller's JSON and a message line.
 
@@ -57,6 +88,12 @@ def build_widget(d):
     canvas = d.figure.canvas
     live = isinstance(canvas, ipw.DOMWidget)
     fig_box = canvas if live else ipw.Output()
+    if live and d._redraw.live:
+        # the verdict lines leave the live canvas for a readout above it: drawn at every edit
+        # they were most of a redraw (text costs about 0.1 ms a glyph, and its pixels go to the
+        # browser); a saved figure still draws them
+        d._readout_widget = ipw.HTML(readout_html(d.readout, d._readout_colour))
+        d._redraw.print_only(d._artists["title"])
     shown = {"idx": None}
     busy = [False]
     editing = [False]  # an edit made through these controls (they already show it)
@@ -211,5 +248,5 @@ def build_widget(d):
     build_rows()
     show_figure()
     controls = ipw.VBox([elements, ipw.HBox([kind, add_btn, rm_btn]), rows, json_box, msg])
-    return ipw.VBox([controls, fig_box])
+    return ipw.VBox([controls, *([d._readout_widget] if d._readout_widget is not None else []), fig_box])
 

@@ -224,17 +224,17 @@ def integrator(order: int = 1) -> Element:
 
 
 def differentiator(order: int = 1) -> Element:
-    """s^order.
+    """s^order: the inverse of :func:`integrator`, whose ``order`` (1 to :data:`MAX_ORDER`) it takes.
 
     Parameters
     ----------
     order : int
-        Number of differentiators, 1 to :data:`MAX_ORDER`.
+        Number of differentiators.
 
     Returns
     -------
     Element
-        The ``differentiator`` element.
+        ``differentiator``.
     """
     return Element("differentiator", {"order": order})
 
@@ -256,17 +256,18 @@ def real_pole(omega: float) -> Element:
 
 
 def real_zero(omega: float) -> Element:
-    """s/ω + 1: a real zero at s = −ω, unit DC gain.
+    """s/ω + 1: a real zero at s = −ω, unit DC gain (the inverse of :func:`real_pole`, whose
+    ``omega`` it takes: a negative one places the zero in the right half-plane).
 
     Parameters
     ----------
     omega : float
-        Corner frequency ω, rad/s, ≠ 0 (negative: a right-half-plane zero).
+        As :func:`real_pole`'s, rad/s.
 
     Returns
     -------
     Element
-        The ``real_zero`` element.
+        ``real_zero``.
     """
     return Element("real_zero", {"omega": omega})
 
@@ -290,19 +291,18 @@ def complex_pole(omega: float, zeta: float) -> Element:
 
 
 def complex_zero(omega: float, zeta: float) -> Element:
-    """(s/ω)² + 2ζ s/ω + 1: a complex pair, unit DC gain.
+    """(s/ω)² + 2ζ s/ω + 1: a complex pair of zeros, unit DC gain (the inverse of
+    :func:`complex_pole`, whose ``omega`` and ``zeta`` it takes).
 
     Parameters
     ----------
-    omega : float
-        Natural frequency ω > 0, rad/s.
-    zeta : float
-        Damping ratio ζ, |ζ| < 1 (negative: right-half-plane pair).
+    omega, zeta : float
+        As :func:`complex_pole`'s: ω in rad/s, ζ with |ζ| < 1.
 
     Returns
     -------
     Element
-        The ``complex_zero`` element.
+        ``complex_zero``.
     """
     return Element("complex_zero", {"omega": omega, "zeta": zeta})
 
@@ -533,22 +533,13 @@ class Controller:
         return ct.tf(num, den)
 
     def response(self, omega: ArrayLike) -> np.ndarray:
-        """Complex response at s = jω, evaluated factor by factor.
-
-        Parameters
-        ----------
-        omega : array_like
-            Frequencies, rad/s.
-
-        Returns
-        -------
-        numpy.ndarray
-            Complex response, shape of ``omega``.
-        """
+        # evaluated factor by factor, not from the product polynomials of :meth:`polys`
         out = np.ones(np.shape(omega), complex)
         for e in self.elements:
             out = out * e.response(omega)
         return out
+
+    response.__doc__ = Element.response.__doc__  # the same contract as an element's, documented once
 
     @property
     def is_proper(self) -> bool:

@@ -35,7 +35,7 @@ import numpy as np
 
 from ._statespace import as_ss, check_dims, format_roots, hinf_norm, partition, slycot_routine
 from .reduction import ReductionResult, discretize, reduce
-from .wellposed import WellPosednessWarning, check_well_posed, regularized_plant, shift_axis_poles
+from .wellposed import AXIS_TOL, RANK_TOL, WellPosednessWarning, check_well_posed, regularized_plant, shift_axis_poles
 
 __all__ = [
     "HinfResult",
@@ -127,8 +127,8 @@ def synthesize(
     epsilon: float = 1e-3,
     suboptimality: float = 0.0,
     gamma_tol: float = 1e-4,
-    rank_tol: float = 1e-9,
-    axis_tol: float = 1e-9,
+    rank_tol: float = RANK_TOL,
+    axis_tol: float = AXIS_TOL,
     decay_rate: float = 0.0,
     decay_states: np.ndarray | None = None,
 ) -> HinfResult:
@@ -396,8 +396,8 @@ def mixed_sensitivity(
     shift: float = 1e-4,
     suboptimality: float = 0.0,
     gamma_tol: float = 1e-4,
-    rank_tol: float = 1e-9,
-    axis_tol: float = 1e-9,
+    rank_tol: float = RANK_TOL,
+    axis_tol: float = AXIS_TOL,
     decay_rate: float = 0.0,
 ) -> HinfResult:
     """Mixed-sensitivity H∞ design: minimise ‖[W_S·S; W_KS·K·S; W_T·T]‖∞.

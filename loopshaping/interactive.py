@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._designer_widget import build_widget
+from ._designer_widget import build_widget, readout_html
+from ._textcache import CachedTextRenderer
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
 from .freqresp import check_grid, evaluate
@@ -26,7 +27,7 @@ from .nichols import draw, loop_nichols, wrap_phase
 from .specs import Spec
 from .templates import Template
 
-__all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles"]
+__all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles", "readout_html"]
 
 _DEFAULTS = {
     "gain": {"k": 1.0},
@@ -163,7 +164,10 @@ class LiveArtists:
     its markers take a few ms. The ``artists`` are made animated: every full render of the
     canvas caches the figure without them as the background and then draws them on top (so a
     full redraw, a toolbar zoom or a resize still shows them, and ``savefig`` too);
-    :meth:`redraw` restores the background, draws only them and sends the changed pixels.
+    :meth:`redraw` restores the background, draws only them and sends the changed pixels; a line
+    of text that meets the pixels it met before is written from a cache instead of rasterised
+    again (:class:`loopshaping._textcache.CachedTextRenderer`: pixel-identical, and a multi-line
+    title whose one line changed costs that line).
     Until the canvas has rendered once and the browser's view of it is connected it asks for
     a full redraw instead (a blit sent before the browser drew the figure once left it empty).
     A live figure is not "stale" after a blit or a render (pyplot redraws every stale figure
@@ -206,6 +210,8 @@ class LiveArtists:
         canvas = figure.canvas
         self.live = hasattr(canvas, "syncing_data_url") if live is None else bool(live)  # ipympl's Canvas
         self._background = None
+        self._text = None  # the canvas's renderer drawing unchanged lines of text from a cache
+        self._printed = []  # artists drawn into saved files only (print_only)
         if self.live:
             for a in self.artists:
                 a.set_animated(True)
@@ -217,7 +223,7 @@ class LiveArtists:
     def _on_draw(self, event):
         canvas, renderer = event.canvas, event.renderer
         if canvas.is_saving():  # savefig: the axes draw their animated children then, the figure not
-            for a in self.artists:
+            for a in (*self.artists, *self._printed):
                 if getattr(a, "axes", None) is None:
                     a.draw(renderer)
             return
@@ -225,6 +231,48 @@ class LiveArtists:
         for a in self.artists:
             a.draw(renderer)
         self.figure.stale = False  # drawn: their children's updates while drawing are on screen
+
+    def print_only(self, *artists):
+        """Draw ``artists`` into saved files only, no longer on the live canvas (nor in a blit).
+
+        For text a widget beside the live figure shows instead (a verdict, a readout): a line
+        of text costs about 0.1 ms a glyph to draw at each edit, and its pixels enlarge the
+        image sent to the browser. A saved figure still says what it shows. The next full
+        render (asked for here) draws the canvas without them.
+
+        Parameters
+        ----------
+        *artists : matplotlib.artist.Artist
+            Artists of the figure, among :attr:`artists` or not.
+        """
+        for a in artists:
+            if a in self.artists:
+                self.artists.remove(a)
+            # animated: a render of the canvas skips them; savefig draws an axes' animated
+            # children itself, and :meth:`_on_draw` the figure's
+            a.set_animated(True)
+            if a not in self._printed:
+                self._printed.append(a)
+        self._background = None  # cached with them drawn: the next render caches it without
+        self.figure.canvas.draw_idle()
+
+    def settle(self, *artists):
+        """Stop redrawing ``artists`` at each edit: they become part of the cached background.
+
+        For artists that no longer change (a legend whose changing entry moved to a widget).
+        The next full render (asked for here) draws them into the background.
+
+        Parameters
+        ----------
+        *artists : matplotlib.artist.Artist
+            Artists among :attr:`artists`.
+        """
+        for a in artists:
+            if a in self.artists:
+                self.artists.remove(a)
+            a.set_animated(False)
+        self._background = None
+        self.figure.canvas.draw_idle()
 
     @property
     def ready(self) -> bool:
@@ -239,8 +287,11 @@ class LiveArtists:
             canvas.draw_idle()
             return
         canvas.restore_region(self._background)
+        renderer = canvas.get_renderer()
+        if self._text is None or self._text.renderer is not renderer:  # a new canvas size or dpi
+            self._text = CachedTextRenderer(renderer)
         for a in self.artists:
-            self.figure.draw_artist(a)
+            a.draw(self._text)
         canvas.blit(self.figure.bbox)
         self.figure.stale = False  # what changed is on screen: no full render after this message
 
@@ -276,6 +327,10 @@ class Designer:
     update_ms : float
         Wall time of the last :meth:`update` (recompute, artist data and the blit or the
         redraw request), ms: what an edit costs in the kernel before the browser shows it.
+    readout : str
+        The verdict of the figure's last redraw (:meth:`summary`'s lines): the figure's title,
+        or, on a live figure shown by :meth:`widget`, the readout above it (the title is then
+        drawn into saved files only; :meth:`LiveArtists.print_only`).
 
     Raises
     ------
@@ -330,6 +385,9 @@ class Designer:
         self._artists = {}
         self.update_ms = float("nan")
         self._on_update = None  # the widget's controls following an edit made from code
+        self.readout = ""
+        self._readout_colour = "black"
+        self._readout_widget = None  # the ipywidgets.HTML above a live figure showing the readout
 
     # -- saved state
     def to_state(self) -> dict:
@@ -452,9 +510,9 @@ class Designer:
     def _stability(self):
         n = len(self._ss)
         stable, rightmost = np.zeros(n, bool), np.full(n, complex(np.nan, np.nan))
-        if not self.controller.is_proper:
+        num, den = self.controller.polys()  # once: Controller.is_proper would multiply them out again
+        if len(np.trim_zeros(num, "f")) > len(np.trim_zeros(den, "f")):  # improper: undecided
             return stable, rightmost
-        num, den = self.controller.polys()
         for c, ss in enumerate(self._ss):
             if ss is None:
                 continue
@@ -547,7 +605,8 @@ class Designer:
         ----------
         live : bool, optional
             Redraw edits by blitting: only the loop, markers, title and closed-loop lines are
-            re-rendered on a cached background of the bounds and axes (:class:`LiveArtists`).
+            re-rendered on a cached background of the bounds and axes (:class:`LiveArtists`;
+            the title not once :meth:`widget` shows the verdict in a readout above the figure).
             Default: on ipympl's canvas (``%matplotlib widget``), where a full redraw of the
             bounds takes about 0.5 s; off elsewhere (an edit then redraws the figure in full).
 
@@ -603,7 +662,8 @@ class Designer:
         ax_b.set_ylabel("closed-loop magnitude (dB)")
         ax_b.grid(True, which="both", lw=0.3)
         ax_b.legend(fontsize=8)
-        title = fig.suptitle(self._title(st), fontsize=9, color=self._title_colour(st))
+        self.readout, self._readout_colour = self._title(st), self._title_colour(st)
+        title = fig.suptitle(self.readout, fontsize=9, color=self._readout_colour)
         # fixed margins (no layout engine: it would re-run on every redraw); room for the
         # three-line title above the axes
         fig.subplots_adjust(left=0.08, right=0.98, bottom=0.11, top=0.79, wspace=0.42)
@@ -638,8 +698,12 @@ class Designer:
             a["marks"].set_facecolors(self._marker_colours(st))
             a["T"].set_ydata(st.worst_T_db)
             a["S"].set_ydata(st.worst_S_db)
-            a["title"].set_text(self._title(st))
-            a["title"].set_color(self._title_colour(st))
+            self.readout, self._readout_colour = self._title(st), self._title_colour(st)
+            # set on the title also where the widget shows it: a saved figure draws it
+            a["title"].set_text(self.readout)
+            a["title"].set_color(self._readout_colour)
+            if self._readout_widget is not None:
+                self._readout_widget.value = readout_html(self.readout, self._readout_colour)
             if redraw:
                 self._redraw.redraw()
         self.update_ms = 1e3 * (time.perf_counter() - t0)

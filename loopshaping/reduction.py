@@ -15,6 +15,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ._statespace import as_ss, hinf_norm, slycot_routine
+from .wellposed import AXIS_TOL
 
 __all__ = ["ReductionResult", "discretize", "reduce"]
 
@@ -72,7 +73,7 @@ def _stable_unstable_split(sys, axis_tol):
 
 
 def reduce(controller: ct.StateSpace | ct.TransferFunction, order: int, method: str = "balanced", *,
-           axis_tol: float = 1e-9) -> ReductionResult:
+           axis_tol: float = AXIS_TOL) -> ReductionResult:
     """Reduce a controller's order by balanced truncation of its stable part.
 
     The unstable (and marginal, e.g. integrator) part is kept exactly, so the error

@@ -20,7 +20,18 @@ import scipy.linalg as sla
 
 from ._statespace import as_ss, check_dims, format_roots, partition, slycot_routine
 
-__all__ = ["WellPosednessWarning", "check_well_posed", "regularized_plant", "shift_axis_poles"]
+__all__ = ["AXIS_TOL", "RANK_TOL", "WellPosednessWarning", "check_well_posed", "regularized_plant", "shift_axis_poles"]
+
+#: Relative rank tolerance of D12 and D21 (σ_min against the norm of their block row or column):
+#: an exactly singular D comes out of the SVD at round-off, ~n·eps ≈ 1e-15 relative, and a
+#: deliberate regularisation at ``epsilon`` = 1e-3 (:func:`regularized_plant`); 1e-9 sits six
+#: orders above the one and six below the other.
+RANK_TOL = 1e-9
+#: Relative distance from the imaginary axis below which a zero or mode counts as on it
+#: (|Re s| ≤ AXIS_TOL·max(1, |s|)): an integrator or undamped resonance placed on the axis comes
+#: out of the eigenvalue and zero computations at round-off (~1e-15 relative), while the
+#: ``shift`` that moves such a weight pole off the axis (1e-4 rad/s) is five orders above it.
+AXIS_TOL = 1e-9
 
 
 class WellPosednessWarning(UserWarning):
@@ -103,7 +114,7 @@ def shift_axis_poles(sys: ct.StateSpace, epsilon: float, axis_tol: float) -> tup
 
 
 def check_well_posed(generalized_plant: ct.StateSpace | ct.TransferFunction, n_meas: int, n_ctrl: int, *,
-                     rank_tol: float = 1e-9, axis_tol: float = 1e-9) -> None:
+                     rank_tol: float = RANK_TOL, axis_tol: float = AXIS_TOL) -> None:
     """Check SLICOT's assumptions (A1)–(A4) on a generalized plant; raise if one fails.
 
     Parameters

@@ -41,6 +41,7 @@ from .validate import (
     table2,
     table3,
 )
+from .wind import RECORD_LENGTH
 
 __all__ = ["main", "ConfigError", "read_config", "load_controller", "run_config", "output_folder"]
 
@@ -550,7 +551,7 @@ def read_config(path: str | os.PathLike, out: str | os.PathLike | None = None) -
     model = turbine.iea15mw()
     vs = _wind_speeds(cfg["wind_speeds"], model, path, "wind_speeds", operating=True)
     seeds = _checked_seeds(cfg["seeds"], path)
-    kw = dict(duration=_number(cfg, "duration", path, 600.0), dt=_number(cfg, "dt", path, 0.02),
+    kw = dict(duration=_number(cfg, "duration", path, RECORD_LENGTH), dt=_number(cfg, "dt", path, 0.02),
               record_dt=_number(cfg, "record_dt", path, 0.1), transient=_number(cfg, "transient", path, 60.0, positive=False),
               m=_number(cfg, "wohler_exponent", path, 4.0))
     for key in ("duration", "transient"):

@@ -225,7 +225,7 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
         Recorded time per run (s, 1-86400; overrides ``fast``).
     method : {"target", "notch"}, default "target"
         ``"target"``: specification-driven (:func:`specdesign.feasibility.specification_for_target`,
-        then ``design_qft(spec=...)``); ``"notch"``: the notch specification and the
+        then ``design_qft(spec=qft.spec_from_certified(...))``); ``"notch"``: the notch specification and the
         fixed-structure QFT design with a DEL target.
 
     Returns
@@ -292,10 +292,10 @@ def run_demo(out: str | os.PathLike = "specdesign_output", *, fast: bool = False
 
     if method == "target":
         _say("[3/4] QFT design meeting that specification at every plant case (the certificate, reduced; pitch only)")
-        design = qft.design_qft(model, v, spec=target)
+        design = qft.design_qft(model, v, spec=qft.spec_from_certified(target))
     else:
         _say(f"[3/4] QFT design: pitch controller + active tower damping, target −{target_reduction:g} % DEL")
-        design = qft.design_qft(model, v, target_reduction=target_reduction, spec="notch", spec_reduction=spec_reduction)
+        design = qft.design_qft(model, v, spec=qft.spec_notch(target_reduction), spec_reduction=spec_reduction)
     _say("      " + design.summary())
     # the controllers as the transfer functions written to controller_qft.json, so that
     # `specdesign validate` simulates exactly what the demo simulated

@@ -39,6 +39,7 @@ from loopshaping.controller import Controller, Element
 from . import closedloop, spectral, turbine, wind
 from .wind import LOWEST_OMEGA, RECORD_LENGTH, record_window
 from ._checks import as_omega, as_psd, positive_scalar, real_scalar
+from ._docs import docstring_of
 from .closedloop import siso_response
 from .fatigue import TOWER_M
 from .rosco import rosco_baseline, rosco_gain_schedule
@@ -85,7 +86,7 @@ SLSQP_OPTIONS = {"maxiter": 300, "ftol": 1e-10}
 #: regulation (the seed paper shapes around the tower mode, ≈ 1.1 rad/s on the IEA 15 MW).
 KEEP_BELOW = 0.6
 #: Damage reduction (%) the notch-shaped tower specification of the notch designs promises by
-#: default (design_qft(spec="notch"), hinf.spec_like_qft, the demo).
+#: default (qft.spec_notch, hinf.spec_like_qft, the demo).
 SPEC_REDUCTION = 15.0
 #: High-frequency relaxation (dB) of the notch designs' tower specification and the corner
 #: (rad/s) above which it applies: ΔD% is negligible there (:func:`design_specifications`).
@@ -140,18 +141,18 @@ class Notch:
         return self.width * 10 ** (-self.depth_db / 20)
 
     def tf(self) -> ct.TransferFunction:
-        """The notch N(s) as a transfer function.
+        """The element as a transfer function (the formula of its class docstring).
 
         Returns
         -------
         control.TransferFunction
-            N(s), dimensionless, s in rad/s.
+            Dimensionless, s in rad/s.
         """
         w = self.omega_n
         return ct.tf([1, 2 * self.zeta_zero * w, w * w], [1, 2 * self.width * w, w * w])
 
     def response(self, omega: ArrayLike) -> np.ndarray:
-        """N(jω) on a frequency grid.
+        """The element's response on a frequency grid (the formula of its class docstring at s = jω).
 
         Parameters
         ----------
@@ -161,19 +162,22 @@ class Notch:
         Returns
         -------
         numpy.ndarray
-            Complex N(jω) (-), shaped like ``omega``.
+            Complex response (-), shaped like ``omega``.
         """
         s = 1j * np.asarray(omega, dtype=float)
         w = self.omega_n
         return (s * s + 2 * self.zeta_zero * w * s + w * w) / (s * s + 2 * self.width * w * s + w * w)
 
     def to_elements(self) -> tuple[Element, ...]:
-        """The same factor as :mod:`loopshaping.controller` elements: one ``notch``.
+        """The same factor as :mod:`loopshaping.controller` elements.
 
         Returns
         -------
         tuple of loopshaping.controller.Element
-            One ``notch(omega_n, zeta_zero, width)``.
+            A :class:`Notch`: one ``notch(omega_n, zeta_zero, width)``; a :class:`Gain`: one
+            ``gain(10^(gain_db/20))`` (linear); a :class:`LeadLag`: one ``lead_lag(omega_zero,
+            omega_pole)``; a :class:`LowPass`: a ``complex_pole`` (ζ < 1) or two ``real_pole`` at
+            ω_c(ζ ± √(ζ² − 1)) (ζ ≥ 1), unity gain at DC.
         """
         return (lc.notch(self.omega_n, self.zeta_zero, self.width),)
 
@@ -201,39 +205,16 @@ class Gain:
         if isinstance(self.gain_db, (bool, np.bool_, str, bytes)) or not np.isfinite(self.gain_db):
             raise ValueError(f"Gain.gain_db={self.gain_db!r} must be a finite number of dB")
 
+    @docstring_of(Notch)
     def tf(self) -> ct.TransferFunction:
-        """The gain as a static transfer function.
-
-        Returns
-        -------
-        control.TransferFunction
-            10^(gain_db/20) (-).
-        """
         return ct.tf([10 ** (self.gain_db / 20)], [1])
 
+    @docstring_of(Notch)
     def response(self, omega: ArrayLike) -> np.ndarray:
-        """The gain's response on a frequency grid.
-
-        Parameters
-        ----------
-        omega : array_like
-            Frequencies, rad/s (any shape).
-
-        Returns
-        -------
-        numpy.ndarray
-            Complex 10^(gain_db/20) (-), shaped like ``omega``.
-        """
         return np.full(np.shape(omega), 10 ** (self.gain_db / 20), dtype=complex)
 
+    @docstring_of(Notch)
     def to_elements(self) -> tuple[Element, ...]:
-        """The same factor as :mod:`loopshaping.controller` elements: one ``gain`` (linear).
-
-        Returns
-        -------
-        tuple of loopshaping.controller.Element
-            One ``gain(10^(gain_db/20))``.
-        """
         return (lc.gain(10 ** (self.gain_db / 20)),)
 
 
@@ -270,40 +251,17 @@ class LeadLag:
         positive_scalar(self.omega_zero, "LeadLag.omega_zero (rad/s)")
         positive_scalar(self.omega_pole, "LeadLag.omega_pole (rad/s)")
 
+    @docstring_of(Notch)
     def tf(self) -> ct.TransferFunction:
-        """The lead-lag as a transfer function.
-
-        Returns
-        -------
-        control.TransferFunction
-            (1 + s/ω_z) / (1 + s/ω_p) (-).
-        """
         return ct.tf([1 / self.omega_zero, 1], [1 / self.omega_pole, 1])
 
+    @docstring_of(Notch)
     def response(self, omega: ArrayLike) -> np.ndarray:
-        """The lead-lag's response on a frequency grid.
-
-        Parameters
-        ----------
-        omega : array_like
-            Frequencies, rad/s (any shape).
-
-        Returns
-        -------
-        numpy.ndarray
-            Complex (1 + jω/ω_z) / (1 + jω/ω_p) (-), shaped like ``omega``.
-        """
         s = 1j * np.asarray(omega, dtype=float)
         return (1 + s / self.omega_zero) / (1 + s / self.omega_pole)
 
+    @docstring_of(Notch)
     def to_elements(self) -> tuple[Element, ...]:
-        """The same factor as :mod:`loopshaping.controller` elements: one ``lead_lag``.
-
-        Returns
-        -------
-        tuple of loopshaping.controller.Element
-            One ``lead_lag(omega_zero, omega_pole)``.
-        """
         return (lc.lead_lag(self.omega_zero, self.omega_pole),)
 
 
@@ -338,42 +296,19 @@ class LowPass:
         positive_scalar(self.omega_c, "LowPass.omega_c (rad/s)")
         positive_scalar(self.zeta, "LowPass.zeta")
 
+    @docstring_of(Notch)
     def tf(self) -> ct.TransferFunction:
-        """The low-pass as a transfer function.
-
-        Returns
-        -------
-        control.TransferFunction
-            ω_c² / (s² + 2ζ ω_c s + ω_c²) (-).
-        """
         w = self.omega_c
         return ct.tf([w * w], [1, 2 * self.zeta * w, w * w])
 
+    @docstring_of(Notch)
     def response(self, omega: ArrayLike) -> np.ndarray:
-        """The low-pass's response on a frequency grid.
-
-        Parameters
-        ----------
-        omega : array_like
-            Frequencies, rad/s (any shape).
-
-        Returns
-        -------
-        numpy.ndarray
-            Complex response (-), shaped like ``omega``.
-        """
         s = 1j * np.asarray(omega, dtype=float)
         w = self.omega_c
         return w * w / (s * s + 2 * self.zeta * w * s + w * w)
 
+    @docstring_of(Notch)
     def to_elements(self) -> tuple[Element, ...]:
-        """The same factor as :mod:`loopshaping.controller` elements, unity gain at DC.
-
-        Returns
-        -------
-        tuple of loopshaping.controller.Element
-            A ``complex_pole`` (ζ < 1) or two ``real_pole`` at ω_c(ζ ± √(ζ² − 1)) (ζ ≥ 1).
-        """
         if self.zeta < 1:
             return (lc.complex_pole(self.omega_c, self.zeta),)
         r = math.sqrt(self.zeta ** 2 - 1)
@@ -510,17 +445,17 @@ class Specification:
         return siso_response(self.baseline, omega, "baseline", method="batched") * self.shaping(omega)
 
     def magnitude(self, omega: ArrayLike) -> np.ndarray:
-        """|W_y(jω)| on a frequency grid.
+        """|W_y(jω)|, output units per m/s (linear, not dB): the modulus of :meth:`response`.
 
         Parameters
         ----------
         omega : array_like
-            Frequencies, rad/s.
+            As :meth:`response`'s (rad/s).
 
         Returns
         -------
         numpy.ndarray
-            |W_y(jω)|, output units per m/s (linear, not dB).
+            Real, shaped like ``omega``.
         """
         return np.abs(self.response(omega))
 
@@ -982,7 +917,7 @@ class ShapingResult:
     certified : specdesign.feasibility.TargetSpecification or None
         From :func:`specdesign.feasibility.shape_whole_band`: the certified pair (tower and
         generator-speed specifications, the certificate, the plant cases) to hand to
-        ``design_qft(model, v, spec=...)`` or to edit and :func:`specdesign.feasibility.recertify`;
+        ``design_qft(model, v, spec=qft.spec_from_certified(...))`` or to edit and :func:`specdesign.feasibility.recertify`;
         None from :func:`shape_to_target`.
     """
 

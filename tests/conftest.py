@@ -59,12 +59,17 @@ def pytest_collection_modifyitems(config, items):
 
 
 @pytest.fixture(scope="session")
-def discon_in():
-    """The rosco package's DISCON.IN of the IEA 15 MW monopile (skipped without the package)."""
+def rosco_cases():
+    """The rosco package's Test_Cases folder (skipped without the package)."""
     from specdesign.rosco import rosco_test_cases
 
     try:
-        cases = rosco_test_cases()
+        return rosco_test_cases()
     except ModuleNotFoundError as e:
         pytest.skip(f"the rosco package is not installed ({e})")
-    return cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"
+
+
+@pytest.fixture(scope="session")
+def discon_in(rosco_cases):
+    """The rosco package's DISCON.IN of the IEA 15 MW monopile (skipped without the package)."""
+    return rosco_cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"

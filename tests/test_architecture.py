@@ -373,12 +373,14 @@ def test_a_named_default_is_used_by_every_signature_that_shares_it():
     # slack_db, or listed below), a signature with that parameter and that value uses the constant
     # itself, in specdesign and in loopshaping (which has its own constants: it never imports
     # specdesign); a literal copy of the value fails here
-    from specdesign import closedloop, fatigue
+    from specdesign import closedloop, fatigue, wind
 
     named = _named_constants()
     for param, const in (("m", "TOWER_M"), ("blade_m", "BLADE_M")):
         named.setdefault(param, []).append((f"specdesign.fatigue.{const}", getattr(fatigue, const)))
     named.setdefault("min_decay", []).append(("specdesign.closedloop.MIN_DECAY_RATE", closedloop.MIN_DECAY_RATE))
+    # a simulated record's length is IEC 61400-1's 10-minute record, the one a spectral DEL counts over
+    named.setdefault("duration", []).append(("specdesign.wind.RECORD_LENGTH", wind.RECORD_LENGTH))
     copies = []
     for qual, sig in _signatures():
         for p in sig.parameters.values():

@@ -28,7 +28,7 @@ def model():
 def design(model):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        return qft.design_qft(model, 19.0, spec="notch")
+        return qft.design_qft(model, 19.0, spec=qft.spec_notch())
 
 
 @pytest.fixture(scope="module")

@@ -11,8 +11,8 @@ Oracles:
   bit for bit;
 - the simulator: ROSCO's own compiled controller (``specdesign.rosco.Discon``, the rosco
   package's libdiscon 2.10) in the loop, on a copy of ROSCO's IEA 15 MW DISCON.IN with
-  ``VS_ControlMode`` 1 (and 3) and peak shaving off (``PS_Mode`` 0: its minimum pitch follows
-  ROSCO's wind-speed estimator, which the workbench does not model), driven by the same wind.
+  ``VS_ControlMode`` 1 (and 3) and peak shaving off (``PS_Mode`` 0: its minimum pitch belongs
+  to the pitch controller, tests/test_peak_shaving.py), driven by the same wind.
   The compiled real controller exists for this turbine, so it is the oracle rather than a
   second Python transcription of the same Fortran. Acceptance of the issue: rotor speed,
   torque and pitch SD within 2 % at 5, 9, 11 and 13 m/s (measured: ≤ 0.08 % in mode 1,
@@ -165,8 +165,7 @@ def test_torque_law_read_from_discon_in():
     assert float(entries["WE_GearboxRatio"].values[0]) == 1.0  # direct drive: no conversion
     with pytest.raises(ValueError, match=r"VS_ControlMode = 2 .*mode=3"):
         torque_law_from_discon(path)
-    with pytest.warns(UserWarning, match="PS_Mode = 1: peak shaving"):
-        law = torque_law_from_discon(path, mode=1)
+    law = torque_law_from_discon(path, mode=1)
     assert (law.k_opt, law.kp, law.ki, law.min_speed, law.reference_speed, law.rated_torque, law.transition_torque,
             law.max_rate, law.ss_corner) == tuple(raw.values())
 
@@ -178,10 +177,8 @@ def test_torque_law_gearbox_conversion(tmp_path):
     assert n == 1
     p = tmp_path / "DISCON.IN"
     p.write_text(text)
-    with pytest.warns(UserWarning, match="PS_Mode"):
-        a, b = torque_law_from_discon(iea15mw_discon(), mode=1), torque_law_from_discon(p, mode=1)
-    with pytest.warns(UserWarning, match="PS_Mode"):
-        assert torque_law_from_discon(write_discon(p, tmp_path / "cp.IN", VS_ConstPower=1), mode=1).const_power
+    a, b = torque_law_from_discon(iea15mw_discon(), mode=1), torque_law_from_discon(p, mode=1)
+    assert torque_law_from_discon(write_discon(p, tmp_path / "cp.IN", VS_ConstPower=1), mode=1).const_power
     assert not b.const_power  # the IEA 15 MW's VS_ConstPower = 0
     with pytest.raises(ValueError, match="VS_ConstPower = 2 must be 0"):
         torque_law_from_discon(write_discon(p, tmp_path / "cp2.IN", VS_ConstPower=2), mode=1)

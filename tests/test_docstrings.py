@@ -66,3 +66,36 @@ def test_examples_run(modname):
     mod = importlib.import_module(modname)
     res = doctest.testmod(mod, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)
     assert res.failed == 0, f"{res.failed} of {res.attempted} examples of {modname} failed"
+
+
+def test_an_overriding_method_takes_its_sources_docstring_with_its_note():
+    # issue 32: documented once. The note goes after the summary, where numpydoc reads an
+    # extended summary; the parameters stay the source's
+    from numpydoc.docscrape import FunctionDoc
+
+    from specdesign._docs import docstring_of
+
+    class Base:
+        def step(self, dt):
+            """One step.
+
+            Parameters
+            ----------
+            dt : float
+                Step, s.
+            """
+
+    class Child(Base):
+        @docstring_of(Base, note="The child also counts its steps.")
+        def step(self, dt):
+            pass
+
+    doc = FunctionDoc(Child.step)
+    assert doc["Summary"] == ["One step."] and doc["Extended Summary"] == ["The child also counts its steps."]
+    assert [p.name for p in doc["Parameters"]] == ["dt"]
+
+    def again(self, dt):  # Base has none: refused when the class is defined, naming both
+        pass
+
+    with pytest.raises(AttributeError, match="Base.again has no docstring to give .*again"):
+        docstring_of(Base)(again)

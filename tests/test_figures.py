@@ -39,11 +39,11 @@ def model():
 @pytest.fixture(scope="module")
 def design(model):
     """A QFT design made small (9 design frequencies, short tuning): a real QFTDesign in ~5 s."""
-    from specdesign.qft import design_qft
+    from specdesign.qft import design_qft, spec_notch
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a short tuning may miss a spec; figures still apply
-        return design_qft(model, 19.0, spec="notch", speed_relax_db=6.0, refine=0, maxfev=150,
+        return design_qft(model, 19.0, spec=spec_notch(speed_relax_db=6.0), refine=0, maxfev=150,
                           design_omega=[0.01, 0.05, 0.1, 0.3, 0.6, 1.0, 1.06, 1.5, 3.0],
                           dense_omega=np.logspace(-2, 1, 100))
 

@@ -18,23 +18,14 @@ from specdesign.rosco import (
     read_discon,
     rosco_gain_schedule,
     rosco_scheduled,
-    rosco_test_cases,
     write_discon,
 )
 from specdesign.turbine import TurbineModel, from_openfast
 
 
 @pytest.fixture(scope="module")
-def cases():
-    try:
-        return rosco_test_cases()
-    except ModuleNotFoundError as e:
-        pytest.skip(f"the rosco package is not installed ({e})")
-
-
-@pytest.fixture(scope="module")
-def nrel5mw(cases):
-    return from_openfast(cases / "NREL-5MW/NREL-5MW.fst")
+def nrel5mw(rosco_cases):
+    return from_openfast(rosco_cases / "NREL-5MW/NREL-5MW.fst")
 
 
 def _discon_pitch_schedule(path):
@@ -57,22 +48,22 @@ def test_nrel5mw_matches_its_published_figures(nrel5mw):
 
 @pytest.mark.parametrize("deck, discon", [("NREL-5MW/NREL-5MW.fst", "NREL-5MW/DISCON.IN"),
                                           ("BAR_10/BAR_10.fst", "BAR_10/BAR_10_DISCON.IN")])
-def test_trim_pitch_follows_the_discon_operating_schedule(cases, deck, discon):
+def test_trim_pitch_follows_the_discon_operating_schedule(rosco_cases, deck, discon):
     # issue 15: within 0.5 deg at 13-25 m/s (measured: 0.10 deg at most for both)
-    m = from_openfast(cases / deck)
-    v_sched, pitch_sched = _discon_pitch_schedule(cases / discon)
+    m = from_openfast(rosco_cases / deck)
+    v_sched, pitch_sched = _discon_pitch_schedule(rosco_cases / discon)
     v = np.arange(13.0, 25.5, 1.0)
     trim = np.array([m.trim(x).pitch for x in v])
     assert np.max(np.abs(np.rad2deg(trim - np.interp(v, v_sched, pitch_sched)))) < 0.5
     assert m.rated_wind_speed() < m.wind_range[0] <= m.rated_wind_speed() + 0.1
 
 
-def test_pole_placement_reproduces_the_nrel5mw_discon_gains(cases, nrel5mw):
+def test_pole_placement_reproduces_the_nrel5mw_discon_gains(rosco_cases, nrel5mw):
     # issue 15: Kp, Ki within 3 % of DISCON.IN's, pole placement at the deck's own tuning
     # (Examples/Tune_Cases/NREL5MW.yaml: omega_pc 0.6 rad/s, zeta_pc 0.7; VS_ConstPower = 1,
     # so ROSCO's constant-power term in A); measured: Kp within 2.2 %, Ki within 1.3 %
-    s = from_discon(cases / "NREL-5MW/DISCON.IN")
-    v, _ = _discon_pitch_schedule(cases / "NREL-5MW/DISCON.IN")
+    s = from_discon(rosco_cases / "NREL-5MW/DISCON.IN")
+    v, _ = _discon_pitch_schedule(rosco_cases / "NREL-5MW/DISCON.IN")
     g = rosco_gain_schedule(nrel5mw, v, omega_pc=0.6, zeta_pc=0.7, constant_power=True)
     n = s.gearbox_ratio  # the model's gains act on rotor speed, DISCON's on generator speed
     assert np.max(np.abs(g.Kp / n / s.kp - 1)) < 0.03
@@ -85,7 +76,7 @@ def test_pole_placement_reproduces_the_nrel5mw_discon_gains(cases, nrel5mw):
     assert rosco_scheduled(nrel5mw, schedule=s).schedule_pitch.size == 30
 
 
-def test_pole_placement_reproduces_the_bar10_discon_gains(cases):
+def test_pole_placement_reproduces_the_bar10_discon_gains(rosco_cases):
     # issue 15 ("and one more"): BAR_10 at its own tuning (Examples/Tune_Cases/BAR.yaml:
     # omega_pc 0.1 rad/s, zeta_pc 1.2, VS_ConstPower 0). Its blades are BeamDyn's (CompElast = 2);
     # the ElastoDyn blade file gives a rotor inertia 2.4 % below the 3.05636434e8 kg·m² BAR.yaml
@@ -93,32 +84,32 @@ def test_pole_placement_reproduces_the_bar10_discon_gains(cases):
     # Kp within 3 % (0.005 absolute where it changes sign, ~20.5 m/s), Ki within 3 %; measured
     # 2.1 % (< 0.0001 absolute) and 1.7 %; with the blade-file inertia 7.4 % and 4.0 %
     # (printed by the snippet in docs/turbines.md).
-    path = cases / "BAR_10/BAR_10_DISCON.IN"
+    path = rosco_cases / "BAR_10/BAR_10_DISCON.IN"
     s = from_discon(path)
     v, _ = _discon_pitch_schedule(path)
     n = s.gearbox_ratio
-    m = from_openfast(cases / "BAR_10/BAR_10.fst", rotor_inertia=3.05636434e8)
+    m = from_openfast(rosco_cases / "BAR_10/BAR_10.fst", rotor_inertia=3.05636434e8)
     g = rosco_gain_schedule(m, v, omega_pc=0.1, zeta_pc=1.2)
     near_zero = np.abs(s.kp) < 0.1 * np.max(np.abs(s.kp))
     assert np.all(np.abs(g.Kp / n - s.kp)[near_zero] < 0.005)
     assert np.max(np.abs(g.Kp / n / s.kp - 1)[~near_zero]) < 0.03
     assert np.max(np.abs(g.Ki / n / s.ki - 1)) < 0.03
-    plain = rosco_gain_schedule(from_openfast(cases / "BAR_10/BAR_10.fst"), v, omega_pc=0.1, zeta_pc=1.2)
+    plain = rosco_gain_schedule(from_openfast(rosco_cases / "BAR_10/BAR_10.fst"), v, omega_pc=0.1, zeta_pc=1.2)
     assert np.max(np.abs(plain.Ki / n / s.ki - 1)) > 0.03  # the inertia is what closes the gap
     with pytest.raises(ValueError, match="rotor_inertia"):
-        from_openfast(cases / "BAR_10/BAR_10.fst", rotor_inertia=-1.0)
+        from_openfast(rosco_cases / "BAR_10/BAR_10.fst", rotor_inertia=-1.0)
 
 
-def test_decks_the_model_cannot_represent_are_refused_by_name(cases):
+def test_decks_the_model_cannot_represent_are_refused_by_name(rosco_cases):
     with pytest.raises(ValueError, match=r"CompSub = 1: the substructure is flexible"):
-        from_openfast(cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile.fst")
+        from_openfast(rosco_cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile.fst")
     with pytest.raises(ValueError, match=r"NREL-2p8-127_Cp_Ct_Cq.txt\): the TSR axis of the rotor table must be uniform"):
-        from_openfast(cases / "NREL_2p8_127/NREL-2p8-127.fst")
+        from_openfast(rosco_cases / "NREL_2p8_127/NREL-2p8-127.fst")
 
 
-def test_missing_or_inconsistent_values_name_the_file_and_key(cases, tmp_path):
+def test_missing_or_inconsistent_values_name_the_file_and_key(rosco_cases, tmp_path):
     deck = tmp_path / "NREL-5MW"
-    shutil.copytree(cases / "NREL-5MW", deck)
+    shutil.copytree(rosco_cases / "NREL-5MW", deck)
     ed = deck / "NRELOffshrBsline5MW_Onshore_ElastoDyn.dat"
     text = ed.read_text()
     ed.write_text(text.replace("NacMass ", "NacMas_ ", 1))
@@ -149,17 +140,16 @@ def test_simulate_synthesises_the_wind_for_the_models_rotor(nrel5mw):
 
 
 # ----------------------------------------------------------------------------- below rated
-def test_torque_law_of_the_discon_is_attached_and_trims_from_cut_in(cases, tmp_path):
+def test_torque_law_of_the_discon_is_attached_and_trims_from_cut_in(rosco_cases, tmp_path):
     # the NREL 5 MW's own DISCON.IN runs constant power above rated (VS_ConstPower = 1): its law
-    # is attached with it; its peak shaving (PS_Mode = 1) is not modelled, and a warning says so
-    with pytest.warns(UserWarning, match="PS_Mode = 1: peak shaving"):
-        plain = from_openfast(cases / "NREL-5MW/NREL-5MW.fst")
+    # is attached with it (its peak shaving, PS_Mode = 1, is the pitch controller's: rosco_scheduled)
+    plain = from_openfast(rosco_cases / "NREL-5MW/NREL-5MW.fst")
     assert plain.torque_control is not None and plain.torque_control.const_power
     assert plain.trim(7.0).region == "2"
     # the same DISCON.IN with constant torque above rated and no peak shaving: its law
     # (VS_ControlMode 2, run as 3: TSR tracking on the measured rotor speed) is attached
-    discon = write_discon(cases / "NREL-5MW/DISCON.IN", tmp_path / "DISCON.IN", VS_ConstPower=0, PS_Mode=0)
-    m = from_openfast(cases / "NREL-5MW/NREL-5MW.fst", discon=discon)
+    discon = write_discon(rosco_cases / "NREL-5MW/DISCON.IN", tmp_path / "DISCON.IN", VS_ConstPower=0, PS_Mode=0)
+    m = from_openfast(rosco_cases / "NREL-5MW/NREL-5MW.fst", discon=discon)
     assert m.torque_control is not None and m.torque_control.mode == 3 and not m.torque_control.const_power
     # published (Jonkman et al. 2009): cut-in 3 m/s, rated 11.4 m/s, optimal TSR 7.55
     # (DISCON's VS_TSRopt 7.5); above rated the trim is the model without the law

@@ -284,7 +284,7 @@ def test_qft_specs_are_design_qfts(model):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        q = qft.design_qft(model, V, spec="notch", speed_relax_db=4.5, maxfev=1, refine=0)
+        q = qft.design_qft(model, V, spec=qft.spec_notch(speed_relax_db=4.5), maxfev=1, refine=0)
     like = hinf.spec_like_qft(model, V, speed_relax_db=4.5)
     tower, speed, notch = like.tower, like.speed, like.notch
     w = np.logspace(-2, 1, 300)

@@ -12,7 +12,6 @@ import shutil
 
 import pytest
 
-from specdesign.rosco import rosco_test_cases
 from specdesign.turbine import from_openfast
 
 ED = "NRELOffshrBsline5MW_Onshore_ElastoDyn.dat"
@@ -23,18 +22,10 @@ BLD = "NRELOffshrBsline5MW_Blade.dat"
 pytestmark = pytest.mark.filterwarnings("ignore:.*torque law below rated is not modelled:UserWarning")
 
 
-@pytest.fixture(scope="module")
-def cases():
-    try:
-        return rosco_test_cases()
-    except ModuleNotFoundError as e:
-        pytest.skip(f"the rosco package is not installed ({e})")
-
-
 @pytest.fixture
-def deck(cases, tmp_path):
+def deck(rosco_cases, tmp_path):
     d = tmp_path / "NREL-5MW"
-    shutil.copytree(cases / "NREL-5MW", d)
+    shutil.copytree(rosco_cases / "NREL-5MW", d)
     return d
 
 

@@ -14,7 +14,7 @@ from specdesign._checks import finite_system, spec_made_at
 from specdesign.feasibility import specification_for_target
 from specdesign.hinf import design as hdesign
 from specdesign.hinf import design_hinf, spec_from_certified, spec_from_pair
-from specdesign.qft import design_qft
+from specdesign import qft
 from specdesign.turbine import iea15mw
 
 
@@ -41,7 +41,7 @@ def test_a_specification_made_at_19_is_refused_at_21(model, at19, design):
         if design == "hinf":
             design_hinf(model, 21.0, spec=spec_from_certified(at19))
         else:
-            design_qft(model, 21.0, spec=at19)
+            qft.design_qft(model, 21.0, spec=qft.spec_from_certified(at19))
 
 
 def test_design_hinf_refuses_design_specifications_made_elsewhere(model):

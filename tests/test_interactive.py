@@ -302,3 +302,110 @@ def test_a_live_figure_asks_for_no_full_render_when_an_edit_blits(monkeypatch):
         ex.fig.axes[0].set_xlim(0.01, 10.0)  # a change from code: drawn after the cell, as pyplot does
         assert requests == [] and ex.fig.stale
     plt.close("all")
+
+
+@pytest.fixture
+def ipympl_canvas():
+    """Figures on ipympl's canvas as in JupyterLab, the browser's end a no-op; Agg again after."""
+    plt.switch_backend("module://ipympl.backend_nbagg")  # closes every figure
+
+    def as_in_the_browser(fig):
+        canvas = fig.canvas
+        canvas.syncing_data_url = False  # the browser's view said it is initialised
+        canvas.send = lambda *args, **kwargs: None
+        canvas.draw()
+        return canvas
+
+    yield as_in_the_browser
+    plt.switch_backend("Agg")
+
+
+def _ink_in(rgba, text, renderer):
+    """Whether an image (RGBA, 0-255 or 0-1) has a non-white pixel inside a text's box."""
+    box = text.get_window_extent(renderer)
+    h = rgba.shape[0]
+    part = np.asarray(rgba)[max(int(h - box.y1), 0):int(np.ceil(h - box.y0)), int(box.x0):int(np.ceil(box.x1)), :3]
+    return bool(np.any(part < (250 if part.dtype == np.uint8 else 250 / 255)))
+
+
+def _saved(fig):
+    import io
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    buf.seek(0)
+    return plt.imread(buf)
+
+
+@pytest.mark.filterwarnings("ignore:Passing unrecognized arguments:DeprecationWarning")  # ipympl's toolbar, in traitlets
+def test_the_designers_verdict_moves_to_a_readout_beside_a_live_figure_and_stays_in_saved_ones(loop, ipympl_canvas):
+    # in a notebook with widgets the verdict lines (the figure's title before) are an HTML
+    # readout above the live canvas, word for word summary()'s (the oracle: the title a figure on
+    # its own draws); the canvas no longer draws them, at an edit or a full render, and a saved
+    # figure still does, pixel for pixel as a figure drawn without blitting (live=False)
+    from loopshaping.interactive import readout_html
+
+    P, tmpl, b = loop
+    G = lc.Controller((lc.gain(379.0), lc.real_zero(42.0), lc.complex_pole(247.0, 0.5)))
+    d = Designer(b, tmpl, G)
+    ui = d.widget()
+    controls, readout, fig_box = ui.children
+    assert fig_box is d.figure.canvas and d._redraw.live
+    canvas = ipympl_canvas(d.figure)
+    title = d._artists["title"]
+    assert title not in d._redraw.artists  # the blit draws the loop, markers and closed-loop lines only
+    for k in (379.0, -100.0, 1e5):
+        st = d.set_param(0, k=k)
+        colour = "black" if st.all_stable and st.bounds_met else "tab:red"
+        assert d.readout == d.summary() == title.get_text()
+        assert readout.value == readout_html(d.summary(), colour)
+        assert not _ink_in(canvas.buffer_rgba(), title, canvas.get_renderer())  # not on the canvas
+    assert d.readout.startswith("UNSTABLE") and "#d62728" in readout.value  # k = 1e5, red as the title was
+    canvas.draw()  # a full render (a resize, a zoom) leaves it out too
+    assert not _ink_in(canvas.buffer_rgba(), title, canvas.get_renderer())
+    saved = _saved(d.figure)
+    assert _ink_in(saved, title, canvas.get_renderer())
+    plt.close(d.figure)
+    static = Designer(b, tmpl, G)  # its views set by the same starting controller
+    static.draw(live=False)
+    static.set_param(0, k=1e5)
+    np.testing.assert_array_equal(saved, _saved(static.figure))
+
+
+@pytest.mark.filterwarnings("ignore:Passing unrecognized arguments:DeprecationWarning")  # ipympl's toolbar, in traitlets
+def test_the_explorers_changing_text_moves_to_a_readout_beside_a_live_figure(ipympl_canvas):
+    # the notch's parameters (the legend label) and its promise and verdicts (the title) are an
+    # HTML readout above the live canvas, word for word those a figure on its own draws (the
+    # oracle: an explorer drawn live=False at the same notch); the legend names the
+    # specification only and is part of the background; a saved figure's title says it all
+    from loopshaping.interactive import readout_html
+    from specdesign import feasibility, spec
+    from specdesign.plots.spec import NotchExplorer
+    from specdesign.turbine import iea15mw
+
+    model = iea15mw()
+    base = spec.baseline_analysis(model, 19.0)
+    # with the pitch checker: its verdict names where a notch is infeasible (notebook 03's)
+    checker = feasibility.pitch_checkers(model, 19.0, spec.speed_specification(model, 19.0, margin_db=3.0),
+                                         max_sensitivity=None)[0]
+    ex = NotchExplorer(base, checker=checker)
+    ui = ex.widget()
+    sliders, readout, fig_box = ui.children
+    assert fig_box is ex.fig.canvas
+    canvas = ipympl_canvas(ex.fig)
+    assert ex._redraw.artists == [ex.line, ex.marker]  # the data alone is blitted
+    static = NotchExplorer(base, checker=checker, live=False)
+    infeasible = []
+    for n in ((1.05, 12.0, 0.2), (1.08, 30.0, 0.02), (0.8, 3.3, 0.5)):
+        ex.update(*n)
+        static.update(*n, redraw=False)
+        where, *verdict = ex.readout.split("\n")
+        assert static.line.get_label() == f"specification $|W_y|$: {where}"
+        assert verdict == static.ax_mag.get_title().split("\n")
+        assert readout.value == readout_html(ex.readout)
+        infeasible.append("INFEASIBLE" in ex.readout)
+        assert ex._legend_text.get_text() == "specification $|W_y|$ with the notch"
+    assert any(infeasible) and not all(infeasible)  # the sweep met both verdicts (the deep notches infeasible)
+    assert ex.ax_mag.get_title() == ex.readout  # drawn into a saved figure
+    renderer = canvas.get_renderer()
+    assert not _ink_in(canvas.buffer_rgba(), ex.ax_mag.title, renderer) and _ink_in(_saved(ex.fig), ex.ax_mag.title, renderer)

@@ -99,15 +99,19 @@ def test_bad_input_is_named(model, plant):
     with pytest.raises(TypeError, match="model"):
         qft.design_qft(plant, 19.0)
     with pytest.raises(ValueError, match="wind_speed"):
-        qft.design_qft(model, 30.0, spec="notch")
+        qft.design_qft(model, 30.0, spec=qft.spec_notch())
     with pytest.raises(ValueError, match="max_sensitivity"):
-        qft.design_qft(model, 19.0, spec="notch", max_sensitivity=0.9)
+        qft.design_qft(model, 19.0, spec=qft.spec_notch(), max_sensitivity=0.9)
     with pytest.raises(TypeError, match="plant"):
         qft.general_form("not a plant", OMEGA)
     with pytest.raises(TypeError, match=r"unknown option\(s\) \['max_sensitivty'\].*'max_sensitivity'"):
-        qft.design_qft(model, 19.0, spec="notch", max_sensitivty=1.5)  # a typo is named, not an internal function's TypeError
+        qft.design_qft(model, 19.0, spec=qft.spec_notch(), max_sensitivty=1.5)  # a typo is named, not an internal function's TypeError
     with pytest.raises(ValueError, match="speed_relax_db.*must increase"):
-        qft.design_qft(model, 19.0, spec="notch", speed_relax_db=(6.0, 3.0))
+        qft.spec_notch(25.0, speed_relax_db=(6.0, 3.0))
+    with pytest.raises(ValueError, match="speed_relax_db.*≥ 0 dB"):
+        qft.spec_notch(25.0, speed_relax_db=-1.0)
+    with pytest.raises(ValueError, match="target_reduction"):
+        qft.spec_notch(100.0)
 
 
 # ----------------------------------------------------------------------------- the 19 m/s design
@@ -115,7 +119,7 @@ def test_bad_input_is_named(model, plant):
 def design(model):
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)  # design_qft warns when a spec is not met
-        return qft.design_qft(model, 19.0, spec="notch")
+        return qft.design_qft(model, 19.0, spec=qft.spec_notch())
 
 
 def test_design_meets_its_bounds_at_the_design_frequencies(design):
@@ -223,7 +227,7 @@ def test_design_is_reproducible_under_round_off(model, v):
     vp = v - 1e-9 if v >= model.wind_range[1] else v + 1e-9
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        a, b = qft.design_qft(model, v, spec="notch"), qft.design_qft(model, vp, spec="notch")
+        a, b = qft.design_qft(model, v, spec=qft.spec_notch()), qft.design_qft(model, vp, spec=qft.spec_notch())
     assert a.success, a.message
     assert b.success, b.message
     assert abs(a.del_reduction - b.del_reduction) < 0.2
@@ -242,7 +246,7 @@ def test_the_specifications_it_met_pass_the_feasibility_check(model, design):
 
 
 def test_a_given_specification_pair_is_what_the_design_meets(model):
-    # design_qft(spec=...): no notch spec, no DEL penalty; the pair handed over is met. Checked
+    # design_qft(spec=spec_from_pair(...)): no notch spec, no DEL penalty; the pair handed over is met. Checked
     # independently of the tuner's grids: the nominal closed loop by the explicit formula on a
     # dense grid against the specification's own transfer functions.
     from specdesign import closedloop, spec
@@ -250,7 +254,7 @@ def test_a_given_specification_pair_is_what_the_design_meets(model):
     d = spec.design_specifications(model, 19.0, speed_relax_db=6.0, tower_relax_db=0.0)
     # ROSCO's map + 3 dB, with a narrow 2 dB dip at 1.5 rad/s that a plain 600-point grid misses
     tower = spec.Specification(d.base.system, (spec.Gain(3.0), spec.Notch(1.5, 2.0, 0.01)), name="W_tower")
-    q = qft.design_qft(model, 19.0, spec=(tower, d.speed))
+    q = qft.design_qft(model, 19.0, spec=qft.spec_from_pair(tower, d.speed))
     assert np.min(np.abs(q.dense_omega / 1.5 - 1)) < 1e-3  # the dense check is refined at the spec's own dip
     assert q.success, q.message
     assert q.tower_spec is tower and q.speed_spec is d.speed
@@ -264,7 +268,9 @@ def test_a_given_specification_pair_is_what_the_design_meets(model):
     assert np.max(20 * np.log10(t_my / np.abs(tower.response(w)))) <= 0.1  # issue 14: |T| ≤ |W| + 0.1 dB
     assert np.max(20 * np.log10(t_om / np.abs(d.speed.response(w)))) <= 0.1
     assert q.del_reduction >= q.promise.exact_del - 0.1
-    with pytest.raises(ValueError, match="spec='W' must be 'target', 'notch'"):
+    with pytest.raises(TypeError, match="spec must be a qft.QFTSpecification"):
         qft.design_qft(model, 19.0, spec="W")
-    with pytest.raises(TypeError, match="spec must be"):
-        qft.design_qft(model, 19.0, spec=(1.0, 2.0))
+    with pytest.raises(TypeError, match="spec must be a qft.QFTSpecification"):
+        qft.design_qft(model, 19.0, spec=(tower, d.speed))
+    with pytest.raises(TypeError, match="tower must be a specification with response"):
+        qft.spec_from_pair(1.0, 2.0)

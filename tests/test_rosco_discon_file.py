@@ -19,7 +19,6 @@ from specdesign.rosco import (
     read_discon,
     rosco_gain_schedule,
     rosco_scheduled,
-    rosco_test_cases,
     speed_filter,
 )
 from specdesign.turbine import iea15mw
@@ -28,14 +27,6 @@ from specdesign.turbine import iea15mw
 @pytest.fixture(scope="module")
 def schedule():
     return from_discon(iea15mw_discon())
-
-
-@pytest.fixture(scope="module")
-def cases():
-    try:
-        return rosco_test_cases()
-    except ModuleNotFoundError as e:
-        pytest.skip(f"the rosco package is not installed ({e})")
 
 
 def test_embedded_discon_is_the_shipped_rosco_schedule(schedule):
@@ -129,11 +120,11 @@ def test_bad_files_name_the_file_line_and_key(tmp_path):
     assert entries["PC_GS_KI"].line == 57
 
 
-def test_rosco_shipped_discon_files_read_as_rosco_reads_them(cases):
+def test_rosco_shipped_discon_files_read_as_rosco_reads_them(rosco_cases):
     utilities = pytest.importorskip("rosco.toolbox.utilities")
-    files = [cases / "NREL-5MW/DISCON.IN", cases / "BAR_10/BAR_10_DISCON.IN",
-             cases / "NREL_2p8_127/NREL-2p8-127_DISCON.IN",
-             cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"]
+    files = [rosco_cases / "NREL-5MW/DISCON.IN", rosco_cases / "BAR_10/BAR_10_DISCON.IN",
+             rosco_cases / "NREL_2p8_127/NREL-2p8-127_DISCON.IN",
+             rosco_cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"]
     for f in files:
         ref = utilities.read_DISCON(str(f))
         s = from_discon(f)

@@ -200,7 +200,7 @@ def test_the_session_of_a_qft_design_reloads_bitwise_and_reopens_the_designer(tm
     model = iea15mw()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        d = qft.design_qft(model, 19.0, target_reduction=25.0, spec="notch")
+        d = qft.design_qft(model, 19.0, spec=qft.spec_notch(25.0))
     designer = Designer(d.pitch_bounds, d.pitch_template, Controller.from_tf(d.pitch_controller))
     designer.set_param(0, k=1.1 * designer.controller.elements[0].params["k"])
     s = Session.from_qft(d, designer=designer, results={"note": "gain +10 %"})

@@ -1,7 +1,7 @@
 """Issue 14: the specification's promise is the target, and the design meets that specification.
 
 specification_for_target → TargetSpecification (certified over the plant cases) →
-design_qft(spec=...) (the certificate reduced, checked as any QFT design). The acceptance
+design_qft(spec=spec_from_certified(...)) (the certificate reduced, checked as any QFT design). The acceptance
 numbers are the issue's: promise ≥ 24.5 % recomputed independently within 0.5 pp, nominal
 |T_MyT,w| ≤ |W_MyT| + 0.1 dB on a dense 0.005-20 rad/s grid, every plant case meeting the
 specifications at the dense check, prediction ≥ promise − 0.1 pp, v and v + 1e-9 within 0.2 pp.
@@ -15,7 +15,7 @@ import pytest
 
 from specdesign import closedloop, spectral, wind
 from specdesign import feasibility as fz
-from specdesign.qft import design_qft
+from specdesign.qft import design_qft, spec_from_certified, spec_from_pair, spec_notch
 from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw
 
@@ -35,7 +35,7 @@ def _chain(model, v, target=25.0):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy: "solution may be inaccurate" on some rungs
         ts = fz.specification_for_target(model, v, target, **NO_HF)
-    return ts, design_qft(model, v, spec=ts)
+    return ts, design_qft(model, v, spec=spec_from_certified(ts))
 
 
 @pytest.fixture(scope="module")
@@ -114,14 +114,18 @@ def test_an_infeasible_target_says_why(model):
 
 def test_the_certificate_structure_needs_a_target_specification(model, chain19):
     ts, _ = chain19
-    with pytest.raises(ValueError, match="TargetSpecification"):
-        design_qft(model, 19.0, spec=(ts.tower, ts.speed), structure="certificate")
+    with pytest.raises(ValueError, match="needs a certified specification.*spec_from_certified.*'pair'"):
+        design_qft(model, 19.0, spec=spec_from_pair(ts.tower, ts.speed), structure="certificate")
+    with pytest.raises(ValueError, match="needs a certified specification.*'notch'"):
+        design_qft(model, 19.0, spec=spec_notch(25.0), structure="certificate")
     with pytest.raises(ValueError, match="structure"):
-        design_qft(model, 19.0, spec=ts, structure="youla")
+        design_qft(model, 19.0, spec=spec_from_certified(ts), structure="youla")
     with pytest.raises(ValueError, match="made at 19"):
-        design_qft(model, 21.0, spec=ts)
+        design_qft(model, 21.0, spec=spec_from_certified(ts))
     with pytest.raises(TypeError, match="options"):
-        design_qft(model, 19.0, spec=ts, maxfev=10)
+        design_qft(model, 19.0, spec=spec_from_certified(ts), maxfev=10)
+    with pytest.raises(TypeError, match="target must be a feasibility.TargetSpecification.*spec_from_pair"):
+        spec_from_certified((ts.tower, ts.speed))
 
 
 def test_qft_bounds_checker_agrees_with_a_brute_force_scan(model, chain19):
@@ -172,8 +176,8 @@ def test_a_specification_driven_schedule(model):
     (d,) = design_schedule(model, (25.0,), progress=False, **NO_HF)  # specification-driven by default
     assert d.success and d.promise.exact_del >= 24.5 and d.del_reduction >= d.promise.exact_del - 0.1
     assert d.options["structure"] == "certificate"
-    with pytest.raises(ValueError, match="specification"):
-        design_schedule(model, (25.0,), specification="youla")
+    with pytest.raises(TypeError, match="spec_notch"):
+        design_schedule(model, (25.0,), spec="youla")
 
 
 def test_the_figures_say_which_specification_the_design_meets(model, chain19):
@@ -208,7 +212,7 @@ def test_a_hand_edited_specification_is_recertified(model, chain19):
     ts, _ = chain19
     bump = fz.recertify(model, ts, tower=ts.tower.add(spec.Notch(2.5, -3.0, 0.3)))  # +3 dB room at 2.5 rad/s
     assert bump.promise.exact_del <= ts.promise.exact_del and bump.design is ts.design
-    d = design_qft(model, 19.0, spec=bump)
+    d = design_qft(model, 19.0, spec=spec_from_certified(bump))
     assert d.success and d.del_reduction >= bump.promise.exact_del - 0.1
     with pytest.raises(ValueError, match=r"exceeds the edited W_MyT by .* dB at .* rad/s for the plant case"):
         fz.recertify(model, ts, tower=ts.tower.add(spec.Gain(-2.0)))
@@ -220,7 +224,8 @@ def test_a_hand_edited_specification_is_recertified(model, chain19):
 
 def test_the_default_design_is_specification_driven(model, chain19):
     # Issue 14: design_qft's default specification is the feasible one for target_reduction,
-    # so the default design is exactly the chain specification_for_target → design_qft(spec=).
+    # so the default design is exactly the chain specification_for_target →
+    # design_qft(spec=spec_from_certified(...)).
     ts, d = chain19
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy, as in _chain
@@ -229,10 +234,17 @@ def test_the_default_design_is_specification_driven(model, chain19):
     assert default.promise.exact_del == pytest.approx(ts.promise.exact_del, abs=1e-9)
     assert default.del_reduction == pytest.approx(d.del_reduction, abs=1e-9)
     # the fixed-structure tuner's options are refused by name, with the way to reach them
-    with pytest.raises(TypeError, match=r"\['maxfev', 'speed_relax_db'\].*spec='notch'"):
-        design_qft(model, 19.0, speed_relax_db=4.5, maxfev=10)
-    with pytest.raises(ValueError, match="spec='W' must be"):
+    with pytest.raises(TypeError, match=r"\['maxfev'\].*spec=qft.spec_notch"):
+        design_qft(model, 19.0, maxfev=10)
+    # the notch design's speed ladder is its specification's, named with the way to give it
+    with pytest.raises(TypeError, match=r"unknown option.*'speed_relax_db'.*spec=qft.spec_notch\(target_reduction, "
+                                        r"speed_relax_db=...\)"):
+        design_qft(model, 19.0, speed_relax_db=4.5)
+    # a specification is made by a named function, never guessed from a string or a tuple
+    with pytest.raises(TypeError, match="spec must be a qft.QFTSpecification.*spec_from_certified.*spec_notch"):
         design_qft(model, 19.0, spec="W")
+    with pytest.raises(TypeError, match="spec must be a qft.QFTSpecification"):
+        design_qft(model, 19.0, spec=ts)
 
 
 @pytest.fixture(scope="module")
@@ -270,7 +282,7 @@ def test_an_element_specification_promises_the_target_and_is_met(model, elements
         p = model.linearize(v)
         bound = np.abs(closedloop.t_tower_wind(p, rosco_baseline(model, v), w)) * np.abs(w_spec.response(w)) / t_rosco
         assert np.max(20 * np.log10(np.abs(closedloop.t_tower_wind(p, cert, w)) / bound)) <= 1e-6
-    d = design_qft(model, 19.0, spec=ts)
+    d = design_qft(model, 19.0, spec=spec_from_certified(ts))
     assert d.success, d.message
     t_my = np.abs(closedloop.t_tower_wind(plant, d.pitch_controller, w))
     assert np.max(20 * np.log10(t_my / np.abs(w_spec.response(w)))) <= 0.1
@@ -323,4 +335,4 @@ def test_the_default_design_certifies_and_meets_on_the_plant_cases_asked_for(mod
     assert d.success and d.del_reduction >= 25.0 - 0.1
     ts, _ = chain19
     with pytest.raises(TypeError, match="case_offsets"):
-        design_qft(model, 19.0, spec=ts, template_offsets=(-0.5, 0.5))
+        design_qft(model, 19.0, spec=spec_from_certified(ts), template_offsets=(-0.5, 0.5))

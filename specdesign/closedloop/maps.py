@@ -308,14 +308,10 @@ def t_tower_wind(P: PlantLike, C: ElementLike, omega: ArrayLike, **atd: Any) -> 
 
     Parameters
     ----------
-    P : control.LTI or Mapping
-        Named plant LTI or its responses (as in :func:`t_output_wind`).
-    C : control.LTI, float, array_like or None
-        Pitch controller C_β (rad per rad/s) or its response on ``omega``.
-    omega : array_like
-        Frequencies, rad/s.
-    **atd : dict, optional
-        ``atd_controller`` and ``atd_measurement`` of :func:`t_output_wind`.
+    P, C, omega, **atd
+        As :func:`t_gen_speed_wind` and :func:`t_output_wind` take them: the named plant (or its
+        responses), the pitch controller C_β (rad per rad/s, or its response), the frequencies
+        (rad/s) and the ATD's ``atd_controller`` and ``atd_measurement``.
 
     Returns
     -------
@@ -368,12 +364,9 @@ def closed_loop_del(sys: control.LTI, omega: ArrayLike, wind_psd: ArrayLike, m: 
 
     Parameters
     ----------
-    sys : control.LTI
-        Closed-loop (or open-loop) named LTI system.
-    omega : array_like
-        Frequencies, rad/s: 1-D, increasing, non-negative.
-    wind_psd : array_like
-        One-sided wind PSD S_W on ``omega``, (m/s)² per rad/s.
+    sys, omega, wind_psd, input
+        The system, the grid (rad/s), the wind PSD ((m/s)² per rad/s) and the disturbance input,
+        as :func:`output_psd` takes them.
     m : float
         Wöhler exponent (-), > 0.
     output : str
@@ -381,8 +374,6 @@ def closed_loop_del(sys: control.LTI, omega: ArrayLike, wind_psd: ArrayLike, m: 
     method : str
         One of :func:`specdesign.spectral.damage_rate`'s methods ("dirlik", "narrowband",
         "tovo_benasciutti", ...).
-    input : str
-        Name of the disturbance input (``wind`` by default).
 
     Returns
     -------

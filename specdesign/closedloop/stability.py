@@ -407,14 +407,9 @@ def unstable_poles(model: TurbineModel | KernelPlant | None, controller: Any, wi
 
     Parameters
     ----------
-    model : TurbineModel or KernelPlant
-        The turbine, with a linearisation.
-    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
-        Anything :func:`specdesign.simulate.simulate` runs with a linear form.
-    wind_speed : float
-        Operating point, m/s.
-    parts : tuple, optional
-        :func:`loop_parts` of the same arguments, if already at hand.
+    model, controller, wind_speed, parts
+        As :func:`closed_loop_matrices` takes them: the turbine (with a linearisation), a
+        controller with a linear form, the operating point (m/s) and, optionally, the loop parts.
 
     Returns
     -------

@@ -14,6 +14,8 @@ Layout
   or ROSCO's gain-scheduled PI) and its discrete bank for the compiled loop.
 - :mod:`specdesign.controller.torque`: ROSCO's generator-torque controller below rated
   (:class:`TorqueLaw`, its steady state, its linearisation and its compiled step).
+- :mod:`specdesign.controller.peak_shaving`: ROSCO's peak shaving (:class:`PeakShaving`), its
+  minimum pitch at ROSCO's extended-Kalman-filter wind estimate (ported) and its compiled step.
 - :mod:`specdesign.controller.noise`: what a controller measures, :class:`SensorNoise` (white
   sensor noise and the 3P ripple the simulator adds between the plant and every controller).
 - :mod:`specdesign.controller.discon_file`: ROSCO's parameter file DISCON.IN read and written
@@ -41,6 +43,7 @@ from .lti import (
     tustin_matrices,
 )
 from .noise import IEA15MW_SENSORS, SensorNoise
+from .peak_shaving import PeakShaving, peak_shaving_from_discon
 from .scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from .torque import (
     TORQUE_MODES,
@@ -70,6 +73,8 @@ __all__ = [
     "FORMS",
     "SCHEDULE_FILTER_OMEGA",
     "ScheduledController",
+    "PeakShaving",
+    "peak_shaving_from_discon",
     "TORQUE_MODES",
     "TORQUE_REGIONS",
     "TorqueLaw",

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 from .lti import as_lti, split_integrator, split_slow, tustin_matrices
+from .peak_shaving import PeakShaving
 
 __all__ = ["SCHEDULE_FILTER_OMEGA", "FORMS", "ScheduledController", "schedule_filter_coefficients", "controller_bank"]
 
@@ -29,6 +30,16 @@ SCHEDULE_FILTER_OMEGA = 0.1
 
 #: The two forms of :class:`ScheduledController`.
 FORMS = ("output", "gains")
+
+
+def _check_peak_shaving(ps, form):
+    """ScheduledController's ``peak_shaving``: a PeakShaving, with ROSCO's form of the PI only, or None."""
+    if ps is None:
+        return
+    if not isinstance(ps, PeakShaving):
+        raise TypeError(f"peak_shaving must be a PeakShaving (peak_shaving_from_discon) or None, got {type(ps).__name__}")
+    if form != "gains":
+        raise ValueError("peak_shaving is for form='gains' only (it lifts the lower limit of ROSCO's PI)")
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare by identity
@@ -74,6 +85,10 @@ class ScheduledController:
         ``filter_omega``, discretised exactly. A damping ratio ζ: second order,
         ω_f²/(s² + 2ζω_f s + ω_f²), discretised by Tustin, as ROSCO filters its scheduling
         pitch (``Filters.f90``: ω_f = 0.25·F_LPFCornerFreq, ζ = 0.7).
+    peak_shaving : PeakShaving or None, optional
+        ROSCO's peak shaving (``form="gains"`` only): the PI's lower limit lifted every step
+        to the minimum pitch at ROSCO's filtered wind-speed estimate (see
+        :mod:`specdesign.controller.peak_shaving`). None (default): the limits alone.
 
     Raises
     ------
@@ -94,6 +109,7 @@ class ScheduledController:
     error_filter: object = field(default=None, repr=False)
     pitch_limits: tuple | None = None
     filter_damping: float | None = None
+    peak_shaving: PeakShaving | None = None
 
     def __post_init__(self):
         b = np.atleast_1d(np.asarray(self.schedule_pitch, dtype=float))
@@ -109,6 +125,7 @@ class ScheduledController:
             object.__setattr__(self, "filter_damping", positive_scalar(self.filter_damping, "filter_damping"))
         if self.form not in FORMS:
             raise ValueError(f"form must be one of {FORMS}, got {self.form!r}")
+        _check_peak_shaving(self.peak_shaving, self.form)
         if self.form == "output":
             if self.kp is not None or self.ki is not None or self.error_filter is not None or self.pitch_limits is not None:
                 raise ValueError("kp, ki, error_filter and pitch_limits are for form='gains' only")

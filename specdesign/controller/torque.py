@@ -29,8 +29,10 @@ raises the pitch controller's. Torque is then limited to [``VS_MinTq``, min(``VS
 ``VS_MaxRat``. PIs are ROSCO's: forward Euler integrator
 saturated at the output limits. Filters are ROSCO's Tustin forms, reset to their input on
 the first call. Peak shaving (``PS_Mode``, a minimum pitch ``PS_BldPitchMin`` interpolated at
-the wind speed estimated by ROSCO's extended Kalman filter) is not modelled, the estimator being
-outside the workbench: the pitch limit is the model's, and :func:`torque_law_from_discon` warns.
+the wind speed estimated by ROSCO's extended Kalman filter) belongs to the pitch controller
+(:mod:`specdesign.controller.peak_shaving`, run by :func:`specdesign.rosco.rosco_scheduled`); its
+limit reaches this law as ``pitch_min`` of :func:`torque_step` (the smoother and the state
+machine measure the pitch from it), the law's ``fine_pitch`` without it.
 
 All quantities here are on the rotor (low-speed) shaft in SI: a DISCON.IN's generator-side
 speeds are divided by its gearbox ratio N, torques multiplied by it (K by N³, PI gains by N²).
@@ -38,7 +40,6 @@ speeds are divided by its gearbox ratio N, torques multiplied by it (K by N³, P
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -52,7 +53,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
 
 __all__ = ["TORQUE_MODES", "TORQUE_PARAMS", "TORQUE_STATES", "TORQUE_REGIONS", "TRIM_TOL", "TorqueLaw", "torque_law",
-           "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step"]
+           "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step", "rosco_lpf1"]
 
 #: Regions of a trim (:attr:`specdesign.turbine.OperatingPoint.region`): "1.5" minimum speed held
 #: by the PI, "2" K·Ω², "2.5" the torque controller's rated speed held by the PI, "2.5s" its PI
@@ -298,19 +299,15 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
         :data:`TORQUE_MODES` (mode 2: pass ``mode=3``), ``VS_ConstPower`` not 0 or 1, or
         ``VS_FBP`` or ``PRC_Mode`` not 0 (laws the workbench does not run).
 
-    Warns
+    Notes
     -----
-    UserWarning
-        For ``PS_Mode`` not 0, naming the file, line and key: peak shaving is not modelled (the
-        pitch limit is the model's).
+    A file's peak shaving (``PS_Mode = 1``) is the pitch controller's, not this law's:
+    :func:`specdesign.rosco.rosco_scheduled` runs it with the file's schedule.
 
     Examples
     --------
-    >>> import warnings
     >>> from specdesign.rosco import iea15mw_discon
-    >>> with warnings.catch_warnings():
-    ...     warnings.simplefilter("ignore", UserWarning)  # its PS_Mode = 1: peak shaving not modelled
-    ...     law = torque_law_from_discon(iea15mw_discon(), mode=1)
+    >>> law = torque_law_from_discon(iea15mw_discon(), mode=1)
     >>> law.mode, round(law.min_speed, 4)
     (1, 0.5236)
     """
@@ -335,13 +332,6 @@ def torque_law_from_discon(path: str | Path, *, mode: int | None = None) -> Torq
     if const_power not in (0, 1):
         raise ValueError(f"{p}: line {entries['VS_ConstPower'].line}: VS_ConstPower = {const_power} must be 0 "
                          "(constant torque above rated) or 1 (constant power)")
-    if "PS_Mode" in entries and int(f("PS_Mode")) != 0:
-        warnings.warn(f"{p}: line {entries['PS_Mode'].line}: PS_Mode = {int(f('PS_Mode'))}: peak shaving (ROSCO's "
-                      "minimum pitch PS_BldPitchMin at its wind-speed estimate WE_Vw_F, an extended Kalman filter the "
-                      "workbench does not model) is not modelled; the pitch limit is the model's. Where the pitch "
-                      "dips to that table it matters (the NREL 5 MW's deck: 6 % in tower DEL at 19 m/s, "
-                      "docs/turbines.md); compare with the compiled DISCON on write_discon(path, out, PS_Mode=0)",
-                      UserWarning, stacklevel=2)
     n = f("WE_GearboxRatio")
     if not n > 0:
         raise ValueError(f"{p}: line {entries['WE_GearboxRatio'].line}: WE_GearboxRatio must be positive")
@@ -496,8 +486,30 @@ def close_torque_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray
 
 # ----------------------------------------------------------------------------- compiled step
 @njit(cache=True)
-def _lpf1(st, iy, iu, u, corner, dt, first):
-    # ROSCO's LPFilter (Tustin), reset to its input on the first call
+def rosco_lpf1(st: np.ndarray, iy: int, iu: int, u: float, corner: float, dt: float, first: bool) -> float:
+    """One step of ROSCO's first-order low-pass ``LPFilter`` (``Filters.f90``: Tustin of ω_c/(s + ω_c)).
+
+    Parameters
+    ----------
+    st : numpy.ndarray
+        State array holding the filter's last output at ``iy`` and last input at ``iu``, updated.
+    iy, iu : int
+        Their indices.
+    u : float
+        Input.
+    corner : float
+        Corner ω_c (rad/s).
+    dt : float
+        Step (s).
+    first : bool
+        Reset to the input first, as ROSCO does on its first call (set ``st[iy]`` and ``st[iu]``
+        and pass False to reset to another value).
+
+    Returns
+    -------
+    float
+        Output.
+    """
     if first:
         st[iy] = u
         st[iu] = u
@@ -522,7 +534,7 @@ def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):
 
 @njit(cache=True)
 def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitch: float, dt: float,
-                first: bool) -> tuple[float, float]:
+                first: bool, pitch_min: float = math.nan, reference: float = math.nan) -> tuple[float, float]:
     """One step of ROSCO's torque controller (compiled; :mod:`specdesign.controller.torque`).
 
     Parameters
@@ -542,6 +554,15 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         Step (s).
     first : bool
         The first call (filters and integrators start at their inputs, as ROSCO's do).
+    pitch_min : float, optional
+        The pitch controller's lower limit of the previous step (rad), ROSCO's ``PC_MinPit``:
+        NaN (default) for the law's ``fine_pitch`` (``tq[T_PITCH_MIN]``), or the peak-shaving limit
+        (:func:`specdesign.controller.peak_shaving.peak_shaving_step`). Region 3 starts
+        ``PC_Switch`` above it, and the setpoint smoother measures the pitch from it.
+    reference : float, optional
+        Modes 3 and 4: the tracking reference (rad/s) to use instead of theirs, ROSCO's
+        ``VS_ControlMode = 2`` reference TSR·WE_Vw/R on a wind estimate
+        (:func:`specdesign.controller.peak_shaving.tsr_reference`); NaN (default): their own.
 
     Returns
     -------
@@ -552,6 +573,8 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     """
     mode = int(tq[T_MODE])
     c = tq[T_FILT_CORNER]
+    if math.isnan(pitch_min):
+        pitch_min = tq[T_PITCH_MIN]
     if first:
         st[S_WF] = omega
         st[S_WF2] = omega
@@ -560,7 +583,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         st[S_SSF] = 0.0
         st[S_PLAST] = power
     if tq[T_FILT_TYPE] == 1.0:
-        wf = _lpf1(st, S_WF, S_U1, omega, c, dt, False)
+        wf = rosco_lpf1(st, S_WF, S_U1, omega, c, dt, False)
     else:
         h2 = dt * dt * c * c
         z = tq[T_FILT_DAMP]
@@ -582,8 +605,10 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
         ref = math.sqrt(max(st[S_TQ], 0.0) / k)
     else:
         ref = tq[T_VS_REF]
+    if mode != 1 and not math.isnan(reference):
+        ref = reference
     if tq[T_REF_CORNER] > 0.0:
-        ref = _lpf1(st, S_REF, S_REF_U, ref, tq[T_REF_CORNER], dt, first)
+        ref = rosco_lpf1(st, S_REF, S_REF_U, ref, tq[T_REF_CORNER], dt, first)
     vs_ref = min(max(ref, tq[T_MIN_SPEED]), tq[T_VS_REF])
     if ssf > 0.0:
         vs_ref -= ssf
@@ -593,7 +618,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     min_om = k * tq[T_MIN_SPEED] ** 2
     max_om = k * tq[T_VS_REF] ** 2
     # state machine, on the previous step's PI outputs (StateMachine)
-    rgn3 = tq[T_PITCH_MIN] + tq[T_PC_SWITCH]
+    rgn3 = pitch_min + tq[T_PC_SWITCH]
     if first:
         state = 4 if pitch >= rgn3 else 2
     elif pitch >= rgn3:
@@ -609,9 +634,9 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     st[S_STATE] = state
     # setpoint smoother (SetpointSmoother), on the measured pitch and the last step's power
     if tq[T_SS_MODE] != 0.0:
-        d = ((pitch - tq[T_PITCH_MIN]) / 0.524 * tq[T_SS_VS]
+        d = ((pitch - pitch_min) / 0.524 * tq[T_SS_VS]
              - (tq[T_RATED_POWER] - st[S_PLAST]) / tq[T_RATED_POWER] * tq[T_SS_PC]) * tq[T_PC_REF]
-        st[S_SSF] = _lpf1(st, S_SSF, S_SS_U, d, tq[T_SS_CORNER], dt, first)
+        st[S_SSF] = rosco_lpf1(st, S_SSF, S_SS_U, d, tq[T_SS_CORNER], dt, first)
     last = st[S_TQ]
     # VS_ConstPower: the rated power on the filtered speed above rated, and as every mode's ceiling
     const_power = tq[T_CONST_POWER] != 0.0

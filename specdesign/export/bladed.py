@@ -55,6 +55,10 @@ class DisconExport:
 def _as_controller(obj: object, name: str | None):
     """``obj`` as what :func:`controller_bank` takes: a ScheduledController or an LTI."""
     if isinstance(obj, ScheduledController):
+        if obj.peak_shaving is not None:  # the library runs no wind-speed estimator
+            raise ValueError(f"controller_or_design {obj.name!r} carries ROSCO's peak shaving "
+                             f"({obj.peak_shaving.name}), which the exported library does not run: export "
+                             "dataclasses.replace(controller, peak_shaving=None), or run the deck's own ROSCO DISCON")
         return obj, name or obj.name
     if hasattr(obj, "pitch_controller"):  # a design record: QFTDesign, HinfDesign
         atd = getattr(obj, "atd_controller", None)
@@ -228,7 +232,8 @@ def export_discon(controller_or_design: object, folder: str | Path, *, dt: float
         For an object that is not a controller or a design.
     ValueError
         For a non-positive ``dt`` or ``gearbox_ratio``, an unknown ``torque``, a non-positive
-        ``pitch_rate_limit`` or a negative ``atd_highpass``.
+        ``pitch_rate_limit`` or a negative ``atd_highpass``, or a ScheduledController with
+        ROSCO's peak shaving (its wind-speed estimator is not exported).
     CompilerNotFoundError
         If no C compiler is found to build the library.
 

@@ -354,7 +354,7 @@ static int load(Controller *c, const char *path, char *msg, size_t msg_size)
 }
 
 /* ------------------------------------------------------------------------------ torque law */
-/* ROSCO's LPFilter (Tustin), reset to its input on the first call: torque.py, _lpf1 */
+/* ROSCO's LPFilter (Tustin), reset to its input on the first call: torque.py, rosco_lpf1 */
 static double lpf1(double *st, int iy, int iu, double u, double corner, double dt, int first)
 {
     if (first) {

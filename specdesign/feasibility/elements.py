@@ -503,12 +503,9 @@ def element_specification(model, wind_speed, target_reduction=TARGET_REDUCTION, 
 
     Parameters
     ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine.
-    wind_speed : float
-        Operating point, m/s.
-    target_reduction : float
-        Tower-base DEL reduction the specification must promise, % (0-100).
+    model, wind_speed, target_reduction
+        The turbine, the operating point (m/s) and the tower-base DEL reduction to promise (%),
+        as :func:`specification_for_target` takes them.
     headroom_pp : sequence of float
         Extra reductions (percentage points) asked of the certificates of the fallback (elements
         above their envelope), tried in turn after :data:`FOLLOW`.

@@ -31,9 +31,9 @@ def shape_whole_band(base: Baseline, target_reduction: float, *, quantity: str =
     the baseline's model and wind speed (the baseline must come from
     :func:`specdesign.spec.baseline_analysis` of ``tower_base_my`` with ROSCO and the default
     wind). The promise reported is that of the specification handed to the design;
-    ``certified`` is the pair to give ``design_qft(model, v, spec=res.certified)``, or to edit
-    by hand (``res.certified.tower.add(Notch(...))``) and re-check with
-    :func:`~specdesign.feasibility.recertify`.
+    ``certified`` is the pair to give
+    ``design_qft(model, v, spec=qft.spec_from_certified(res.certified))``, or to edit by hand
+    (``res.certified.tower.add(Notch(...))``) and re-check with :func:`~specdesign.feasibility.recertify`.
 
     Parameters
     ----------

@@ -15,7 +15,7 @@ notches) and |T_{Ω,w}(jω)| ≤ |W_Ω(jω)| (generator speed, the baseline's T_
 :func:`design_hinf` takes the feasible pair of a DEL target, as ``specdesign.qft.design_qft`` does
 (:func:`specdesign.feasibility.specification_for_target`, 25 %, certified over plant cases), and
 meets it at every case (pitch only); ``spec=spec_like_qft(model, v)`` takes the specifications of
-``design_qft(spec="notch")`` (the tower spec relaxed above ≈ 1.3
+``design_qft(spec=spec_notch(...))`` (the tower spec relaxed above ≈ 1.3
 rad/s, the speed spec relaxed by QFT's dB ladder). Either way H∞ and QFT are compared on the same
 specifications. Dividing each
 output by its specification gives performance outputs whose H∞ norm is ≤ 1 exactly when

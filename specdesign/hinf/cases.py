@@ -401,10 +401,8 @@ def refine_on_cases(model, target, pitch_controller: ct.LTI, *, margin_db: float
 
     Parameters
     ----------
-    model : specdesign.turbine.TurbineModel
-        The turbine the pair was made on.
-    target : specdesign.feasibility.TargetSpecification
-        The pair and its plant cases.
+    model, target
+        The turbine and the certified pair, as :func:`check_pair` takes them.
     pitch_controller : control.LTI
         Starting C_β (rad per rad/s, β = −C_β·Ω_g), e.g. the reduced H∞ controller.
     margin_db : float

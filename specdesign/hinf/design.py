@@ -322,7 +322,7 @@ def design_hinf(
         (:func:`generalized_plant`). Default: 0.1 rad/s when ``decay_rate`` > 0 (without it
         the shift would move the controller's integral action to −α), none otherwise.
     max_hf_gain_ratio : float or None
-        κ of the high-frequency gain bound with ``spec="target"``: the pair is made under it
+        κ of the high-frequency gain bound without ``spec``: the pair is made under it
         (``specification_for_target(max_hf_gain_ratio=...)``, which refuses a target it makes
         infeasible, naming it), and the multi-model step holds |C_β| ≤ κ·|C_ROSCO| on
         HF_OMEGA-HF_END (2-10 rad/s, 3P included) with C_β strictly proper (``case_check``'s

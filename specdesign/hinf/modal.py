@@ -91,10 +91,8 @@ def modal_response(kinds: tuple[str, ...], x: np.ndarray, s: np.ndarray,
 
     Parameters
     ----------
-    kinds : tuple of str
-        From :func:`modal_parameters`.
-    x : numpy.ndarray
-        The parameters (real).
+    kinds, x
+        The modal form, as :func:`modal_parameters` returns it.
     s : numpy.ndarray
         Complex frequencies, e.g. jω with ω in rad/s, shape (n,).
     jacobian : bool
@@ -199,10 +197,8 @@ def modal_matrices_jacobian(kinds: tuple[str, ...], x: np.ndarray) -> list[tuple
 
     Parameters
     ----------
-    kinds : tuple of str
-        From :func:`modal_parameters`.
-    x : numpy.ndarray
-        The parameters (real).
+    kinds, x
+        The modal form, as :func:`modal_parameters` returns it.
 
     Returns
     -------
@@ -234,10 +230,8 @@ def modal_bounds(kinds: tuple[str, ...], x: np.ndarray, max_rate: float) -> list
 
     Parameters
     ----------
-    kinds : tuple of str
-        From :func:`modal_parameters`.
-    x : numpy.ndarray
-        The parameters (real).
+    kinds, x
+        The modal form, as :func:`modal_parameters` returns it.
     max_rate : float
         Largest |Re λ| and Im λ allowed, rad/s (> 0).
 

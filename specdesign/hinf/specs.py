@@ -20,7 +20,7 @@ from .. import spec as sp
 from ..fatigue import TOWER_M
 from ..feasibility import MAX_HF_GAIN_RATIO, TargetSpecification, specification_for_target
 from ..feasibility.target import TARGET_REDUCTION
-from ..qft.design import SPEED_RELAX_DB
+from ..qft.specs import SPEED_RELAX_DB
 
 if TYPE_CHECKING:
     from ..spec import Specification
@@ -240,7 +240,7 @@ def spec_from_qft(design: Any) -> HinfSpecification:
     Examples
     --------
     >>> from specdesign import hinf, qft, turbine
-    >>> q = qft.design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
+    >>> q = qft.design_qft(turbine.iea15mw(), 19.0, spec=qft.spec_notch(25.0))  # doctest: +SKIP
     >>> hinf.spec_from_qft(q).kind  # doctest: +SKIP
     'qft_design'
     """
@@ -256,7 +256,7 @@ def spec_like_qft(model: TurbineModel, wind_speed: float, *, speed_relax_db: flo
                   spec_reduction: float = sp.SPEC_REDUCTION, tower_relax_db: float = sp.TOWER_RELAX_DB,
                   tower_relax_omega: float = sp.TOWER_RELAX_OMEGA,
                   m: float = TOWER_M, omega: ArrayLike | None = None) -> HinfSpecification:
-    """QFT's notch specifications (those of ``design_qft(spec="notch")``), one pair per relaxation.
+    """QFT's notch specifications (those of ``design_qft(spec=qft.spec_notch(...))``), one pair per relaxation.
 
     Built as :func:`specdesign.spec.design_specifications` builds them for QFT: W_MyT is ROSCO's
     T_{MyT,w} × the notches of :func:`specdesign.spec.shape_to_target` × two leads relaxing it by

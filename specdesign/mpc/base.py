@@ -55,7 +55,7 @@ import numpy as np
 from .._checks import positive_scalar
 
 __all__ = ["DiscreteTurbine", "discretize_turbine", "kalman_gain", "operating_wind_speed", "pitch_wind_estimate",
-           "prediction_matrices", "within_limits", "MEASURED", "MEASUREMENT_STD", "OPERATING_POINTS"]
+           "prediction_matrices", "steps_per_sample", "within_limits", "MEASURED", "MEASUREMENT_STD", "OPERATING_POINTS"]
 
 #: Values of ``operating_point``: the estimate scheduled online (default), the trim of the
 #: run's initial pitch held, or a fixed design point given by the user (module docstring).
@@ -361,6 +361,38 @@ def pitch_wind_estimate(model, pitch: float) -> float:
         return hi
     v = scipy.optimize.brentq(lambda s: model.trim(s).pitch - pitch, lo, hi, xtol=1e-6)
     return round(float(v), 3)
+
+
+def steps_per_sample(ts: float, dt: float) -> int:
+    """Simulation steps per controller sample: ``ts`` checked to be a whole multiple of ``dt``.
+
+    Parameters
+    ----------
+    ts : float
+        The controller's sample time (s).
+    dt : float
+        The simulation step (s).
+
+    Returns
+    -------
+    int
+        ts/dt, ≥ 1.
+
+    Raises
+    ------
+    ValueError
+        If ``ts`` is not a whole multiple of ``dt`` (to 1e-9 of ``ts``: the round-off of a
+        step such as 0.02 s written in decimal).
+
+    Examples
+    --------
+    >>> steps_per_sample(0.1, 0.02)
+    5
+    """
+    every = int(round(ts / dt))
+    if every < 1 or abs(every * dt - ts) > 1e-9 * ts:
+        raise ValueError(f"ts={ts} s must be a whole multiple of the simulation step dt={dt} s")
+    return every
 
 
 def within_limits(model, ts: float, u: np.ndarray, uprev: np.ndarray, pitch0: float) -> np.ndarray:

@@ -36,7 +36,7 @@ from threadpoolctl import ThreadpoolController
 from .._checks import positive_scalar
 from .._docs import docstring_of
 from ..simulate import SimulationDivergedError, simulate
-from .base import MEASURED, discretize_turbine, within_limits
+from .base import MEASURED, discretize_turbine, steps_per_sample, within_limits
 from .economic import economic_problem, solve_cone
 from .quadratic import QuadraticMPC
 from .sampled import SampledController
@@ -370,11 +370,10 @@ class ClonedController(SampledController):
         the grid points its wind estimate crosses: in class-B turbulence at 19 m/s, 15-23 m/s).
     name : str, default "behavioural cloning"
         Label.
-    operating_point : {"estimated", "initial pitch"}, default "estimated"
-        The model scheduled on the run's own wind estimate, or held at the trim of its initial
-        pitch (:class:`~specdesign.mpc.sampled.SampledController`).
-    wind_speeds : array_like, optional
-        Grid of the schedule (m/s); default every 1 m/s over ``model.wind_range``.
+    operating_point, wind_speeds : str, array_like
+        Where the model is linearised, as :class:`~specdesign.mpc.sampled.SampledController`
+        takes them (default: scheduled on the run's own wind estimate, every 1 m/s over
+        ``model.wind_range``; or ``"initial pitch"``).
 
     Attributes
     ----------
@@ -396,24 +395,9 @@ class ClonedController(SampledController):
         self.saturated = 0
         super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds)
 
+    @docstring_of(SampledController, note=('Here the regressor trained nearest the operating point, under ``"regressor"``; '
+                                           "a ValueError if none was trained within ``max_gap`` of its wind speed."))
     def build(self, dm) -> dict:
-        """The regressor of the operating point.
-
-        Parameters
-        ----------
-        dm : DiscreteTurbine
-            The discrete model there.
-
-        Returns
-        -------
-        dict
-            ``{"regressor": ...}``.
-
-        Raises
-        ------
-        ValueError
-            If no regressor was trained within ``max_gap`` of its wind speed.
-        """
         if None in self.regressors:
             return {"regressor": self.regressors[None]}
         near = min(self.regressors, key=lambda v: abs(v - dm.wind_speed))
@@ -422,20 +406,8 @@ class ClonedController(SampledController):
                              f"(trained at {sorted(self.regressors)}); clone at this wind speed too")
         return {"regressor": self.regressors[near]}
 
+    @docstring_of(SampledController, note="The clone also sets its count of saturated commands (``saturated``) to zero.")
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
-        """Initialise the runs (see :meth:`SampledController.start`) and the saturation count.
-
-        Parameters
-        ----------
-        dt : float
-            Simulation step (s).
-        wind : numpy.ndarray
-            (R,) wind at t = 0 (m/s).
-        pitch : numpy.ndarray
-            (R,) initial pitch (rad).
-        torque : numpy.ndarray
-            (R,) generator torque (N·m).
-        """
         self.saturated = 0
         super().start(dt, wind, pitch, torque)
 
@@ -497,26 +469,12 @@ class OpenLoopPlayback:
         """
         if np.size(pitch) != self.commands.shape[0]:
             raise ValueError(f"commands has {self.commands.shape[0]} rows but the simulation has {np.size(pitch)} runs")
-        self._every = int(round(self.ts / dt))
-        if self._every < 1 or abs(self._every * dt - self.ts) > 1e-9 * self.ts:
-            raise ValueError(f"ts={self.ts} s must be a whole multiple of the simulation step dt={dt} s")
+        self._every = steps_per_sample(self.ts, dt)
         self._k = 0
 
     def __call__(self, t: float, y: dict) -> np.ndarray:
-        """The command of every run at step ``t``.
-
-        Parameters
-        ----------
-        t : float
-            Time (s).
-        y : dict
-            Outputs (unused: open loop).
-
-        Returns
-        -------
-        numpy.ndarray
-            (R,) pitch commands (rad).
-        """
+        """(R,) pitch commands (rad) of every run at time ``t`` (s), the measured outputs ``y`` unused (open
+        loop): the simulator's callable contract, as :meth:`specdesign.mpc.sampled.SampledController.__call__`."""
         j = min(self._k // self._every, self.commands.shape[1] - 1)
         self._k += 1
         return self.commands[:, j].copy()

@@ -54,6 +54,7 @@ from .base import (
     DiscreteTurbine,
     discretize_turbine,
     prediction_matrices,
+    steps_per_sample,
     within_limits,
 )
 from .cloning import CloningRegressor, Demonstrations
@@ -156,19 +157,8 @@ class ColletMPC(QuadraticMPC):
         super().__init__(model, ts, horizon, preview=preview, measured=measured, name=name,
                          operating_point="design point", design_speed=design_speed)
 
+    @docstring_of(SampledController, note='Here the QP of :func:`collet_qp` at the design point, under ``"qp"``.')
     def build(self, dm: DiscreteTurbine) -> dict:
-        """The QP at the design point (:func:`collet_qp`).
-
-        Parameters
-        ----------
-        dm : DiscreteTurbine
-            The discrete model.
-
-        Returns
-        -------
-        dict
-            ``{"qp": ...}``.
-        """
         return {"qp": collet_qp(dm, self.horizon, self.rho, speed_weight=self.speed_weight,
                                 rated_speed=float(self.model.rated_rotor_speed))}
 
@@ -345,10 +335,8 @@ def preview_demonstrations(model, design_speed: float, terms, wind, wind_dt: flo
 
     Parameters
     ----------
-    model : TurbineModel
-        The turbine.
-    design_speed : float
-        Design and mean wind speed (m/s).
+    model, design_speed : TurbineModel, float
+        The turbine and its design (and mean) wind speed, m/s, about whose trim the expert optimises.
     terms : sequence of FatigueTerm
         The surrogate's priced components (Eq. 4).
     wind : numpy.ndarray
@@ -465,9 +453,7 @@ class PreviewClone:
         R = np.size(pitch)
         if R != self.wind.shape[0]:
             raise ValueError(f"preview has {self.wind.shape[0]} runs but the simulation has {R}")
-        self._every = int(round(self.ts / dt))
-        if self._every < 1 or abs(self._every * dt - self.ts) > 1e-9 * self.ts:
-            raise ValueError(f"ts={self.ts} s must be a whole multiple of the simulation step dt={dt} s")
+        self._every = steps_per_sample(self.ts, dt)
         M, q = self.history, len(COLLET_OUTPUTS)
         self._k = 0
         self._y = np.zeros((R, M, q))
@@ -476,20 +462,8 @@ class PreviewClone:
         self.saturated = 0
 
     def __call__(self, t: float, y: dict) -> np.ndarray:
-        """Pitch setpoint of every run (held between samples).
-
-        Parameters
-        ----------
-        t : float
-            Time (s).
-        y : dict
-            Output name → (R,) measured outputs (SI).
-
-        Returns
-        -------
-        numpy.ndarray
-            (R,) absolute pitch setpoints (rad).
-        """
+        """(R,) absolute pitch setpoints (rad) of every run at time ``t`` (s), held between samples: the
+        simulator's callable contract, as :meth:`specdesign.mpc.sampled.SampledController.__call__`."""
         k = self._k
         self._k += 1
         if k % self._every:

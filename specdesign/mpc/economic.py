@@ -42,6 +42,7 @@ from ..fatigue import (
 )
 from ..simulate import simulate
 from ..turbine import rosco_baseline
+from ..wind import RECORD_LENGTH
 from .base import MEASURED, DiscreteTurbine, discretize_turbine
 from .sampled import SampledController
 
@@ -103,7 +104,7 @@ class FatigueTerm:
 
 
 def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3), prices: dict | None = None,
-                      ultimate: dict | None = None, classes=("A", "B", "C"), duration: float = 600.0,
+                      ultimate: dict | None = None, classes=("A", "B", "C"), duration: float = RECORD_LENGTH,
                       outputs=None) -> tuple:
     """Fit the variance-damage surrogate of each priced load on simulated histories of this turbine.
 
@@ -425,11 +426,10 @@ class EconomicMPC(SampledController):
         Outputs the Kalman filter reads.
     name : str, default "economic MPC"
         Label.
-    operating_point : {"estimated", "initial pitch"}, default "estimated"
-        The model scheduled on the run's own wind estimate, or held at the trim of its initial
-        pitch (:class:`~specdesign.mpc.sampled.SampledController`).
-    wind_speeds : array_like, optional
-        Grid of the schedule (m/s); default every 1 m/s over ``model.wind_range``.
+    operating_point, wind_speeds : str, array_like
+        Where the model is linearised, as :class:`~specdesign.mpc.sampled.SampledController`
+        takes them (default: scheduled on the run's own wind estimate, every 1 m/s over
+        ``model.wind_range``; or ``"initial pitch"``).
 
     Attributes
     ----------
@@ -461,19 +461,8 @@ class EconomicMPC(SampledController):
         state.pop("term_values", None)
         return state
 
+    @docstring_of(SampledController, note='Here the compiled problem of :func:`economic_problem`, under ``"problem"``.')
     def build(self, dm: DiscreteTurbine) -> dict:
-        """The compiled problem at one operating point.
-
-        Parameters
-        ----------
-        dm : DiscreteTurbine
-            The discrete model.
-
-        Returns
-        -------
-        dict
-            ``{"problem": ...}`` (:func:`economic_problem`).
-        """
         return {"problem": economic_problem(dm, self.terms, self.horizon, speed_weight=self.speed_weight,
                                             activity_weight=self.activity_weight,
                                             rated_speed=float(self.model.rated_rotor_speed),

@@ -56,6 +56,7 @@ import time
 import numpy as np
 
 from .._checks import bad_measurements, positive_scalar
+from .._docs import docstring_of
 from ..fatigue import BLADE_M, SNCurve
 from ..fatigue_online import StreamingDamage
 from .base import MEASURED
@@ -334,19 +335,10 @@ class HealthMPC(SampledController):
             state.pop(k, None)
         return state
 
+    @docstring_of(SampledController, note=("Here the trim state ``x_trim`` (n,), the moment scale ``moment_scale`` (N·m) "
+                                           "and the prediction model ``lpv`` (:class:`LPVTurbine`), at the run's mean "
+                                           "wind speed."))
     def build(self, dm) -> dict:
-        """Per-operating-point data: the trim state, the moment scale and the prediction model.
-
-        Parameters
-        ----------
-        dm : DiscreteTurbine
-            The discrete model at the run's mean wind speed.
-
-        Returns
-        -------
-        dict
-            ``x_trim`` (n,), ``moment_scale`` (N·m) and ``lpv`` (:class:`LPVTurbine`).
-        """
         if self.lpv:
             if self._lpv is None:
                 self._lpv = lpv_turbine(self.model, self.ts, self.horizon, wind_speeds=self.wind_speeds)
@@ -358,20 +350,9 @@ class HealthMPC(SampledController):
         return {"x_trim": np.asarray(op.x, float), "moment_scale": positive_scalar(scale, "trim blade moment"),
                 "lpv": lpv}
 
+    @docstring_of(SampledController, note="Each run's online blade damage starts at zero (its S-N curve: ``blade_m``, "
+                                          "``del_budget``), its mean blade moment and speed reference at its trim.")
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
-        """Initialise every run at its trim and its online blade damage at zero.
-
-        Parameters
-        ----------
-        dt : float
-            Simulation step (s).
-        wind : numpy.ndarray
-            (R,) wind at t = 0 (m/s).
-        pitch : numpy.ndarray
-            (R,) initial pitch (rad).
-        torque : numpy.ndarray
-            (R,) generator torque (N·m).
-        """
         super().start(dt, wind, pitch, torque)
         sn = SNCurve(m=self.blade_m, s_ref=self.del_budget if self.del_budget is not None else 1e6)
         self._run["damage"] = [StreamingDamage(sn) for _ in range(np.asarray(pitch).size)]
@@ -395,34 +376,10 @@ class HealthMPC(SampledController):
         run = getattr(self, "_run", None)
         return np.array([] if run is None else [d.damage for d in run["damage"]])
 
+    @docstring_of(SampledController, note="``y`` needs ``blade_root_my`` and ``gen_speed`` besides the measured "
+                                          "outputs; a run with a NaN or inf in one of them also holds its damage count, "
+                                          "mean moment and speed reference.")
     def __call__(self, t: float, y: dict) -> np.ndarray:
-        """Pitch command of every run (the simulator's callable contract).
-
-        Parameters
-        ----------
-        t : float
-            Time (s).
-        y : dict
-            Output name → (R,) measured outputs (SI); needs ``blade_root_my``.
-
-        Returns
-        -------
-        numpy.ndarray
-            (R,) absolute pitch command (rad), held between samples.
-
-        Raises
-        ------
-        RuntimeError
-            If called before :meth:`start`.
-
-        Warns
-        -----
-        RuntimeWarning
-            Once per signal, for a NaN or inf measurement (``blade_root_my``, ``gen_speed`` or
-            a measured output): that run holds its last command and its state (damage count,
-            mean moment, speed reference, estimate) until the signal is finite again
-            (:func:`specdesign._checks.bad_measurements`, the convention of every controller).
-        """
         run = getattr(self, "_run", None)
         if run is None:
             raise RuntimeError("HealthMPC.start(dt, wind, pitch, torque) must be called first "

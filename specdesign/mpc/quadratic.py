@@ -178,13 +178,10 @@ class QuadraticMPC(SampledController):
         record's end) instead of the estimate d̂ held. Default None: no preview.
     name : str, default "quadratic MPC"
         Label.
-    operating_point : {"estimated", "initial pitch"}, default "estimated"
-        The model scheduled on the run's own wind estimate, or held at the trim of its initial
-        pitch (:class:`~specdesign.mpc.sampled.SampledController`).
-    wind_speeds : array_like, optional
-        Grid of the schedule (m/s); default every 1 m/s over ``model.wind_range``.
-    design_speed : float, optional
-        The fixed operating point (m/s) of ``operating_point="design point"``.
+    operating_point, wind_speeds, design_speed : str, array_like, float
+        Where the model is linearised, as :class:`~specdesign.mpc.sampled.SampledController`
+        takes them (default: scheduled on the run's own wind estimate, every 1 m/s over
+        ``model.wind_range``; or ``"initial pitch"``, or ``"design point"`` at ``design_speed``, m/s).
 
     Attributes
     ----------
@@ -229,44 +226,16 @@ class QuadraticMPC(SampledController):
                          design_speed=design_speed)
         positive_scalar(model.pitch_rate_limit, "model.pitch_rate_limit")
 
+    @docstring_of(SampledController, note='Here the QP of :func:`quadratic_qp`, under ``"qp"``.')
     def build(self, dm: DiscreteTurbine) -> dict:
-        """The QP at one operating point (:func:`quadratic_qp`).
-
-        Parameters
-        ----------
-        dm : DiscreteTurbine
-            The discrete model.
-
-        Returns
-        -------
-        dict
-            ``{"qp": ...}``.
-        """
         return {"qp": quadratic_qp(dm, self.horizon, self.weights, float(self.model.rated_rotor_speed),
                                    float(self.model.pitch_rate_limit),
                                    (float(self.model.pitch_min), float(self.model.pitch_max)),
                                    preview=self.preview is not None)}
 
+    @docstring_of(SampledController, note="With a ``preview`` it is checked first: a ValueError if it has another "
+                                          "number of runs or does not start with the simulation's wind.")
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
-        """Initialise the runs (:meth:`SampledController.start`), checking the preview's runs.
-
-        Parameters
-        ----------
-        dt : float
-            Simulation step (s).
-        wind : numpy.ndarray
-            (R,) wind at t = 0 (m/s).
-        pitch : numpy.ndarray
-            (R,) initial pitch (rad).
-        torque : numpy.ndarray
-            (R,) generator torque (N·m).
-
-        Raises
-        ------
-        ValueError
-            If the preview has another number of runs, or does not start with the
-            simulation's wind.
-        """
         if self.preview is not None:
             w = self.preview[0]
             if w.shape[0] != np.size(pitch):

@@ -17,6 +17,7 @@ from .base import (
     kalman_gain,
     operating_wind_speed,
     pitch_wind_estimate,
+    steps_per_sample,
 )
 from .lpv import check_speeds, lpv_observer, vertex_pair
 
@@ -135,7 +136,7 @@ class SampledController:
         return self._points[key]
 
     def build(self, dm: DiscreteTurbine) -> dict:
-        """Subclass hook: what ``policy`` needs at one operating point.
+        """What ``policy`` needs at one operating point (a subclass hook).
 
         Parameters
         ----------
@@ -145,7 +146,7 @@ class SampledController:
         Returns
         -------
         dict
-            Extra entries of :meth:`point` (none here).
+            Extra entries of :meth:`point` (none in this base class).
         """
         return {}
 
@@ -208,9 +209,7 @@ class SampledController:
         ValueError
             If ``ts`` is not a whole multiple of ``dt``.
         """
-        every = int(round(self.ts / dt))
-        if every < 1 or abs(every * dt - self.ts) > 1e-9 * self.ts:
-            raise ValueError(f"ts={self.ts} s must be a whole multiple of the simulation step dt={dt} s")
+        every = steps_per_sample(self.ts, dt)
         pitch = np.asarray(pitch, float)
         if self.operating_point == "estimated":
             # the trim table inverted at the measured pitch: the filter's starting point only

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from loopshaping.interactive import LiveArtists
+from loopshaping.interactive import LiveArtists, readout_html
 
 from ..spec import Baseline, Notch, promise_of
 from .conventions import tf_magnitude_label
@@ -97,7 +97,9 @@ class NotchExplorer:
     bounds_checker : specdesign.qft.boundscheck.BoundsChecker, optional
         The pitch loop's QFT problem at the same speed (:func:`specdesign.qft.boundscheck.bounds_checker`):
         every update also says whether the QFT bounds of ROSCO's map × the notch are empty
-        anywhere (:attr:`bounds_verdict`).
+        anywhere (:attr:`bounds_verdict`). The explorer calls its
+        :meth:`~specdesign.qft.boundscheck.BoundsChecker.precompute` (about 1 s, once), so
+        a move decides the verdict by comparisons instead of a bound computation (35-70 ms).
     live : bool, optional
         Redraw a move by blitting the line, marker, title and legend on a cached background
         (:class:`loopshaping.interactive.LiveArtists`); default: on ipympl's canvas
@@ -118,6 +120,11 @@ class NotchExplorer:
     update_ms : float
         Wall time of the last :meth:`update` in the kernel (compute, artist data and the
         blit or the redraw request), ms: what a slider move costs before the browser shows it.
+    readout : str
+        What the last update says: the notch (ω_n, depth, width) and its promise and verdicts,
+        one per line. The figure shows it in its title and legend, or, on a live figure shown
+        by :meth:`widget`, a readout above the figure does (the figure's legend then names the
+        specification only, and its title is drawn into saved figures only).
 
     Examples
     --------
@@ -137,7 +144,7 @@ class NotchExplorer:
         self.base = base
         self.checker = checker
         self.verdict = None
-        self.bounds_checker = bounds_checker
+        self.bounds_checker = bounds_checker if bounds_checker is None else bounds_checker.precompute()
         self.bounds_verdict = None
         self.notch = notch or Notch(1.05, 6.0, 0.2)
         # not shown by pyplot at the end of the cell: widget() shows it once, with the sliders
@@ -160,6 +167,8 @@ class NotchExplorer:
         self.promise = None
         self._out = None  # the ipywidgets Output a static (non-ipympl) figure is shown in
         self._sliders, self._sent, self._quiet = None, {}, False  # the widget's sliders, once built
+        self.readout = ""
+        self._readout_widget = None  # the ipywidgets.HTML above a live figure showing the readout
         if hasattr(self.fig.canvas, "header_visible"):  # ipympl: no "Figure n" label above the plot
             self.fig.canvas.header_visible = False
             self.fig.canvas.toolbar_position = "right"  # beside the figure, not over its labels
@@ -193,9 +202,10 @@ class NotchExplorer:
         """
         t0 = time.perf_counter()
         self.notch = Notch(float(omega_n), float(depth_db), float(width))
-        self.line.set_label(f"specification $|W_y|$: notch at {self.notch.omega_n:.3g} rad/s, "
-                            f"{self.notch.depth_db:.3g} dB, ζ_p = {self.notch.width:.3g}")
-        self._legend_text.set_text(self.line.get_label())
+        at = f"notch at {self.notch.omega_n:.3g} rad/s, {self.notch.depth_db:.3g} dB, ζ_p = {self.notch.width:.3g}"
+        if self._readout_widget is None:  # the figure says it (the readout widget does beside a live one)
+            self.line.set_label(f"specification $|W_y|$: {at}")
+            self._legend_text.set_text(self.line.get_label())
         shaping = self.notch.response(self.base.omega)
         self.promise = promise_of(shaping, self.base)
         self.line.set_ydata(self._t_db + 20 * np.log10(np.abs(shaping)))
@@ -215,7 +225,12 @@ class NotchExplorer:
             b = self.bounds_checker
             self.bounds_verdict = b.check(b.rosco_nominal * self.notch.response(b.template.omega))
             title += "\n" + self.bounds_verdict.summary()
-        self.ax_mag.set_title(title, fontsize=9)
+        self.readout = f"{at}\n{title}"
+        if self._readout_widget is None:
+            self.ax_mag.set_title(title, fontsize=9)
+        else:  # drawn into a saved figure only, which says where the notch is in its title then
+            self.ax_mag.set_title(self.readout, fontsize=9)
+            self._readout_widget.value = readout_html(self.readout)
         if self._sliders is not None:  # a call from code: the sliders follow (not a move)
             self._quiet = True
             try:
@@ -289,7 +304,8 @@ class NotchExplorer:
         -------
         ipywidgets.VBox
             The sliders and the figure (needs ipywidgets; with ``%matplotlib widget`` the
-            figure is the live canvas, otherwise a static image re-shown on every move).
+            figure is the live canvas, under a readout of :attr:`readout`, otherwise a static
+            image re-shown on every move).
         """
         import ipywidgets as widgets
 
@@ -335,12 +351,24 @@ class NotchExplorer:
         for name, sl in sliders.items():
             sl.observe(lambda change, name=name: moved(change, name), names="value")
         canvas = self.fig.canvas
+        readout = []
         if isinstance(canvas, widgets.DOMWidget):
             fig_box = canvas
+            if self._redraw.live and self._readout_widget is None:
+                # the changing lines leave the live canvas for a readout above it: drawn at every
+                # move they were most of a redraw (text costs about 0.1 ms a glyph, a new mathtext
+                # legend label a parse, and their pixels go to the browser)
+                self._readout_widget = widgets.HTML()
+                self.line.set_label("specification $|W_y|$ with the notch")
+                self._legend_text.set_text(self.line.get_label())
+                self._redraw.settle(self._legend)
+                self._redraw.print_only(self.ax_mag.title)
+                self.update(self.notch.omega_n, self.notch.depth_db, self.notch.width, redraw=False)
+            readout = [self._readout_widget] if self._readout_widget is not None else []
         else:
             fig_box = self._out = widgets.Output()
             self._show()
-        return widgets.VBox([widgets.VBox(list(sliders.values())), fig_box])
+        return widgets.VBox([widgets.VBox(list(sliders.values())), *readout, fig_box])
 
 
 def plot_frontier(frontiers: dict, ax: Axes | None = None) -> Axes:

@@ -1,6 +1,8 @@
 """QFT design of the pitch controller C_β and an active tower damping (ATD) controller.
 
 Modules: :mod:`~specdesign.qft.design` (the design at one operating point and over a schedule),
+:mod:`~specdesign.qft.specs` (:class:`QFTSpecification`, the one kind of specification
+:func:`design_qft` takes, and the functions that make it),
 :mod:`~specdesign.qft.result` (its record, :class:`QFTDesign`), :mod:`~specdesign.qft.structure`
 (the fixed controller structures and their parameter vector), :mod:`~specdesign.qft.tuner`
 (objective, constraints, the tuner); the loop
@@ -10,8 +12,8 @@ The seed paper's Sect. 4 on the embedded turbine model, as a deterministic autom
 procedure, in two forms. :func:`design_qft`'s default is specification-driven: the certified
 specification pair for a DEL target (:func:`specdesign.feasibility.specification_for_target`),
 then its certificate reduced to the lowest order that meets the pair at every plant case
-(:mod:`~specdesign.qft.certificate`), checked as below. ``design_qft(spec="notch")`` is the
-fixed-structure design of the sections below (notch specification, DEL target, tuner).
+(:mod:`~specdesign.qft.certificate`), checked as below. ``design_qft(spec=spec_notch(target))`` is
+the fixed-structure design of the sections below (notch specification, DEL target, tuner).
 Sign convention (:mod:`specdesign.closedloop`):
 
     β_cmd = −C_β·Ω_g − C_atd·z,    z = tower-top fore-aft velocity (m/s),
@@ -81,7 +83,6 @@ from __future__ import annotations
 from ..closedloop import general_form, partial_loop
 from .checks import fine_pitch_lift
 from .design import (
-    SPEED_RELAX_DB,
     check_design_speed,
     design_qft,
     design_schedule,
@@ -90,6 +91,7 @@ from .design import (
     held_lift,
 )
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign
+from .specs import SPEED_RELAX_DB, QFTSpecification, spec_from_certified, spec_from_pair, spec_notch
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 
 __all__ = [
@@ -97,6 +99,10 @@ __all__ = [
     "general_form",
     "partial_loop",
     "design_qft",
+    "QFTSpecification",
+    "spec_from_certified",
+    "spec_from_pair",
+    "spec_notch",
     "design_schedule",
     "held_lift",
     "check_design_speed",

@@ -31,7 +31,6 @@ from ..feasibility import (
     HF_END,
     MAX_HF_GAIN_RATIO,
     HF_OMEGA,
-    TargetSpecification,
     hf_check_omega,
     hf_gain_bound,
     specification_for_target,
@@ -42,6 +41,7 @@ from ..spec import KEEP_BELOW, SPEC_REDUCTION, TOWER_RELAX_DB, TOWER_RELAX_OMEGA
 from .certificate import design_from_certificate
 from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign, assemble_design
+from .specs import SPEED_RELAX_DB, QFTSpecification, spec_from_certified
 from .structure import controllers, from_vector, rosco_start
 from .tuner import TuningProblem, tune
 
@@ -49,14 +49,7 @@ if TYPE_CHECKING:
 
     from ..turbine import TurbineModel
 
-__all__ = ["design_qft", "design_schedule", "design_table", "format_table", "SPEED_RELAX_DB", "check_design_speed",
-           "held_lift"]
-
-
-#: Relaxations (dB) of the generator-speed spec the notch design (``spec="notch"``) tries in turn,
-#: smallest first: ROSCO's T_{Ω,w} dips at the tower mode where a well-damped loop cannot follow
-#: it, and 3 dB is the least that the IEA 15 MW designs met; hinf.spec_like_qft uses the same.
-SPEED_RELAX_DB = (3.0, 4.5, 6.0, 8.0)
+__all__ = ["design_qft", "design_schedule", "design_table", "format_table", "check_design_speed", "held_lift"]
 
 
 def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01)):
@@ -80,17 +73,16 @@ def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01
 
 
 def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = TARGET_REDUCTION, *,
-               speed_relax_db: float | Sequence[float] | None = None, spec: Any = "target",
-               structure: str | None = None, **kwargs: Any) -> QFTDesign:
+               spec: QFTSpecification | None = None, structure: str | None = None, **kwargs: Any) -> QFTDesign:
     """QFT design at ``wind_speed`` (m/s) that meets a fatigue-based specification pair.
 
     By default specification-driven (the method's centre, seed paper Sect. 3-4): the feasible
     specification pair for ``target_reduction`` first
     (:func:`specdesign.feasibility.specification_for_target`, certified over the plant cases),
     then the controller that meets it at every plant case on the dense check (its certificate
-    reduced to the lowest order that does, 2-5 s). ``spec="notch"`` is the earlier automatic
-    procedure: fixed structures (PI + notch + low-pass and an ATD) started from ROSCO, tuned
-    against the bounds of every plant case with a DEL-target penalty (5-60 s).
+    reduced to the lowest order that does, 2-5 s). ``spec=spec_notch(target)`` is the earlier
+    automatic procedure: fixed structures (PI + notch + low-pass and an ATD) started from
+    ROSCO, tuned against the bounds of every plant case with a DEL-target penalty (5-60 s).
 
     Parameters
     ----------
@@ -99,33 +91,30 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     wind_speed : float
         Operating point, m/s (above rated, inside ``model.wind_range``).
     target_reduction : float
-        Tower-base DEL reduction (1 Hz, m = 4) vs ROSCO, % (0-100): with ``spec="target"`` the
-        promise of the specification that is made and met; with ``spec="notch"`` the predicted
-        reduction the tuner must reach. Not used with a given specification.
-    speed_relax_db : float or sequence of float, optional
-        Only with ``spec="notch"``: relaxation of the generator-speed spec in dB (≥ 0), or an
-        increasing sequence tried in turn (default :data:`SPEED_RELAX_DB`): the design with the
-        smallest relaxation that meets every spec is returned (else the last attempt, with a
-        warning). With a specification-driven design the certificate sets it.
-    spec : "target", "notch", TargetSpecification or (tower, speed)
-        ``"target"`` (default): ``specification_for_target(model, wind_speed,
-        target_reduction)``, then as for a TargetSpecification. ``"notch"``: the
-        fixed-structure design against the notch specification and the DEL target.
-        Otherwise the specification pair to meet:
-        a :class:`specdesign.feasibility.TargetSpecification`, or two objects with a
-        ``response(omega)`` (e.g. :class:`specdesign.spec.Specification`), W_MyT and W_Ω of
-        the nominal case. Each plant case gets ROSCO's map at its speed times the nominal
-        ratio W/T^ROSCO; no DEL penalty is used (the specification carries the target, and
-        ``target_reduction`` is set to its promise). ``success`` then means: every bound met,
-        the dense check passed for every case, every loop stable.
+        Tower-base DEL reduction (1 Hz, m = 4) vs ROSCO, % (0-100): without ``spec``, the
+        promise of the specification that is made and met. Not used with a ``spec`` (it
+        carries its own).
+    spec : QFTSpecification, optional
+        The specification to meet. Default: the certified pair
+        ``specification_for_target(model, wind_speed, target_reduction)``, as with
+        :func:`spec_from_certified`. Made from other sources by :func:`spec_from_certified`
+        (a :class:`specdesign.feasibility.TargetSpecification` made beforehand),
+        :func:`spec_from_pair` (W_MyT, W_Ω: each plant case gets ROSCO's map at its speed
+        times the nominal ratio W/T^ROSCO; no DEL penalty, ``target_reduction`` is set to the
+        pair's promise) or :func:`spec_notch` (the notch specification made here, a DEL target
+        and a ladder of speed relaxations: the design with the smallest relaxation that meets
+        every spec is returned, else the last attempt, with a warning). ``success`` means:
+        every bound met, the dense check passed for every case, every loop stable (and with
+        :func:`spec_notch` the DEL target reached).
     structure : {"certificate", "fixed"}, optional
         The controller designed. ``"fixed"``: the tuned fixed structures (PI + notch + low-pass
-        and a first-order ATD). ``"certificate"`` (only with ``"target"`` or a
-        TargetSpecification; their default): the specification's certificate reduced to the
-        lowest order that meets it over the plant cases
+        and a first-order ATD). ``"certificate"`` (only with a certified pair, the default's
+        or :func:`spec_from_certified`'s; their default): the specification's certificate
+        reduced to the lowest order that meets it over the plant cases
         (:func:`specdesign.qft.certificate.design_from_certificate`; options
-        ``max_sensitivity``, ``min_decay``, ``design_omega``, ``dense_omega``, and with
-        ``spec="target"`` ``template_offsets``, the plant cases the pair is certified on).
+        ``max_sensitivity``, ``min_decay``, ``design_omega``, ``dense_omega``, and without
+        ``spec`` ``template_offsets``, ``max_hf_gain_ratio`` and ``held_below_rated``, with
+        which the pair is made).
     **kwargs
         Options of each design attempt (keyword only; the certificate takes only the four
         named above, the fixed structures all of these):
@@ -135,7 +124,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             (:func:`specdesign.spec.shape_to_target`, notches above ``keep_below`` rad/s).
         template_offsets : sequence of float, default (-1, -0.5, 0.5, 1)
             Wind-speed offsets (m/s) of the neighbouring operating points (clipped to
-            ``model.wind_range``). With ``spec="target"`` the plant cases the specification is
+            ``model.wind_range``). Without ``spec`` the plant cases the specification is
             certified on and met on (``specification_for_target(case_offsets=...)``).
         design_omega : array_like, optional
             QFT design frequencies, rad/s (default :data:`DEFAULT_DESIGN_OMEGA` plus the
@@ -153,14 +142,14 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             Protected band of the notch specification, rad/s (power regulation).
         max_hf_gain_ratio : float or None, default :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO` (the measured κ, on)
             κ of the high-frequency gain bound, |C_β(jω)| ≤ κ·|C_ROSCO(jω)| on HF_OMEGA-HF_END
-            (2-10 rad/s, 3P inside) with C_β strictly proper; None switches it off. With
-            ``spec="target"`` the certificate is made under it
+            (2-10 rad/s, 3P inside) with C_β strictly proper; None switches it off. Without
+            ``spec`` the certificate is made under it
             (``specification_for_target(max_hf_gain_ratio=...)``, which refuses a target the bound
             makes infeasible, naming it) and the design meets it with its order margin; a
-            TargetSpecification carries its own. The fixed structures are checked against it
+            certified pair carries its own. The fixed structures are checked against it
             (dense check "hf_gain").
         held_below_rated : bool, default False
-            Only with ``spec="target"``: the design is held below rated by a schedule (its
+            Only without ``spec``: the design is held below rated by a schedule (its
             lowest design speed): the certificate, and the controller reduced from it, lift the
             pitch off fine pitch for the torque law's speed deficit by at most its
             ``pitch_switch`` (``specification_for_target(held_below_rated=True)``;
@@ -180,112 +169,127 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
     Raises
     ------
     TypeError
-        If ``model`` is not a :class:`specdesign.turbine.TurbineModel`, an option is unknown
-        (or belongs to the other design: ``speed_relax_db`` and the tuner's options need
-        ``spec="notch"`` or ``structure="fixed"``).
+        If ``model`` is not a :class:`specdesign.turbine.TurbineModel`, ``spec`` is not a
+        :class:`QFTSpecification` (the message names the functions that make one), an option
+        is unknown (or belongs to the other design: the tuner's options need
+        :func:`spec_notch`, :func:`spec_from_pair` or ``structure="fixed"``).
     ValueError
         If ``wind_speed`` is outside ``model.wind_range``; ``target_reduction`` is not
         strictly between 0 and 100 %; no certified specification reaches it ("infeasible
-        because ...", from :func:`specdesign.feasibility.specification_for_target`);
-        ``spec`` is an unknown string; a relaxation is negative or not finite;
-        ``tower_relax_omega`` or ``min_decay`` is not positive; ``max_sensitivity`` ≤ 1;
-        ``template_offsets`` is not a 1-D array of finite offsets; or a frequency grid is
-        invalid.
+        because ...", from :func:`specdesign.feasibility.specification_for_target`); ``spec``
+        was made at another wind speed; ``structure="certificate"`` is asked of a spec without
+        a certificate; a relaxation is negative or not finite; ``tower_relax_omega`` or
+        ``min_decay`` is not positive; ``max_sensitivity`` ≤ 1; ``template_offsets`` is not a
+        1-D array of finite offsets; or a frequency grid is invalid.
 
     Warns
     -----
     RuntimeWarning
-        When no relaxation of ``speed_relax_db`` gives a design that meets every
+        When no relaxation of a :func:`spec_notch` ladder gives a design that meets every
         specification (the last attempt is returned, ``success`` False).
 
     Examples
     --------
     >>> from specdesign import turbine
-    >>> from specdesign.qft import design_qft
+    >>> from specdesign.qft import design_qft, spec_notch
     >>> d = design_qft(turbine.iea15mw(), 19.0)  # doctest: +SKIP
     >>> print(d.summary())  # doctest: +SKIP
-    >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec="notch")  # doctest: +SKIP
+    >>> fixed = design_qft(turbine.iea15mw(), 19.0, spec=spec_notch(25.0))  # doctest: +SKIP
     """
-    ladder = _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs)
-    if isinstance(spec, str) and spec == "target":
+    _checked_options(model, wind_speed, spec, structure, kwargs)
+    v = model.check_wind_speed(wind_speed)
+    if spec is None:
+        spec = _spec_for_target(model, v, target_reduction, structure, kwargs)
+    spec_made_at(spec.target if spec.target is not None else spec, v)
+    if structure == "certificate" and spec.kind != "certified":
+        raise ValueError(f"structure='certificate' needs a certified specification (no spec, or "
+                         f"qft.spec_from_certified(a feasibility.TargetSpecification): it carries the certificate), "
+                         f"got a {spec.kind!r} specification")
+    if spec.kind == "notch":
+        return _design_notch(model, wind_speed, spec, kwargs)
+    if spec.kind == "certified" and structure != "fixed":
+        return design_from_certificate(model, spec.target, **_certificate_options(kwargs))
+    return _design_single(model, wind_speed, None, speed_relax_db=float(SPEED_RELAX_DB[0]), given=(spec.tower, spec.speed),
+                          **kwargs)
+
+
+def _spec_for_target(model, v, target_reduction, structure, kwargs) -> QFTSpecification:
+    """:func:`design_qft`'s default specification: the certified pair for ``target_reduction``
+    at ``v`` (m/s), made with the options of ``kwargs`` that make it (taken out of them)."""
+    made = {}
+    if structure != "fixed":
         # the plant cases the pair is certified on are the ones the design must meet it on
-        offsets = kwargs.pop("template_offsets") if structure != "fixed" and "template_offsets" in kwargs else None
-        # the certificate meets the high-frequency gain bound, and so does the design reduced from it
-        hf = {k: kwargs.pop(k) for k in ("max_hf_gain_ratio", "held_below_rated") if structure != "fixed" and k in kwargs}
-        spec = specification_for_target(model, model.check_wind_speed(wind_speed), target_reduction,
-                                        **({} if offsets is None else {"case_offsets": offsets}), **hf)
-    elif isinstance(spec, str):  # "notch"
-        spec = None
-    if structure == "certificate" and not isinstance(spec, TargetSpecification):
-        raise ValueError("structure='certificate' needs spec='target' or a feasibility.TargetSpecification (it carries "
-                         "the certificate)")
-    if isinstance(spec, TargetSpecification) and structure != "fixed":
-        allowed = {"max_sensitivity", "min_decay", "design_omega", "dense_omega"}
         if "template_offsets" in kwargs:
-            raise TypeError("design_qft(spec=TargetSpecification) meets the pair on the plant cases it was certified on "
-                            "(spec.case_speeds): make the specification with specification_for_target(..., "
-                            "case_offsets=...) instead of passing template_offsets=")
-        for k in ("max_hf_gain_ratio", "held_below_rated"):
-            if k in kwargs:
-                raise TypeError(f"design_qft(spec=TargetSpecification) meets the {k} its certificate was made with "
-                                f"(spec.max_hf_gain_ratio, spec.held_lift_limit): make the specification with "
-                                f"specification_for_target(..., {k}=...) instead of passing it here")
-        if set(kwargs) - allowed:
-            raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
-                            f"got {sorted(set(kwargs) - allowed)}")
-        spec_made_at(spec, model.check_wind_speed(wind_speed))
-        return design_from_certificate(model, spec, **kwargs)
-    if spec is not None:
-        spec_made_at(spec, model.check_wind_speed(wind_speed))
-        return _design_single(model, wind_speed, None, speed_relax_db=float(ladder[0]), given=_given_spec(spec), **kwargs)
+            made["case_offsets"] = kwargs.pop("template_offsets")
+        # the certificate meets the high-frequency gain bound, and so does the design reduced from it
+        made.update({k: kwargs.pop(k) for k in ("max_hf_gain_ratio", "held_below_rated") if k in kwargs})
+    return spec_from_certified(specification_for_target(model, v, target_reduction, **made))
+
+
+def _certificate_options(kwargs) -> dict:
+    """``kwargs`` checked to be options of :func:`design_from_certificate` (a certified pair's)."""
+    allowed = {"max_sensitivity", "min_decay", "design_omega", "dense_omega"}
+    if "template_offsets" in kwargs:
+        raise TypeError("design_qft(spec=spec_from_certified(...)) meets the pair on the plant cases it was certified "
+                        "on (spec.target.case_speeds): make the specification with specification_for_target(..., "
+                        "case_offsets=...) instead of passing template_offsets=")
+    for k in ("max_hf_gain_ratio", "held_below_rated"):
+        if k in kwargs:
+            raise TypeError(f"design_qft(spec=spec_from_certified(...)) meets the {k} its certificate was made with "
+                            f"(max_hf_gain_ratio, held_lift_limit of the TargetSpecification): make the specification "
+                            f"with specification_for_target(..., {k}=...) instead of passing it here")
+    if set(kwargs) - allowed:
+        raise TypeError(f"design_qft(structure='certificate') takes the options {sorted(allowed)}, "
+                        f"got {sorted(set(kwargs) - allowed)}")
+    return kwargs
+
+
+def _design_notch(model, wind_speed, spec, kwargs) -> QFTDesign:
+    """:func:`design_qft` with :func:`spec_notch`: the fixed structures against the notch
+    specification for each speed relaxation in turn, the first that meets every spec kept."""
     design = None
-    for relax in ladder:
-        with warnings.catch_warnings():
+    for relax in spec.speed_relax_db:
+        with warnings.catch_warnings():  # each attempt's own miss is the next rung's business; the last one's is said below
             warnings.simplefilter("ignore", RuntimeWarning)
-            design = _design_single(model, wind_speed, target_reduction, speed_relax_db=float(relax), **kwargs)
+            design = _design_single(model, wind_speed, spec.target_reduction, speed_relax_db=relax, **kwargs)
         if design.success:
             return design
-    warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {ladder[-1]:g} dB): {design.message}",
-                  RuntimeWarning, stacklevel=2)
+    warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {spec.speed_relax_db[-1]:g} dB): "
+                  f"{design.message}", RuntimeWarning, stacklevel=3)
     return design
 
 
-def _checked_options(model, wind_speed, speed_relax_db, spec, structure, kwargs) -> np.ndarray:
+def _checked_options(model, wind_speed, spec, structure, kwargs) -> None:
     """:func:`design_qft`'s arguments checked at the door, in its order (unknown options, the
-    model, the wind speed, ``spec``, options of the other design, the relaxation ladder,
-    ``structure``): the ladder of speed relaxations (dB, increasing)."""
-    options = [n for n, p in inspect.signature(_design_single).parameters.items() if p.kind is p.KEYWORD_ONLY]
-    unknown = sorted(set(kwargs) - set(options) - {"speed_relax_db", "held_below_rated"})
+    model, the wind speed, ``spec``, options of the other design, ``structure``)."""
+    options = [n for n, p in inspect.signature(_design_single).parameters.items()
+               if p.kind is p.KEYWORD_ONLY and n not in ("given", "speed_relax_db")]
+    unknown = sorted(set(kwargs) - set(options) - {"held_below_rated"})
     if unknown:  # named here, not as a TypeError of an internal function
-        raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}")
+        ladder = (" (speed_relax_db is the notch specification's: spec=qft.spec_notch(target_reduction, "
+                  "speed_relax_db=...))" if "speed_relax_db" in unknown else "")
+        raise TypeError(f"design_qft got unknown option(s) {unknown}; its options are {sorted(options)}{ladder}")
     if not (isinstance(model, turbine.TurbineModel) or callable(getattr(model, "baseline_controller", None))):
         raise TypeError(f"model must be a specdesign.turbine.TurbineModel (e.g. turbine.iea15mw()) or a "
                         f"specdesign.openfast.LinearTurbine, got {type(model).__name__}")
     check_design_speed(model, wind_speed)
-    if isinstance(spec, str) and spec not in ("target", "notch"):
-        raise ValueError(f"spec={spec!r} must be 'target', 'notch', a feasibility.TargetSpecification or a pair "
-                         "(tower, speed)")
+    if spec is not None and not isinstance(spec, QFTSpecification):
+        raise TypeError(f"spec must be a qft.QFTSpecification, got {spec!r}: make it with qft.spec_from_certified "
+                        "(a feasibility.TargetSpecification), qft.spec_from_pair (W_MyT, W_Ω) or qft.spec_notch (the "
+                        "notch specification and a DEL target); without spec the certified pair for target_reduction "
+                        "is made")
     fixed_only = set(kwargs) - {"max_sensitivity", "min_decay", "design_omega", "dense_omega", "template_offsets",
                                 "max_hf_gain_ratio", "held_below_rated"}
-    if isinstance(spec, str) and spec == "target" and structure != "fixed" and (fixed_only or speed_relax_db is not None):
-        named = sorted(fixed_only | ({"speed_relax_db"} if speed_relax_db is not None else set()))
-        raise TypeError(f"design_qft options {named} belong to the fixed-structure design: pass spec='notch' (the "
-                        "notch specification and a DEL target) or structure='fixed'; the specification-driven default "
-                        "takes max_sensitivity, min_decay, design_omega, dense_omega, template_offsets, "
-                        "max_hf_gain_ratio")
-    if "held_below_rated" in kwargs and not (isinstance(spec, str) and spec == "target" and structure != "fixed"):
-        raise TypeError("design_qft's held_below_rated belongs to the specification-driven design (spec='target'): "
+    if spec is None and structure != "fixed" and fixed_only:
+        raise TypeError(f"design_qft options {sorted(fixed_only)} belong to the fixed-structure design: pass "
+                        "spec=qft.spec_notch(target_reduction) (the notch specification and a DEL target) or "
+                        "structure='fixed'; the specification-driven default takes max_sensitivity, min_decay, "
+                        "design_omega, dense_omega, template_offsets, max_hf_gain_ratio, held_below_rated")
+    if "held_below_rated" in kwargs and not (spec is None and structure != "fixed"):
+        raise TypeError("design_qft's held_below_rated belongs to the specification-driven default (no spec): "
                         "the certificate is made to keep fine pitch below rated")
-    if speed_relax_db is None:
-        speed_relax_db = SPEED_RELAX_DB
-    ladder = np.atleast_1d(np.asarray(speed_relax_db, float))
-    if ladder.ndim != 1 or ladder.size == 0 or not np.all(np.isfinite(ladder)) or np.any(ladder < 0):
-        raise ValueError(f"speed_relax_db={speed_relax_db!r} must be a relaxation ≥ 0 dB or a sequence of them")
-    if np.any(np.diff(ladder) <= 0):  # the first that works is kept: a ladder out of order would skip a smaller one
-        raise ValueError(f"speed_relax_db={speed_relax_db!r} must increase (dB): the smallest relaxation that works is kept")
     if structure not in (None, "certificate", "fixed"):
         raise ValueError(f"structure={structure!r} must be 'certificate' or 'fixed'")
-    return ladder
 
 
 def check_design_speed(model, wind_speed: float) -> float:
@@ -336,17 +340,6 @@ def check_design_speed(model, wind_speed: float) -> float:
         raise ValueError(f"wind_speed={wind_speed!r} m/s is {where}; pitch designs start at {lo:g} m/s "
                          f"(model.wind_range), and a schedule holds its lowest design down to rated")
     return model.check_wind_speed(wind_speed)
-
-
-def _given_spec(spec):
-    """(tower, speed) of a TargetSpecification or a pair, each with ``response(omega)``."""
-    from ..spec import specification_pair
-
-    pair = specification_pair(spec)
-    if pair is None or not all(hasattr(x, "response") for x in pair):
-        raise TypeError("spec must be a feasibility.TargetSpecification or a pair (tower, speed) of specifications with "
-                        f"response(omega), got {type(spec).__name__}")
-    return pair
 
 
 def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, given=None, spec_reduction=SPEC_REDUCTION,
@@ -440,8 +433,9 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
 
 
 def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17, 19, 21, 23, 25),
-                    target_reduction: float | Sequence[float] = TARGET_REDUCTION, *, specification: str = "target",
-                    progress: bool = True, **kwargs: Any) -> tuple[QFTDesign, ...]:
+                    target_reduction: float | Sequence[float] | None = None, *,
+                    spec: QFTSpecification | Sequence[QFTSpecification] | None = None, progress: bool = True,
+                    **kwargs: Any) -> tuple[QFTDesign, ...]:
     """:func:`design_qft` at every wind speed (m/s); returns a tuple of :class:`QFTDesign`.
 
     Parameters
@@ -450,13 +444,17 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         The turbine.
     wind_speeds : sequence of float
         Operating points, m/s.
-    target_reduction : float or sequence of float
-        Tower-base DEL reduction to reach, %: one number, or one value per wind speed.
-    specification : {"target", "notch"}
-        ``"target"`` (default): specification-driven, the specification for the target first
-        (:func:`specdesign.feasibility.specification_for_target`), then the design that meets
-        it (:func:`design_qft`'s default). ``"notch"``: the fixed-structure design against the
-        notch specification and a DEL target (``design_qft(spec="notch")``).
+    target_reduction : float or sequence of float, optional
+        Without ``spec``: the tower-base DEL reduction to reach, %: one number, or one value per
+        wind speed (default :data:`specdesign.feasibility.target.TARGET_REDUCTION`). With
+        ``spec`` it is not given: a notch specification carries its own target.
+    spec : QFTSpecification or sequence of QFTSpecification, optional
+        None (default): specification-driven, at each speed the certified pair for the target
+        first (:func:`specdesign.feasibility.specification_for_target`), then the design that
+        meets it (:func:`design_qft`'s default). A :func:`spec_notch` specification (it does not
+        depend on the speed): the fixed-structure design against the notch specification made at
+        each speed, with its DEL target and relaxation ladder; or one per wind speed. A certified
+        pair or a given pair is made at one speed: design it with :func:`design_qft`.
     progress : bool
         Show a progress bar over the wind speeds (tqdm.auto: a widget in Jupyter).
     **kwargs
@@ -472,10 +470,12 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     ValueError
         If ``wind_speeds`` is not a non-empty 1-D sequence, ``target_reduction`` is not one
         DEL reduction in (0, 100) % or one per wind speed (every one checked before the first
-        design), ``specification`` is unknown, or :func:`design_qft` (or, with
-        ``"target"``, :func:`specdesign.feasibility.specification_for_target`) raises.
+        design), ``spec`` is a sequence of another length than ``wind_speeds``, or
+        :func:`design_qft` (or, without ``spec``,
+        :func:`specdesign.feasibility.specification_for_target`) raises.
     TypeError
-        As :func:`design_qft`; for a bool or a string as a target.
+        As :func:`design_qft`; for a bool or a string as a target; for a ``spec`` that is not a
+        :func:`spec_notch` specification, or one given with ``target_reduction``.
 
     Warns
     -----
@@ -483,8 +483,8 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
         As :func:`design_qft`, for each wind speed whose design does not meet every spec; and
         for a model with a torque law when the lowest design, which a schedule holds below
         rated, lifts the pitch off fine pitch for the speed deficit there
-        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``). With
-        ``"target"`` that design is made with ``held_below_rated=True`` (its certificate and
+        (:func:`specdesign.qft.fine_pitch_lift` above the law's ``pitch_switch``). Without
+        ``spec`` that design is made with ``held_below_rated=True`` (its certificate and
         its reduction keep the lift within ``pitch_switch``), so the warning is for the notch
         designs or a target that cannot be met so.
 
@@ -494,14 +494,19 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
     >>> from specdesign.qft import design_schedule, design_table, format_table
     >>> designs = design_schedule(turbine.iea15mw(), (15, 19, 23))  # doctest: +SKIP
     >>> print(format_table(design_table(designs)))  # doctest: +SKIP
+    >>> from specdesign.qft import spec_notch
+    >>> notch = design_schedule(turbine.iea15mw(), (15, 19, 23), spec=spec_notch(25.0))  # doctest: +SKIP
     """
     vs = np.atleast_1d(np.asarray(wind_speeds, float))
     if vs.ndim != 1 or vs.size == 0:
         raise ValueError("wind_speeds must be a non-empty 1-D sequence of wind speeds in m/s")
-    if specification not in ("notch", "target"):
-        raise ValueError(f"specification={specification!r} must be 'notch' or 'target'")
+    specs = _schedule_specs(spec, target_reduction, vs.size)
     for v in vs:  # before any design: a speed below the design range is refused with its reason
         check_design_speed(model, float(v))
+    if specs is not None:  # each notch specification carries its target (design_qft does not read the argument)
+        target_reduction = [x.target_reduction for x in specs]
+    elif target_reduction is None:
+        target_reduction = TARGET_REDUCTION
     # every target too (a bool or a string is no target), before the first design
     per_speed = np.ndim(target_reduction) != 0
     if per_speed and np.shape(target_reduction) != vs.shape:
@@ -512,14 +517,37 @@ def design_schedule(model: TurbineModel, wind_speeds: Sequence[float] = (15, 17,
 
     out = []
     lowest = int(np.argmin(vs))
-    held = specification == "target" and getattr(model, "torque_control", None) is not None
-    for i, (v, tr) in enumerate(tqdm(list(zip(vs, targets)), desc=f"QFT designs ({specification} specification)",
+    held = specs is None and getattr(model, "torque_control", None) is not None
+    kind = "target" if specs is None else "notch"
+    for i, (v, tr) in enumerate(tqdm(list(zip(vs, targets)), desc=f"QFT designs ({kind} specification)",
                                      unit="speed", disable=not progress)):
         # the lowest design is held below rated: made to keep fine pitch for the speed deficit there
         extra = {"held_below_rated": True} if held and i == lowest else {}
-        out.append(design_qft(model, float(v), float(tr), spec=specification, **kwargs, **extra))
+        out.append(design_qft(model, float(v), float(tr), spec=None if specs is None else specs[i], **kwargs, **extra))
     _warn_held_design(model, out[lowest])
     return tuple(out)
+
+
+def _schedule_specs(spec, target_reduction, n) -> tuple[QFTSpecification, ...] | None:
+    """:func:`design_schedule`'s ``spec`` as one notch specification per wind speed (None without
+    one), refusing the kinds made at one speed and a target given beside a specification."""
+    if spec is None:
+        return None
+    many = isinstance(spec, Sequence) and not isinstance(spec, str)
+    specs = tuple(spec) if many else (spec,) * n
+    for s in specs:
+        if not isinstance(s, QFTSpecification) or s.kind != "notch":
+            got = f"a {s.kind!r} specification" if isinstance(s, QFTSpecification) else repr(s)
+            raise TypeError(f"design_schedule's spec must be qft.spec_notch(target_reduction) (applied at every wind "
+                            f"speed) or one per wind speed, got {got}: a qft.spec_from_certified or qft.spec_from_pair "
+                            "specification is made at one speed (design it with qft.design_qft); without spec each "
+                            "speed gets the certified pair for target_reduction")
+    if len(specs) != n:
+        raise ValueError(f"spec has {len(specs)} specifications for {n} wind speeds; give one or one per wind speed")
+    if target_reduction is not None:
+        raise TypeError("design_schedule: give target_reduction or spec, not both: a notch specification carries its "
+                        "DEL target (qft.spec_notch(target_reduction))")
+    return specs
 
 
 def held_lift(model, design) -> float | None:

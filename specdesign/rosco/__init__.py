@@ -19,6 +19,8 @@ Re-exported here, the same objects, from the layers ROSCO stands on:
   (:class:`TorqueLaw`, :func:`torque_law`, :func:`torque_law_from_discon`, its steady state
   :func:`steady_state` and linearisation :func:`close_torque_loop`, the compiled
   :func:`torque_step` the simulator runs), which the turbine model closes in its trim.
+- :mod:`specdesign.controller.peak_shaving`: ROSCO's peak shaving (:class:`PeakShaving`,
+  :func:`peak_shaving_from_discon`), which :func:`rosco_scheduled` runs with a DISCON.IN's schedule.
 
 Layers: :mod:`specdesign.controller` < :mod:`specdesign.turbine` < this package; it never
 imports :mod:`specdesign.simulate` or :mod:`specdesign.closedloop`.
@@ -26,6 +28,7 @@ imports :mod:`specdesign.simulate` or :mod:`specdesign.closedloop`.
 from __future__ import annotations
 
 from ..controller.discon_file import DisconEntry, DisconSchedule, from_discon, read_discon, write_discon
+from ..controller.peak_shaving import PeakShaving, peak_shaving_from_discon
 from ..controller.torque import (
     TORQUE_MODES,
     TORQUE_REGIONS,
@@ -68,4 +71,6 @@ __all__ = [
     "steady_state",
     "close_torque_loop",
     "torque_step",
+    "PeakShaving",
+    "peak_shaving_from_discon",
 ]

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 
 from .._checks import positive_scalar
 from ..controller.discon_file import DisconSchedule
+from ..controller.peak_shaving import peak_shaving_from_discon
 from ..controller.scheduled import FORMS, SCHEDULE_FILTER_OMEGA, ScheduledController
 from ..turbine import TurbineModel, iea15mw
 from ..turbine.baseline import (
@@ -70,7 +71,7 @@ ROSCO_SCHEDULE_DAMPING = 0.7
 def rosco_scheduled(model: TurbineModel | None = None, wind_speeds: ArrayLike | None = None, *, name: str = "ROSCO",
                     form: str = "gains", schedule: object = None,
                     scheduling_filter: str = "first_order",
-                    tower_damper: TowerDamper | None = None) -> ScheduledController:
+                    tower_damper: TowerDamper | None = None, peak_shaving: bool = True) -> ScheduledController:
     """The ROSCO baseline PI (tower damping off unless asked) with its gain schedule on filtered pitch.
 
     ``form="gains"`` (default) is ROSCO's own scheduling: K_p and K_i of
@@ -111,6 +112,12 @@ def rosco_scheduled(model: TurbineModel | None = None, wind_speeds: ArrayLike | 
         DisconSchedule whose file has ``TD_Mode = 1``, which runs the file's ``FA_KI`` and
         ``FA_HPFCornerFreq`` (its ``FA_IntSat`` is not applied: the simulator's ATD path is
         linear). A TowerDamper given here replaces the file's.
+    peak_shaving : bool, optional
+        With a DisconSchedule whose file has ``PS_Mode = 1``: run ROSCO's peak shaving, the
+        PI's lower limit lifted to ``PS_BldPitchMin`` at ROSCO's filtered wind-speed estimate
+        (its extended Kalman filter, ported, on the model's Cp table:
+        :func:`specdesign.controller.peak_shaving.peak_shaving_from_discon`). True (default);
+        False runs the file without it, as ``PS_Mode = 0`` would. Ignored otherwise.
 
     Returns
     -------
@@ -121,8 +128,9 @@ def rosco_scheduled(model: TurbineModel | None = None, wind_speeds: ArrayLike | 
     ------
     ValueError
         For an unknown ``form`` or ``scheduling_filter``, a wind speed outside the model's or
-        the schedule's range, or a DisconSchedule with ``wind_speeds``, with ``form="output"``
-        or whose reference speed (``PC_RefSpd`` / ``WE_GearboxRatio``) differs from the model's
+        the schedule's range, or a DisconSchedule with ``wind_speeds``, with ``form="output"``,
+        with peak shaving on an estimator the workbench does not run (``WE_Mode`` not 2: the
+        message names the file, line and key; pass ``peak_shaving=False``) or whose reference speed (``PC_RefSpd`` / ``WE_GearboxRatio``) differs from the model's
         rated rotor speed by more than 0.1 %.
     TypeError
         For a ``schedule`` that is neither a RoscoSchedule nor a DisconSchedule.
@@ -150,6 +158,10 @@ def rosco_scheduled(model: TurbineModel | None = None, wind_speeds: ArrayLike | 
         if tower_damper is None and schedule.td_mode == 1:
             tower_damper = TowerDamper(schedule.fa_ki, schedule.fa_hpf_corner, schedule.fa_int_sat)
         sc = _discon_scheduled(model, schedule, wind_speeds, name, form, scheduling_filter)
+        ps = peak_shaving_from_discon(schedule.path, model.tsr_grid, model.pitch_grid, model.cp_table) \
+            if peak_shaving else None
+        if ps is not None:
+            sc = dataclasses.replace(sc, peak_shaving=ps)
         return sc if tower_damper is None else _with_damper(sc, tower_damper)
     if schedule is not None and not isinstance(schedule, RoscoSchedule):
         raise TypeError(f"schedule must be a RoscoSchedule or a DisconSchedule (from_discon), got {type(schedule).__name__}")

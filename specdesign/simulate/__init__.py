@@ -69,10 +69,24 @@ frozen, see :func:`simulate`), so the pitch is held at fine pitch as ROSCO holds
 ``torque_control="auto"`` (default) runs the law in the runs whose wind speed is below rated
 and holds the trim torque in the others (bit for bit the results before the law existed),
 except a law with constant power above rated (``VS_ConstPower = 1``, e.g. the NREL 5 MW's
-DISCON.IN), which runs in every run as the linearisation has it;
+DISCON.IN), which runs in every run as the linearisation has it, and any law under a
+controller with peak shaving (below);
 ``"rosco"`` runs it in every run (region 3 is then rated torque, or rated power
 P/(η·Ω_f) with ``VS_ConstPower = 1``, with the transitions);
 a ``TorqueLaw`` runs that law in every run; ``None`` holds the trim torque everywhere.
+
+Peak shaving (a :class:`ScheduledController` in ROSCO's form with ``peak_shaving``, which
+:func:`specdesign.rosco.rosco_scheduled` attaches for a DISCON.IN with ``PS_Mode = 1``): each
+step :func:`specdesign.controller.peak_shaving.peak_shaving_step` runs ROSCO's wind-speed
+estimator (its extended Kalman filter, ported) on the measured rotor speed, the last pitch
+command and the last torque command, and lifts the PI's lower limit to ``PS_BldPitchMin`` at
+the filtered estimate (the integrator at the last step's limit, the command at this one's, as
+ROSCO). As in ROSCO, the torque law then reads the last pitch command as the measured pitch and
+that limit as the minimum pitch (smoother, state machine), the smoother's shift of the
+speed reference enters the PI's error unfiltered, and a file in ``VS_ControlMode = 2`` gives
+the torque law its reference TSR·WE_Vw/R on the estimate
+(:func:`specdesign.controller.peak_shaving.tsr_reference`). A controller without it runs bit
+for bit as before.
 The pitch loop's stability check (:func:`warn_unstable`) covers the speeds at or above rated
 only: below rated the pitch loop is open.
 

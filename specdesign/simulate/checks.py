@@ -167,16 +167,10 @@ def check_loop_step(plant: KernelPlant, controller: object, wind_speed: float, d
 
     Parameters
     ----------
-    plant : KernelPlant or TurbineModel
-        The plant, with a linearisation.
-    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
-        The controller.
-    wind_speed : float
-        Mean wind speed (m/s) of the linearisation.
-    dt : float
-        Simulation step (s).
-    parts : tuple, optional
-        The result of :func:`specdesign.closedloop.loop_parts` for these arguments, if at hand.
+    plant, controller, wind_speed, dt, parts
+        As :func:`sampled_loop_radius` takes them: the plant (with a linearisation), the
+        controller, the linearisation's mean wind speed (m/s), the simulation step (s) and,
+        optionally, the loop parts.
 
     Raises
     ------
@@ -219,14 +213,9 @@ def checked_loop(plant: KernelPlant, controller: object, wind_speed: float, dt: 
 
     Parameters
     ----------
-    plant : KernelPlant
-        The plant, with a linearisation.
-    controller : control.LTI, loopshaping.controller.Controller or ScheduledController
-        The controller.
-    wind_speed : float
-        Mean wind speed (m/s) of the linearisation.
-    dt : float
-        Simulation step (s).
+    plant, controller, wind_speed, dt
+        The loop, as :func:`sampled_loop_radius` takes them (a KernelPlant; wind speed in m/s, step
+        in s).
 
     Returns
     -------

@@ -20,7 +20,7 @@ from ..controller.scheduled import ScheduledController, controller_bank, schedul
 from ..controller.torque import TORQUE_PARAMS, TorqueLaw
 from ..turbine import iea15mw
 from ..turbine.plant import KernelPlant, turbine_plant
-from ..wind import wind_series
+from ..wind import RECORD_LENGTH, wind_series
 from .checks import check_step, warn_unstable
 from .kernels import (NONFINITE, Bank, GainsPI, LoopSetup, Runs, compiled_for, linear_outputs, linear_plant_params,
                       linear_rhs, run_callable)
@@ -100,7 +100,7 @@ class SimulationResult:
 
 
 def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds: ArrayLike, *,
-             seeds: ArrayLike | None = None, wind: ArrayLike | None = None, duration: float = 600.0, dt: float = 0.02,
+             seeds: ArrayLike | None = None, wind: ArrayLike | None = None, duration: float = RECORD_LENGTH, dt: float = 0.02,
              record_dt: float = 0.1, transient: float = 60.0, wind_dt: float | None = None,
              turbulence_class: str = "B", linear: bool = False, wind_rotor_radius: float | None = None,
              wind_mean_tol: float = WIND_MEAN_TOLERANCE, torque_control: object = "auto",
@@ -146,7 +146,9 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     torque_control : {"auto", "rosco", None} or specdesign.rosco.TorqueLaw, optional
         Generator torque of the compiled loop (see :mod:`specdesign.simulate`): "auto" runs
         the plant's torque law (the model's ``torque_control``) in the runs below rated and
-        holds the trim torque above (a constant-power law runs in every run); "rosco" runs it
+        holds the trim torque above (a constant-power law runs in every run, and so does any
+        law under a controller with peak shaving, whose limit can hold the pitch above rated
+        while ROSCO's torque controller regulates the speed); "rosco" runs it
         in every run; a TorqueLaw runs that one in every run; None holds the trim torque
         everywhere. Ignored with ``linear=True`` (the linearisation closes the law below
         rated, and above rated a constant-power one) and for a callable controller (it
@@ -227,14 +229,15 @@ def simulate(plant: TurbineModel | KernelPlant, controller: object, wind_speeds:
     wind, wind_dt, seeds = _wind_records(vs, seeds, wind, wind_dt, times, radius, turbulence_class, wind_mean_tol)
     S = wind.shape[1]
     check_step(plant, vs, times.dt)
-    TQ, above = _torque_params(plant, torque_control, vs, S, linear)
+    peak_shaving = getattr(controller, "peak_shaving", None) is not None
+    TQ, above = _torque_params(plant, torque_control, vs, S, linear, peak_shaving)
     rhs, outfn, runs, trim_speeds = _plant_runs(plant, vs, S, linear, wind, TQ)
     noise_of = _measurement_noise(noise, plant, vs, seeds, S, times, trim_speeds)
     kind, run_batch, step_all, outputs_all = compiled_for(rhs, outfn)
     ny = len(plant.output_names)
     lim_names = tuple(plant.output_limits)
     setup = LoopSetup(kind, wind_dt, times.dt, times.nsteps, times.rec_every, ny, plant.index("gen_speed"),
-                      plant.index("tower_top_vel"), *_torque_outputs(plant, TQ),
+                      plant.index("tower_top_vel"), *_torque_outputs(plant, TQ, peak_shaving),
                       np.array([plant.index(n) for n in lim_names], dtype=np.int64),
                       np.array([float(plant.output_limits[n]) for n in lim_names]))
     Y = np.empty((runs.X0.shape[0], ny + 1, (times.nsteps + times.rec_every - 1) // times.rec_every))
@@ -388,6 +391,7 @@ def _bank_records(controller, plant, dt):
     same = _same_locals(Ad, Bd, Cd, Dd, Rq, Ns)
     sfilt = schedule_filter_coefficients(fw, getattr(controller, "filter_damping", None), dt)
     cmd_lim = np.array((-np.inf, np.inf) if plant.pitch_limits is None else plant.pitch_limits, dtype=float)
+    ps = np.zeros(0)
     if pi is None:
         pi_on, kp, ki = False, np.zeros(K), np.zeros(K)
         Af, Bf, Cf, Df, lim = np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1), np.array([-np.inf, np.inf])
@@ -396,8 +400,10 @@ def _bank_records(controller, plant, dt):
         # the PI's integrator never holds more than the command can reach: its own limits
         # narrowed to the plant's (the plant's alone when it has none), so it cannot wind up
         lim = np.array([max(lim[0], cmd_lim[0]), min(lim[1], cmd_lim[1])])
+        if controller.peak_shaving is not None:  # ROSCO's minimum pitch from its wind estimate (form="gains")
+            ps = controller.peak_shaving.params()
     bank = Bank(Ad, Bd, Cd, Dd, Rq, Ns, same, np.ascontiguousarray(sched_pitch), sfilt, cmd_lim)
-    gpi = GainsPI(pi_on, *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim)))
+    gpi = GainsPI(pi_on, *(np.ascontiguousarray(a, dtype=float) for a in (kp, ki, Af, Bf, Cf, Df, lim, ps)))
     return bank, gpi
 
 
@@ -429,7 +435,7 @@ def _same_locals(Ad, Bd, Cd, Dd, Rq, Ns):
     return np.array([first.setdefault(k, q) for q, k in enumerate(keys)], dtype=np.int64)
 
 
-def _torque_params(plant, torque_control, vs, S, linear):
+def _torque_params(plant, torque_control, vs, S, linear, peak_shaving=False):
     """(R, TORQUE_PARAMS) torque-law parameters per run (mode 0: torque held) and the mask of
     wind speeds where the pitch loop is active (not below rated under the torque law)."""
     rated = plant.rated_wind_speed
@@ -443,8 +449,9 @@ def _torque_params(plant, torque_control, vs, S, linear):
             raise ValueError("torque_control='rosco' needs a plant with a torque law (a TurbineModel with "
                              "torque_control, e.g. iea15mw()); pass a specdesign.rosco.TorqueLaw instead")
         on[:] = True
-    elif torque_control == "auto":  # a constant-power law (VS_ConstPower = 1) acts above rated too
-        on = (~above | law.const_power) if law is not None else on
+    elif torque_control == "auto":  # a constant-power law (VS_ConstPower = 1) acts above rated too, and
+        # any law with peak shaving: at its limit the pitch stops regulating and the torque PI takes over
+        on = (~above | law.const_power | peak_shaving) if law is not None else on
     elif torque_control is not None:
         raise ValueError(f"torque_control={torque_control!r} must be 'auto', 'rosco', None or a specdesign.rosco.TorqueLaw")
     if linear:
@@ -455,7 +462,10 @@ def _torque_params(plant, torque_control, vs, S, linear):
     return TQ, above
 
 
-def _torque_outputs(plant, TQ):
+def _torque_outputs(plant, TQ, peak_shaving=False):
+    """Indices of the power and the pitch, which the torque law and peak shaving read (0 for unread)."""
+    if peak_shaving and not TQ[:, 0].any():
+        return 0, plant.index("pitch")
     if not TQ[:, 0].any():
         return 0, 0
     return plant.index("power"), plant.index("pitch")

@@ -31,7 +31,8 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:  # pragma: no cover
     import control
 
-from ..controller.torque import S_TQ, T_MODE, TORQUE_STATES, torque_step
+from ..controller.peak_shaving import PEAK_SHAVING_STATES, peak_shaving_step, tsr_reference
+from ..controller.torque import S_TQ, T_MODE, T_PC_REF, TORQUE_STATES, torque_step
 from ..turbine import aero_loads as _turbine_aero
 from ..turbine import mechanics as _turbine_mechanics
 from ..turbine import outputs as _turbine_outputs
@@ -93,16 +94,9 @@ def linear_outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: flo
 
     Parameters
     ----------
-    x : numpy.ndarray
-        Deviation state of the linear model, float64[nx].
-    wind : float
-        Rotor-effective wind speed (m/s), absolute.
-    pitch_cmd : float
-        Pitch command (rad), absolute.
-    gen_torque : float
-        Generator torque (N·m), absolute.
-    p : numpy.ndarray
-        Flat parameters from :func:`linear_plant_params`.
+    x, wind, pitch_cmd, gen_torque, p
+        The deviation state (float64[nx]), the absolute wind (m/s), pitch command (rad) and
+        generator torque (N·m), and the flat parameters, as :func:`linear_rhs` takes them.
     y : numpy.ndarray
         Output: float64[ny], the absolute outputs (written).
     """
@@ -320,6 +314,9 @@ class GainsPI(NamedTuple):
         The speed-error filter by Tustin.
     lim : numpy.ndarray
         (2,) limits of its integrator and output, rad.
+    ps : numpy.ndarray
+        ROSCO's peak shaving (:meth:`specdesign.controller.peak_shaving.PeakShaving.params`),
+        which lifts the lower limit with its wind-speed estimate, or an empty array for none.
     """
 
     on: bool
@@ -330,6 +327,7 @@ class GainsPI(NamedTuple):
     Cf: np.ndarray
     Df: np.ndarray
     lim: np.ndarray
+    ps: np.ndarray
 
 
 class Runs(NamedTuple):
@@ -380,6 +378,7 @@ def _run_one(setup, bank, gpi, p, x, w, beta0, omega_ref, torque, tq, noise, Yr)
     Ad, Bd, Cd, Dd, Rq, Ns, same = bank.Ad, bank.Bd, bank.Cd, bank.Dd, bank.Rq, bank.Ns, bank.same
     sched_pitch, sfilt, cmd_lim = bank.sched_pitch, bank.sfilt, bank.cmd_lim
     pi_on, kp, ki, Af, Bf, Cf, Df, lim = gpi.on, gpi.kp, gpi.ki, gpi.Af, gpi.Bf, gpi.Cf, gpi.Df, gpi.lim
+    ps = gpi.ps
     K = sched_pitch.size
     noisy = noise.shape[1] > 0
     nx = x.size
@@ -419,6 +418,12 @@ def _run_one(setup, bank, gpi, p, x, w, beta0, omega_ref, torque, tq, noise, Yr)
     tq_on = tq[T_MODE] != 0.0
     tst = np.zeros(TORQUE_STATES)
     tst[S_TQ] = torque  # the torque law's last command: the trim torque, as ROSCO measures it at start
+    # peak shaving (ROSCO's PC_MinPit from its wind estimate): the limit of the last step and of this one
+    ps_on = ps.size > 0
+    pst = np.zeros(PEAK_SHAVING_STATES)
+    ps_last = lim[0]
+    ps_min = lim[0]
+    eshift = 0.0  # the pitch reference's shift from ROSCO's setpoint smoother (with peak shaving), rad/s
     qs = 0  # the last step's scheduling segment, where the search starts
     j = 0
     for k in range(nsteps):
@@ -450,9 +455,25 @@ def _run_one(setup, bank, gpi, p, x, w, beta0, omega_ref, torque, tq, noise, Yr)
             speed += noise[0, k]
             vel += noise[1, k]
         # Both loops feed back with a minus sign: β = −C_β·ΔΩ_g − C_atd·ẋ_top.
+        if ps_on:
+            # ROSCO's order: its wind estimate first, on the last torque command, then the torque law on
+            # the last step's limit. ROSCO's measured pitch is its own last command (ReadAvrSWAP), and
+            # the estimator, the smoother and the state machine near that limit tell the difference.
+            ps_last = ps_min
+            ps_min = peak_shaving_step(ps, pst, speed, bcmd, torque, w[0], dt, k == 0)
+            if k == 0:
+                ps_last = ps_min
         if tq_on:  # ROSCO's torque law; its setpoint smoother moves the pitch reference
-            torque, wref = torque_step(tq, tst, speed, y[i_power], y[i_pitch], dt, k == 0)
-            e = -(speed - wref)
+            if ps_on:
+                torque, wref = torque_step(tq, tst, speed, y[i_power], bcmd, dt, k == 0, ps_last,
+                                           tsr_reference(ps, pst))
+                # ROSCO filters the speed, not its reference: the smoother's shift, which peak
+                # shaving turns negative at the limit, enters the PI's error unfiltered (below)
+                e = -(speed - tq[T_PC_REF])
+                eshift = wref - tq[T_PC_REF]
+            else:
+                torque, wref = torque_step(tq, tst, speed, y[i_power], y[i_pitch], dt, k == 0)
+                e = -(speed - wref)
         else:
             e = -(speed - omega_ref)
         v = -vel
@@ -536,6 +557,8 @@ def _run_one(setup, bank, gpi, p, x, w, beta0, omega_ref, torque, tq, noise, Yr)
                 xfn[i] = a
             for i in range(nf):
                 xf[i] = xfn[i]
+            if ps_on:
+                ef += eshift
             if f == 0.0:
                 kpv = kp[q]
                 kiv = ki[q]
@@ -548,9 +571,17 @@ def _run_one(setup, bank, gpi, p, x, w, beta0, omega_ref, torque, tq, noise, Yr)
             # pitch limits: anti-windup. With infinite limits this is the plain PI.
             lo = lim[0] - beta0
             hi = lim[1] - beta0
-            integ = min(max(integ, lo), hi)
-            u += min(max(kpv * ef + integ, lo), hi)
-        bcmd = min(max(beta0 + u, cmd_lim[0]), cmd_lim[1])
+            if ps_on:  # peak shaving: the integrator and PI held at the last step's limit, the command at this one's
+                lo = max(lim[0], ps_last) - beta0
+                integ = min(max(integ, lo), hi)
+                u += max(min(max(kpv * ef + integ, lo), hi), max(lim[0], ps_min) - beta0)
+            else:
+                integ = min(max(integ, lo), hi)
+                u += min(max(kpv * ef + integ, lo), hi)
+        if ps_on:
+            bcmd = min(max(beta0 + u, cmd_lim[0], ps_min), cmd_lim[1])
+        else:
+            bcmd = min(max(beta0 + u, cmd_lim[0]), cmd_lim[1])
         if sfilt.size == 1:  # first order, exact discretisation: sfilt = [1 − exp(−ω_f·dt)]
             bf += sfilt[0] * (bcmd - bf)
         else:  # second order by Tustin, sfilt = [b0, b1, b2, a1, a2] normalised by a0

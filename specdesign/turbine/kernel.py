@@ -210,20 +210,13 @@ def mechanics(x: np.ndarray, aero_torque: float, thrust: float, pitch_cmd: float
 
     Parameters
     ----------
-    x : numpy.ndarray
-        State, float64[5] (:data:`STATE_NAMES`, SI).
+    x, pitch_cmd, gen_torque, p, dx
+        As :func:`rhs` takes them: the state (float64[5], SI), pitch demand (rad), generator
+        torque on the rotor shaft (N·m), parameter array and the derivative (written).
     aero_torque : float
         Aerodynamic torque (N·m).
     thrust : float
         Thrust (N).
-    pitch_cmd : float
-        Collective pitch demand (rad).
-    gen_torque : float
-        Generator torque on the rotor shaft (N·m).
-    p : numpy.ndarray
-        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
-    dx : numpy.ndarray
-        Output: float64[5], the state derivative (written).
     """
     dx[0], dx[1], dx[2], dx[3], dx[4] = mechanics_scalars(x[0], x[1], x[2], x[3], x[4], aero_torque, thrust,
                                                           pitch_cmd, gen_torque, p)
@@ -242,16 +235,8 @@ def mechanics_scalars(rotor_speed: float, tower_top_disp: float, tower_top_vel: 
     ----------
     rotor_speed, tower_top_disp, tower_top_vel, pitch, pitch_rate : float
         The state (:data:`STATE_NAMES`: rad/s, m, m/s, rad, rad/s).
-    aero_torque : float
-        Aerodynamic torque (N·m).
-    thrust : float
-        Thrust (N).
-    pitch_cmd : float
-        Collective pitch demand (rad).
-    gen_torque : float
-        Generator torque on the rotor shaft (N·m).
-    p : numpy.ndarray
-        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    aero_torque, thrust, pitch_cmd, gen_torque, p
+        As :func:`mechanics` takes them (N·m, N, rad, N·m; the flat parameter array).
 
     Returns
     -------
@@ -364,16 +349,9 @@ def outputs(x: np.ndarray, wind: float, pitch_cmd: float, gen_torque: float, p: 
 
     Parameters
     ----------
-    x : numpy.ndarray
-        State, float64[5] (:data:`STATE_NAMES`, SI).
-    wind : float
-        Rotor-effective wind speed (m/s).
-    pitch_cmd : float
-        Collective pitch demand (rad).
-    gen_torque : float
-        Generator torque on the rotor shaft (N·m).
-    p : numpy.ndarray
-        Flat parameter array (:meth:`specdesign.turbine.TurbineModel.kernel_params`).
+    x, wind, pitch_cmd, gen_torque, p
+        The state (float64[5], SI), wind (m/s), pitch demand (rad), generator torque (N·m) and
+        parameter array, as :func:`rhs` takes them.
     y : numpy.ndarray
         Output: float64[7], written: gen_speed (rad/s), tower_base_my (N·m), tower_top_acc
         (m/s²), tower_top_vel (m/s), pitch (rad), power (W, electrical), blade_root_my (N·m).

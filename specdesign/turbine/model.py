@@ -257,14 +257,9 @@ class TurbineModel:
 
         Parameters
         ----------
-        x : array_like
-            State, shape (5,) (:data:`STATE_NAMES`, SI).
-        wind : float
-            Rotor-effective wind speed (m/s).
-        pitch_cmd : float
-            Collective pitch demand (rad).
-        gen_torque : float
-            Generator torque (N·m).
+        x, wind, pitch_cmd, gen_torque
+            The state (5,) (SI), wind (m/s), pitch demand (rad) and generator torque (N·m), as
+            :meth:`derivatives` takes them.
 
         Returns
         -------

@@ -23,12 +23,8 @@ Modules, in the order they build on each other:
 - :mod:`~specdesign.validate.surrogate`: a Gaussian-process surrogate of a campaign's DEL over
   its conditions, against the look-up table.
 
-Per wind speed, seeds are pooled the way fatigue adds up: DEL over S seeds of equal length
-is (mean_s DEL_s^m)^{1/m} (the DEL of the concatenated damage), SDs are pooled as
-√(mean_s var_s), the power is the plain mean. A *relative change* designed vs baseline is
-100·(X_designed/X_baseline − 1) %; a *reduction* is minus that. Both controllers see the same
-seeds (paired), and standard errors come from the jackknife over paired seeds (delete one
-seed from both controllers), or a seeded paired bootstrap.
+How seeds are pooled per wind speed (as fatigue adds up), what a relative change and a
+reduction are, and the paired-seed standard errors: :mod:`~specdesign.validate.stats`.
 
 Weibull mean (Table 2's "Mean" column): Σ w_i c_i with w_i = f(v_i)/Σ_j f(v_j), f the Weibull
 pdf with k = 2.2, A = 11.29 m/s evaluated at the operating points. This reproduces the means

@@ -22,6 +22,7 @@ from ..controller.torque import TorqueLaw
 from ..fatigue import TOWER_M
 from ..simulate import SimulationResult, check_step, turbine_plant
 from ..simulate.checks import checked_loop
+from ..wind import RECORD_LENGTH
 from ._loop import has_linear_form
 from .campaign_record import Campaign
 from ._point import SPECTRA, campaign_point
@@ -94,7 +95,7 @@ def check_campaign_step(model, controllers: Mapping, wind_speeds, dt: float) -> 
 
 
 @on_one_blas_thread  # the tasks' own limit (campaign_point) nests in it: two local threads never undo it
-def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, duration: float = 600.0, dt: float = 0.02,
+def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, duration: float = RECORD_LENGTH, dt: float = 0.02,
                  record_dt: float = 0.1, transient: float = 60.0, m: float = TOWER_M, predict: bool = True,
                  turbulence_class: str = "B", keep_series: bool | int = False, linear_twin: bool = False,
                  volterra: int = 0, executor=None, progress: bool | None = None,

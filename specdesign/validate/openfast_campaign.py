@@ -30,6 +30,7 @@ from ..openfast.turbsim import TURBSIM_GRID, turbsim_field
 from ..rosco.discon import rosco_library
 from ..simulate import SimulationResult
 from ..turbine import iea15mw
+from ..wind import RECORD_LENGTH
 from ._point import SPECTRA
 from .campaign_record import Campaign
 from .metrics import INDICATORS, indicators
@@ -107,7 +108,7 @@ def _sha(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
 
 
-def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Deck, duration: float = 600.0,
+def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Deck, duration: float = RECORD_LENGTH,
                           transient: float = 60.0, dt: float | None = None, record_dt: float = 0.05, m: float = TOWER_M,
                           folder=None, processes: int | None = None, progress: bool | None = None,
                           turbulence_class: str = "B", grid_points: int = TURBSIM_GRID["points"],

@@ -269,12 +269,9 @@ def paired_change(designed, baseline, indicator: str = "tower_del", *, m: float 
         Wöhler exponent (for the DEL).
     wind_speeds : array_like, optional
         (W,) wind speeds (m/s) to label the result; default 0..W−1.
-    method : {"jackknife", "bootstrap"}, default "jackknife"
-        Standard error by :func:`resampled_se`.
-    n_boot : int, default 2000
-        Bootstrap replicates.
-    seed : int, default 0
-        Seed of ``np.random.default_rng`` for the bootstrap.
+    method, n_boot, seed
+        The standard error's method ("jackknife" by default), bootstrap replicates and seed, as
+        :func:`resampled_se` takes them.
 
     Returns
     -------

@@ -12,6 +12,7 @@ from ..closedloop import local_response, t_output_wind
 from ..fatigue import TOWER_M, del_rainflow
 from ..simulate import wind_series
 from ..turbine import OUTPUT_NAMES
+from ..wind import RECORD_LENGTH
 from ._loop import has_linear_form, rotor_radius
 from .stats import pool, seeds_from
 
@@ -152,7 +153,7 @@ class VolterraPrediction:
     duration: float
 
 
-def volterra_prediction(model, controller, wind_speed: float, *, seeds=range(1000, 1200), duration: float = 600.0,
+def volterra_prediction(model, controller, wind_speed: float, *, seeds=range(1000, 1200), duration: float = RECORD_LENGTH,
                         dt: float = 0.1, order: int = 3, m: float = TOWER_M, output: str = "tower_base_my",
                         turbulence_class: str = "B", chunk: int = 50) -> VolterraPrediction:
     """DEL of ``output`` predicted by the Volterra series over synthetic periodic wind records.
