@@ -58,7 +58,11 @@ def model():
 def qft19(model):
     from specdesign import qft
 
-    return qft.design_qft(model, 19.0)
+    # a design with a slow mode besides its integrator, so that the export's conditional
+    # integration of slow states is exercised: the 25 % design without the high-frequency gain
+    # bound has a pole at −0.019 rad/s (< SLOW_OMEGA = 0.1 rad/s); the bounded default's slowest
+    # besides the integrator is a pair at 0.18 rad/s (clamped integrator only)
+    return qft.design_qft(model, 19.0, max_hf_gain_ratio=None)
 
 
 def _runs(model, python_controller, record, speeds, **python_kw):

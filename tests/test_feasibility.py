@@ -15,10 +15,9 @@ from specdesign.rosco import rosco_baseline
 from specdesign.turbine import iea15mw
 
 
-#: These tests check the certificate machinery on the 25 % pair as it was made before the
-#: high-frequency gain bound became a default (issue 28 item 1): under the bound's default
-#: κ = fz.HF_GAIN_RATIO the 25 % target is refused at 15-25 m/s (best certified promise
-#: 19.8-24.8 %, docs/feasibility.md), and tests/test_hf_bound.py checks the bounded designs.
+#: These tests check the certificate machinery on the 25 % pair without the high-frequency gain
+#: bound (issue 28 item 1), whose certificates reach further; tests/test_hf_bound.py checks the
+#: default designs, under the bound's κ = fz.HF_GAIN_RATIO.
 NO_HF = {"max_hf_gain_ratio": None}
 
 
@@ -196,8 +195,9 @@ def test_a_fixed_speed_relaxation_gives_the_largest_slack(model):
     base = spec.baseline_analysis(model, 19.0)
     # the certificate meets the 6 dB map; W_Ω covers what it needs at the other plant cases too
     assert t.design.speed_relax_db == 6.0 and t.speed_relax_db >= 6.0 and t.promise.exact_del >= 25.0
-    ratio = np.abs(t.design.t_tower) / np.abs(base.t_response)
-    over = spec.promise_of(10 ** ((t.slack_db + 0.1) / 20) * ratio, base).exact_del
+    # 0.1 dB more slack (twice the bisection's tolerance) on top of the pair's, the cases' margin
+    # (gain and bumps) kept
+    over = spec.promise_of(t.tower.add(spec.Gain(0.1)), base).exact_del
     assert over < 25.0 < t.promise.exact_del < 25.0 + 1.0
 
 

@@ -23,6 +23,8 @@ from loopshaping.specs import controller_gain
 from specdesign import closedloop, spec
 from specdesign import feasibility as fz
 from specdesign.feasibility import HF_END, HF_GAIN_RATIO, HF_OMEGA, YoulaProblem
+from specdesign.feasibility.margin import MARGIN_BUMPS
+from specdesign.feasibility.target import SEARCH_MARGIN_PP, TARGET_REDUCTION
 from specdesign.turbine import iea15mw
 
 matplotlib.use("Agg")
@@ -74,11 +76,11 @@ def test_one_default_for_the_bound_in_every_entry_point():
     from specdesign.qft.design import _design_single
 
     assert HF_GAIN_RATIO is not None and HF_GAIN_RATIO > 0
-    # one name, one default (feasibility.MAX_HF_GAIN_RATIO: off, since the measured κ refuses the
-    # paper's 25 % at 15-25 m/s), in every entry point
+    # one name, one default (feasibility.MAX_HF_GAIN_RATIO: the measured κ, on), in every entry point
     for fn in (fz.YoulaProblem.__init__, fz.achievable_pitch, fz.pitch_frontier, fz.specification_for_target,
                fz.CertificateSearch.__init__, design_hinf, spec_for_target, _design_single):
         assert inspect.signature(fn).parameters["max_hf_gain_ratio"].default is fz.MAX_HF_GAIN_RATIO, fn.__qualname__
+    assert fz.MAX_HF_GAIN_RATIO == HF_GAIN_RATIO  # issue 28 item 1: the bound is part of every design by default
 
 
 def test_the_constant_is_the_documented_measurement():
@@ -133,49 +135,81 @@ def test_controller_gain_spec_and_the_designers_verdict():
         Designer(bounds, tmpl, gain_bound=5.0)
 
 
-#: A target every certified pair reaches under the measured bound at 15-25 m/s: the best promises
-#: under κ = HF_GAIN_RATIO are 19.8-24.8 % (docs/feasibility.md, benchmarks/hf_bound.py's table);
-#: the paper's 25 % is refused under it at every one of these speeds
-#: (test_the_25_percent_target_is_refused_under_the_measured_bound).
-FEASIBLE_TARGET = 18.0
+#: The wind speeds of the paper's Table 3: issue 28's "Done when" asks the designs there to meet
+#: the bound and still promise the target (TARGET_REDUCTION, 25 %).
+SPEEDS = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
 
 
 @pytest.fixture(scope="module")
 def qft_designs(model):
     from specdesign.qft import design_qft
 
-    return {v: design_qft(model, v, FEASIBLE_TARGET, max_hf_gain_ratio=HF_GAIN_RATIO) for v in (15.0, 19.0, 25.0)}
+    return {v: design_qft(model, v) for v in SPEEDS}  # the default: 25 % under κ = HF_GAIN_RATIO
 
 
-@pytest.mark.parametrize("v", [15.0, 19.0, 25.0])
-def test_design_qft_meets_the_bound_and_is_strictly_proper(model, qft_designs, v):
+@pytest.mark.slow
+@pytest.mark.parametrize("v", SPEEDS)
+def test_design_qft_meets_the_bound_and_promises_the_target(model, qft_designs, v):
     d = qft_designs[v]
     assert d.success, d.message
     assert d.options["max_hf_gain_ratio"] == HF_GAIN_RATIO
     assert gain_ratio(model, v, d.pitch_controller, HF_GAIN_RATIO) <= 1.0
     assert direct_term(d.pitch_controller) == 0.0
     assert "hf_gain" in d.pitch_check.names and d.pitch_check.spec_passed[d.pitch_check.names.index("hf_gain")]
-    assert d.promise.exact_del >= FEASIBLE_TARGET
+    assert d.promise.exact_del >= TARGET_REDUCTION + SEARCH_MARGIN_PP
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("v", [15.0, 19.0, 25.0])
 def test_design_hinf_meets_the_bound_and_is_strictly_proper(model, v):
     from specdesign.hinf import design_hinf
 
-    d = design_hinf(model, v, FEASIBLE_TARGET, max_hf_gain_ratio=HF_GAIN_RATIO)
+    d = design_hinf(model, v)  # the default: 25 % under κ = HF_GAIN_RATIO
     assert d.case_check.met and d.case_check.proper
     assert d.case_check.hf_excess_db <= 0.0
     assert gain_ratio(model, v, d.pitch_controller, HF_GAIN_RATIO) <= 1.0
     assert direct_term(d.pitch_controller) == 0.0
+    assert d.promised_del_reduction >= TARGET_REDUCTION
 
 
-def test_the_25_percent_target_is_refused_under_the_measured_bound(model):
-    from specdesign.qft import design_qft
-
+def test_the_25_percent_target_needs_the_cases_margin_where_their_excess_lies(model):
+    # 19 m/s under the measured κ: raising the certificate's map by the plant cases' largest
+    # excess everywhere (margin_bumps=0, the search before) promises at most 24.8 % over the
+    # ladder (docs/feasibility.md's table before the shaped margin), so 25 % is refused; the
+    # margin that follows the cases' excess certifies it, and the pair is met at every plant case
+    # on recertify's own dense grid (refined around the bumps' roots)
+    search = fz.CertificateSearch(model, 19.0, margin_bumps=0)
     with pytest.raises(ValueError, match=rf"high-frequency gain bound \|C\| ≤ {HF_GAIN_RATIO:g}"):
-        design_qft(model, 19.0, max_hf_gain_ratio=HF_GAIN_RATIO)  # 25 %: the best certified promise under it is 24.8 % here
-    d = design_qft(model, 19.0, 25.0)  # the default, off: the pair of before
-    assert d.success and d.options["max_hf_gain_ratio"] is None
+        search.for_target(TARGET_REDUCTION)
+    ts = fz.specification_for_target(model, 19.0)
+    assert ts.max_hf_gain_ratio == HF_GAIN_RATIO and ts.promise.exact_del >= TARGET_REDUCTION + SEARCH_MARGIN_PP
+    bumps = [e for e in ts.tower.elements if isinstance(e, spec.Notch)]
+    assert bumps and all(e.depth_db < 0 for e in bumps)  # bumps: W_MyT only rises above the certificate's map
+    again = fz.recertify(model, ts)
+    assert again.promise.exact_del == pytest.approx(ts.promise.exact_del, abs=1e-9)
+    with pytest.raises(ValueError, match="margin_bumps"):
+        fz.CertificateSearch(model, 19.0, margin_bumps=MARGIN_BUMPS + 1)
+
+
+def test_the_cases_margin_lies_above_their_excess_and_promises_no_less_than_a_uniform_one():
+    from specdesign.feasibility.margin import case_margin, shaping_db
+
+    w = np.geomspace(0.005, 20.0, 900)
+    # an excess like the IEA 15 MW's: a hump in the wind band, a peak at the tower mode
+    p = 0.6 * np.exp(-(np.log(w / 0.12) / 0.6) ** 2) + 2.0 * np.exp(-(np.log(w / 1.13) / 0.04) ** 2) + 0.1
+    weight_omega = np.geomspace(0.01, 10.0, 400)
+    weight = np.exp(-(np.log(weight_omega / 1.1) / 0.3) ** 2) + 0.2 * np.exp(-(np.log(weight_omega / 0.15) / 0.8) ** 2)
+
+    def promise(elements):  # a stand-in promise: it falls with the margin where the weight lies
+        return -float(np.sum(np.interp(w, weight_omega, weight) * shaping_db(elements, w)))
+
+    uniform = case_margin(w, p, weight_omega, weight, promise, max_bumps=0)
+    assert len(uniform) == 1 and uniform[0].gain_db == pytest.approx(p.max())
+    shaped = case_margin(w, p, weight_omega, weight, promise)
+    assert np.all(shaping_db(shaped, w) >= p - 1e-9)  # on or above the excess at every point
+    assert promise(shaped) > promise(uniform)
+    for e in shaped[1:]:  # bumps centred where the promise is evaluated
+        assert weight_omega[0] <= e.omega_n <= weight_omega[-1] and e.depth_db <= 0
 
 
 def test_the_bode_and_nichols_figures_draw_the_bound(model, qft_designs):

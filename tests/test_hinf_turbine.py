@@ -405,7 +405,7 @@ def test_a_certified_pair_it_does_not_meet_is_said_with_the_miss(model):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy: "solution may be inaccurate" on some rungs
-        # the 25 % pair of before the high-frequency gain bound (refused under its default κ)
+        # the 25 % pair without the high-frequency gain bound
         ts = feasibility.specification_for_target(model, V, 25.0, max_hf_gain_ratio=None)
     with pytest.warns(RuntimeWarning, match="not met") as rec:
         res = hinf.design_hinf(model, V, spec=hinf.spec_from_certified(ts), measurements=("gen_speed", "tower_top_vel"))

@@ -40,7 +40,9 @@ specification that is feasible by construction, with the exact (Dirlik) promise.
 pointwise upper bound of condition 1 (the smallest |T_{MyT,w}| inside the speed and margin
 disks at every frequency): the true frontier lies between the two.
 :func:`specification_for_target` inverts the frontier: the smallest speed relaxation whose
-design promises a requested DEL reduction, and the specification pair it certifies.
+design promises a requested DEL reduction, and the specification pair it certifies; the plant
+cases' margin in its W_MyT follows their excess where it lies (a gain and bumps,
+:func:`~specdesign.feasibility.margin.case_margin`).
 :func:`element_specification` writes such a certified tower specification as ROSCO's map times
 a few shaping elements (gain, lag, lead, notches and bumps) over the whole band, editable by hand:
 the elements follow a certificate's envelope, and :meth:`CertificateSearch.for_tower` certifies
@@ -49,6 +51,7 @@ them with a Youla design made to meet them (the tower bound, |T_{MyT,w}| ≤ |W_
 Modules: :mod:`~specdesign.feasibility.conditions` (the necessary conditions, the frontier),
 :mod:`~specdesign.feasibility.achievable` (the convex Youla design),
 :mod:`~specdesign.feasibility.target` (the specification for a target),
+:mod:`~specdesign.feasibility.margin` (the plant cases' margin in it),
 :mod:`~specdesign.feasibility.elements` (the same in shaping elements),
 :mod:`~specdesign.feasibility.shaping` (:func:`shape_whole_band`: the same from a
 :func:`specdesign.spec.baseline_analysis` baseline, as :func:`specdesign.spec.shape_to_target`

@@ -421,7 +421,7 @@ def pitch_frontier(model, wind_speed, speed_relax_db=(0.5, 1.5, 3.0, 4.5, 6.0, 8
         Frequency grid, rad/s (default :func:`specdesign.spec.default_omega`).
     max_hf_gain_ratio : float or None
         κ of the high-frequency gain bound on the designs (see :func:`achievable_pitch`;
-        default :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO`, None: off; :data:`~specdesign.feasibility.HF_GAIN_RATIO` is the measured κ). The pointwise
+        default :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO`, on; None: off; :data:`~specdesign.feasibility.HF_GAIN_RATIO` is the measured κ). The pointwise
         ``bound`` ignores it (it stays an upper bound).
 
     Returns

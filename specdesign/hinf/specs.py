@@ -152,8 +152,8 @@ def spec_for_target(model: TurbineModel, wind_speed: float, target_reduction: fl
     m : float
         Wöhler exponent of the tower-base S-N curve on ranges (-).
     max_hf_gain_ratio : float or None
-        κ of the certificate's high-frequency gain bound (:func:`specification_for_target`);
-        None: no bound.
+        κ of the certificate's high-frequency gain bound (:func:`specification_for_target`;
+        default the measured κ, on); None: no bound.
 
     Returns
     -------

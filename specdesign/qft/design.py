@@ -140,7 +140,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             Required closed-loop decay rate, 1/s (poles left of −min_decay).
         keep_below : float, default 0.6
             Protected band of the notch specification, rad/s (power regulation).
-        max_hf_gain_ratio : float or None, default :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO` (None: off)
+        max_hf_gain_ratio : float or None, default :data:`~specdesign.feasibility.MAX_HF_GAIN_RATIO` (the measured κ, on)
             κ of the high-frequency gain bound, |C_β(jω)| ≤ κ·|C_ROSCO(jω)| on HF_OMEGA-HF_END
             (2-10 rad/s, 3P inside) with C_β strictly proper; None switches it off. Without
             ``spec`` the certificate is made under it
