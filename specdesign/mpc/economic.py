@@ -427,9 +427,7 @@ class EconomicMPC(SampledController):
     name : str, default "economic MPC"
         Label.
     operating_point, wind_speeds : str, array_like
-        Where the model is linearised, as :class:`~specdesign.mpc.sampled.SampledController`
-        takes them (default: scheduled on the run's own wind estimate, every 1 m/s over
-        ``model.wind_range``; or ``"initial pitch"``).
+        As :class:`~specdesign.mpc.sampled.SampledController` takes them.
 
     Attributes
     ----------
