@@ -166,7 +166,7 @@ class LiveArtists:
     full redraw, a toolbar zoom or a resize still shows them, and ``savefig`` too);
     :meth:`redraw` restores the background, draws only them and sends the changed pixels; a line
     of text that meets the pixels it met before is written from a cache instead of rasterised
-    again (:class:`loopshaping._textcache.CachedTextRenderer`: pixel-identical, and a multi-line
+    again (``loopshaping._textcache.CachedTextRenderer``: pixel-identical, and a multi-line
     title whose one line changed costs that line).
     Until the canvas has rendered once and the browser's view of it is connected it asks for
     a full redraw instead (a blit sent before the browser drew the figure once left it empty).

@@ -231,7 +231,7 @@ FIGURES = {
     "qft.plot_design_nichols": (_design_nichols, "[deg]", ["[dB]", "[dB]"],
                                 ["nominal loop L0", "ω = 0.01 rad/s", "ω = 0.05 rad/s", "ω = 1.5 rad/s",
                                  "solid: lower bound", "dashed: upper bound"]),
-    "qft.plot_design_bode": (_design_bode, "(rad/s)", ["dB re 1 (rad/s)/(m/s)", "dB re 1 N·m/(m/s)"],
+    "qft.plot_design_bode": (_design_bode, "(rad/s)", ["dB re 1 (rad/s)/(m/s)", "dB re 1 N·m/(m/s)", "dB re 1 rad/(rad/s)"],
                              ["ROSCO", "generator-speed spec W_Ω", "tower-load spec W_y as shaped", "W_y relaxed",
                               "checked against", "QFT"]),
     "validation.plot_spectra": (_spectra, "(rad/s)", ["(N·m)²/(rad/s)"],
