@@ -42,7 +42,7 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from .discon_file import read_discon
-from .torque import rosco_lpf1
+from .torque import rosco_lpf1, rosco_lpf2
 
 __all__ = ["WE_MODES", "PeakShaving", "peak_shaving_from_discon", "peak_shaving_step", "tsr_reference",
            "PEAK_SHAVING_STATES"]
@@ -284,25 +284,6 @@ def peak_shaving_from_discon(path: str | Path, tsr_grid: ArrayLike, pitch_grid: 
 
 # ----------------------------------------------------------------------------- compiled step
 @njit(cache=True)
-def _lpf2(st, iy, iy2, iu1, iu2, u, corner, damp, dt, reset):
-    # ROSCO's SecLPFilter (Tustin), reset to its input
-    if reset:
-        st[iy] = u
-        st[iy2] = u
-        st[iu1] = u
-        st[iu2] = u
-    h2 = dt * dt * corner * corner
-    a2 = h2 + 4.0 + 4.0 * damp * corner * dt
-    y = (h2 * u + 2.0 * h2 * st[iu1] + h2 * st[iu2] - (2.0 * h2 - 8.0) * st[iy]
-         - (h2 + 4.0 - 4.0 * damp * corner * dt) * st[iy2]) / a2
-    st[iu2] = st[iu1]
-    st[iu1] = u
-    st[iy2] = st[iy]
-    st[iy] = y
-    return y
-
-
-@njit(cache=True)
 def _interp1(ps, ix, iy, n, x):
     # ROSCO's interp1d: linear, held at the ends
     if x <= ps[ix]:
@@ -382,8 +363,8 @@ def peak_shaving_step(ps: np.ndarray, st: np.ndarray, omega: float, pitch: float
     if ps[H_FILT_TYPE] == 1.0:
         wf = rosco_lpf1(st, S_WF, S_WU1, omega, c, dt, first)
     else:
-        wf = _lpf2(st, S_WF, S_WF2, S_WU1, S_WU2, omega, c, ps[H_FILT_DAMP], dt, first)
-    tf = _lpf2(st, S_TF, S_TF2, S_TU1, S_TU2, torque, c, 0.7, dt, first)
+        wf = rosco_lpf2(st, S_WF, S_WF2, S_WU1, S_WU2, omega, c, ps[H_FILT_DAMP], dt, first)
+    tf = rosco_lpf2(st, S_TF, S_TF2, S_TU1, S_TU2, torque, c, 0.7, dt, first)
     vw_f = rosco_lpf1(st, S_VF, S_VU, st[S_VW], ps[H_WE_CORNER], dt, first)
     # WindSpeedEstimator: inputs held in the estimator's range, which it leaves when one is held
     lo_speed = 0.25 * ps[H_MIN_SPEED]

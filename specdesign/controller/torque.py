@@ -53,7 +53,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..turbine import TurbineModel
 
 __all__ = ["TORQUE_MODES", "TORQUE_PARAMS", "TORQUE_STATES", "TORQUE_REGIONS", "TRIM_TOL", "TorqueLaw", "torque_law",
-           "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step", "rosco_lpf1"]
+           "torque_law_from_discon", "steady_state", "close_torque_loop", "torque_step", "rosco_lpf1", "rosco_lpf2"]
 
 #: Regions of a trim (:attr:`specdesign.turbine.OperatingPoint.region`): "1.5" minimum speed held
 #: by the PI, "2" K·Ω², "2.5" the torque controller's rated speed held by the PI, "2.5s" its PI
@@ -522,6 +522,50 @@ def rosco_lpf1(st: np.ndarray, iy: int, iu: int, u: float, corner: float, dt: fl
     return y
 
 
+
+@njit(cache=True)
+def rosco_lpf2(st: np.ndarray, iy: int, iy2: int, iu1: int, iu2: int, u: float, corner: float, damp: float,
+               dt: float, reset: bool) -> float:
+    """One step of ROSCO's second-order low-pass ``SecLPFilter`` (``Filters.f90``: Tustin of
+    ω_c²/(s² + 2ζω_c·s + ω_c²)).
+
+    Parameters
+    ----------
+    st : numpy.ndarray
+        State array holding the last two outputs at ``iy``, ``iy2`` and inputs at ``iu1``, ``iu2``, updated.
+    iy, iy2, iu1, iu2 : int
+        Their indices.
+    u : float
+        Input.
+    corner : float
+        ω_c (rad/s).
+    damp : float
+        ζ (-).
+    dt : float
+        Step (s).
+    reset : bool
+        Start the filter at its input (ROSCO's first call).
+
+    Returns
+    -------
+    float
+        The filtered value.
+    """
+    if reset:
+        st[iy] = u
+        st[iy2] = u
+        st[iu1] = u
+        st[iu2] = u
+    h2 = dt * dt * corner * corner
+    a2 = h2 + 4.0 + 4.0 * damp * corner * dt
+    y = (h2 * u + 2.0 * h2 * st[iu1] + h2 * st[iu2] - (2.0 * h2 - 8.0) * st[iy]
+         - (h2 + 4.0 - 4.0 * damp * corner * dt) * st[iy2]) / a2
+    st[iu2] = st[iu1]
+    st[iu1] = u
+    st[iy2] = st[iy]
+    st[iy] = y
+    return y
+
 @njit(cache=True)
 def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):
     # ROSCO's PIController: forward-Euler integral saturated at the output limits
@@ -585,16 +629,7 @@ def torque_step(tq: np.ndarray, st: np.ndarray, omega: float, power: float, pitc
     if tq[T_FILT_TYPE] == 1.0:
         wf = rosco_lpf1(st, S_WF, S_U1, omega, c, dt, False)
     else:
-        h2 = dt * dt * c * c
-        z = tq[T_FILT_DAMP]
-        a2 = h2 + 4.0 + 4.0 * z * c * dt
-        a1 = 2.0 * h2 - 8.0
-        a0 = h2 + 4.0 - 4.0 * z * c * dt
-        wf = (h2 * omega + 2.0 * h2 * st[S_U1] + h2 * st[S_U2] - a1 * st[S_WF] - a0 * st[S_WF2]) / a2
-        st[S_U2] = st[S_U1]
-        st[S_U1] = omega
-        st[S_WF2] = st[S_WF]
-        st[S_WF] = wf
+        wf = rosco_lpf2(st, S_WF, S_WF2, S_U1, S_U2, omega, c, tq[T_FILT_DAMP], dt, False)
     # setpoints, with the smoother's shift of the previous step (ComputeVariablesSetpoints)
     ssf = st[S_SSF]
     pc_ref = tq[T_PC_REF] - ssf if ssf < 0.0 else tq[T_PC_REF]
