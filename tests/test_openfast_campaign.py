@@ -15,7 +15,7 @@ from numpy.testing import assert_allclose
 pytest.importorskip("openfast_io")
 
 from specdesign.openfast import OpenFASTInstall, iea15mw_monopile
-from specdesign.validate import indicators, run_campaign
+from specdesign.validate import indicators, read_openfast_runs, run_campaign
 from specdesign.validate.openfast_campaign import run_openfast_campaign
 
 # The fake OpenFAST: reads TMax and DT_Out from the .fst, the seed from the wind file's name,
@@ -124,6 +124,29 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
     # another controller under a stored name is refused
     with pytest.raises(ValueError, match="other settings or another controller under the name 'A'"):
         run_openfast_campaign({"A": ctrls["B"]}, [19.0], [0], **kw)
+
+
+def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake):
+    # read_openfast_runs gives back what run_openfast_campaign stored, value for value and
+    # spectrum for spectrum; a run whose result.npz is not written yet (a run in progress) is
+    # not counted; a folder that is not there is named
+    inst, calls, lib = fake
+    ctrls = {"A": _controller(tmp_path, lib, "a", "1.0"), "B": _controller(tmp_path, lib, "b", "0.5")}
+    camp = run_openfast_campaign(ctrls, [19.0], [0, 2], deck=iea15mw_monopile(), duration=40.0, transient=10.0,
+                                 record_dt=0.05, install=inst, processes=2, folder=tmp_path / "camp",
+                                 initial_conditions=False)
+    runs = read_openfast_runs(tmp_path / "camp")
+    assert [(r.controller, r.wind_speed, r.seed) for r in runs] == [("A", 19.0, 0), ("A", 19.0, 2), ("B", 19.0, 0),
+                                                                      ("B", 19.0, 2)]
+    for r in runs:
+        ci, si = camp.controllers.index(r.controller), (0, 2).index(r.seed)
+        for k, v in r.values.items():
+            assert_allclose(v, camp.values[k][ci, 0, si], rtol=0, err_msg=k)
+        assert r.meta["settings"]["duration"] == 40.0 and r.omega.shape == r.welch["tower_base_my"].shape
+    (tmp_path / "camp" / "B" / "19mps_seed2" / "result.npz").unlink()
+    assert len(read_openfast_runs(tmp_path / "camp")) == 3
+    with pytest.raises(FileNotFoundError, match="campaign's folder"):
+        read_openfast_runs(tmp_path / "nowhere")
 
 
 def test_failed_run_is_reported_and_the_rest_kept(tmp_path, fake):

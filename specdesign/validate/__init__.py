@@ -41,6 +41,7 @@ from .campaign import check_campaign_step, check_plant_step, concat_campaigns, r
 from .campaign_record import Campaign
 from .lifetime_del import DEL_CHANNELS, LifetimeDEL, WindClimate, lifetime, weibull_bins, wind_climate
 from .metrics import ACTUATOR_INDICATORS, INDICATORS, Indicators, indicators
+from .openfast_campaign import OpenFASTRun, read_openfast_runs
 from .prediction import LinearPrediction, closed_loop_response, linear_prediction, loop_plant, prediction_grid
 from .stats import (WEIBULL_A, WEIBULL_K, PairedChange, paired_change, pool, resampled_se, seeds_from, weibull_weights,
                     welch_psd)
@@ -62,6 +63,7 @@ __all__ = [
     "volterra_response", "VolterraPrediction", "volterra_prediction",
     # campaign
     "Campaign", "run_campaign", "concat_campaigns", "seeds_from", "check_plant_step", "check_campaign_step",
+    "OpenFASTRun", "read_openfast_runs",
     # surrogate
     "CONDITIONS", "DelData", "del_data", "SurrogatePrediction", "GPSurrogate", "fit_gp", "LookupTable", "fit_lut",
     "SurrogateComparison", "compare_surrogates",

@@ -36,7 +36,8 @@ from .campaign_record import Campaign
 from .metrics import INDICATORS, indicators
 from .stats import seeds_from, welch_psd
 
-__all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES"]
+__all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES", "OpenFASTRun",
+           "read_openfast_runs"]
 
 #: OpenFAST channel → workbench series of an OpenFAST campaign (SI after reading).
 OPENFAST_SERIES = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power",
@@ -61,6 +62,85 @@ class DisconController:
     library: Path
     parameters: Path
     dt: float | None = None
+
+
+@dataclass(frozen=True)
+class OpenFASTRun:
+    """One finished run of an OpenFAST campaign folder, as :func:`read_openfast_runs` reads it.
+
+    Parameters
+    ----------
+    controller : str
+        The controller's name in the campaign (its folder's name).
+    wind_speed : float
+        Mean hub-height wind speed, m/s.
+    seed : int
+        The campaign's seed (TurbSim's is ``specdesign.wind.seed_for(wind_speed, seed)``).
+    values : dict
+        Indicator → value in its unit (:data:`~specdesign.validate.metrics.INDICATORS`; DELs in
+        N·m, SDs in rad or rad/s, power in W, travel in rad, time at the rate limit in s); an
+        indicator the run predates is absent, never filled in.
+    omega : numpy.ndarray
+        Frequencies of the Welch spectra, rad/s.
+    welch : dict
+        Output → one-sided Welch PSD of the recorded run on ``omega`` (unit²·s/rad).
+    meta : dict
+        The run's ``run.json``: settings, the controller files' digests, TurbSim's seeds.
+    """
+
+    controller: str
+    wind_speed: float
+    seed: int
+    values: dict
+    omega: np.ndarray
+    welch: dict
+    meta: dict
+
+
+def read_openfast_runs(folder) -> list[OpenFASTRun]:
+    """The finished runs in an OpenFAST campaign folder, without running anything.
+
+    A campaign still running (or stopped) is read as far as it got: a run counts once its
+    ``run.json`` and ``result.npz`` are both there (written last, so a run in progress is
+    skipped). Use it to tabulate a long campaign before it ends.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        The ``folder`` given to :func:`run_openfast_campaign` (``store`` of
+        :func:`specdesign.validate.run_campaign` with an OpenFAST plant).
+
+    Returns
+    -------
+    list of OpenFASTRun
+        Sorted by controller, wind speed and seed.
+
+    Raises
+    ------
+    FileNotFoundError
+        ``folder`` is not a directory.
+    ValueError
+        A run's files do not read (naming the folder).
+    """
+    root = Path(folder)
+    if not root.is_dir():
+        raise FileNotFoundError(f"folder {root} is not a directory: pass the campaign's folder (its store)")
+    runs = []
+    for js in sorted(root.glob("*/*mps_seed*/run.json")):
+        npz = js.with_name("result.npz")
+        if not npz.is_file():
+            continue
+        try:
+            meta = json.loads(js.read_text())
+            with np.load(npz) as z:
+                data = {k: z[k] for k in z.files}
+        except (OSError, ValueError) as e:
+            raise ValueError(f"run folder {js.parent} does not read ({e}): delete it to run it again") from e
+        values = {k[len("value_"):]: float(a) for k, a in data.items() if k.startswith("value_")}
+        welch = {k[len("welch_"):]: a for k, a in data.items() if k.startswith("welch_")}
+        runs.append(OpenFASTRun(str(meta["controller"]), float(meta["wind_speed"]), int(meta["seed"]), values,
+                                data["omega"], welch, meta))
+    return sorted(runs, key=lambda r: (r.controller, r.wind_speed, r.seed))
 
 
 def as_discon(controller) -> DisconController:
