@@ -33,10 +33,13 @@ from collections import defaultdict
 from pathlib import Path
 
 import control as ct
-import numpy as np
+import matplotlib
 
-from specdesign import spec, validate
-from specdesign.closedloop import turbine_loop_poles
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
+import numpy as np  # noqa: E402
+
+from specdesign import closedloop, spec, validate, wind  # noqa: E402
 
 #: Bands of the tower-base moment's variance, rad/s: (label, low, high).
 BANDS = (("wind 0.05-0.6", 0.05, 0.6), ("0.6-0.85", 0.6, 0.85), ("tower mode 0.85-1.5", 0.85, 1.5),
@@ -119,41 +122,106 @@ def report(folder, baseline="ROSCO", m=4.0) -> str:
     return "\n".join(lines)
 
 
-def damping(speeds, target=25.0) -> str:
-    """Closed-loop damping near the tower mode of the baseline and the QFT design (as
-    openfast_table3.py designs it) on OpenFAST's linearisation at each speed."""
-    from specdesign.openfast import iea15mw_monopile, linearize_deck  # OpenFAST's side only with --damping
+def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
+    """Closed-loop damping near the tower mode of the baseline and of each design (as
+    openfast_table3.py makes it: ``QFT`` the certified chain, ``QFT+ATD`` the paper's structure)
+    on OpenFAST's linearisation at each speed, both loops closed
+    (:func:`specdesign.closedloop.closed_loop`); with ``figures`` (a folder) the paper's Fig. 8
+    from OpenFAST per speed: the runs' seed-mean Welch spectra (solid) against |T|²S_W on the
+    same linearisation (dashed)."""
+    from specdesign.openfast import iea15mw_monopile  # OpenFAST's side only with --damping
 
     sys.path.insert(0, str(Path(__file__).parent))
-    from openfast_table3 import designs  # the campaign's own design step, so the controllers are those run
+    # the campaign's own model and design step: the controllers it ran
+    from openfast_table3 import STRUCTURES, designs, openfast_model
 
-    model = linearize_deck(iea15mw_monopile(), speeds, processes=1)
-    made = designs(model, speeds, target)
-    plant = validate.loop_plant(model)
+    model = openfast_model(iea15mw_monopile(), speeds, processes=1)
+    made = {label: designs(model, speeds, target, structure) for structure, (label, _) in STRUCTURES.items()
+            if label in names}
     lines = ["| wind (m/s) | controller | closed-loop poles in "
              f"{TOWER_MODE_BAND[0]}-{TOWER_MODE_BAND[1]} rad/s: |p| (rad/s), ζ | least ζ |", "|---|---|---|---|"]
     for v in speeds:
-        for name, c in (("baseline (ROSCO's PI on the linearisation)", spec.baseline_controller(model, v)),
-                        ("QFT", ct.tf(made[v]["design"].pitch_controller))):
-            p = turbine_loop_poles(plant, c, v)
+        plant = model.linearize(v)
+        loops = [(BASELINE, spec.baseline_controller(model, v), None)]
+        loops += [(label, ct.tf(m[v]["design"].pitch_controller), m[v]["design"].atd_controller)
+                  for label, m in made.items()]
+        predicted = {}
+        for name, c, atd in loops:
+            cl = closedloop.closed_loop(plant, c, atd, warn=False)
+            p = cl.poles()
             p = p[(p.imag > 0) & (np.abs(p) >= TOWER_MODE_BAND[0]) & (np.abs(p) <= TOWER_MODE_BAND[1])]
             z = -p.real / np.abs(p)
             lines.append(f"| {v:g} | {name} | " + ", ".join(f"{abs(a):.3f}, {b:.3f}" for a, b in zip(p, z))
                          + f" | {z.min() if z.size else float('nan'):.3f} |")
+            predicted[name] = cl
+        if figures is not None:
+            _fig8(runs, v, model, predicted, Path(figures))
     return "\n".join(lines)
+
+
+#: The baseline's name in the damping table and Fig. 8 (its linear loop is ROSCO's PI placed on
+#: OpenFAST's rotor model; in the runs, ROSCO's compiled DISCON).
+BASELINE = "ROSCO"
+_COLOURS = {"ROSCO": "tab:blue", "QFT": "tab:red", "QFT+ATD": "tab:green"}
+
+
+def _fig8(runs, v, model, loops, folder):
+    """The paper's Fig. 8 from OpenFAST at ``v``: generator speed (rpm²·s/rad) and tower-base
+    moment (MN²·m²·s/rad) PSDs, runs (solid) vs linear prediction (dashed)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    rpm = 30.0 / math.pi
+    # the seeds every controller drawn has finished: the spectra compared on the same winds
+    here = [r for r in runs if r.wind_speed == v and r.controller in loops]
+    seeds = set.intersection(*({r.seed for r in here if r.controller == n} for n in loops if any(
+        r.controller == n for r in here)))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
+    for (out, unit, k), ax in zip((("gen_speed", "rpm²·s/rad", rpm ** 2), ("tower_base_my", "MN²·m²·s/rad", 1e-12)),
+                                  axes):
+        shown = []
+        for name, cl in loops.items():
+            mine = [r for r in here if r.controller == name and r.seed in seeds]
+            if not mine:
+                continue
+            w = mine[0].omega[1:]
+            psd = np.mean([r.welch[out][1:] for r in mine], axis=0) * k
+            ax.loglog(w, psd, color=_COLOURS.get(name, "k"), label=f"{name}, OpenFAST")
+            t = np.array([cl[out, "wind"](1j * x) for x in w])
+            sw = wind.rotor_effective_spectrum(w, v, model.rotor_radius, turbulence_class="B") * wind.record_window(w, 600.0)
+            ax.loglog(w, np.abs(t) ** 2 * sw * k, "--", color=_COLOURS.get(name, "k"), label=f"{name}, linear")
+            shown.append(psd[(w >= 0.05) & (w <= 10)])
+        # the range the runs span, not the linear roll-off's decades
+        lo, hi = min(x.min() for x in shown), max(x.max() for x in shown)
+        ax.set_ylim(lo / 3, hi * 3)
+        ax.set_xlim(0.05, 10)
+        ax.set_xlabel("frequency ω (rad/s)")
+        ax.set_ylabel(f"PSD ({unit})")
+        ax.set_title("generator speed" if out == "gen_speed" else "tower-base fore-aft moment")
+        ax.axvline(3 * 7.56 * math.pi / 30, color="0.6", lw=0.8)  # 3P at rated rotor speed (7.56 rpm)
+        ax.grid(True, which="both", alpha=0.3)
+    fig.suptitle(f"OpenFAST (solid, seeds {', '.join(map(str, sorted(seeds)))}) vs linear prediction (dashed) "
+                 f"at {v:g} m/s; grey line: 3P")
+    axes[1].legend(fontsize=8)
+    path = folder / f"openfast_fig8_{v:g}mps.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    print(f"wrote {path}", file=sys.stderr)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--folder", default="build/openfast_table3/runs", help="the campaign's run folder")
     ap.add_argument("--baseline", default="ROSCO")
-    ap.add_argument("--damping", action="store_true", help="also the closed-loop tower-mode damping (designs again)")
+    ap.add_argument("--damping", action="store_true",
+                    help="also the closed-loop tower-mode damping on OpenFAST's linearisations (designs again)")
+    ap.add_argument("--figures", default=None, help="with --damping: folder for Fig. 8 from OpenFAST per speed")
     args = ap.parse_args()
     text = report(Path(args.folder))
     print(text)
     if args.damping:
-        speeds = sorted({r.wind_speed for r in validate.read_openfast_runs(args.folder) if r.controller != args.baseline})
-        print("\n" + damping(speeds))
+        runs = validate.read_openfast_runs(args.folder)
+        designed = [r for r in runs if r.controller != args.baseline]
+        print("\n" + linear_side(runs, sorted({r.wind_speed for r in designed}), {r.controller for r in designed},
+                                  figures=args.figures))
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 """The paper's Table 3 from OpenFAST: QFT designs at 15-25 m/s (the specification for a DEL
-target and the design meeting it, as ``specdesign demo``), exported as DISCON libraries, and
+target and the design meeting it, as ``specdesign demo``; with ``--structure atd`` the paper's
+PI + notch + low-pass and tower damper), exported as DISCON libraries, and
 ROSCO's compiled DISCON, run in OpenFAST on the shipped IEA 15 MW monopile deck with TurbSim
 winds (IEC Kaimal NTM class B, 4 seeds × 600 s per speed after 60 s discarded, as the paper);
 rainflow DELs, the specification's promise and the linear prediction side by side.
@@ -11,10 +12,11 @@ A long run (~1.3 s of CPU per simulated second per run: 2 controllers × 6 speed
     nohup nice -n 10 python benchmarks/openfast_table3.py --processes 2 > table3.log 2>&1 &
     python benchmarks/openfast_table3.py --speeds 19 --seeds 1 --duration 30 --transient 10  # a smoke run
 
-Designs are made on the reduced model (``--plant reduced``, default) or, when
-``specdesign.openfast.linearize_deck`` exists, on OpenFAST's linearisations of the deck
-(``--plant openfast``). Without ``specdesign.export`` only ROSCO runs (its indicators are
-printed; Table 3 needs a design).
+Designs are made on the reduced model (``--plant reduced``, default) or on OpenFAST's
+linearisations of the deck (``--plant openfast``: always those at :data:`LINEARISED`, so the
+designs do not depend on which speeds a call runs). ``--rosco-only`` runs ROSCO only (its
+indicators are printed; Table 3 needs a design). ``benchmarks/openfast_report.py`` tabulates
+the runs finished so far.
 """
 from __future__ import annotations
 
@@ -28,18 +30,46 @@ import control as ct
 import numpy as np
 
 from specdesign import feasibility, qft, spec, turbine, validate
-from specdesign.openfast import find_openfast, iea15mw_monopile
+from specdesign.export import export_discon
+from specdesign.openfast import find_openfast, iea15mw_monopile, linearize_deck
 
 
-def designs(model, speeds, target) -> dict:
+#: OpenFAST's linearisations the design model is made of, whatever speeds a call runs: the plant
+#: cases (v ± 0.5, ± 1 m/s) are interpolated between them, so a design depends on this set, and a
+#: campaign resumed or extended speed by speed must design on the same model to find its runs.
+LINEARISED = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
+
+
+def openfast_model(deck, speeds=(), **kwargs):
+    """The design model on OpenFAST's linearisations: :data:`LINEARISED` and any other ``speeds``
+    (cached by ``linearize_deck``; ``kwargs`` go to it)."""
+    return linearize_deck(deck, sorted(set(LINEARISED) | {float(v) for v in speeds}), **kwargs)
+
+
+#: The designs a campaign can run: controller name, export folder prefix.
+STRUCTURES = {"certificate": ("QFT", "export_"), "atd": ("QFT+ATD", "export_atd_")}
+
+
+def designs(model, speeds, target, structure="certificate") -> dict:
     """QFT design per speed. Deterministic: a resumed run designs again and exports the same
-    parameter files, so the runs already in the campaign folder are recognised (by digest)."""
+    parameter files, so the runs already in the campaign folder are recognised (by digest).
+
+    ``structure="certificate"``: the default chain (the certified specification for the target,
+    the design reduced from its certificate; pitch only). ``"atd"``: the paper's structure, the
+    fixed PI + notch + low-pass pitch controller and a first-order tower damper (ATD) on the
+    tower-top velocity tuned against the notch specification with the DEL target
+    (``qft.spec_notch(target)``); its promise is the notch specification's."""
     res = {}
     for v in speeds:
         t = time.monotonic()
-        pair = feasibility.specification_for_target(model, v, target)
-        d = qft.design_qft(model, v, spec=qft.spec_from_certified(pair))
-        res[v] = {"design": d, "promise": float(pair.promise.exact_del)}
+        if structure == "atd":
+            d = qft.design_qft(model, v, spec=qft.spec_notch(target))
+            promise = float(d.row()["promised_del_pct"])  # the relaxed specification the design meets
+        else:
+            pair = feasibility.specification_for_target(model, v, target)
+            d = qft.design_qft(model, v, spec=qft.spec_from_certified(pair))
+            promise = float(pair.promise.exact_del)
+        res[v] = {"design": d, "promise": promise}
         print(f"design at {v:g} m/s: {time.monotonic() - t:.0f} s; {d.summary()}", file=sys.stderr, flush=True)
     return res
 
@@ -54,6 +84,8 @@ def main() -> None:
     ap.add_argument("--processes", type=int, default=None, help="OpenFAST processes at a time (default: CPUs)")
     ap.add_argument("--nice", type=int, default=0, help="niceness added to OpenFAST (on top of this process's)")
     ap.add_argument("--plant", choices=("reduced", "openfast"), default="reduced")
+    ap.add_argument("--structure", choices=tuple(STRUCTURES), default="certificate",
+                    help="the design: the certified chain (QFT, pitch only) or the paper's PI + notch + ATD (QFT+ATD)")
     ap.add_argument("--rosco-only", action="store_true", help="run ROSCO only (no design, no Table 3)")
     ap.add_argument("--out", default="build/openfast_table3")
     args = ap.parse_args()
@@ -65,21 +97,13 @@ def main() -> None:
     deck = iea15mw_monopile()
     model = reduced = turbine.iea15mw()
     discon_in = deck.fst.with_name(f"{deck.name}_DISCON.IN")
-    export = None
-    if not args.rosco_only:
-        try:
-            from specdesign.export import (
-                export_discon as export,  # issue 27's DISCON export
-            )
-        except ImportError:
-            print("specdesign.export is not available: ROSCO only", file=sys.stderr)
+    export = None if args.rosco_only else export_discon
     if export is not None and args.plant == "openfast":
-        from specdesign.openfast import linearize_deck  # issue 27's linearisations
-
         # cached in ~/.cache/specdesign/linearizations (keyed by the case's files and the OpenFAST
         # version): a resumed run, or examples/openfast_chain.py, reads them back
-        model = linearize_deck(deck, speeds, processes=args.processes or 2, nice=args.nice, progress=True)
-    made = designs(model, speeds, args.target) if export is not None else {}
+        model = openfast_model(deck, speeds, processes=args.processes or 2, nice=args.nice, progress=True)
+    label, prefix = STRUCTURES[args.structure]
+    made = designs(model, speeds, args.target, args.structure) if export is not None else {}
     camps = []
     for v in speeds:
         controllers = {"ROSCO": discon_in}
@@ -87,9 +111,9 @@ def main() -> None:
             # the generator torque as the deck's DISCON runs it: ROSCO's law below rated, constant
             # torque above (VS_ConstPower = 0); the pitch rate limited as ROSCO's PC_MaxRat; the
             # tower-top velocity of an ATD loop high-passed (OpenFAST's acceleration has a bias)
-            controllers["QFT"] = export(made[v]["design"], out / f"export_{v:g}", dt=0.01, model=reduced,
+            controllers[label] = export(made[v]["design"], out / f"{prefix}{v:g}", dt=0.01, model=reduced,
                                         torque="rosco", pitch_rate_limit=reduced.pitch_rate_limit,
-                                        atd_highpass=0.05, name=f"QFT {v:g} m/s")
+                                        atd_highpass=0.05, name=f"{label} {v:g} m/s")
         camps.append(validate.run_campaign(
             controllers, [v], args.seeds, plant=deck, duration=args.duration, transient=args.transient,
             store=out / "runs", progress=True,
@@ -110,14 +134,16 @@ def main() -> None:
     # the linear predictions of both controllers on the design model, per speed
     pred = np.full((2, len(speeds)), np.nan)
     for wi, v in enumerate(speeds):
-        c = ct.tf(made[v]["design"].pitch_controller)
+        d = made[v]["design"]
         # the design's own baseline: ROSCO's PI on the design plant (on OpenFAST's linearisations,
         # LinearTurbine's pole placement; turbine.rosco_baseline takes a TurbineModel only)
         pred[0, wi] = validate.linear_prediction(model, spec.baseline_controller(model, v), v).del_
-        # the pitch controller as an LTI (a one-speed schedule is that LTI; scheduled() needs a TurbineModel)
-        pred[1, wi] = validate.linear_prediction(model, c, v).del_
-    camp = dataclasses.replace(camp, predicted_del=pred[[camp.index("ROSCO"), camp.index("QFT")]])
-    t3 = validate.table3(camp, "QFT", "ROSCO", promised={v: made[v]["promise"] for v in speeds})
+        # the pitch controller as an LTI (a one-speed schedule is that LTI; scheduled() needs a
+        # TurbineModel); with an ATD the design's own prediction (both loops closed)
+        pred[1, wi] = (validate.linear_prediction(model, ct.tf(d.pitch_controller), v).del_ if d.atd_controller is None
+                       else pred[0, wi] * (1 - d.del_reduction / 100))
+    camp = dataclasses.replace(camp, predicted_del=pred[[camp.index("ROSCO"), camp.index(label)]])
+    t3 = validate.table3(camp, label, "ROSCO", promised={v: made[v]["promise"] for v in speeds})
     text = t3.to_markdown() if hasattr(t3, "to_markdown") else str(t3)
     (out / "table3.md").write_text(text + "\n")
     print("\n" + text)
