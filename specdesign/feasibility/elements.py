@@ -28,8 +28,9 @@ notch with a negative depth is a bump), chosen over the whole band, in two steps
 So the specification is feasible by construction (its certificate meets it at every plant
 case), its promise is that of the specification handed to the design, and it is editable
 (``tower.add(...)``, then :func:`recertify`). Each step is a continuous function of the input (a
-convex design, a converged smooth fit, a monotone root), so a rounding error in the operating
-point moves the result by a rounding error. When no (headroom, envelope) of :data:`FOLLOW`
+convex design, a fit on inputs rounded to :data:`FIT_INPUT_DB`, which a non-convex fit needs to
+return the same elements, a monotone root), so a rounding error in the operating point moves the
+result by a rounding error. When no (headroom, envelope) of :data:`FOLLOW`
 certifies, the elements are instead fitted *above* the envelope of certificates made for
 larger targets (:data:`HEADROOM_PP`), each then feasible through that certificate: maximise
 promise(s + g) − :data:`REGULARISATION`·mean(e²) with g the log-sum-exp of r − s at
