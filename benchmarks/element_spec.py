@@ -97,6 +97,8 @@ guarantee (the notch designs of notebooks 04-06).
 
 {table}
 
+{infeasible}
+
 The same shaping and design a rounding error away (v' = v + 1e-9 m/s, or v − 1e-9 at the top of
 the model's range):
 
@@ -222,7 +224,7 @@ def main():
     clock.wrap(target, "recertify", "recertify")
     clock.wrap(elements, "_fit", "fallback fits")
     clock.note_follow(elements, "_followed")
-    fallbacks = []
+    fallbacks, refused = [], []
     t_all = time.perf_counter()
     rows, near_rows = [], []
     say = lambda rows, line: (print(line, flush=True), rows.append(line))
@@ -247,6 +249,7 @@ def main():
                     fallbacks.append(v)
             except ValueError as e:
                 say(rows, f"| {v:g} | infeasible: {e} | | | | | | | {os.getloadavg()[0]:.1f} | |")
+                refused.append(v)
                 continue
             ts = res.certified
             tf = feasibility.specification_for_target(model, v, args.target)
@@ -277,6 +280,13 @@ def main():
             target=args.target, command=" ".join(["python benchmarks/element_spec.py"] + os.sys.argv[1:]),
             seconds=time.perf_counter() - t_all, load=os.getloadavg()[0], table="\n".join(rows),
             near="\n".join(near_rows), v=example.design.wind_speed,
+            infeasible=(f"At {', '.join(f'{x:g}' for x in refused)} m/s no element specification is certified for "
+                        f"{args.target:g} % under the default high-frequency gain bound (κ = "
+                        f"{feasibility.MAX_HF_GAIN_RATIO:g}): the row's message says, per followed certificate, at which "
+                        "speed relaxations no Youla design meets the elements (or by how much a plant case exceeds them), "
+                        "and per fallback headroom what its envelope and elements promise; `specification_for_target`'s "
+                        "transfer-function pair, the default of `design_qft`, is certified there (docs/feasibility.md)."
+                        if refused else "Every speed of the table is certified."),
             fallback=(f"It ran at {', '.join(f'{x:g}' for x in fallbacks)} m/s (the path column)." if fallbacks
                       else "No speed in the table needed it (the path column)."),
             elements="\n".join(f"    {e!r}" for e in example.tower.elements)))
