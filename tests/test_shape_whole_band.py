@@ -5,13 +5,18 @@ The acceptance numbers are the issue's: promise ≥ 24.5 % recomputed independen
 |W|²S_W against ROSCO's |T|²S_W) within 0.5 pp; the certificate meets the pair at every plant case
 (the explicit SISO formula T = P_yw + P_yβ·T_βw on a dense 0.005-20 rad/s grid); the design handed
 the pair meets |T_MyT,w| ≤ |W_MyT| + 0.1 dB and predicts ≥ promise − 0.1 pp; the shaping and the
-design at v − 1e-9 m/s give the same promise and prediction within 0.2 pp. The speed is 25 m/s, where
-the ±3 % envelope of the certificate alone left no element specification and where v − 1e-9 m/s
-failed outright while the fit stopped at an iteration cap (issue 14).
+design at v − 1e-9 m/s give the same promise and prediction within 0.01 pp and the same
+controller order (issue 28 item 4; issue 14 asked 0.2 pp). The speed is 25 m/s, where the ±3 %
+envelope of the certificate alone left no element specification and where v − 1e-9 m/s failed
+outright while the fit stopped at an iteration cap (issue 14), and where under the high-frequency
+gain bound the envelope fit fell into another local minimum 1e-9 m/s away (5 notches and 4, the
+predictions 0.49 pp apart: elements.FIT_INPUT_DB). Everything runs with the default options
+(the bound on, the plant cases' margin shaped), as a user gets it.
 """
 from __future__ import annotations
 
 import warnings
+from dataclasses import astuple
 
 import numpy as np
 import pytest
@@ -70,18 +75,11 @@ def test_an_unreachable_whole_band_target_says_which_constraint_binds(base25):
         fz.shape_whole_band(base25, 70.0, headroom_pp=(3.0,))
 
 
-#: The element path's acceptance (issue 14) is checked as it was measured: without the
-#: high-frequency gain bound and with the plant cases' uniform margin. Under the default bound
-#: (issue 28) at 25 m/s the fallback certifies no 25 % elements (its envelopes promise 21-29 %,
-#: the elements up to 24.3 %) and a 1e-9 m/s step moved the prediction by 0.49 pp: open.
-ELEMENT_OPTIONS = {"max_hf_gain_ratio": None, "margin_bumps": 0}
-
-
 @pytest.fixture(scope="module")
 def whole25(base25):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy accuracy notes on some rungs
-        return fz.shape_whole_band(base25, 25.0, **ELEMENT_OPTIONS)
+        return fz.shape_whole_band(base25, 25.0)
 
 
 def _explicit_maps(model, v, controller, w):
@@ -97,6 +95,7 @@ def test_the_whole_band_specification_at_25_mps_promises_the_target_and_is_met(m
     res = whole25
     ts = res.certified
     assert res.success and res.specification is ts.tower
+    assert ts.max_hf_gain_ratio == fz.MAX_HF_GAIN_RATIO  # the default: the high-frequency gain bound on
     assert {type(e).__name__ for e in ts.tower.elements} <= {"Gain", "LeadLag", "Notch"}
     # the promise, recomputed independently: Dirlik DEL on |W|²S_W against ROSCO's |T|²S_W
     w = np.geomspace(0.0005, 20.0, 4000)
@@ -108,16 +107,18 @@ def test_the_whole_band_specification_at_25_mps_promises_the_target_and_is_met(m
     assert res.promise.exact_del >= 25.0
     assert 100 * (1 - del_w / del_r) >= 24.5
     assert abs(100 * (1 - del_w / del_r) - res.promise.exact_del) <= 0.5
-    # the certificate at every plant case, against W_i = T^ROSCO_i · W/T^ROSCO (nominal), both maps
+    # the certificate at every plant case, against W_i = T^ROSCO_i · W/T^ROSCO (nominal), both maps;
+    # W_MyT with room for the design step (for_tower accepts half of TOWER_ROOM_DB below it on its
+    # own grid; this grid is another, so half of that is asserted)
     cert = ts.design.controller(model)
     rosco_nom = _explicit_maps(model, 25.0, rosco_baseline(model, 25.0), w)
     assert len(ts.case_speeds) == 3  # 24, 24.5, 25 m/s: the cases above 25 m/s are clipped to the range
     for v in ts.case_speeds:
         rosco = _explicit_maps(model, v, rosco_baseline(model, v), w)
         got = _explicit_maps(model, v, cert, w)
-        for k, wy in enumerate((ts.tower, ts.speed)):
+        for k, (wy, room) in enumerate(((ts.tower, fz.target.TOWER_ROOM_DB / 4), (ts.speed, 0.0))):
             bound = rosco[k] * np.abs(wy.response(w)) / rosco_nom[k]
-            assert np.max(20 * np.log10(got[k] / bound)) <= 1e-6, (v, k)
+            assert np.max(20 * np.log10(got[k] / bound)) <= 1e-6 - room, (v, k)
     d = design25
     assert d.success, d.message
     t_my = _explicit_maps(model, 25.0, d.pitch_controller, w)[0]
@@ -145,20 +146,25 @@ def test_the_promise_is_the_target_plus_the_margin_by_an_independent_dirlik(mode
 
 @pytest.mark.slow
 def test_a_rounding_error_in_the_wind_speed_moves_neither_promise_nor_prediction(model, base25, whole25, design25):
-    # issue 14's acceptance: the design at v and at v ± 1e-9 m/s predicts the same reduction within
-    # 0.2 pp (25 m/s is the top of the model's range, so − 1e-9). The certificate is the same to its
-    # solver's tolerance and the settle step pins the promise at target + margin; the fitted
-    # notches may differ (a multi-modal fit: see docs/spec_elements.md), so they are not compared
+    # issue 28 item 4: the design at v and at v ± 1e-9 m/s has the same order and predicts the same
+    # reduction within 0.01 pp (25 m/s is the top of the model's range, so − 1e-9). The envelope
+    # fit runs on inputs rounded to elements.FIT_INPUT_DB, so it returns the same elements (only
+    # the settled gain follows the promise, continuous in v); the certificate is the same to its
+    # solver's tolerance and the settle step pins the promise at target + margin
     v = 25.0 - 1e-9
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
-        near = fz.shape_whole_band(spec.baseline_analysis(model, v), 25.0, **ELEMENT_OPTIONS).certified
+        near = fz.shape_whole_band(spec.baseline_analysis(model, v), 25.0).certified
     ts = whole25.certified
+    assert [type(e) for e in near.tower.elements] == [type(e) for e in ts.tower.elements]
+    for a, b in zip(near.tower.elements[1:], ts.tower.elements[1:]):  # [0] is the settled Gain
+        assert np.allclose(astuple(a), astuple(b), rtol=1e-9, atol=0.0), (a, b)
     assert abs(near.speed_relax_db - ts.speed_relax_db) <= 1e-3
     assert abs(near.promise.exact_del - ts.promise.exact_del) <= 1e-6
     d = design_qft(model, v, spec=spec_from_certified(near))
     assert d.success, d.message
-    assert abs(d.del_reduction - design25.del_reduction) <= 0.2
+    assert d.parameters["order"] == design25.parameters["order"]
+    assert abs(d.del_reduction - design25.del_reduction) <= 0.01
 
 
 @pytest.mark.slow
@@ -173,6 +179,14 @@ def test_a_hand_edit_of_the_whole_band_specification_is_recertified(model, whole
         fz.recertify(model, ts, tower=ts.tower.add(spec.Notch(1.08, 6.0, 0.3)))
 
 
+#: The fallback (elements fitted above a certificate for a larger target) is reached only when
+#: every followed certificate fails, which the default options do not at 15, 19 or 25 m/s; forced
+#: at 25 m/s under the default high-frequency gain bound it refuses, naming the bound (measured:
+#: its envelopes promise 21.4-28.8 %, its elements up to 24.3 %, and no certificate promises
+#: 32 %, best 31.7 %), so its mechanics are checked without the bound and with the uniform margin.
+FALLBACK_OPTIONS = {"max_hf_gain_ratio": None, "margin_bumps": 0}
+
+
 def test_the_fallback_fits_elements_above_a_larger_certificate(model, monkeypatch):
     # when no followed certificate can be certified (FOLLOW exhausted; forced here), the elements
     # are fitted above the envelope of a certificate for a larger target: still a certified pair
@@ -184,7 +198,7 @@ def test_the_fallback_fits_elements_above_a_larger_certificate(model, monkeypatc
     monkeypatch.setattr(elements, "FOLLOW", ())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
-        ts = fz.element_specification(model, 25.0, 25.0, **ELEMENT_OPTIONS)
+        ts = fz.element_specification(model, 25.0, 25.0, **FALLBACK_OPTIONS)
     assert ts.promise.exact_del == pytest.approx(25.0 + elements.PROMISE_MARGIN_PP, abs=1e-6)
     again = fz.recertify(model, ts)
     assert again.speed_relax_db == pytest.approx(ts.speed_relax_db, abs=1e-9)

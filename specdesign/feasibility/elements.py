@@ -28,8 +28,9 @@ notch with a negative depth is a bump), chosen over the whole band, in two steps
 So the specification is feasible by construction (its certificate meets it at every plant
 case), its promise is that of the specification handed to the design, and it is editable
 (``tower.add(...)``, then :func:`recertify`). Each step is a continuous function of the input (a
-convex design, a converged smooth fit, a monotone root), so a rounding error in the operating
-point moves the result by a rounding error. When no (headroom, envelope) of :data:`FOLLOW`
+convex design, a fit on inputs rounded to :data:`FIT_INPUT_DB`, which a non-convex fit needs to
+return the same elements, a monotone root), so a rounding error in the operating point moves the
+result by a rounding error. When no (headroom, envelope) of :data:`FOLLOW`
 certifies, the elements are instead fitted *above* the envelope of certificates made for
 larger targets (:data:`HEADROOM_PP`), each then feasible through that certificate: maximise
 promise(s + g) − :data:`REGULARISATION`·mean(e²) with g the log-sum-exp of r − s at
@@ -165,6 +166,20 @@ SEED_ABOVE_DB, SEED_RISE_DB, SEED_WINDOW, SEED_SENS_FLOOR, SEED_SPACING = 0.1, 3
 #: A bump is seeded this far (dB) above the ratio it follows, and every seed's depth is clipped to
 #: SEED_DEPTH_DB (negative: a bump), inside the fits' :data:`NOTCH_DEPTH_BOUNDS_DB`.
 SEED_BUMP_LIFT_DB, SEED_DEPTH_DB = 0.3, (-15.0, 30.0)
+#: Quanta of the envelope fit's inputs (:func:`_followed`): the envelope r rounded to
+#: FIT_INPUT_DB dB, ΔD% (its weight and the notch seeds) divided by its peak and rounded to
+#: FIT_SENS_REL (a 1e-9 m/s step moves it by ~3e-12 of its peak). The fit is
+#: non-convex and its parameters degenerate (the lag's and the lead's zeros coincide at its
+#: minima: Gauss-Newton Hessians of condition 1e16-1e18), so L-BFGS-B stops where its cost is
+#: flat to rounding, 1e-6-3e-5 from where a 1e-8 dB change of r stops it, and the next notch's
+#: fit, warm-started there, fell into another local minimum: at 25 m/s on the IEA 15 MW under the
+#: default high-frequency gain bound, 25 and 25 − 1e-9 m/s (r 1.8e-8 dB apart) gave 5 and 4
+#: notches and predictions 0.49 pp apart. On rounded inputs the fit is the same computation, so a
+#: rounding error of the operating point changes the elements only when it carries one of the
+#: 480 values across a rounding boundary (for a 1e-9 m/s step, r moves ≤ 2e-8 dB: at most
+#: 480·2e-8/0.01 ≈ 1e-3 of such steps); 0.01 dB is far below what the elements resolve (they
+#: follow r to within tenths of a dB) and the promise is settled on the unrounded elements.
+FIT_INPUT_DB, FIT_SENS_REL = 0.01, 1e-6
 _DB = 10 / np.log(10)  # 10·log10(x) = _DB·ln(x)
 _ORDERS = (0.0, 0.75, 1.0, 1.5, 2.0, 4.0)  # the moments spectral.SpectralStats holds, in its order
 
@@ -367,14 +382,14 @@ def _dense_ratio(cert, base):
     return w, 20 * np.log10(np.abs(cert.tower.response(w)) / np.abs(siso_response(base.system, w)))
 
 
-def _seeds(base, grid, r):
+def _seeds(omega, sensitivity, grid, r):
     """Notch centres and depths (dB): first the certificate's rises between the lag and the lead
     (above 0 dB, or 3 dB above its minimum within ±5 %: the narrow bump between two dips beside
     the tower mode), bumps the elements must follow, then the peaks of ΔD%·room (reductions that
     pay), each list largest first."""
     from scipy.ndimage import minimum_filter1d
 
-    sens = np.interp(grid, base.omega, base.sensitivity)
+    sens = np.interp(grid, omega, sensitivity)
     band = (grid > LAG_OMEGA) & (grid < LEAD_OMEGA)
     rise = r - minimum_filter1d(r, size=max(3, round(SEED_WINDOW / np.log(grid[1] / grid[0]))), mode="nearest")
 
@@ -417,10 +432,13 @@ def _followed(search, base, promise, t, aim, max_notches, for_target, headroom_p
     # its upper envelope: a plant case's resonance lies a few per cent from the nominal one, so
     # elements that dip into the certificate's narrow dips would ask the cases for what they cannot give
     r = maximum_filter1d(r, size=max(1, round(2 * envelope / np.log(w[1] / w[0]))), mode="nearest")
+    # the fit's inputs rounded (FIT_INPUT_DB): a non-convex fit, the same on the same inputs
+    r = FIT_INPUT_DB * np.round(r / FIT_INPUT_DB)
     sens = np.maximum(base.sensitivity, 0.0)
+    sens = FIT_SENS_REL * np.round(sens / (sens.max() * FIT_SENS_REL))  # peak 1: a scale-free weight
     weight = (sens + WEIGHT_FLOOR * sens.max()) * np.gradient(np.log(w))
     weight = weight / weight.sum()
-    seeds = _seeds(base, w, r)
+    seeds = _seeds(w, sens, w, r)
     x, bounds = _start(w, r)
     # notch centres on the design grid (0.01-10 rad/s): the pair's promise is also evaluated there
     lo, hi = max(bounds[1][0], np.log(NOTCH_BAND[0])), min(bounds[1][1], np.log(NOTCH_BAND[1]))
@@ -464,7 +482,7 @@ def _fit_above(model, cert, base, promise, grid, t0, t, aim, max_notches, headro
         tried.append(f"{h:g} pp, ±{100 * env:g} %: envelope {reach:.1f} %")
         if reach < aim + ENVELOPE_LOSS_PP:  # elements above r promise at most what r does
             continue
-        seeds = _seeds(base, grid, r)
+        seeds = _seeds(base.omega, base.sensitivity, grid, r)
         x, bounds = _start(grid, r)
         fits = []
         lo, hi = max(bounds[1][0], np.log(NOTCH_BAND[0])), min(bounds[1][1], np.log(NOTCH_BAND[1]))
