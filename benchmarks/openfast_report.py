@@ -50,6 +50,18 @@ TOWER_MODE_BAND = (0.85, 1.4)
 DEG = 180.0 / math.pi
 
 
+def openfast_times(run) -> tuple[float, float]:
+    """OpenFAST's own ``Total CPU Time`` and ``Total Real Time`` of a run (minutes) from the log
+    kept in its folder; NaN where the log does not say."""
+    out = [float("nan"), float("nan")]
+    for log in run.folder.glob("*.log"):
+        for line in log.read_text(errors="replace").splitlines():
+            for i, key in enumerate(("Total CPU Time:", "Total Real Time:")):
+                if key in line:
+                    out[i] = float(line.split(key)[1].split()[0])
+    return out[0], out[1]
+
+
 def band_variance(omega, psd, lo, hi) -> float:
     """∫ PSD dω over lo ≤ ω < hi (rad/s), trapezoidal on the Welch grid."""
     m = (omega >= lo) & (omega < hi)
@@ -110,6 +122,14 @@ def report(folder, baseline="ROSCO", m=4.0) -> str:
                          f"| {trav[0][0]:.0f} ({trav[0][1]} seeds) / {trav[1][0]:.0f} ({trav[1][1]} seeds) "
                          f"| {st['rate_limit_time', 'design'][0]:.2f} |")
             bands.append((v, name, st))
+    times = np.array([openfast_times(r) for r in runs])
+    ok = ~np.isnan(times).any(axis=1)
+    if ok.any():
+        length = runs[0].meta["settings"]["duration"] + runs[0].meta["settings"]["transient"]
+        lines += ["", f"OpenFAST's own times per {length:g} s run ({ok.sum()} runs): CPU {times[ok, 0].min():.1f}-"
+                      f"{times[ok, 0].max():.1f} min (median {np.median(times[ok, 0]):.1f}; "
+                      f"{60 * np.median(times[ok, 0]) / length:.2f} s of CPU per simulated second), wall "
+                      f"{times[ok, 1].min():.1f}-{times[ok, 1].max():.1f} min (the load of the machine)"]
     lines += ["", "Tower-base moment variance by band, mean over the paired seeds (MN²·m²); design / baseline:", ""]
     head = "| wind (m/s) | controller | " + " | ".join(f"{b[0]} rad/s" for b in BANDS) + " |"
     lines += [head, "|" + "---|" * (head.count("|") - 1)]

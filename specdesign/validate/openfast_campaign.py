@@ -86,6 +86,8 @@ class OpenFASTRun:
         Output → one-sided Welch PSD of the recorded run on ``omega`` (unit²·s/rad).
     meta : dict
         The run's ``run.json``: settings, the controller files' digests, TurbSim's seeds.
+    folder : pathlib.Path
+        The run's folder (OpenFAST's log and summaries are kept there).
     """
 
     controller: str
@@ -95,6 +97,7 @@ class OpenFASTRun:
     omega: np.ndarray
     welch: dict
     meta: dict
+    folder: Path
 
 
 def read_openfast_runs(folder) -> list[OpenFASTRun]:
@@ -139,7 +142,7 @@ def read_openfast_runs(folder) -> list[OpenFASTRun]:
         values = {k[len("value_"):]: float(a) for k, a in data.items() if k.startswith("value_")}
         welch = {k[len("welch_"):]: a for k, a in data.items() if k.startswith("welch_")}
         runs.append(OpenFASTRun(str(meta["controller"]), float(meta["wind_speed"]), int(meta["seed"]), values,
-                                data["omega"], welch, meta))
+                                data["omega"], welch, meta, js.parent))
     return sorted(runs, key=lambda r: (r.controller, r.wind_speed, r.seed))
 
 
