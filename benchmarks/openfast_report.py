@@ -158,10 +158,14 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
     model = openfast_model(iea15mw_monopile(), speeds, processes=1)
     made = {label: designs(model, speeds, target, structure) for structure, (label, _) in STRUCTURES.items()
             if label in names}
+    label, lo, hi = BANDS[2]
     lines = ["| wind (m/s) | controller | closed-loop poles in "
-             f"{TOWER_MODE_BAND[0]}-{TOWER_MODE_BAND[1]} rad/s: |p| (rad/s), ζ | least ζ |", "|---|---|---|---|"]
+             f"{TOWER_MODE_BAND[0]}-{TOWER_MODE_BAND[1]} rad/s: |p| (rad/s), ζ | least ζ "
+             f"| linear \\|T\\|²S_W in the {label} rad/s band (MN²·m²) |", "|---|---|---|---|---|"]
+    w = np.geomspace(lo, hi, 400)
     for v in speeds:
         plant = model.linearize(v)
+        sw = wind.rotor_effective_spectrum(w, v, model.rotor_radius, turbulence_class="B") * wind.record_window(w, 600.0)
         loops = [(BASELINE, spec.baseline_controller(model, v), None)]
         loops += [(label, ct.tf(m[v]["design"].pitch_controller), m[v]["design"].atd_controller)
                   for label, m in made.items()]
@@ -171,8 +175,10 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
             p = cl.poles()
             p = p[(p.imag > 0) & (np.abs(p) >= TOWER_MODE_BAND[0]) & (np.abs(p) <= TOWER_MODE_BAND[1])]
             z = -p.real / np.abs(p)
+            t = np.array([cl["tower_base_my", "wind"](1j * x) for x in w])
+            var = float(np.trapezoid(np.abs(t) ** 2 * sw, w))
             lines.append(f"| {v:g} | {name} | " + ", ".join(f"{abs(a):.3f}, {b:.3f}" for a, b in zip(p, z))
-                         + f" | {z.min() if z.size else float('nan'):.3f} |")
+                         + f" | {z.min() if z.size else float('nan'):.3f} | {var / 1e12:.3g} |")
             predicted[name] = cl
         if figures is not None:
             _fig8(runs, v, model, predicted, Path(figures))
