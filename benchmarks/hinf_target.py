@@ -3,7 +3,8 @@
 For each wind speed: ``specification_for_target(model, v, target)`` (the pair certified over the
 plant cases v + (−1, −0.5, 0.5, 1) m/s within the model's range, by a pitch-only controller,
 docs/spec_driven.md), then ``design_hinf(model, v, spec=spec_from_certified(pair))`` (pitch only: Riccati synthesis,
-balanced truncation to 8 states, the multi-model H∞ step of specdesign.hinf.cases). The check
+balanced truncation to the lowest of hinf.ORDERS states whose multi-model H∞ step
+(specdesign.hinf.cases) meets the pair; the high-frequency gain bound on by default). The check
 is recomputed here by the explicit closed-loop formula (closedloop.t_tower_wind /
 t_gen_speed_wind) at every plant case, each case's weight from ROSCO's loop at that speed
 (W_i = |T^ROSCO_i|·|W/T^ROSCO_nominal|), on a dense 0.005-20 rad/s grid (4000 points) refined
