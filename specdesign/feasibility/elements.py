@@ -70,8 +70,8 @@ from .target import (
     recertify,
 )
 
-__all__ = ["BELOW_WEIGHT", "ENVELOPES", "ENVELOPE_LOSS_PP", "FIT_OMEGA", "FOLLOW", "FOLLOW_GAIN_DB", "HEADROOM_PP",
-           "MAX_ITERATIONS", "MAX_NOTCHES", "PROMISE_MARGIN_PP", "REGULARISATION", "SMOOTHING_DB",
+__all__ = ["BELOW_WEIGHT", "ENVELOPES", "ENVELOPE_LOSS_PP", "FIT_INPUT_DB", "FIT_OMEGA", "FIT_SENS_REL", "FOLLOW",
+           "FOLLOW_GAIN_DB", "HEADROOM_PP", "MAX_ITERATIONS", "MAX_NOTCHES", "PROMISE_MARGIN_PP", "REGULARISATION", "SMOOTHING_DB",
            "element_specification"]
 
 #: The fallback's extra DEL reductions (percentage points) asked of the certificate, tried in
@@ -179,7 +179,10 @@ SEED_BUMP_LIFT_DB, SEED_DEPTH_DB = 0.3, (-15.0, 30.0)
 #: 480 values across a rounding boundary (for a 1e-9 m/s step, r moves ≤ 2e-8 dB: at most
 #: 480·2e-8/0.01 ≈ 1e-3 of such steps); 0.01 dB is far below what the elements resolve (they
 #: follow r to within tenths of a dB) and the promise is settled on the unrounded elements.
-FIT_INPUT_DB, FIT_SENS_REL = 0.01, 1e-6
+FIT_INPUT_DB = 0.01
+#: ΔD% (the fit's weights and notch seeds) is rounded to this fraction of its peak, for the same
+#: reason as :data:`FIT_INPUT_DB`.
+FIT_SENS_REL = 1e-6
 _DB = 10 / np.log(10)  # 10·log10(x) = _DB·ln(x)
 _ORDERS = (0.0, 0.75, 1.0, 1.5, 2.0, 4.0)  # the moments spectral.SpectralStats holds, in its order
 
