@@ -7,8 +7,8 @@ PNG of the whole figure. Pillow encodes that PNG with a filter chosen row by row
 default level: most of a Designer gain step in the kernel (about 32 of 57 ms on the shared
 machine, for its 1000 × 520 px figure). Such an image is runs of zeros broken by a few
 thousand changed pixels, and deflate's run-length strategy on unfiltered rows compresses it
-as small (31 kB against Pillow's 33 kB) in a fifth of the time. :func:`install` gives a live
-canvas that encoder; what the image holds and when it is full or a difference are
+as small (31 kB against Pillow's 33 kB) in a fifth of the time. :func:`install_encoder` gives
+a live canvas that encoder; what the image holds and when it is full or a difference are
 matplotlib's, line for line.
 """
 from __future__ import annotations
@@ -19,7 +19,7 @@ import zlib
 
 import numpy as np
 
-__all__ = ["install", "png_rgba"]
+__all__ = ["install_encoder", "png_rgba"]
 
 _SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -89,7 +89,7 @@ def _diff_image(canvas):
     return png_rgba(output.view(np.uint8).reshape(*output.shape, 4))
 
 
-def install(canvas) -> bool:
+def install_encoder(canvas) -> bool:
     """Have ``canvas`` encode the images it sends to the browser with :func:`png_rgba`.
 
     Only a canvas whose ``get_diff_image`` is matplotlib's web backend's own (ipympl's, webagg's)

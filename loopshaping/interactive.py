@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _diffpng
-from ._designer_widget import build_widget, readout_html
+from ._diffpng import install_encoder
+from ._designer_widget import build_widget, latest_only, readout_html
 from ._textcache import CachedTextRenderer
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
@@ -28,7 +28,7 @@ from .nichols import draw, loop_nichols, wrap_phase
 from .specs import Spec
 from .templates import Template
 
-__all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles", "readout_html"]
+__all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles", "latest_only", "readout_html"]
 
 _DEFAULTS = {
     "gain": {"k": 1.0},
@@ -223,7 +223,7 @@ class LiveArtists:
             figure.stale_callback = None
             # the image of the changed pixels sent after each blit, encoded in a fifth of the
             # time Pillow takes (most of a Designer gain step was that encoding)
-            _diffpng.install(canvas)
+            install_encoder(canvas)
 
     def _on_draw(self, event):
         canvas, renderer = event.canvas, event.renderer

@@ -221,13 +221,20 @@ _IDLE_FOR_2S = """() => {
 #: canvas, that canvas onto the visible one). Reported (build/browser-screenshots/redraw_ms.json),
 #: never asserted: speed belongs to benchmarks.
 _WATCH_REDRAW = """([fig]) => {
-  const rec = window.__rec = {up: null, sent: [], pngs: [], todata: [], decoded: [], shown: [], done: null};
+  const rec = window.__rec = {up: null, sent: [], received: [], long: [], pngs: [], todata: [], decoded: [], shown: [], done: null};
   window.__fig_canvases = [...fig.querySelectorAll('canvas')];
   if (!window.__hooked) {  // once per page; the prototypes' methods, wrapped
     window.__hooked = true;
     const now = () => performance.now();
-    const send = WebSocket.prototype.send;
+    // the page's tasks over 50 ms (the main thread busy: no message handled, nothing drawn)
+    new PerformanceObserver(list => { for (const e of list.getEntries()) window.__rec?.long.push([e.startTime, e.duration]); })
+      .observe({type: 'longtask'});
+    const send = WebSocket.prototype.send, seen = new WeakSet();
     WebSocket.prototype.send = function (data) {
+      if (!seen.has(this)) {  // the kernel's socket: each message it brings
+        seen.add(this);
+        this.addEventListener('message', () => window.__rec?.received.push(now()));
+      }
       if (window.__rec) {  // a widget's state sent to the kernel with a value: the slider's
         const text = typeof data === 'string' ? data : new TextDecoder().decode(data);
         if (text.includes('comm_msg') && text.includes('"value"')) window.__rec.sent.push(now());
@@ -265,12 +272,41 @@ _WATCH_REDRAW = """([fig]) => {
 }"""
 
 
+#: In the kernel (``exec``, ``{obj}`` the explorer or the Designer): its ``update`` wrapped to
+#: record the wall-clock start and end of each call, ms (the page's clock is the same machine's).
+_STAMP_UPDATES = """
+def _stamped(*args, _update={obj}.update, _stamps=[], **kwargs):
+    import time
+    t0 = 1e3 * time.time()
+    out = _update(*args, **kwargs)
+    _stamps.append((t0, 1e3 * time.time()))
+    return out
+_stamped.stamps = _stamped.__kwdefaults__["_stamps"]
+{obj}.update = _stamped
+def _sent(self, msg, buffers=None, *, _send=__import__("ipywidgets").Widget._send, _log=[]):
+    import time
+    _log.append((1e3 * time.time(), type(self).__name__))
+    return _send(self, msg, buffers)
+__import__("ipywidgets").Widget._send = _sent
+del _stamped, _sent
+"""
+
+#: In the kernel, after the drag: the messages its widgets sent, (wall-clock ms, widget class),
+#: and ipywidgets as it was.
+_SENT_MESSAGES = """(lambda w, wrapper: (setattr(w, "_send", wrapper.__kwdefaults__["_send"]), wrapper.__kwdefaults__["_log"])[1])(
+    __import__("ipywidgets").Widget, __import__("ipywidgets").Widget._send)"""
+
+
 def _timeline(rec):
     """The page's record of a drag (``_WATCH_REDRAW``) as ms after the release, per stage."""
     up = rec["up"]
     after = lambda ts: [round(t - up, 1) for t in ts if t >= up]  # noqa: E731
     pngs = [(round(t - up, 1), n) for t, n in rec["pngs"] if t >= up]
+    shown = [t for t in rec["shown"] if rec["sent"] and t >= rec["sent"][-1]]
     return {
+        # from the last value the slider sent (during the drag or after the release) to the
+        # last draw of the figure: the kernel's and the browser's share of the settle time
+        "last_value_to_settled_ms": round(shown[-1] - rec["sent"][-1], 1) if shown else None,
         # the slider's values sent after the release (ipywidgets holds a value back while the
         # kernel handles the one before: the last is sent once the kernel is idle)
         "values_sent_ms": after(rec["sent"]),
@@ -282,6 +318,15 @@ def _timeline(rec):
         "ipympl_todataurl_ms": [round(d, 1) for t, d in rec["todata"] if t >= up],
         "png_drawn_ms": after([t for t, _ in rec["decoded"]]),
         "canvas_shown_ms": after(rec["shown"]),
+        # every message the page's sockets brought after the release (the kernel's: images,
+        # widget states, status), and the page's tasks over 50 ms (start, duration)
+        "messages_received_ms": after(rec["received"]),
+        "long_tasks_ms": [(round(t - up, 1), round(d, 1)) for t, d in rec["long"] if t + d >= up],
+        # the kernel's updates (start, end) after the release, on the page's clock
+        "kernel_updates_ms": [(round(a - rec["origin"] - up, 1), round(b - rec["origin"] - up, 1))
+                              for a, b in rec["kernel"] if b - rec["origin"] >= up],
+        # the messages the kernel's widgets sent after the release: (ms, the widget's class)
+        "kernel_messages_ms": [(round(t - rec["origin"] - up, 1), w) for t, w in rec["kernel_sent"] if t - rec["origin"] >= up],
     }
 
 
@@ -299,9 +344,15 @@ def _timed_drag(page, lab, name, obj, figure, handle, dx, what):
     page.evaluate("window.__idle_since = null")
     page.wait_for_function(_IDLE_FOR_2S, timeout=120_000, polling=100)
     page.evaluate(_WATCH_REDRAW, [figure.element_handle()])
+    # the kernel's side of the same timeline: the wall-clock start and end (ms) of each update
+    # the drag causes, by a wrapper on the object's own update, removed after
+    _kernel_value(lab, name, f"exec({_STAMP_UPDATES.format(obj=obj)!r})")
     _drag(page, handle, dx)
     page.wait_for_function("window.__rec.done !== null", timeout=60_000)
     rec = page.evaluate("window.__rec")
+    rec["kernel"] = ast.literal_eval(_kernel_value(lab, name, f"{obj}.__dict__.pop('update').stamps"))
+    rec["kernel_sent"] = ast.literal_eval(_kernel_value(lab, name, _SENT_MESSAGES))
+    rec["origin"] = page.evaluate("performance.timeOrigin")
     ms = float(rec["done"])
     assert ms >= 0, f"{what}: the figure's canvas was never drawn after the drag"
     callback_ms = float(_kernel_value(lab, name, f"{obj}.update_ms"))

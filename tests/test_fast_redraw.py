@@ -190,7 +190,7 @@ def test_the_live_canvas_sends_the_images_matplotlib_would_encoded_faster():
         assert modes == ["full"] + ["diff"] * 5
     finally:
         plt.switch_backend("Agg")
-    assert not _diffpng.install(plt.figure().canvas)  # Agg's canvas sends nothing: left as it is
+    assert not _diffpng.install_encoder(plt.figure().canvas)  # Agg's canvas sends nothing: left as it is
     plt.close("all")
     with pytest.raises(ValueError, match="pixels"):
         _diffpng.png_rgba(np.zeros((4, 3, 3), np.uint8))  # RGB, not RGBA
