@@ -9,7 +9,7 @@ slider) and notebook 04's Designer on the 19 m/s pitch loop of ``design_qft(spec
 (a sweep of the gain, ±0.15 decade) are built on ipympl's canvas as in JupyterLab, the
 browser's end replaced by a no-op (``send``): the callback then computes, sets the artists'
 data, blits them and encodes the changed pixels as PNG, as it does in a notebook. Printed: the
-median callback, and its parts measured apart (compute alone, the blit of the artists, the PNG
+median callback (and as it was with matplotlib's PNG encoder), and its parts measured apart (compute alone, the blit of the artists, the PNG
 of the changed pixels and its size), beside what the shortcuts replace (the explorer's exact
 QFT bounds check, the blit with every line of text rasterised, the PNG as matplotlib encodes
 it with Pillow). Each figure twice, back to back: on its own, its
@@ -27,8 +27,9 @@ import matplotlib
 matplotlib.use("module://ipympl.backend_nbagg")
 
 import numpy as np  # noqa: E402
-from matplotlib.backends.backend_webagg_core import FigureCanvasWebAggCore  # noqa: E402
+from matplotlib.backends.backend_webagg_core import FigureCanvasWebAggCore
 
+from loopshaping._diffpng import install_encoder
 from loopshaping.controller import Controller  # noqa: E402
 from loopshaping.interactive import Designer  # noqa: E402
 from specdesign import feasibility, qft, spec  # noqa: E402
@@ -56,14 +57,19 @@ def _median_ms(fn, args):
 
 
 def _parts(canvas, redraw, update, args):
-    """Median ms of: the callback; compute alone; the blit of the artists with the text cache and
-    without it (every line rasterised, as before the cache); ipympl's diff image.
+    """Median ms of: the callback, and with matplotlib's PNG encoder; compute alone; the blit of
+    the artists with the text cache and without it (every line rasterised, as before the cache);
+    the PNG of the changed pixels, and by matplotlib's encoder; then the PNGs' median kB.
 
-    The parts are timed on the midpoints of ``args`` (values not seen yet, so the lines that
-    change are drawn as in a drag, not found in the cache).
+    The callback with matplotlib's encoder and the parts are timed on values between those of
+    ``args`` (a third and two thirds of the way: not seen yet, so the lines that change are drawn
+    as in a drag, not found in the cache).
     """
     callback = _median_ms(update, args)
-    mid = 0.5 * (args[1:] + args[:-1])
+    del canvas.get_diff_image  # the callback as before loopshaping._diffpng: matplotlib's encoder
+    pillow_callback = _median_ms(update, args[:-1] + (args[1:] - args[:-1]) / 3)  # values not seen yet
+    install_encoder(canvas)
+    mid = args[:-1] + 2 * (args[1:] - args[:-1]) / 3
     compute = _median_ms(lambda a: update(a, redraw=False), mid)
     blit, plain, diff, pillow, size, pillow_size = [], [], [], [], [], []
     for a in mid:
@@ -88,15 +94,16 @@ def _parts(canvas, redraw, update, args):
         diff.append(t2 - t1)
         pillow.append(t3 - t2)
         plain.append(t4 - t3)
-    return (callback, compute, *(1e3 * float(np.median(x)) for x in (blit, plain, diff, pillow)),
+    return (callback, pillow_callback, compute, *(1e3 * float(np.median(x)) for x in (blit, plain, diff, pillow)),
             *(float(np.median(x)) / 1e3 for x in (size, pillow_size)))
 
 
 def _report(what, canvas, parts, replaced):
-    callback, compute, blit, plain, diff, pillow, kb, pillow_kb = parts
+    callback, pillow_callback, compute, blit, plain, diff, pillow, kb, pillow_kb = parts
     w, h = canvas.get_width_height(physical=True)
     print(f"{what} ({w}x{h} px)")
-    print(f"  callback (update_ms)               {callback:7.1f} ms   target ≤ 40 ms")
+    print(f"  callback (update_ms)               {callback:7.1f} ms   target ≤ 40 ms "
+          f"(with matplotlib's PNG encoder: {pillow_callback:.1f} ms)")
     print(f"    compute (verdicts, data)         {compute:7.1f} ms   {replaced}")
     print(f"    blit of the changed artists      {blit:7.1f} ms   (every line of text rasterised: {plain:.1f} ms)")
     print(f"    PNG of the changed pixels        {diff:7.1f} ms   {kb:.1f} kB (matplotlib's, by Pillow: {pillow:.1f} ms, {pillow_kb:.1f} kB)")

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._diffpng import install_encoder
 from ._designer_widget import build_widget, latest_only, readout_html
+from ._diffpng import install_encoder
 from ._textcache import CachedTextRenderer
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
@@ -166,7 +166,7 @@ class LiveArtists:
     canvas caches the figure without them as the background and then draws them on top (so a
     full redraw, a toolbar zoom or a resize still shows them, and ``savefig`` too);
     :meth:`redraw` restores the background, draws only them and sends the changed pixels (as a
-    PNG encoded by ``loopshaping._diffpng``, in a fifth of the time Pillow takes); a line
+    PNG made by ``loopshaping._diffpng`` in about half the time matplotlib takes); a line
     of text that meets the pixels it met before is written from a cache instead of rasterised
     again (``loopshaping._textcache.CachedTextRenderer``: pixel-identical, and a multi-line
     title whose one line changed costs that line).
@@ -221,8 +221,8 @@ class LiveArtists:
             # no full render requested by each change (pyplot's draw_idle on "stale" in
             # interactive mode): the owner redraws, by a blit
             figure.stale_callback = None
-            # the image of the changed pixels sent after each blit, encoded in a fifth of the
-            # time Pillow takes (most of a Designer gain step was that encoding)
+            # the image of the changed pixels sent after each blit, made in about half the
+            # time matplotlib takes (its PNG encoding was most of a Designer gain step)
             install_encoder(canvas)
 
     def _on_draw(self, event):

@@ -7,9 +7,11 @@ playwright's own browser downloads are not used), runs all cells, checks that th
 slider, and checks from pixels that the live (ipympl) figure changed, then saves the notebook
 through JupyterLab and reads it back to check that every code cell ran and none errored. Each
 drag's redraw time is reported (never asserted) as two numbers: the browser's, from the release
-to the settled figure, and the kernel's, the slider callback alone (``update_ms`` of the
-explorer or the Designer, read from the notebook's kernel through its connection file), beside the
-lines of text its blits took from the text cache and drew. Screenshots go to
+to the last draw of the figure's canvas, and the kernel's, the slider callback alone
+(``update_ms`` of the explorer or the Designer, read from the notebook's kernel through its
+connection file), beside the lines of text its blits took from the text cache and drew and a
+timeline of the step (the values sent, the kernel's updates and widget messages, the images
+and their bytes, ipympl's work on them in the page). Screenshots go to
 ``build/browser-screenshots/`` (kept by CI as artefacts). The server and its kernels are
 stopped in every case (the process group it was started in).
 
@@ -300,7 +302,9 @@ _SENT_MESSAGES = """(lambda w, wrapper: (setattr(w, "_send", wrapper.__kwdefault
 def _timeline(rec):
     """The page's record of a drag (``_WATCH_REDRAW``) as ms after the release, per stage."""
     up = rec["up"]
-    after = lambda ts: [round(t - up, 1) for t in ts if t >= up]  # noqa: E731
+    def after(ts):
+        return [round(t - up, 1) for t in ts if t >= up]
+
     pngs = [(round(t - up, 1), n) for t, n in rec["pngs"] if t >= up]
     shown = [t for t in rec["shown"] if rec["sent"] and t >= rec["sent"][-1]]
     return {

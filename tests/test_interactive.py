@@ -114,7 +114,7 @@ def test_in_a_kernel_a_slider_value_is_drawn_after_its_message_and_only_the_late
     # message that brought it, so the kernel is idle at once and the browser sends the next
     # value during the redraw; values that came meanwhile are skipped for the latest; a typed
     # value drops a slider value not drawn yet. Without a loop (the tests above) at once.
-    P, tmpl, b = loop
+    _, tmpl, b = loop
     d = Designer(b, tmpl, lc.Controller((lc.gain(-379.0), lc.real_zero(42.0))))
     ui = d.widget()
     _, _, rows, json_box, _ = ui.children[0].children
