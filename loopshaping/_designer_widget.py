@@ -4,13 +4,12 @@ Kept apart so that the designer's numbers and figure import no widget library.
 """
 from __future__ import annotations
 
-import asyncio
 import html
 import math
 
 from .controller import KINDS
 
-__all__ = ["build_widget", "latest_only", "readout_html", "LOG_STEP", "LOG_SPAN"]
+__all__ = ["build_widget", "readout_html", "LOG_STEP", "LOG_SPAN"]
 
 LOG_STEP = 0.005  # decades per slider step: 1.2 %, fine enough to place a corner frequency
 LOG_SPAN = 1.0  # decades either side of the value the slider was built around (re-centred on a typed value)
@@ -47,50 +46,6 @@ def readout_html(text: str, colour: str = "black") -> str:
 
     return (f'<div style="font-size:12px;line-height:1.35;white-space:pre-wrap;padding-left:3px;color:{to_hex(colour)}">'
             f"{html.escape(text, quote=False)}</div>")
-
-
-def latest_only(apply):
-    """``apply(value)`` soon after the kernel handled the message, for the latest value only.
-
-    A slider's values come one message at a time: the browser sends the next once the kernel
-    is idle after the one before. Handled in the message, a redraw keeps the kernel busy, so
-    the value a user released the slider at waits for the redraw of the one before *and* for
-    the idle status to reach the browser and the value to come back (two trips through the
-    Jupyter server). Applied just after the message (the kernel's event loop), the kernel is
-    idle at once, the next value is already there when the redraw ends, and values that came
-    meanwhile are skipped for the latest. Without a running event loop (a script, the tests)
-    a value is applied at once.
-
-    Parameters
-    ----------
-    apply : callable
-        ``apply(value)``.
-
-    Returns
-    -------
-    callable
-        ``submit(value)``; ``submit.cancel()`` drops a value not applied yet.
-    """
-    pending = []
-
-    def flush():
-        if pending:
-            value = pending.pop()
-            pending.clear()
-            apply(value)
-
-    def submit(value):
-        try:
-            loop = asyncio.get_running_loop()
-        except RuntimeError:  # no event loop: now
-            apply(value)
-            return
-        if not pending:
-            loop.call_soon(flush)
-        pending[:] = [value]
-
-    submit.cancel = pending.clear
-    return submit
 
 
 def build_widget(d):
@@ -224,18 +179,12 @@ def build_widget(d):
             if min(dist) < 0.5 * sl.step:
                 return
             sent[:] = [new]
-            soon(new)
-
-        def move_to(new):
             if apply(idx, name, new):
                 set_quietly(text, new)
-
-        soon = latest_only(move_to)
 
         def on_text(ch):
             if quiet[0]:
                 return
-            soon.cancel()  # a slider value not drawn yet is older than the typed one
             v = float(ch["new"])
             if is_log and not (math.isfinite(v) and v != 0):
                 msg.value = f"<span style='color:#c00'>{name} = {v!r} rejected: a log-scale value must be finite and non-zero</span>"

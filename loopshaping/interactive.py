@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._designer_widget import build_widget, latest_only, readout_html
+from ._designer_widget import build_widget, readout_html
 from ._diffpng import install_encoder
 from ._textcache import CachedTextRenderer
 from .bounds import Bounds
@@ -28,7 +28,7 @@ from .nichols import draw, loop_nichols, wrap_phase
 from .specs import Spec
 from .templates import Template
 
-__all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles", "latest_only", "readout_html"]
+__all__ = ["DesignState", "Designer", "LiveArtists", "closed_loop_poles", "readout_html"]
 
 _DEFAULTS = {
     "gain": {"k": 1.0},

@@ -6,8 +6,6 @@ starting notch by :func:`specdesign.spec.promise_of` on the same notch.
 """
 from __future__ import annotations
 
-import asyncio
-
 import control as ct
 import matplotlib
 import numpy as np
@@ -109,36 +107,6 @@ def test_gain_and_frequency_controls_move_in_log_steps_and_keep_typed_values(loo
     assert "rejected" in msg.value and d.controller.elements[2].params["zeta_zero"] == 0.05
 
 
-def test_in_a_kernel_a_slider_value_is_drawn_after_its_message_and_only_the_latest(loop):
-    # in a kernel (an event loop running) the Designer draws a slider's value just after the
-    # message that brought it, so the kernel is idle at once and the browser sends the next
-    # value during the redraw; values that came meanwhile are skipped for the latest; a typed
-    # value drops a slider value not drawn yet. Without a loop (the tests above) at once.
-    _, tmpl, b = loop
-    d = Designer(b, tmpl, lc.Controller((lc.gain(-379.0), lc.real_zero(42.0))))
-    ui = d.widget()
-    _, _, rows, json_box, _ = ui.children[0].children
-    slider, text = rows.children[0].children
-    drawn = []
-    update = d.update
-    d.update = lambda *a, **k: (drawn.append(d.controller.elements[0].params["k"]), update(*a, **k))[1]
-
-    async def drag(values, typed=None):
-        for v in values:
-            slider.value = v  # one message each
-        assert not drawn  # nothing drawn within the messages
-        if typed is not None:
-            text.value = typed
-        await asyncio.sleep(0)  # the loop runs what the messages left
-
-    asyncio.run(drag([400.0, 420.0, 450.0]))
-    assert drawn == [-450.0] and text.value == -450.0 and '"k": -450.0' in json_box.value
-    drawn.clear()
-    asyncio.run(drag([500.0], typed=-1234.5))
-    assert drawn == [-1234.5] and d.controller.elements[0].params["k"] == -1234.5
-    plt.close(d.figure)
-
-
 def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
     from specdesign import spec
     from specdesign.plots.spec import NotchExplorer
@@ -175,20 +143,6 @@ def test_the_notch_explorer_keeps_its_starting_notch_and_has_no_redraw_box():
     assert [s.value for s in sliders] == [1.05, 9.0, 0.2]
     sliders[1].value = 15.0  # a move again
     assert ex.notch == spec.Notch(1.05, 15.0, 0.2)
-
-    # in a kernel (an event loop running) a value is drawn just after its message, the latest
-    # only, with the notch as the other sliders left it when it is drawn
-    drawn = []
-    update = ex.update
-    ex.update = lambda **k: (drawn.append((k["omega_n"], k["depth_db"], k["width"])), update(**k))[1]
-
-    async def moves():
-        sliders[1].value, sliders[1].value, sliders[0].value = 10.0, 11.0, 1.2
-        assert not drawn and ex.notch == spec.Notch(1.05, 15.0, 0.2)
-        await asyncio.sleep(0)
-
-    asyncio.run(moves())
-    assert drawn == [(1.05, 11.0, 0.2), (1.2, 11.0, 0.2)] and ex.notch == spec.Notch(1.2, 11.0, 0.2)
     plt.close("all")
 
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from loopshaping.interactive import LiveArtists, latest_only, readout_html
+from loopshaping.interactive import LiveArtists, readout_html
 
 from ..spec import Baseline, Notch, promise_of
 from .conventions import tf_magnitude_label
@@ -344,18 +344,10 @@ class NotchExplorer:
                         self._quiet = False
                 return
             self._sent[name] = [new]
-            soon[name](new)
-
-        def move_to(new, name):
-            # the notch as it is when the value is drawn (another slider's value may have been
-            # drawn since this one came)
             vals = dict(omega_n=self.notch.omega_n, depth_db=self.notch.depth_db, width=self.notch.width)
             vals[name] = new
             self.update(**vals)
 
-        # drawn just after the message that brought it, the latest value only: the kernel is
-        # idle at once and the browser sends the next value during the redraw
-        soon = {name: latest_only(lambda new, name=name: move_to(new, name)) for name in sliders}
         for name, sl in sliders.items():
             sl.observe(lambda change, name=name: moved(change, name), names="value")
         canvas = self.fig.canvas
