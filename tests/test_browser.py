@@ -127,16 +127,18 @@ def _run_all(page, url, token, name, timeout_s):
     panel = ".jp-NotebookPanel:not(.lm-mod-hidden)"  # the notebook just opened, not an earlier tab
     idle = "() => /\\| Idle/.test(document.querySelector('.jp-StatusBar-Widget')?.innerText || '')"
     prompts = f"() => [...document.querySelectorAll('{panel} .jp-CodeCell .jp-InputPrompt')].map(e => e.textContent)"
+    dialog = page.locator(".jp-Dialog", has_text="Select Kernel")
     for attempt in range(3):
         time.sleep(2)
-        dialog = page.locator(".jp-Dialog", has_text="Select Kernel")
         if dialog.count():  # JupyterLab sometimes asks even though the notebook names python3
             dialog.locator(".jp-mod-accept").click()
         page.wait_for_function(idle, timeout=90_000)  # the kernel started and connected
-        page.locator(f"{panel} .jp-Notebook").first.click(position={"x": 5, "y": 5})
-        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
-        page.locator(".lm-Menu-itemLabel").get_by_text("Run All Cells", exact=True).click()
+        if dialog.count():  # ... also after the kernel said it is idle: it covered the menu once
+            dialog.locator(".jp-mod-accept").click()
         try:  # a run-all sent while the kernel was still connecting is lost: send it again
+            page.locator(f"{panel} .jp-Notebook").first.click(position={"x": 5, "y": 5}, timeout=10_000)
+            page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click(timeout=10_000)
+            page.locator(".lm-Menu-itemLabel").get_by_text("Run All Cells", exact=True).click(timeout=10_000)
             page.wait_for_function(f"() => ({prompts})().some(t => /\\[(\\*|\\d+)\\]/.test(t))", timeout=15_000)
             break
         except PlaywrightTimeout:
