@@ -9,9 +9,10 @@ slider) and notebook 04's Designer on the 19 m/s pitch loop of ``design_qft(spec
 (a sweep of the gain, ±0.15 decade) are built on ipympl's canvas as in JupyterLab, the
 browser's end replaced by a no-op (``send``): the callback then computes, sets the artists'
 data, blits them and encodes the changed pixels as PNG, as it does in a notebook. Printed: the
-median callback, and its parts measured apart (compute alone, the blit of the artists,
-ipympl's diff image), beside what the shortcuts replace (the explorer's exact QFT bounds check,
-the blit with every line of text rasterised). Each figure twice, back to back: on its own, its
+median callback (and as it was with matplotlib's PNG encoder), and its parts measured apart (compute alone, the blit of the artists, the PNG
+of the changed pixels and its size), beside what the shortcuts replace (the explorer's exact
+QFT bounds check, the blit with every line of text rasterised, the PNG as matplotlib encodes
+it with Pillow). Each figure twice, back to back: on its own, its
 changing text (the Designer's verdict, the explorer's title and legend label) drawn on the
 canvas at each step; and as its ``widget()`` shows it, that text in an ipywidgets readout above
 the figure. The browser's time on top is measured by tests/test_browser.py.
@@ -26,7 +27,9 @@ import matplotlib
 matplotlib.use("module://ipympl.backend_nbagg")
 
 import numpy as np  # noqa: E402
+from matplotlib.backends.backend_webagg_core import FigureCanvasWebAggCore
 
+from loopshaping._diffpng import install_encoder
 from loopshaping.controller import Controller  # noqa: E402
 from loopshaping.interactive import Designer  # noqa: E402
 from specdesign import feasibility, qft, spec  # noqa: E402
@@ -54,16 +57,21 @@ def _median_ms(fn, args):
 
 
 def _parts(canvas, redraw, update, args):
-    """Median ms of: the callback; compute alone; the blit of the artists with the text cache and
-    without it (every line rasterised, as before the cache); ipympl's diff image.
+    """Median ms of: the callback, and with matplotlib's PNG encoder; compute alone; the blit of
+    the artists with the text cache and without it (every line rasterised, as before the cache);
+    the PNG of the changed pixels, and by matplotlib's encoder; then the PNGs' median kB.
 
-    The parts are timed on the midpoints of ``args`` (values not seen yet, so the lines that
-    change are drawn as in a drag, not found in the cache).
+    The callback with matplotlib's encoder and the parts are timed on values between those of
+    ``args`` (a third and two thirds of the way: not seen yet, so the lines that change are drawn
+    as in a drag, not found in the cache).
     """
     callback = _median_ms(update, args)
-    mid = 0.5 * (args[1:] + args[:-1])
+    del canvas.get_diff_image  # the callback as before loopshaping._diffpng: matplotlib's encoder
+    pillow_callback = _median_ms(update, args[:-1] + (args[1:] - args[:-1]) / 3)  # values not seen yet
+    install_encoder(canvas)
+    mid = args[:-1] + 2 * (args[1:] - args[:-1]) / 3
     compute = _median_ms(lambda a: update(a, redraw=False), mid)
-    blit, plain, diff = [], [], []
+    blit, plain, diff, pillow, size, pillow_size = [], [], [], [], [], []
     for a in mid:
         update(a, redraw=False)
         t0 = time.perf_counter()
@@ -71,27 +79,34 @@ def _parts(canvas, redraw, update, args):
         for artist in redraw.artists:
             artist.draw(redraw._text)
         t1 = time.perf_counter()
+        last = canvas._last_buff
         canvas._png_is_old = True
-        canvas.get_diff_image()
+        size.append(len(canvas.get_diff_image()))  # the live canvas's encoder (loopshaping._diffpng)
         t2 = time.perf_counter()
+        canvas._last_buff, canvas._png_is_old = last, True  # the same image, as matplotlib encodes it
+        pillow_size.append(len(FigureCanvasWebAggCore.get_diff_image(canvas)))
+        t3 = time.perf_counter()
         canvas.restore_region(redraw._background)
         for artist in redraw.artists:
             redraw.figure.draw_artist(artist)
-        t3 = time.perf_counter()
+        t4 = time.perf_counter()
         blit.append(t1 - t0)
         diff.append(t2 - t1)
-        plain.append(t3 - t2)
-    return callback, compute, *(1e3 * float(np.median(x)) for x in (blit, plain, diff))
+        pillow.append(t3 - t2)
+        plain.append(t4 - t3)
+    return (callback, pillow_callback, compute, *(1e3 * float(np.median(x)) for x in (blit, plain, diff, pillow)),
+            *(float(np.median(x)) / 1e3 for x in (size, pillow_size)))
 
 
 def _report(what, canvas, parts, replaced):
-    callback, compute, blit, plain, diff = parts
+    callback, pillow_callback, compute, blit, plain, diff, pillow, kb, pillow_kb = parts
     w, h = canvas.get_width_height(physical=True)
     print(f"{what} ({w}x{h} px)")
-    print(f"  callback (update_ms)               {callback:7.1f} ms   target ≤ 40 ms")
+    print(f"  callback (update_ms)               {callback:7.1f} ms   target ≤ 40 ms "
+          f"(with matplotlib's PNG encoder: {pillow_callback:.1f} ms)")
     print(f"    compute (verdicts, data)         {compute:7.1f} ms   {replaced}")
     print(f"    blit of the changed artists      {blit:7.1f} ms   (every line of text rasterised: {plain:.1f} ms)")
-    print(f"    ipympl's PNG diff image          {diff:7.1f} ms")
+    print(f"    PNG of the changed pixels        {diff:7.1f} ms   {kb:.1f} kB (matplotlib's, by Pillow: {pillow:.1f} ms, {pillow_kb:.1f} kB)")
 
 
 def _explorer(base, notch, checker, qc, readout):
@@ -141,7 +156,7 @@ def main():
                 f"(its QFT verdict computed exactly: +{t_exact:.1f} ms)")
     print(f"    (bounds checker: built in {t_build * 1e3:.0f} ms, precomputed in {t_pre * 1e3:.0f} ms, once)")
 
-    d = qft.design_qft(model, 19.0, target_reduction=25.0, spec="notch")
+    d = qft.design_qft(model, 19.0, spec=qft.spec_notch(25.0))  # as notebook 04 builds it
     for readout, mode in MODES.items():
         designer, canvas = _designer(d, readout)
         k0 = designer.controller.elements[0].params["k"]

@@ -109,9 +109,10 @@ def build_widget(d):
         keep = elements.value if select is None else select
         busy[0] = True
         try:
-            elements.options = d.element_options()
-            if elements.options:
-                elements.value = min(keep or 0, len(elements.options) - 1)
+            with elements.hold_sync():  # the new labels and the selection in one message
+                elements.options = d.element_options()
+                if elements.options:
+                    elements.value = min(keep or 0, len(elements.options) - 1)
         finally:
             busy[0] = False
         d.selected = elements.value or 0

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._designer_widget import build_widget, readout_html
+from ._diffpng import install_encoder
 from ._textcache import CachedTextRenderer
 from .bounds import Bounds
 from .controller import KINDS, Controller, Element
@@ -164,7 +165,8 @@ class LiveArtists:
     its markers take a few ms. The ``artists`` are made animated: every full render of the
     canvas caches the figure without them as the background and then draws them on top (so a
     full redraw, a toolbar zoom or a resize still shows them, and ``savefig`` too);
-    :meth:`redraw` restores the background, draws only them and sends the changed pixels; a line
+    :meth:`redraw` restores the background, draws only them and sends the changed pixels (as a
+    PNG made by ``loopshaping._diffpng`` in about half the time matplotlib takes); a line
     of text that meets the pixels it met before is written from a cache instead of rasterised
     again (``loopshaping._textcache.CachedTextRenderer``: pixel-identical, and a multi-line
     title whose one line changed costs that line).
@@ -219,6 +221,9 @@ class LiveArtists:
             # no full render requested by each change (pyplot's draw_idle on "stale" in
             # interactive mode): the owner redraws, by a blit
             figure.stale_callback = None
+            # the image of the changed pixels sent after each blit, made in about half the
+            # time matplotlib takes (its PNG encoding was most of a Designer gain step)
+            install_encoder(canvas)
 
     def _on_draw(self, event):
         canvas, renderer = event.canvas, event.renderer

@@ -7,9 +7,11 @@ playwright's own browser downloads are not used), runs all cells, checks that th
 slider, and checks from pixels that the live (ipympl) figure changed, then saves the notebook
 through JupyterLab and reads it back to check that every code cell ran and none errored. Each
 drag's redraw time is reported (never asserted) as two numbers: the browser's, from the release
-to the settled figure, and the kernel's, the slider callback alone (``update_ms`` of the
-explorer or the Designer, read from the notebook's kernel through its connection file), beside the
-lines of text its blits took from the text cache and drew. Screenshots go to
+to the last draw of the figure's canvas, and the kernel's, the slider callback alone
+(``update_ms`` of the explorer or the Designer, read from the notebook's kernel through its
+connection file), beside the lines of text its blits took from the text cache and drew and a
+timeline of the step (the values sent, the kernel's updates and widget messages, the images
+and their bytes, ipympl's work on them in the page). Screenshots go to
 ``build/browser-screenshots/`` (kept by CI as artefacts). The server and its kernels are
 stopped in every case (the process group it was started in).
 
@@ -125,16 +127,18 @@ def _run_all(page, url, token, name, timeout_s):
     panel = ".jp-NotebookPanel:not(.lm-mod-hidden)"  # the notebook just opened, not an earlier tab
     idle = "() => /\\| Idle/.test(document.querySelector('.jp-StatusBar-Widget')?.innerText || '')"
     prompts = f"() => [...document.querySelectorAll('{panel} .jp-CodeCell .jp-InputPrompt')].map(e => e.textContent)"
+    dialog = page.locator(".jp-Dialog", has_text="Select Kernel")
     for attempt in range(3):
         time.sleep(2)
-        dialog = page.locator(".jp-Dialog", has_text="Select Kernel")
         if dialog.count():  # JupyterLab sometimes asks even though the notebook names python3
             dialog.locator(".jp-mod-accept").click()
         page.wait_for_function(idle, timeout=90_000)  # the kernel started and connected
-        page.locator(f"{panel} .jp-Notebook").first.click(position={"x": 5, "y": 5})
-        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
-        page.locator(".lm-Menu-itemLabel").get_by_text("Run All Cells", exact=True).click()
+        if dialog.count():  # ... also after the kernel said it is idle: it covered the menu once
+            dialog.locator(".jp-mod-accept").click()
         try:  # a run-all sent while the kernel was still connecting is lost: send it again
+            page.locator(f"{panel} .jp-Notebook").first.click(position={"x": 5, "y": 5}, timeout=10_000)
+            page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click(timeout=10_000)
+            page.locator(".lm-Menu-itemLabel").get_by_text("Run All Cells", exact=True).click(timeout=10_000)
             page.wait_for_function(f"() => ({prompts})().some(t => /\\[(\\*|\\d+)\\]/.test(t))", timeout=15_000)
             break
         except PlaywrightTimeout:
@@ -210,26 +214,126 @@ _IDLE_FOR_2S = """() => {
 }"""
 
 
-#: In the page: from the release of a slider handle (pointerup) to the last change of the canvas
-#: it drives, polled every few ms; the time a user waits for the figure to settle. Reported
-#: (build/browser-screenshots/redraw_ms.json), never asserted: speed belongs to benchmarks.
+#: In the page: from the release of a slider handle (pointerup) to the last draw of the visible
+#: canvas of the figure it drives: the time a user waits for the figure to settle. Measured by
+#: hooks, not by polling the canvas (an earlier version compared ``toDataURL`` snapshots every
+#: 5 ms: each snapshot is a PNG encode of the canvas on the page's one thread, which delayed the
+#: very messages it timed). The hooks also record where the time goes: each value the slider
+#: sends to the kernel (the page's websocket), each PNG image the figure receives from ipympl
+#: (``URL.createObjectURL`` of its blob: arrival time, bytes), ipympl's own ``toDataURL`` of its
+#: off-screen canvas at each image, and each ``drawImage`` (the decoded PNG onto the off-screen
+#: canvas, that canvas onto the visible one). Reported (build/browser-screenshots/redraw_ms.json),
+#: never asserted: speed belongs to benchmarks.
 _WATCH_REDRAW = """([fig]) => {
-  window.__redraw = null; window.__t_up = null; window.__changes = 0;
-  // every canvas of the ipympl figure (the image canvas and the rubber-band canvas over it)
-  const snap = () => [...fig.querySelectorAll('canvas')].map(c => c.toDataURL()).join('|');
-  let last = snap(), t_last = null;
-  document.addEventListener('pointerup', () => { window.__t_up = performance.now(); }, {capture: true, once: true});
+  const rec = window.__rec = {up: null, sent: [], received: [], long: [], pngs: [], todata: [], decoded: [], shown: [], done: null};
+  window.__fig_canvases = [...fig.querySelectorAll('canvas')];
+  if (!window.__hooked) {  // once per page; the prototypes' methods, wrapped
+    window.__hooked = true;
+    const now = () => performance.now();
+    // the page's tasks over 50 ms (the main thread busy: no message handled, nothing drawn)
+    new PerformanceObserver(list => { for (const e of list.getEntries()) window.__rec?.long.push([e.startTime, e.duration]); })
+      .observe({type: 'longtask'});
+    const send = WebSocket.prototype.send, seen = new WeakSet();
+    WebSocket.prototype.send = function (data) {
+      if (!seen.has(this)) {  // the kernel's socket: each message it brings
+        seen.add(this);
+        this.addEventListener('message', () => window.__rec?.received.push(now()));
+      }
+      if (window.__rec) {  // a widget's state sent to the kernel with a value: the slider's
+        const text = typeof data === 'string' ? data : new TextDecoder().decode(data);
+        if (text.includes('comm_msg') && text.includes('"value"')) window.__rec.sent.push(now());
+      }
+      return send.apply(this, arguments);
+    };
+    const url = URL.createObjectURL;
+    URL.createObjectURL = function (blob) {
+      if (window.__rec && blob && blob.type === 'image/png') window.__rec.pngs.push([now(), blob.size]);
+      return url.apply(this, arguments);
+    };
+    const toData = HTMLCanvasElement.prototype.toDataURL;
+    HTMLCanvasElement.prototype.toDataURL = function () {
+      const t = now(), out = toData.apply(this, arguments);
+      if (window.__rec && !this.isConnected) window.__rec.todata.push([t, now() - t]);  // ipympl's, off screen
+      return out;
+    };
+    const draw = CanvasRenderingContext2D.prototype.drawImage;
+    CanvasRenderingContext2D.prototype.drawImage = function (src) {
+      const t = now(), out = draw.apply(this, arguments), r = window.__rec;
+      if (r && src instanceof HTMLImageElement && !this.canvas.isConnected) r.decoded.push([t, now() - t]);
+      if (r && (window.__fig_canvases || []).includes(this.canvas)) r.shown.push(now());
+      return out;
+    };
+  }
+  document.addEventListener('pointerup', () => { rec.up = performance.now(); }, {capture: true, once: true});
   const tick = () => {
-    const s = snap();
-    if (s !== last) { last = s; t_last = performance.now(); window.__changes += 1; }
-    const quiet = performance.now() - Math.max(t_last ?? 0, window.__t_up ?? Infinity);
-    if (window.__t_up !== null && quiet > 2000) {
-      window.__redraw = t_last === null ? -1 : Math.max(0, t_last - window.__t_up); return;
+    const last = rec.shown.length ? rec.shown[rec.shown.length - 1] : null;
+    if (rec.up !== null && performance.now() - Math.max(last ?? 0, rec.up) > 2000) {
+      rec.done = last === null ? -1 : Math.max(0, last - rec.up); return;
     }
-    setTimeout(tick, 5);
+    setTimeout(tick, 50);
   };
   tick();
 }"""
+
+
+#: In the kernel (``exec``, ``{obj}`` the explorer or the Designer): its ``update`` wrapped to
+#: record the wall-clock start and end of each call, ms (the page's clock is the same machine's).
+_STAMP_UPDATES = """
+def _stamped(*args, _update={obj}.update, _stamps=[], **kwargs):
+    import time
+    t0 = 1e3 * time.time()
+    out = _update(*args, **kwargs)
+    _stamps.append((t0, 1e3 * time.time()))
+    return out
+_stamped.stamps = _stamped.__kwdefaults__["_stamps"]
+{obj}.update = _stamped
+def _sent(self, msg, buffers=None, *, _send=__import__("ipywidgets").Widget._send, _log=[]):
+    import time
+    _log.append((1e3 * time.time(), type(self).__name__))
+    return _send(self, msg, buffers)
+__import__("ipywidgets").Widget._send = _sent
+del _stamped, _sent
+"""
+
+#: In the kernel, after the drag: the messages its widgets sent, (wall-clock ms, widget class),
+#: and ipywidgets as it was.
+_SENT_MESSAGES = """(lambda w, wrapper: (setattr(w, "_send", wrapper.__kwdefaults__["_send"]), wrapper.__kwdefaults__["_log"])[1])(
+    __import__("ipywidgets").Widget, __import__("ipywidgets").Widget._send)"""
+
+
+def _timeline(rec):
+    """The page's record of a drag (``_WATCH_REDRAW``) as ms after the release, per stage."""
+    up = rec["up"]
+    def after(ts):
+        return [round(t - up, 1) for t in ts if t >= up]
+
+    pngs = [(round(t - up, 1), n) for t, n in rec["pngs"] if t >= up]
+    shown = [t for t in rec["shown"] if rec["sent"] and t >= rec["sent"][-1]]
+    return {
+        # from the last value the slider sent (during the drag or after the release) to the
+        # last draw of the figure: the kernel's and the browser's share of the settle time
+        "last_value_to_settled_ms": round(shown[-1] - rec["sent"][-1], 1) if shown else None,
+        # the slider's values sent after the release (ipywidgets holds a value back while the
+        # kernel handles the one before: the last is sent once the kernel is idle)
+        "values_sent_ms": after(rec["sent"]),
+        "values_sent_before_release": sum(t < up for t in rec["sent"]),
+        # ipympl's images after the release: arrival (ms) and size (bytes)
+        "images_ms_bytes": pngs,
+        "images_during_drag": sum(t < up for t, _ in rec["pngs"]),
+        # ipympl re-encodes its whole off-screen canvas as a data URL at every image
+        "ipympl_todataurl_ms": [round(d, 1) for t, d in rec["todata"] if t >= up],
+        "png_drawn_ms": after([t for t, _ in rec["decoded"]]),
+        "canvas_shown_ms": after(rec["shown"]),
+        # every message the page's sockets brought after the release (the kernel's: images,
+        # widget states, status), and the page's tasks over 50 ms (start, duration)
+        "messages_received_ms": after(rec["received"]),
+        "long_tasks_ms": [(round(t - up, 1), round(d, 1)) for t, d in rec["long"] if t + d >= up],
+        # the kernel's updates (start, end) after the release, on the page's clock
+        "kernel_updates_ms": [(round(a - rec["origin"] - up, 1), round(b - rec["origin"] - up, 1))
+                              for a, b in rec["kernel"] if b - rec["origin"] >= up],
+        # the messages the kernel's widgets sent after the release: (ms, the widget's class)
+        "kernel_messages_ms": [(round(t - rec["origin"] - up, 1), w) for t, w in rec["kernel_sent"] if t - rec["origin"] >= up],
+    }
 
 
 def _timed_drag(page, lab, name, obj, figure, handle, dx, what):
@@ -246,10 +350,17 @@ def _timed_drag(page, lab, name, obj, figure, handle, dx, what):
     page.evaluate("window.__idle_since = null")
     page.wait_for_function(_IDLE_FOR_2S, timeout=120_000, polling=100)
     page.evaluate(_WATCH_REDRAW, [figure.element_handle()])
+    # the kernel's side of the same timeline: the wall-clock start and end (ms) of each update
+    # the drag causes, by a wrapper on the object's own update, removed after
+    _kernel_value(lab, name, f"exec({_STAMP_UPDATES.format(obj=obj)!r})")
     _drag(page, handle, dx)
-    page.wait_for_function("window.__redraw !== null", timeout=60_000)
-    ms = float(page.evaluate("window.__redraw"))
-    assert ms >= 0, f"{what}: the figure's canvases never changed after the drag"
+    page.wait_for_function("window.__rec.done !== null", timeout=60_000)
+    rec = page.evaluate("window.__rec")
+    rec["kernel"] = ast.literal_eval(_kernel_value(lab, name, f"{obj}.__dict__.pop('update').stamps"))
+    rec["kernel_sent"] = ast.literal_eval(_kernel_value(lab, name, _SENT_MESSAGES))
+    rec["origin"] = page.evaluate("performance.timeOrigin")
+    ms = float(rec["done"])
+    assert ms >= 0, f"{what}: the figure's canvas was never drawn after the drag"
     callback_ms = float(_kernel_value(lab, name, f"{obj}.update_ms"))
     blitted = _kernel_value(lab, name, f"{obj}._redraw.ready") == "True"
     # lines of text the blits wrote from the cache / rasterised (CachedTextRenderer)
@@ -259,11 +370,13 @@ def _timed_drag(page, lab, name, obj, figure, handle, dx, what):
     out = SHOTS / "redraw_ms.json"
     times = json.loads(out.read_text()) if out.is_file() else {}
     times[what] = {"ms": round(ms, 1), "callback_ms": round(callback_ms, 1), "blitted": blitted,
-                   "text_lines_cached": text[0], "text_lines_drawn": text[1], "load_1min": load}
+                   "text_lines_cached": text[0], "text_lines_drawn": text[1], "load_1min": load,
+                   "timeline": _timeline(rec)}
     out.write_text(json.dumps(times, indent=1))
     print(f"{what}: the figure settled {ms:.0f} ms after the release, the kernel's callback took "
           f"{callback_ms:.0f} ms, {'blitted' if blitted else 'full redraw'}, {text[0]} lines of text from the cache "
-          f"and {text[1]} drawn (load {load:.1f}; acceptance on an idle machine: ≤ 150 ms)")
+          f"and {text[1]} drawn (load {load:.1f}; acceptance on an idle machine: ≤ 150 ms); ms after the release: "
+          f"{json.dumps(times[what]['timeline'])}")
     # on ipympl's canvas, once the browser showed the figure, a move blits (a full redraw of the
     # Designer's bounds took 0.5 s of the kernel alone). The text cache's hits are recorded, not
     # asserted: a short drag off the design changes the Designer's verdict lines at every step,

@@ -1,10 +1,12 @@
 """The live figures' fast paths draw what the slow paths draw (issue 30: a slider step in ≤ 150 ms).
 
-Two shortcuts make a slider step cheap, and each is checked against the path it replaces on a
+Three shortcuts make a slider step cheap, and each is checked against the path it replaces on a
 sweep of slider values: the QFT bounds checker's precomputed brackets (the oracle: the same
-checker without them, one exact bound computation per check) and the blit's cache of rendered
+checker without them, one exact bound computation per check), the blit's cache of rendered
 text lines (the oracle: the same artists drawn on the same background without the cache, pixel
-for pixel). Their speed is measured in benchmarks/bench_redraw.py, never asserted here.
+for pixel) and the live canvas's PNG encoder of the changed pixels (the oracle: matplotlib's
+own image of them, decoded). Their speed is measured in benchmarks/bench_redraw.py, never
+asserted here.
 """
 from __future__ import annotations
 
@@ -141,3 +143,54 @@ def test_the_designers_title_lines_blit_the_same_pixels_as_drawing_them():
         assert text.hits >= 7 and text.misses > 0  # the unchanged lines of every step came from the cache
     finally:
         plt.close(fig)
+
+
+@pytest.mark.filterwarnings("ignore:Passing unrecognized arguments:DeprecationWarning")  # ipympl's toolbar, in traitlets
+def test_the_live_canvas_sends_the_images_matplotlib_would_encoded_faster():
+    # after each blit ipympl's canvas sends the changed pixels as a PNG; LiveArtists gives it a
+    # faster encoder (loopshaping._diffpng). The oracle: matplotlib's own get_diff_image from
+    # the same pixels and the same last image, decoded by Pillow: the same pixels, the same
+    # mode (the first image full, a gain step's a difference)
+    import io
+
+    from matplotlib.backends.backend_webagg_core import FigureCanvasWebAggCore
+    from PIL import Image
+
+    from loopshaping import _diffpng
+
+    def decoded(png):
+        return np.asarray(Image.open(io.BytesIO(png)).convert("RGBA"))
+
+    P = [ct.tf([k], [1, 31, 30]) for k in (1.0, 5.0, 10.0)]
+    tmpl = qft.Template.from_systems(P, np.array([0.1, 5.0, 100.0]))
+    b = qft.intersect(qft.bounds(tmpl, "stability", 1.2), qft.bounds(tmpl, "sensitivity", 2.0))
+    G = lc.Controller((lc.gain(379.0), lc.real_zero(42.0), lc.complex_pole(247.0, 0.5), lc.real_pole(300.0)))
+    plt.switch_backend("module://ipympl.backend_nbagg")  # closes every figure
+    try:
+        d = Designer(b, tmpl, G)
+        d.widget()
+        canvas = d.figure.canvas
+        assert canvas.get_diff_image.__func__ is _diffpng._diff_image
+        canvas.syncing_data_url = False  # the browser's view said it is initialised
+        sent = []
+        canvas.send = lambda content, buffers=None: sent.extend(buffers or [])  # the comm to the browser
+        modes = []
+        for k in (None, 379.0, 400.0, -50.0, 1e5, 379.0):
+            last, full = canvas._last_buff.copy(), canvas._force_full
+            if k is None:
+                canvas.draw()  # the first render: a full image
+            else:
+                d.set_param(0, k=k)  # a blit: the changed pixels
+            assert d._redraw.ready and len(sent) == 1  # one image an edit
+            modes.append(canvas._current_image_mode)
+            canvas._last_buff, canvas._force_full, canvas._png_is_old = last, full, True
+            want = FigureCanvasWebAggCore.get_diff_image(canvas)
+            assert canvas._current_image_mode == modes[-1]
+            np.testing.assert_array_equal(decoded(sent.pop()), decoded(want), err_msg=f"k={k}")
+        assert modes == ["full"] + ["diff"] * 5
+    finally:
+        plt.switch_backend("Agg")
+    assert not _diffpng.install_encoder(plt.figure().canvas)  # Agg's canvas sends nothing: left as it is
+    plt.close("all")
+    with pytest.raises(ValueError, match="pixels"):
+        _diffpng.png_rgba(np.zeros((4, 3, 3), np.uint8))  # RGB, not RGBA
