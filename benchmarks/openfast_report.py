@@ -115,11 +115,11 @@ def report(folder, baseline="ROSCO", m=4.0) -> str:
             if st is None:
                 continue
             n = len(st["seeds"])
-            trav = st["pitch_travel", "base"], st["pitch_travel", "design"]
+            trav = [f"{x:.0f}" if k else "not recorded" for x, k in (st["pitch_travel", "base"], st["pitch_travel", "design"])]
             lines.append(f"| {v:g} | {name} | {n} ({', '.join(map(str, st['seeds']))}) | {_pm(st, 'tower_del', n)} "
                          f"| {_pm(st, 'gen_speed_sd', n)} | {_pm(st, 'blade_del', n)} "
                          f"| {st['pitch_rate_sd', 'base'][0]:.3f} / {st['pitch_rate_sd', 'design'][0]:.3f} "
-                         f"| {trav[0][0]:.0f} ({trav[0][1]} seeds) / {trav[1][0]:.0f} ({trav[1][1]} seeds) "
+                         f"| {trav[0]} / {trav[1]} "
                          f"| {st['rate_limit_time', 'design'][0]:.2f} |")
             bands.append((v, name, st))
     times = np.array([openfast_times(r) for r in runs])
@@ -160,7 +160,7 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
             if label in names}
     label, lo, hi = BANDS[2]
     lines = ["| wind (m/s) | controller | closed-loop poles in "
-             f"{TOWER_MODE_BAND[0]}-{TOWER_MODE_BAND[1]} rad/s: |p| (rad/s), ζ | least ζ "
+             f"{TOWER_MODE_BAND[0]}-{TOWER_MODE_BAND[1]} rad/s: \\|p\\| (rad/s), ζ | least ζ "
              f"| linear \\|T\\|²S_W in the {label} rad/s band (MN²·m²) |", "|---|---|---|---|---|"]
     w = np.geomspace(lo, hi, 400)
     for v in speeds:
