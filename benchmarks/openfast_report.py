@@ -62,6 +62,12 @@ def openfast_times(run) -> tuple[float, float]:
     return out[0], out[1]
 
 
+def wind_psd(model, v, omega):
+    """S_W of the linear predictions (rotor-effective wind, class B, weighted by the 600 s
+    record's window as :func:`specdesign.validate.linear_prediction` weights it), (m/s)²·s/rad."""
+    return wind.rotor_effective_spectrum(omega, v, model.rotor_radius, turbulence_class="B") * wind.record_window(omega)
+
+
 def band_variance(omega, psd, lo, hi) -> float:
     """∫ PSD dω over lo ≤ ω < hi (rad/s), trapezoidal on the Welch grid."""
     m = (omega >= lo) & (omega < hi)
@@ -165,7 +171,7 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
     w = np.geomspace(lo, hi, 400)
     for v in speeds:
         plant = model.linearize(v)
-        sw = wind.rotor_effective_spectrum(w, v, model.rotor_radius, turbulence_class="B") * wind.record_window(w, 600.0)
+        sw = wind_psd(model, v, w)
         loops = [(BASELINE, spec.baseline_controller(model, v), None)]
         loops += [(label, ct.tf(m[v]["design"].pitch_controller), m[v]["design"].atd_controller)
                   for label, m in made.items()]
@@ -175,7 +181,7 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
             p = cl.poles()
             p = p[(p.imag > 0) & (np.abs(p) >= TOWER_MODE_BAND[0]) & (np.abs(p) <= TOWER_MODE_BAND[1])]
             z = -p.real / np.abs(p)
-            t = np.array([cl["tower_base_my", "wind"](1j * x) for x in w])
+            t = cl["tower_base_my", "wind"](1j * w)
             var = float(np.trapezoid(np.abs(t) ** 2 * sw, w))
             lines.append(f"| {v:g} | {name} | " + ", ".join(f"{abs(a):.3f}, {b:.3f}" for a, b in zip(p, z))
                          + f" | {z.min() if z.size else float('nan'):.3f} | {var / 1e12:.3g} |")
@@ -210,9 +216,8 @@ def _fig8(runs, v, model, loops, folder):
             psd = np.mean([r.welch[out][1:] for r in mine], axis=0) * k
             ax.loglog(w, psd, color=_COLOURS.get(name, "k"),
                       label=f"{name}, OpenFAST (seeds {', '.join(str(r.seed) for r in mine)})")
-            t = np.array([cl[out, "wind"](1j * x) for x in w])
-            sw = wind.rotor_effective_spectrum(w, v, model.rotor_radius, turbulence_class="B") * wind.record_window(w, 600.0)
-            ax.loglog(w, np.abs(t) ** 2 * sw * k, "--", color=_COLOURS.get(name, "k"), label=f"{name}, linear")
+            t = cl[out, "wind"](1j * w)
+            ax.loglog(w, np.abs(t) ** 2 * wind_psd(model, v, w) * k, "--", color=_COLOURS.get(name, "k"), label=f"{name}, linear")
             shown.append(psd[(w >= 0.05) & (w <= 10)])
         # the range the runs span, not the linear roll-off's decades
         lo, hi = min(x.min() for x in shown), max(x.max() for x in shown)

@@ -522,7 +522,6 @@ def rosco_lpf1(st: np.ndarray, iy: int, iu: int, u: float, corner: float, dt: fl
     return y
 
 
-
 @njit(cache=True)
 def rosco_lpf2(st: np.ndarray, iy: int, iy2: int, iu1: int, iu2: int, u: float, corner: float, damp: float,
                dt: float, reset: bool) -> float:
@@ -565,6 +564,7 @@ def rosco_lpf2(st: np.ndarray, iy: int, iy2: int, iu1: int, iu2: int, u: float, 
     st[iy2] = st[iy]
     st[iy] = y
     return y
+
 
 @njit(cache=True)
 def _pi(err, kp, ki, lo, hi, dt, i0, st, idx, first):

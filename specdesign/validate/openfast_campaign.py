@@ -78,8 +78,8 @@ class OpenFASTRun:
         The campaign's seed (TurbSim's is ``specdesign.wind.seed_for(wind_speed, seed)``).
     values : dict
         Indicator → value in its unit (:data:`~specdesign.validate.metrics.INDICATORS`; DELs in
-        N·m, SDs in rad or rad/s, power in W, travel in rad, time at the rate limit in s); an
-        indicator the run predates is absent, never filled in.
+        N·m, SDs in rad or rad/s, power in W, pitch travel in rad/h, time at the rate limit as a
+        fraction of the record, -); an indicator the run predates is absent, never filled in.
     omega : numpy.ndarray
         Frequencies of the Welch spectra, rad/s.
     welch : dict
@@ -135,8 +135,7 @@ def read_openfast_runs(folder) -> list[OpenFASTRun]:
             continue
         try:
             meta = json.loads(js.read_text())
-            with np.load(npz) as z:
-                data = {k: z[k] for k in z.files}
+            data = _read_result(npz)
         except (OSError, ValueError) as e:
             raise ValueError(f"run folder {js.parent} does not read ({e}): delete it to run it again") from e
         values = {k[len("value_"):]: float(a) for k, a in data.items() if k.startswith("value_")}
@@ -422,6 +421,11 @@ def _load(root: Path, run, meta):
     if not _same(old, meta):
         raise ValueError(f"{f} holds a run of other settings or another controller under the name {run[0]!r} "
                          "(run.json differs): use another folder, or delete that run to redo it")
+    return _read_result(npz)
+
+
+def _read_result(npz: Path) -> dict:
+    """A run's ``result.npz`` as a dict of arrays (read whole: the file is closed after)."""
     with np.load(npz) as z:
         return {k: z[k] for k in z.files}
 
