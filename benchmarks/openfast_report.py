@@ -159,7 +159,7 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
 
     sys.path.insert(0, str(Path(__file__).parent))
     # the campaign's own model and design step: the controllers it ran
-    from openfast_table3 import STRUCTURES, designs, openfast_model
+    from openfast_table3 import STRUCTURES, designs, openfast_model, predicted_del
 
     model = openfast_model(iea15mw_monopile(), speeds, processes=1)
     made = {label: designs(model, speeds, target, structure) for structure, (label, _) in STRUCTURES.items()
@@ -167,7 +167,9 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
     label, lo, hi = BANDS[2]
     lines = ["| wind (m/s) | controller | closed-loop poles in "
              f"{TOWER_MODE_BAND[0]}-{TOWER_MODE_BAND[1]} rad/s: \\|p\\| (rad/s), ζ | least ζ "
-             f"| linear \\|T\\|²S_W in the {label} rad/s band (MN²·m²) |", "|---|---|---|---|---|"]
+             f"| tower mode ζ (closedloop.tower_damping) | linear \\|T\\|²S_W in the {label} rad/s band (MN²·m²) "
+             "| predicted tower DEL (%) |", "|---|---|---|---|---|---|---|"]
+    preds = {}
     w = np.geomspace(lo, hi, 400)
     for v in speeds:
         plant = model.linearize(v)
@@ -176,18 +178,24 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
         loops += [(label, ct.tf(m[v]["design"].pitch_controller), m[v]["design"].atd_controller)
                   for label, m in made.items()]
         predicted = {}
+        base_del = predicted_del(model, v, loops[0][1])
         for name, c, atd in loops:
             cl = closedloop.closed_loop(plant, c, atd, warn=False)
+            change = 100 * (predicted_del(model, v, c, atd) / base_del - 1)
+            preds[name, v] = change
             p = cl.poles()
             p = p[(p.imag > 0) & (np.abs(p) >= TOWER_MODE_BAND[0]) & (np.abs(p) <= TOWER_MODE_BAND[1])]
             z = -p.real / np.abs(p)
             t = cl["tower_base_my", "wind"](1j * w)
             var = float(np.trapezoid(np.abs(t) ** 2 * sw, w))
             lines.append(f"| {v:g} | {name} | " + ", ".join(f"{abs(a):.3f}, {b:.3f}" for a, b in zip(p, z))
-                         + f" | {z.min() if z.size else float('nan'):.3f} | {var / 1e12:.3g} |")
+                         + f" | {z.min() if z.size else float('nan'):.3f} | {closedloop.tower_damping(plant, cl)[1]:.3f} "
+                         f"| {var / 1e12:.3g} | {change:+.1f} |")
             predicted[name] = cl
         if figures is not None:
             _fig8(runs, v, model, predicted, Path(figures))
+    if figures is not None:
+        _fig10(runs, preds, Path(figures))
     return "\n".join(lines)
 
 
@@ -237,16 +245,88 @@ def _fig8(runs, v, model, loops, folder):
     print(f"wrote {path}", file=sys.stderr)
 
 
+def fig9(runs, folder, v=19.0, seed=0, span=(100.0, 300.0)) -> Path | None:
+    """The paper's Fig. 9 from OpenFAST: generator speed, power, tower-base moment and pitch of
+    every controller on the same TurbSim field (``seed`` at ``v`` m/s), ``span`` s of the record;
+    None (and a note) when no run there kept its series (``openfast_table3.py`` keeps seed 0's
+    since the figure was added)."""
+    here = [r for r in runs if r.wind_speed == v and r.seed == seed and r.series]
+    if not here:
+        print(f"Fig. 9: no run at {v:g} m/s, seed {seed} kept its series", file=sys.stderr)
+        return None
+    folder.mkdir(parents=True, exist_ok=True)
+    rows = (("gen_speed", "generator speed (rpm)", 30.0 / math.pi), ("power", "power (MW)", 1e-6),
+            ("tower_base_my", "tower-base My (MN·m)", 1e-6), ("pitch", "blade pitch (deg)", DEG))
+    fig, axes = plt.subplots(len(rows), 1, figsize=(9, 8), sharex=True, constrained_layout=True)
+    for r in sorted(here, key=lambda r: r.controller != BASELINE):
+        dt = float(r.meta["settings"]["record_dt"])
+        n = r.series["gen_speed"].size
+        t = np.arange(n) * dt
+        keep = (t >= span[0]) & (t <= span[1])
+        for (key, label, k), ax in zip(rows, axes):
+            if key in r.series:
+                ax.plot(t[keep], r.series[key][keep] * k, color=_COLOURS.get(r.controller, "k"), lw=0.8,
+                        label=r.controller)
+                ax.set_ylabel(label)
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize=8, ncol=3)
+    axes[-1].set_xlabel("time after the discarded transient (s)")
+    fig.suptitle(f"OpenFAST at {v:g} m/s, seed {seed}: every controller on the same TurbSim field and sea state")
+    path = folder / f"openfast_fig9_{v:g}mps.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    print(f"wrote {path}", file=sys.stderr)
+    return path
+
+
+def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0):
+    """The paper's Fig. 10 from OpenFAST: per design, the tower DEL change against ROSCO's
+    predicted on OpenFAST's linearisation (``preds[name, v]``, %) and measured by rainflow in
+    OpenFAST (paired seeds, ± jackknife SE from two seeds up) against the wind speed."""
+    folder.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(7, 4.2), constrained_layout=True)
+    names = sorted({name for name, _ in preds} - {baseline})
+    for k, name in enumerate(names):
+        speeds = sorted(v for n, v in preds if n == name)
+        colour = _COLOURS.get(name, "k")
+        ax.plot(speeds, [preds[name, v] for v in speeds], "--o", color=colour, mfc="none",
+                label=f"{name}, linear prediction")
+        got = [(v, _cell_stats(runs, baseline, name, v, m)) for v in speeds]
+        got = [(v, st) for v, st in got if st is not None]
+        if got:
+            x = np.array([v for v, _ in got]) + 0.08 * (k - (len(names) - 1) / 2)  # side by side, not on top
+            y = [st["tower_del"][0] for _, st in got]
+            se = [st["tower_del"][1] if len(st["seeds"]) > 1 else 0.0 for _, st in got]
+            ax.errorbar(x, y, yerr=se, fmt="s", color=colour, capsize=3,
+                        label=f"{name}, OpenFAST rainflow (seeds per speed: "
+                              + ", ".join(f"{v:g}: {len(st['seeds'])}" for v, st in got) + ")")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("mean wind speed (m/s)")
+    ax.set_ylabel(f"tower-base DEL change vs {baseline} (%)")
+    ax.set_title("Fig. 10 from OpenFAST: linear prediction vs rainflow (± SE over paired seeds)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    path = folder / "openfast_fig10.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    print(f"wrote {path}", file=sys.stderr)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--folder", default="build/openfast_table3/runs", help="the campaign's run folder")
     ap.add_argument("--baseline", default="ROSCO")
     ap.add_argument("--damping", action="store_true",
                     help="also the closed-loop tower-mode damping on OpenFAST's linearisations (designs again)")
-    ap.add_argument("--figures", default=None, help="with --damping: folder for Fig. 8 from OpenFAST per speed")
+    ap.add_argument("--figures", default=None,
+                    help="folder for Fig. 9 from OpenFAST (19 m/s, seed 0, where its series were kept) and, with "
+                         "--damping, Fig. 8 per speed and Fig. 10")
     args = ap.parse_args()
     text = report(Path(args.folder))
     print(text)
+    if args.figures is not None:
+        fig9(validate.read_openfast_runs(args.folder), Path(args.figures))
     if args.damping:
         runs = validate.read_openfast_runs(args.folder)
         designed = [r for r in runs if r.controller != args.baseline]

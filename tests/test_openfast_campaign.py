@@ -129,12 +129,13 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
 def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake):
     # read_openfast_runs gives back what run_openfast_campaign stored, value for value and
     # spectrum for spectrum; a run whose result.npz is not written yet (a run in progress) is
-    # not counted; a folder that is not there is named
+    # not counted; a folder that is not there is named; the series of the kept seeds (the first
+    # one here) come back as the campaign holds them, the other seeds' are absent
     inst, calls, lib = fake
     ctrls = {"A": _controller(tmp_path, lib, "a", "1.0"), "B": _controller(tmp_path, lib, "b", "0.5")}
     camp = run_openfast_campaign(ctrls, [19.0], [0, 2], deck=iea15mw_monopile(), duration=40.0, transient=10.0,
                                  record_dt=0.05, install=inst, processes=2, folder=tmp_path / "camp",
-                                 initial_conditions=False)
+                                 initial_conditions=False, keep_series=1)
     runs = read_openfast_runs(tmp_path / "camp")
     assert [(r.controller, r.wind_speed, r.seed) for r in runs] == [("A", 19.0, 0), ("A", 19.0, 2), ("B", 19.0, 0),
                                                                       ("B", 19.0, 2)]
@@ -143,6 +144,12 @@ def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake):
         for k, v in r.values.items():
             assert_allclose(v, camp.values[k][ci, 0, si], rtol=0, err_msg=k)
         assert r.meta["settings"]["duration"] == 40.0 and r.omega.shape == r.welch["tower_base_my"].shape
+        if r.seed == 0:
+            for k, a in r.series.items():
+                assert_allclose(a, camp.series[r.controller].outputs[k][0, 0], rtol=0, err_msg=k)
+            assert set(r.series) >= {"tower_base_my", "gen_speed", "pitch", "power"}
+        else:
+            assert r.series == {}
     (tmp_path / "camp" / "B" / "19mps_seed2" / "result.npz").unlink()
     assert len(read_openfast_runs(tmp_path / "camp")) == 3
     with pytest.raises(FileNotFoundError, match="campaign's folder"):

@@ -25,6 +25,8 @@ Every closed-loop construction of the workbench lives here, one module a concern
   (SISO pitch + ATD, a MIMO controller, one loop closed);
 - :mod:`~specdesign.closedloop.stability`: the loop as the simulator runs it (scheduled
   controllers blended at the trim), its poles, hidden modes and instability messages;
+- :mod:`~specdesign.closedloop.modes`: the tower mode's pole and damping ratio in a loop, and the
+  designs' warning when it falls well below ROSCO's;
 - :mod:`~specdesign.closedloop.grid`: frequency grids refined around lightly damped roots.
 """
 from __future__ import annotations
@@ -56,6 +58,14 @@ from .maps import (
                            t_output_wind,
                            t_tower_wind,
 )
+from .modes import (
+                           MIN_TOWER_DAMPING_FRACTION,
+                           TOWER_MODE_SPAN,
+                           TowerDampingWarning,
+                           tower_damping,
+                           tower_damping_message,
+                           tower_pole,
+)
 from .stability import (
                            CERTIFICATE_MAX_SENSITIVITY,
                            DESIGN_MAX_SENSITIVITY,
@@ -76,6 +86,12 @@ from .stability import (
 )
 
 __all__ = [
+    "MIN_TOWER_DAMPING_FRACTION",
+    "TOWER_MODE_SPAN",
+    "TowerDampingWarning",
+    "tower_damping",
+    "tower_damping_message",
+    "tower_pole",
     "ClosedLoopUnstableWarning",
     "fine_pitch_lift",
     "closed_loop",

@@ -622,7 +622,8 @@ def design_table(designs: Iterable[QFTDesign]) -> list[dict[str, Any]]:
 
 
 def format_table(rows: Iterable[dict[str, Any]]) -> str:
-    """Markdown table of :func:`design_table` rows (reductions and changes in %, margins in dB/deg).
+    """Markdown table of :func:`design_table` rows (reductions and changes in %, margins in dB/deg,
+    the tower mode's damping ratio of the design and of ROSCO).
 
     Parameters
     ----------
@@ -648,13 +649,14 @@ def format_table(rows: Iterable[dict[str, Any]]) -> str:
     """
     head = ("| v [m/s] | notch-spec promise DEL [%] | relaxed-spec promise DEL [%] | predicted DEL red. [%] | predicted damage red. [%] | gen-speed SD [%] "
             "| pitch SD [%] | pitch-rate SD [%] | GM pitch [dB] | PM pitch [deg] | GM ATD [dB] | PM ATD [deg] "
-            "| bounds | dense check | stable | states |")
+            "| tower ζ (ROSCO) | bounds | dense check | stable | states |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         lines.append(
             f"| {r['wind_speed']:g} | {r['notch_promise_del_pct']:.1f} | {r['promised_del_pct']:.1f} | {r['predicted_del_pct']:.1f} | {r['predicted_damage_pct']:.1f} "
             f"| {r['gen_speed_sd_change_pct']:+.1f} | {r['pitch_sd_change_pct']:+.1f} | {r['pitch_rate_sd_change_pct']:+.1f} "
             f"| {r['gain_margin_db']:.1f} | {r['phase_margin_deg']:.1f} | {r['atd_gain_margin_db']:.1f} "
-            f"| {r['atd_phase_margin_deg']:.1f} | {'yes' if r['bounds_met'] else 'NO'} | {'pass' if r['dense_check_passed'] else 'FAIL'} "
+            f"| {r['atd_phase_margin_deg']:.1f} | {r['tower_damping_ratio']:.3f} ({r['baseline_tower_damping_ratio']:.3f}) "
+            f"| {'yes' if r['bounds_met'] else 'NO'} | {'pass' if r['dense_check_passed'] else 'FAIL'} "
             f"| {'yes' if r['all_stable'] else 'NO'} | {r['n_states']} |")
     return "\n".join(lines)

@@ -23,6 +23,7 @@ from ..closedloop import (
     plant_responses,
     siso_response,
 )
+from ..closedloop.modes import TowerDampingWarning, tower_damping, tower_damping_message
 from .checks import bounds_met, loop_checks
 
 if TYPE_CHECKING:
@@ -116,6 +117,14 @@ class QFTDesign:
         Phase margin of the same loop, degrees.
     actuator_peak_sensitivity : float
         Maximum over ω and cases of |1/(1 + C_β P_{Ω,β} + C_atd P_{z,β})| (-).
+    tower_damping_ratio : float
+        Damping ratio (-) of the first tower fore-aft mode with both loops closed, nominal case
+        (:func:`specdesign.closedloop.tower_damping`); below
+        :data:`~specdesign.closedloop.MIN_TOWER_DAMPING_FRACTION` of ROSCO's the design warns
+        (:class:`~specdesign.closedloop.TowerDampingWarning`): the promise does not see what else
+        drives the mode on a real turbine.
+    baseline_tower_damping_ratio : float
+        The same with ROSCO's PI (-).
     target_reduction : float
         The requested tower-base DEL reduction, %.
     success : bool
@@ -175,6 +184,8 @@ class QFTDesign:
     atd_gain_margin_db: float
     atd_phase_margin_deg: float
     actuator_peak_sensitivity: float
+    tower_damping_ratio: float
+    baseline_tower_damping_ratio: float
     target_reduction: float
     success: bool
     message: str
@@ -206,7 +217,8 @@ class QFTDesign:
             ``promised_damage_pct``) and the predicted reductions (``predicted_del_pct``,
             ``predicted_damage_pct``), %; the SD changes (``*_sd_change_pct``), %; the margins
             (``gain_margin_db``, ``phase_margin_deg``, ``atd_gain_margin_db``,
-            ``atd_phase_margin_deg``); ``bounds_met``, ``dense_check_passed``, ``all_stable``
+            ``atd_phase_margin_deg``); the tower mode's damping ratios of the design and of
+            ROSCO (``tower_damping_ratio``, ``baseline_tower_damping_ratio``, -); ``bounds_met``, ``dense_check_passed``, ``all_stable``
             (bool) and ``n_states``.
         """
         return {
@@ -224,6 +236,8 @@ class QFTDesign:
             "phase_margin_deg": self.phase_margin_deg,
             "atd_gain_margin_db": self.atd_gain_margin_db,
             "atd_phase_margin_deg": self.atd_phase_margin_deg,
+            "tower_damping_ratio": self.tower_damping_ratio,
+            "baseline_tower_damping_ratio": self.baseline_tower_damping_ratio,
             "bounds_met": self.bounds_met,
             "dense_check_passed": bool(self.pitch_check.passed and self.atd_check.passed),
             "all_stable": self.all_stable,
@@ -244,17 +258,21 @@ class QFTDesign:
                     f"{r['predicted_del_pct']:.1f} % (the specification promises {r['promised_del_pct']:.1f} %), "
                     f"{r['n_states']}-state pitch controller, no ATD; gen-speed SD {r['gen_speed_sd_change_pct']:+.1f} %, "
                     f"pitch SD {r['pitch_sd_change_pct']:+.1f} %, pitch-rate SD {r['pitch_rate_sd_change_pct']:+.1f} %; "
-                    f"pitch loop GM {r['gain_margin_db']:.1f} dB PM {r['phase_margin_deg']:.1f}°; bounds met: "
-                    f"{self.bounds_met}, dense check: {r['dense_check_passed']}, all {len(self.template_speeds)} cases "
+                    f"pitch loop GM {r['gain_margin_db']:.1f} dB PM {r['phase_margin_deg']:.1f}°; {self._tower_text()}; "
+                    f"bounds met: {self.bounds_met}, dense check: {r['dense_check_passed']}, all {len(self.template_speeds)} cases "
                     f"stable: {self.all_stable}; {self.message}")
         return (f"QFT design at {self.wind_speed:g} m/s: tower DEL reduced {r['predicted_del_pct']:.1f} % "
                 f"(notch spec promises {r['notch_promise_del_pct']:.1f} %, relaxed spec {r['promised_del_pct']:.1f} %), "
                 f"gen-speed SD {r['gen_speed_sd_change_pct']:+.1f} %, "
                 f"pitch SD {r['pitch_sd_change_pct']:+.1f} %, pitch-rate SD {r['pitch_rate_sd_change_pct']:+.1f} %; "
                 f"pitch loop GM {r['gain_margin_db']:.1f} dB PM {r['phase_margin_deg']:.1f}°, ATD loop GM "
-                f"{r['atd_gain_margin_db']:.1f} dB PM {r['atd_phase_margin_deg']:.1f}°; bounds met: {self.bounds_met}, "
+                f"{r['atd_gain_margin_db']:.1f} dB PM {r['atd_phase_margin_deg']:.1f}°; {self._tower_text()}; "
+                f"bounds met: {self.bounds_met}, "
                 f"dense check: {r['dense_check_passed']}, all {len(self.template_speeds)} cases stable: {self.all_stable}; "
                 f"{self.message}")
+
+    def _tower_text(self) -> str:
+        return f"tower mode ζ {self.tower_damping_ratio:.3f} (ROSCO {self.baseline_tower_damping_ratio:.3f})"
 
 
 def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_spec, speed_spec, shaping, promise,
@@ -314,6 +332,8 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
         warnings.filterwarnings("ignore", category=UserWarning, module=r"control\.")
         stable = [check_stability(closed_loop(P, cb, ca, warn=False), tol=0.0) for P in prob.plants]
         cl = closed_loop(prob.plants[nom], cb, ca, warn=False)
+        zeta = tower_damping(prob.plants[nom], cl)[1]
+        zeta_rosco = tower_damping(prob.plants[nom], closed_loop(prob.plants[nom], prob.rosco[nom], warn=False))[1]
     all_stable = bool(np.all(stable))
     red, dred, gs, ps, rate = performance
     Rdense = plant_responses(prob.plants, wdense, ("gen_speed", "tower_top_vel"), method=prob.response_method)
@@ -344,6 +364,9 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
     message = "all specifications met" if success else "; ".join(problems)
     if not success:
         warnings.warn(f"design_qft at {v:g} m/s: {message}", RuntimeWarning, stacklevel=3)
+    weak = tower_damping_message("design_qft", v, zeta, zeta_rosco)
+    if weak is not None:
+        warnings.warn(weak, TowerDampingWarning, stacklevel=3)
     return QFTDesign(
         wind_speed=v, pitch_controller=cb, atd_controller=ca, baseline_controller=prob.rosco[nom],
         template_speeds=speeds, design_omega=prob.wd.copy(), dense_omega=wdense, tower_spec=tower_spec,
@@ -354,6 +377,7 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
         pitch_rate_sd_change=100 * (rate - 1), pitch_rate_sd=float(rate * prob.sd0["pitch_rate"]),
         gain_margin_db=float(pitch_check.gain_margin_db[nomp]), phase_margin_deg=float(pitch_check.phase_margin_deg[nomp]),
         atd_gain_margin_db=float(atd_check.gain_margin_db[nomp]), atd_phase_margin_deg=float(atd_check.phase_margin_deg[nomp]),
-        actuator_peak_sensitivity=peak_in, target_reduction=t, success=success, message=message, parameters=parameters,
+        actuator_peak_sensitivity=peak_in, tower_damping_ratio=zeta, baseline_tower_damping_ratio=zeta_rosco,
+        target_reduction=t, success=success, message=message, parameters=parameters,
         options=options,
     )

@@ -15,7 +15,7 @@ import sys
 import tempfile
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -88,6 +88,10 @@ class OpenFASTRun:
         The run's ``run.json``: settings, the controller files' digests, TurbSim's seeds.
     folder : pathlib.Path
         The run's folder (OpenFAST's log and summaries are kept there).
+    series : dict
+        Output → its recorded series after the transient (SI: rad/s, N·m, rad, W), sampled every
+        ``meta["settings"]["record_dt"]`` s, for the seeds the campaign kept
+        (``keep_series``); empty otherwise.
     """
 
     controller: str
@@ -98,6 +102,7 @@ class OpenFASTRun:
     welch: dict
     meta: dict
     folder: Path
+    series: dict = field(default_factory=dict)
 
 
 def read_openfast_runs(folder) -> list[OpenFASTRun]:
@@ -140,8 +145,9 @@ def read_openfast_runs(folder) -> list[OpenFASTRun]:
             raise ValueError(f"run folder {js.parent} does not read ({e}): delete it to run it again") from e
         values = {k[len("value_"):]: float(a) for k, a in data.items() if k.startswith("value_")}
         welch = {k[len("welch_"):]: a for k, a in data.items() if k.startswith("welch_")}
+        series = {k[len("series_"):]: a for k, a in data.items() if k.startswith("series_")}
         runs.append(OpenFASTRun(str(meta["controller"]), float(meta["wind_speed"]), int(meta["seed"]), values,
-                                data["omega"], welch, meta, js.parent))
+                                data["omega"], welch, meta, js.parent, series))
     return sorted(runs, key=lambda r: (r.controller, r.wind_speed, r.seed))
 
 
