@@ -30,11 +30,18 @@ class _Design:
                                     omega=np.array([1.0]), hf_excess_db=-1.0, proper=True)
 
 
-@pytest.mark.parametrize("excess_db, kept", [(-2 * ORDER_ROOM_DB, 8), (-ORDER_ROOM_DB / 2, 10), (0.1, 10)])
-def test_a_lower_order_is_kept_only_when_it_meets_the_pair_with_room(excess_db, kept):
-    # 8 states meeting the pair by less than ORDER_ROOM_DB (still "met": excess ≤ 0) is passed
-    # over, so a rounding error that moves its excess across 0 dB cannot change the order
-    designs = {8: _Design(8, excess_db), 10: _Design(10, -0.3)}
+@pytest.mark.parametrize("excess_8, excess_10, kept", [
+    (-2 * ORDER_ROOM_DB, -0.3, 8),  # met with room: kept
+    (-ORDER_ROOM_DB / 2, -0.3, 10),  # met (excess ≤ 0) without room: passed over for one with room
+    (0.1, -0.3, 10),
+    (-ORDER_ROOM_DB / 2, 0.5, 8),  # ... unless the highest order misses: then the lower one that met
+    (-ORDER_ROOM_DB / 2, -ORDER_ROOM_DB / 2, 8),  # ... or meets without room too: the lowest
+    (0.1, 0.5, 10),  # none meets: the highest, said by its warning
+])
+def test_a_lower_order_is_kept_only_when_it_meets_the_pair_with_room(excess_8, excess_10, kept):
+    # 8 states meeting the pair by less than ORDER_ROOM_DB is passed over when 10 meet it with
+    # room, so a rounding error that moves its excess across 0 dB cannot change the order
+    designs = {8: _Design(8, excess_8), 10: _Design(10, excess_10)}
     assert _lowest_order((8, 10), designs.__getitem__).order == kept
 
 
