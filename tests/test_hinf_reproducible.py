@@ -23,10 +23,10 @@ from specdesign.turbine import iea15mw
 class _Design:
     """The one field ``_lowest_order`` reads."""
 
-    def __init__(self, order, excess_db):
+    def __init__(self, order, excess_db, decay_rate=0.02):
         self.order = order
         self.case_check = CaseCheck(case_speeds=(19.0,), tower_excess_db=(excess_db,), speed_excess_db=(-1.0,),
-                                    tower_omega=(1.0,), speed_omega=(1.0,), max_sensitivity=1.5, decay_rate=0.02,
+                                    tower_omega=(1.0,), speed_omega=(1.0,), max_sensitivity=1.5, decay_rate=decay_rate,
                                     omega=np.array([1.0]), hf_excess_db=-1.0, proper=True)
 
 
@@ -42,7 +42,14 @@ def test_a_lower_order_is_kept_only_when_it_meets_the_pair_with_room(excess_8, e
     # 8 states meeting the pair by less than ORDER_ROOM_DB is passed over when 10 meet it with
     # room, so a rounding error that moves its excess across 0 dB cannot change the order
     designs = {8: _Design(8, excess_8), 10: _Design(10, excess_10)}
-    assert _lowest_order((8, 10), designs.__getitem__).order == kept
+    assert _lowest_order((8, 10), designs.__getitem__, min_decay=0.01).order == kept
+
+
+def test_a_lower_order_with_a_marginal_pole_is_passed_over():
+    # met (decay > 0) by a pole at −1.5e-15 1/s, as a 10-state design at 21 m/s was: a rounding
+    # error from unstable, so not "with room" (min_decay: half the step's decay rate)
+    designs = {8: _Design(8, -0.3, decay_rate=1.5e-15), 10: _Design(10, -0.3)}
+    assert _lowest_order((8, 10), designs.__getitem__, min_decay=0.01).order == 10
 
 
 @pytest.mark.slow
