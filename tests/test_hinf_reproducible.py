@@ -54,12 +54,14 @@ def test_a_lower_order_with_a_marginal_pole_is_passed_over():
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="the multi-model step (refine_on_cases) is path-dependent: "
-                   "19 and 19 + 1e-9 m/s gave predictions 0.07 pp and controllers 13 % apart (docs/hinf.md)")
+                   "19 and 19 + 1e-9 m/s gave predictions 0.053 pp apart (0.069 before the γ grid) "
+                   "and controllers 13 % apart (docs/hinf.md)")
 def test_a_nudged_wind_speed_gives_the_same_hinf_design():
     model = iea15mw()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # a missed pair is said; not what is tested here
-        a, b = design_hinf(model, 19.0), design_hinf(model, 19.0 + 1e-9)
+        # 10 states, the order chosen at both (8 miss the pair): one multi-model step each
+        a, b = design_hinf(model, 19.0, order=10), design_hinf(model, 19.0 + 1e-9, order=10)
     assert b.controller.nstates == a.controller.nstates
     assert abs(b.promised_del_reduction - a.promised_del_reduction) <= 0.01
     assert abs(b.predicted_del_reduction - a.predicted_del_reduction) <= 0.01
