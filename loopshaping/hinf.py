@@ -38,6 +38,7 @@ from .reduction import ReductionResult, discretize, reduce
 from .wellposed import AXIS_TOL, RANK_TOL, WellPosednessWarning, check_well_posed, regularized_plant, shift_axis_poles
 
 __all__ = [
+    "GAMMA_GRID",
     "HinfResult",
     "ReductionResult",
     "WellPosednessWarning",
@@ -47,6 +48,16 @@ __all__ = [
     "reduce",
     "synthesize",
 ]
+
+
+#: Relative step of the grid a suboptimal γ is rounded up to before the controller is formed
+#: (:func:`synthesize` with ``suboptimality`` > 0): γ = (1 + suboptimality)·γ_hi with γ_hi the
+#: bisection's upper end, a step function of the data (a round-off change of the plant can flip
+#: one of its feasibility tests near γ_opt and move γ_hi by up to ``gamma_tol``). Rounded up to
+#: this grid, the controller is formed at the same γ unless (1 + suboptimality)·γ_hi crosses a
+#: grid point: a flipped test changes it with probability ≈ gamma_tol/GAMMA_GRID (2 % at the
+#: default 1e-4), instead of always; the price is a γ at most 0.5 % above the one asked.
+GAMMA_GRID = 0.005
 
 
 # --------------------------------------------------------------------------- results
@@ -148,8 +159,9 @@ def synthesize(
         Size of the regularisation (in the units of z per unit of u, y per unit of noise).
     suboptimality : float
         ≥ 0. With 0 the central controller at the smallest γ the bisection found feasible
-        (within ``gamma_tol`` of γ_opt); with e.g. 0.05 the one at 1.05 times that, usually with
-        much slower, better-conditioned poles.
+        (within ``gamma_tol`` of γ_opt); with e.g. 0.05 the one at 1.05 times that, rounded up to
+        the relative grid :data:`GAMMA_GRID` (so round-off in the data does not move it), usually
+        with much slower, better-conditioned poles.
     gamma_tol : float
         Relative width of the final γ bracket of the bisection.
     rank_tol, axis_tol : float
@@ -239,6 +251,12 @@ def synthesize(
     )
 
 
+def _on_gamma_grid(gamma):
+    """The smallest γ of the relative grid (1 + :data:`GAMMA_GRID`)^k, k whole, that is ≥ ``gamma``."""
+    k = np.ceil(np.log(gamma) / np.log1p(GAMMA_GRID) * (1 - 1e-12))
+    return max(float(np.exp(k * np.log1p(GAMMA_GRID))), gamma)
+
+
 def _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, notes):
     """γ iteration by bisection on SLICOT's suboptimal solver ``sb10fd``.
 
@@ -311,7 +329,7 @@ def _solve(P, n_meas, n_ctrl, suboptimality, gamma_tol, notes):
             hi, sol = mid, s_mid
     gamma_bound = float(hi)
     if suboptimality > 0:
-        gamma_bound = float(hi) * (1.0 + suboptimality)
+        gamma_bound = _on_gamma_grid(float(hi) * (1.0 + suboptimality))
         s_sub = attempt(gamma_bound)
         if s_sub is None:  # pragma: no cover - feasibility is monotone in γ in theory
             raise RuntimeError(f"SLICOT sb10fd failed at γ = {gamma_bound:.6g} above γ_opt")

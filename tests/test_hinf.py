@@ -149,6 +149,26 @@ def test_synthesize_general_plant_against_lft_oracle(d22):
                                                       suboptimality=0.02).gamma, rel=1e-6)
 
 
+def test_suboptimal_gamma_is_rounded_up_to_its_grid_so_round_off_does_not_move_it():
+    # issue 28 item 4: the bisection's upper end γ_hi is a step function of the data; the
+    # controller is formed at (1 + s)·γ_hi rounded up to the grid (1 + GAMMA_GRID)^k
+    P = _general_plant(0.0)
+    res = hinf.synthesize(P, 1, 1, suboptimality=0.02)
+    gamma_hi = hinf.synthesize(P, 1, 1, suboptimality=0.0).gamma_bound  # the same bisection, no rounding
+    k = np.log(res.gamma_bound) / np.log1p(hinf.GAMMA_GRID)
+    assert k == pytest.approx(round(k), abs=1e-9)
+    assert 1.02 * gamma_hi <= res.gamma_bound <= 1.02 * gamma_hi * (1 + hinf.GAMMA_GRID)
+    # the plant moved by 1e-9 relative (a rounding error of the operating point): the same γ, and a
+    # controller that moves by about as much (the central controller is smooth in the data at a
+    # fixed γ; 1e-6 leaves room for the Riccati solutions' conditioning)
+    nudged = ct.ss(np.asarray(P.A) * (1 + 1e-9), P.B, P.C, P.D)
+    res_n = hinf.synthesize(nudged, 1, 1, suboptimality=0.02)
+    assert res_n.gamma_bound == res.gamma_bound
+    w = np.logspace(-2, 1, 200)
+    ka, kb = _freq(res.controller, w)[0, 0], _freq(res_n.controller, w)[0, 0]
+    assert np.max(np.abs(kb - ka) / np.abs(ka)) <= 1e-6
+
+
 @pytest.mark.parametrize("alpha", [0.3, 1.0])
 @pytest.mark.parametrize("d22", [0.0, 0.4])
 def test_decay_rate_bounds_every_closed_loop_pole(alpha, d22):

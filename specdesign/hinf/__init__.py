@@ -34,7 +34,7 @@ Sign convention of the workbench: β = −C_β·Ω_g − C_atd·v_tt. SLICOT clo
 from __future__ import annotations
 
 from .cases import CHECK_OMEGA, CONTINUATION_DB, CaseCheck, check_pair, refine_on_cases
-from .design import DEFAULT_DECAY_RATE, ORDERS, TOWER_BAND, HinfDesign, design_hinf
+from .design import DEFAULT_DECAY_RATE, ORDER_ROOM_DB, ORDERS, TOWER_BAND, HinfDesign, design_hinf
 from .plant import DEFAULT_INTEGRAL_CORNER, DEFAULT_NOISE, GeneralizedPlant, generalized_plant
 from .specs import (
     HinfSpecification,
@@ -56,6 +56,7 @@ __all__ = [
     "GeneralizedPlant",
     "HinfDesign",
     "HinfSpecification",
+    "ORDER_ROOM_DB",
     "ORDERS",
     "design_hinf",
     "generalized_plant",
