@@ -107,7 +107,7 @@ class HinfDesign:
         The same for MyT at ``tower_mode``, dB.
     tower_mode : float
         Frequency of the tower mode (the open-loop pole pair with the highest wind → tower-base
-        moment resonance), rad/s.
+        moment resonance, :func:`specdesign.closedloop.tower_pole`), rad/s.
     pitch_std : float
         Pitch-command standard deviation from the linear model, rad.
     pitch_std_baseline : float
@@ -127,6 +127,13 @@ class HinfDesign:
         The least damping ratio of the reduced loop's oscillatory poles (-; 1 when none).
     zeta_min_frequency : float
         Its |p|, rad/s (nan when none).
+    tower_damping_ratio : float
+        Damping ratio (-) of the first tower fore-aft mode in the reduced loop
+        (:func:`specdesign.closedloop.tower_damping`); below
+        :data:`~specdesign.closedloop.MIN_TOWER_DAMPING_FRACTION` of ROSCO's the design warns
+        (:class:`~specdesign.closedloop.TowerDampingWarning`).
+    baseline_tower_damping_ratio : float
+        The same with ROSCO's PI (-).
     peak_sensitivity : float
         Peak |1/(1 + L_u)| at the actuator, L_u = Σ C_i·P_{y_i,β} (-).
     max_pole_real : float
@@ -188,6 +195,8 @@ class HinfDesign:
     notes: tuple[str, ...]
     zeta_min: float
     zeta_min_frequency: float
+    tower_damping_ratio: float
+    baseline_tower_damping_ratio: float
     peak_sensitivity: float
     max_pole_real: float
     decay_rate: float
@@ -223,25 +232,6 @@ def _response(sys, omega, output=None, input="wind"):
     solves one frequency at a time, minutes on the refined grids of a certified pair."""
     s = ct.ss(sys if output is None else sys[output, input])
     return state_space_response(s.A, s.B, s.C, s.D, np.asarray(omega, float).reshape(-1))[:, 0, 0]
-
-
-def _tower_mode(plant):
-    """Frequency (rad/s) of the tower mode: the open-loop pole pair with the highest resonance from wind to tower-base moment.
-
-    The resonance of a pole λ with residue r is |r|/|Re λ| (its term r/(s − λ) at s = j·Im λ).
-    Not simply the least-damped pair: OpenFAST's monopile plant has a foundation mode at
-    7.1 Hz with 0.7 % damping beside the tower's 0.17 Hz at 12 %.
-    """
-    A = np.asarray(plant.A, dtype=float)
-    lam, V = np.linalg.eig(A)
-    osc = lam.imag > 1e-6
-    if not np.any(osc):
-        raise ValueError("plant has no oscillatory pole: cannot locate the tower mode")
-    b = np.asarray(plant.B, dtype=float)[:, plant.input_labels.index("wind")]
-    c = np.asarray(plant.C, dtype=float)[plant.output_labels.index("tower_base_my")]
-    residue = (c @ V) * np.linalg.solve(V, b)
-    peak = np.abs(residue[osc]) / np.maximum(np.abs(lam[osc].real), np.finfo(float).tiny)
-    return float(np.abs(lam[osc][np.argmax(peak)]))
 
 
 def design_hinf(
@@ -556,7 +546,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
     ws_resp, wt_resp = _response(Ws, omega), _response(Wt, omega)
     speed_ratio = 20 * np.log10(np.abs(t_speed) / np.abs(ws_resp))
     speed_excess = float(np.max(speed_ratio))
-    wt_mode = _tower_mode(plant)
+    wt_mode = abs(closedloop.tower_pole(plant))
     band = np.abs(omega / wt_mode - 1) <= TOWER_BAND
     tower_ratio = 20 * np.log10(np.abs(t_tower) / np.abs(wt_resp))
     tower_band_excess = float(np.max(tower_ratio[band]))
@@ -597,6 +587,10 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
                   "qft.design_qft(spec=...), see docs/hinf.md")
         notes = notes + (missed,)
         warnings.warn(missed, RuntimeWarning, stacklevel=3)
+    zeta_tower, zeta_rosco = closedloop.tower_damping(plant, cl)[1], closedloop.tower_damping(plant, cl0)[1]
+    weak = closedloop.tower_damping_message("design_hinf", v, zeta_tower, zeta_rosco)
+    if weak is not None:
+        warnings.warn(weak, closedloop.TowerDampingWarning, stacklevel=3)
     p = np.asarray(cl.poles())
     osc = p[np.abs(p.imag) > 1e-6]
     zeta = -osc.real / np.abs(osc)
@@ -612,6 +606,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
         notes=notes,
         zeta_min=float(zeta.min()) if zeta.size else 1.0,
         zeta_min_frequency=float(np.abs(osc[np.argmin(zeta)])) if zeta.size else float("nan"),
+        tower_damping_ratio=zeta_tower, baseline_tower_damping_ratio=zeta_rosco,
         peak_sensitivity=float(np.max(np.abs(1.0 / (1.0 + L_u)))),
         max_pole_real=float(p.real.max()),
         decay_rate=float(decay_rate),
