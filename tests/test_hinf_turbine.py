@@ -419,3 +419,14 @@ def test_a_certified_pair_it_does_not_meet_is_said_with_the_miss(model):
     excess = np.max(20 * np.log10(t_my / np.abs(ts.tower.response(w))))
     assert warned > 0 and excess >= warned - 0.01  # the refined grid finds the miss the dense one sees
     assert excess <= warned + 0.1                   # and does not understate it
+
+
+def test_design_records_the_tower_modes_damping(design, model, plant):
+    # the record's ratios are those of the loops it describes, recomputed here: the reduced
+    # controller's MIMO loop and ROSCO's PI on the same plant, the tower pole located by
+    # closedloop.tower_pole (ROSCO's independently by rosco.tower_mode_damping's pole tracking)
+    from specdesign import closedloop, rosco
+    measurements = ("gen_speed",) if design.atd_controller is None else ("gen_speed", "tower_top_vel")
+    loop = closedloop.closed_loop_mimo(plant, design.controller, measurements)
+    assert design.tower_damping_ratio == pytest.approx(closedloop.tower_damping(plant, loop)[1], rel=1e-9)
+    assert design.baseline_tower_damping_ratio == pytest.approx(rosco.tower_mode_damping(model, V, None), rel=1e-9)

@@ -421,6 +421,11 @@ def design_hinf(
             f"specs='{spec.kind}': speed spec relaxed by {design.speed_relax_db:g} dB, the smallest of "
             f"{spec.speed_relax_db} with both specs met on the refined grid" if met else
             f"specs='{spec.kind}': no relaxation of {spec.speed_relax_db} met both specs; the last is returned",))
+    # said of the design returned only (the orders and relaxations passed over are not the result)
+    weak = closedloop.tower_damping_message("design_hinf", v, design.tower_damping_ratio,
+                                            design.baseline_tower_damping_ratio)
+    if weak is not None:
+        warnings.warn(weak, closedloop.TowerDampingWarning, stacklevel=2)
     return design
 
 
@@ -588,9 +593,6 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
         notes = notes + (missed,)
         warnings.warn(missed, RuntimeWarning, stacklevel=3)
     zeta_tower, zeta_rosco = closedloop.tower_damping(plant, cl)[1], closedloop.tower_damping(plant, cl0)[1]
-    weak = closedloop.tower_damping_message("design_hinf", v, zeta_tower, zeta_rosco)
-    if weak is not None:
-        warnings.warn(weak, closedloop.TowerDampingWarning, stacklevel=3)
     p = np.asarray(cl.poles())
     osc = p[np.abs(p.imag) > 1e-6]
     zeta = -osc.real / np.abs(osc)
