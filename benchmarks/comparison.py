@@ -82,7 +82,8 @@ def actuator_table(camps):
 def qft_schedule(model, speeds, say=print):
     """QFT's specification-driven designs at ``speeds``: the workbench's 25 % DEL target, or 15 % at the
     lowest speed if the search refuses 25 % there (the lowest design of a schedule must keep fine
-    pitch when held below rated; at 15 m/s it certifies at most 18.3 %)."""
+    pitch when held below rated; under the default high-frequency bound 25 % is certified at 15 m/s,
+    docs/feasibility.md)."""
     from specdesign import qft
 
     targets = [25.0] * len(speeds)
