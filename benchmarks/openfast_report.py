@@ -48,6 +48,10 @@ BANDS = (("wind 0.05-0.6", 0.05, 0.6), ("0.6-0.85", 0.6, 0.85), ("tower mode 0.8
 #: first fore-aft mode (1.07-1.1 rad/s in OpenFAST's linearisations and runs).
 TOWER_MODE_BAND = (0.85, 1.4)
 DEG = 180.0 / math.pi
+#: The baseline's name in the damping table and Fig. 8 (its linear loop is ROSCO's PI placed on
+#: OpenFAST's rotor model; in the runs, ROSCO's compiled DISCON).
+BASELINE = "ROSCO"
+_COLOURS = {"ROSCO": "tab:blue", "QFT": "tab:red", "QFT+ATD": "tab:green"}
 
 
 def openfast_times(run) -> tuple[float, float]:
@@ -148,24 +152,36 @@ def report(folder, baseline="ROSCO", m=4.0) -> str:
     return "\n".join(lines)
 
 
-def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
-    """Closed-loop damping near the tower mode of the baseline and of each design (as
-    openfast_table3.py makes it: ``QFT`` the certified chain, ``QFT+ATD`` the paper's structure)
-    on OpenFAST's linearisation at each speed, both loops closed
-    (:func:`specdesign.closedloop.closed_loop`); with ``figures`` (a folder) the paper's Fig. 8
-    from OpenFAST per speed: the runs' seed-mean Welch spectra (solid) against |T|²S_W on the
-    same linearisation (dashed)."""
-    from specdesign.openfast import iea15mw_monopile  # OpenFAST's side only with --damping
+def campaign_designs(runs, target=25.0):
+    """OpenFAST's linearisations and the designs the campaign ran (as ``openfast_table3.py``
+    makes them: ``QFT`` the certified chain, ``QFT+ATD`` the paper's structure), each only at
+    the speeds where it ran (a certified pitch-only design may be refused at a speed the
+    campaign never ran it at): (model, {label: {speed: {"design", "promise"}}})."""
+    from specdesign.openfast import iea15mw_monopile  # OpenFAST's side only with --damping/--table3
 
     sys.path.insert(0, str(Path(__file__).parent))
     # the campaign's own model and design step: the controllers it ran
-    from openfast_table3 import STRUCTURES, designs, openfast_model, predicted_del
+    from openfast_table3 import STRUCTURES, designs, openfast_model
 
+    speeds = sorted({r.wind_speed for r in runs})
+    names = {r.controller for r in runs}
     model = openfast_model(iea15mw_monopile(), speeds, processes=1)
-    # each design where the campaign ran it (a certified pitch-only design may be refused at a
-    # speed the campaign never ran it at)
     made = {label: designs(model, sorted({r.wind_speed for r in runs if r.controller == label}), target, structure)
             for structure, (label, _) in STRUCTURES.items() if label in names}
+    return model, made
+
+
+def linear_side(runs, model, made, figures=None) -> tuple[str, dict]:
+    """Closed-loop damping near the tower mode of the baseline and of each design
+    (:func:`campaign_designs`) on OpenFAST's linearisation at each speed, both loops closed
+    (:func:`specdesign.closedloop.closed_loop`), and the linear prediction of the tower DEL
+    change (%, ``openfast_table3.predicted_del``); with ``figures`` (a folder) the paper's
+    Fig. 8 from OpenFAST per speed (the runs' seed-mean Welch spectra, solid, against |T|²S_W
+    on the same linearisation, dashed) and Fig. 10. Returns the table and the predictions
+    {(controller, speed): %}."""
+    from openfast_table3 import predicted_del  # on sys.path since campaign_designs
+
+    speeds = sorted({v for m in made.values() for v in m})
     label, lo, hi = BANDS[2]
     lines = ["| wind (m/s) | controller | closed-loop poles in "
              f"{TOWER_MODE_BAND[0]}-{TOWER_MODE_BAND[1]} rad/s: \\|p\\| (rad/s), ζ | least ζ "
@@ -176,14 +192,14 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
     for v in speeds:
         plant = model.linearize(v)
         sw = wind_psd(model, v, w)
-        loops = [(BASELINE, spec.baseline_controller(model, v), None)]
-        loops += [(label, ct.tf(m[v]["design"].pitch_controller), m[v]["design"].atd_controller)
-                  for label, m in made.items() if v in m]
+        loops = [(BASELINE, spec.baseline_controller(model, v), None, None)]
+        loops += [(name, ct.tf(m[v]["design"].pitch_controller), m[v]["design"].atd_controller, m[v]["design"])
+                  for name, m in made.items() if v in m]
         predicted = {}
-        base_del = predicted_del(model, v, loops[0][1])
-        for name, c, atd in loops:
+        base_del = predicted_del(model, v)
+        for name, c, atd, design in loops:
             cl = closedloop.closed_loop(plant, c, atd, warn=False)
-            change = 100 * (predicted_del(model, v, c, atd) / base_del - 1)
+            change = 100 * (predicted_del(model, v, design) / base_del - 1)
             preds[name, v] = change
             p = cl.poles()
             p = p[(p.imag > 0) & (np.abs(p) >= TOWER_MODE_BAND[0]) & (np.abs(p) <= TOWER_MODE_BAND[1])]
@@ -198,13 +214,93 @@ def linear_side(runs, speeds, names, target=25.0, figures=None) -> str:
             _fig8(runs, v, model, predicted, Path(figures))
     if figures is not None:
         _fig10(runs, preds, Path(figures))
-    return "\n".join(lines)
+    return "\n".join(lines), preds
 
 
-#: The baseline's name in the damping table and Fig. 8 (its linear loop is ROSCO's PI placed on
-#: OpenFAST's rotor model; in the runs, ROSCO's compiled DISCON).
-BASELINE = "ROSCO"
-_COLOURS = {"ROSCO": "tab:blue", "QFT": "tab:red", "QFT+ATD": "tab:green"}
+#: The paper's Table 3 (seed 004, Table 3: fatigue reduction, %, at 15-25 m/s; its "estimation
+#: deviation" is |linear prediction − rainflow|): row → values per wind speed, then the mean it
+#: prints (None where it prints none).
+PAPER_TABLE3 = {
+    "specification": ((37.37, 10.10, 11.78, 20.55, 35.97, 30.35), None),
+    "linear prediction": ((24.81, 24.15, 28.60, 27.93, 35.12, 30.36), None),
+    "rainflow": ((25.91, 22.24, 27.75, 27.28, 34.71, 28.84), None),
+    "deviation": ((1.1, 1.91, 0.85, 0.65, 0.41, 1.52), 1.07),
+}
+PAPER_SPEEDS = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
+
+
+def reduced_model_changes(made, runs, baseline=BASELINE, m=4.0) -> dict:
+    """The designs and ROSCO's LTI form (:func:`specdesign.rosco.rosco_scheduled`) on the
+    workbench's reduced IEA 15 MW model (:func:`specdesign.validate.run_campaign`, its own
+    rotor-effective wind from the same seed numbers as the OpenFAST runs, 600 s after 60 s,
+    the model's torque law below rated and the trim torque above, as the exported library):
+    {(controller, speed): (change %, SE pp, seeds)} of the tower DEL."""
+    from specdesign.rosco import rosco_scheduled
+    from specdesign.simulate import ScheduledController
+    from specdesign.turbine import iea15mw
+
+    reduced = iea15mw()
+    out = {}
+    for name, by_v in made.items():
+        for v, entry in by_v.items():
+            st = _cell_stats(runs, baseline, name, v, m)
+            if st is None:
+                continue
+            d = entry["design"]
+            camp = validate.run_campaign(
+                {baseline: rosco_scheduled(reduced), name: ScheduledController.fixed(d.pitch_controller, d.atd_controller)},
+                [v], st["seeds"], model=reduced, predict=False, progress=False)
+            ch = validate.paired_change(camp.values["tower_del"][1], camp.values["tower_del"][0], "tower_del", m=m)
+            out[name, v] = (float(ch.change[0]), float(ch.se[0]), st["seeds"])
+    return out
+
+
+def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
+    """Table 3 from OpenFAST per design, beside the paper's: the specification the design meets
+    (``openfast_table3.designs``' promise), the linear prediction on OpenFAST's linearisation
+    (``preds``), the OpenFAST rainflow reduction over the paired seeds (± jackknife SE from two
+    seeds up), the deviation (rainflow − prediction, pp; its SE is the rainflow's, the
+    prediction being exact), the reduced model's rainflow on the same seed numbers
+    (:func:`reduced_model_changes`, when given) and the pitch-rate SDs; reductions are positive,
+    as the paper prints them."""
+    blocks = []
+    for name, by_v in made.items():
+        speeds = sorted(by_v)
+        stats = {v: _cell_stats(runs, baseline, name, v, m) for v in speeds}
+        speeds = [v for v in speeds if stats[v] is not None]
+        if not speeds:
+            continue
+        cols = " | ".join(f"{v:g}" for v in speeds)
+        lines = [f"**{name}** (tower-base DEL reduction against {baseline}; seeds per speed: "
+                 + ", ".join(f"{v:g} m/s: {len(stats[v]['seeds'])}" for v in speeds) + ")", "",
+                 f"| tower DEL reduction | {cols} | mean |", "|---|" + "---|" * (len(speeds) + 1)]
+
+        def se(v):
+            n = len(stats[v]["seeds"])
+            return f" ± {stats[v]['tower_del'][1]:.1f}" if n > 1 else ""
+
+        rain = {v: -stats[v]["tower_del"][0] for v in speeds}
+        pred = {v: -preds[name, v] for v in speeds}
+        dev = {v: pred[v] - rain[v] for v in speeds}
+        row = {"specification (this workbench)": [f"{by_v[v]['promise']:.1f} %" for v in speeds] + [""],
+               "linear prediction (OpenFAST's linearisation)": [f"{pred[v]:.1f} %" for v in speeds] + [""],
+               "rainflow, OpenFAST": [f"{rain[v]:.1f}{se(v)} %" for v in speeds] + [f"{np.mean(list(rain.values())):.1f} %"],
+               "deviation, prediction − rainflow": [f"{dev[v]:+.1f}{se(v)} pp" for v in speeds]
+               + [f"{np.mean(list(dev.values())):+.1f} pp (\\|·\\| {np.mean(np.abs(list(dev.values()))):.1f})"]}
+        if reduced is not None:
+            row["rainflow, reduced model (same seed numbers)"] = [
+                (f"{-reduced[name, v][0]:.1f}" + (f" ± {reduced[name, v][1]:.1f}" if len(reduced[name, v][2]) > 1 else "")
+                 + " %") if (name, v) in reduced else "" for v in speeds] + [""]
+        row[f"pitch-rate SD (deg/s): {baseline} / design"] = [
+            f"{stats[v]['pitch_rate_sd', 'base'][0]:.3f} / {stats[v]['pitch_rate_sd', 'design'][0]:.3f}" for v in speeds] + [""]
+        for key, (vals, mean) in PAPER_TABLE3.items():
+            paper = dict(zip(PAPER_SPEEDS, vals))
+            unit = " %" if key != "deviation" else " pp"
+            row[f"the paper: {key}"] = [f"{paper[v]:.2f}{unit}" if v in paper else "" for v in speeds] + [
+                "" if mean is None else f"{mean:.2f}{unit}"]
+        lines += [f"| {k} | " + " | ".join(cells) + " |" for k, cells in row.items()]
+        blocks.append("\n".join(lines))
+    return "\n\n".join(blocks)
 
 
 def _fig8(runs, v, model, loops, folder):
@@ -330,20 +426,25 @@ def main() -> None:
     ap.add_argument("--baseline", default="ROSCO")
     ap.add_argument("--damping", action="store_true",
                     help="also the closed-loop tower-mode damping on OpenFAST's linearisations (designs again)")
+    ap.add_argument("--table3", action="store_true",
+                    help="also Table 3 per design beside the paper's: specification, linear prediction, OpenFAST and "
+                         "reduced-model rainflow, deviation (designs again, runs the reduced model on the same seeds)")
     ap.add_argument("--figures", default=None,
                     help="folder for Fig. 9 from OpenFAST (19 m/s, seed 0, where its series were kept) and, with "
                          "--damping, Fig. 8 per speed and Fig. 10")
     args = ap.parse_args()
     text = report(Path(args.folder))
     print(text)
+    runs = validate.read_openfast_runs(args.folder)
     if args.figures is not None:
-        fig9(validate.read_openfast_runs(args.folder), Path(args.figures))
-    if args.damping:
-        runs = validate.read_openfast_runs(args.folder)
-        designed = [r for r in runs if r.controller != args.baseline]
-        print("\n" + linear_side(runs, sorted({r.wind_speed for r in designed}), {r.controller for r in designed},
-                                  figures=args.figures))
-
+        fig9(runs, Path(args.figures))
+    if args.damping or args.table3:
+        model, made = campaign_designs(runs)
+        damping, preds = linear_side(runs, model, made, figures=args.figures if args.damping else None)
+        if args.damping:
+            print("\n" + damping)
+        if args.table3:
+            print("\n" + table3(runs, made, preds, reduced_model_changes(made, runs)))
 
 if __name__ == "__main__":
     main()

@@ -27,11 +27,11 @@ import sys
 import time
 from pathlib import Path
 
-import control as ct
 import numpy as np
 
-from specdesign import closedloop, feasibility, qft, spec, turbine, validate, wind
+from specdesign import feasibility, qft, spec, turbine, validate
 from specdesign.export import export_discon
+from specdesign.simulate import ScheduledController
 from specdesign.openfast import find_openfast, iea15mw_monopile, linearize_deck
 
 
@@ -75,15 +75,13 @@ def designs(model, speeds, target, structure="certificate") -> dict:
     return res
 
 
-def predicted_del(model, v, pitch, atd=None, m=4.0) -> float:
-    """The linear prediction of the tower-base DEL (1 Hz, N·m) with both loops closed on the
-    design model at ``v`` m/s: Dirlik on |T_{MyT,w}|²·S_W over the 600 s records' grid and window
-    (as :func:`specdesign.validate.linear_prediction` and the promise weight S_W), ``pitch`` on
-    the generator speed and ``atd`` (or None) on the tower-top velocity."""
-    w = validate.prediction_grid()
-    sw = wind.rotor_effective_spectrum(w, v, model.rotor_radius, turbulence_class="B") * wind.record_window(w)
-    loop = closedloop.closed_loop(model.linearize(v), pitch, atd, warn=False)
-    return closedloop.closed_loop_del(loop, w, sw, m)
+def predicted_del(model, v, design=None) -> float:
+    """The linear prediction of the tower-base DEL (1 Hz, N·m) on the design model at ``v`` m/s
+    (:func:`specdesign.validate.linear_prediction`): ``design``'s pitch loop and tower damper
+    closed together, or ROSCO's PI on the design plant (the design's own baseline) for None."""
+    c = (spec.baseline_controller(model, v) if design is None
+         else ScheduledController.fixed(design.pitch_controller, design.atd_controller))
+    return validate.linear_prediction(model, c, v).del_
 
 
 def main() -> None:
@@ -149,9 +147,7 @@ def main() -> None:
     # placement; turbine.rosco_baseline takes a TurbineModel only)
     pred = np.full((2, len(speeds)), np.nan)
     for wi, v in enumerate(speeds):
-        d = made[v]["design"]
-        pred[0, wi] = predicted_del(model, v, spec.baseline_controller(model, v))
-        pred[1, wi] = predicted_del(model, v, ct.tf(d.pitch_controller), d.atd_controller)
+        pred[:, wi] = predicted_del(model, v), predicted_del(model, v, made[v]["design"])
     camp = dataclasses.replace(camp, predicted_del=pred[[camp.index("ROSCO"), camp.index(label)]])
     t3 = validate.table3(camp, label, "ROSCO", promised={v: made[v]["promise"] for v in speeds})
     text = t3.to_markdown() if hasattr(t3, "to_markdown") else str(t3)

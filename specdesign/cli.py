@@ -433,7 +433,7 @@ def load_controller(spec: dict, base: str | os.PathLike, model, *, config: str |
             raise ConfigError(f"{path}: unknown key(s) {sorted(extra)}; a pitch + ATD controller has 'pitch' and 'atd'")
         c = tf(data["pitch"], "pitch")
         if data.get("atd") is not None:
-            return ScheduledController(np.zeros(1), (c,), (tf(data["atd"], "atd"),), name=label)
+            return ScheduledController.fixed(c, tf(data["atd"], "atd"), name=label)
         return c
     raise ConfigError(f"{path}: unknown key(s) {sorted(keys)}; a controller file holds {{'num', 'den'}}, "
                       "{'elements'} (Controller.to_dict), {'pitch', 'atd'} or {'wind_speeds', 'pitch', 'atd'} "

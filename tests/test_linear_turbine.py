@@ -98,6 +98,30 @@ def test_scheduled_controller_is_blended_at_the_sets_trim_pitch(model, lt):
         assert got.del_ == pytest.approx(ref.del_, rel=1e-12)
 
 
+def test_pitch_and_tower_damper_prediction_equals_the_interconnection(model, lt):
+    # a design's two loops as one controller (ScheduledController.fixed), predicted on the
+    # LinearTurbine route, against Dirlik on |T|²S_W of closedloop.closed_loop's interconnection
+    # of the same linearisation (control.interconnect: an independent closing of both loops) on
+    # the same grid and wind PSD; rtol from the two frequency-response routes' round-off (the
+    # PSD spans ~20 decades, Dirlik's moments sum it)
+    from specdesign import closedloop, wind
+    from specdesign.simulate import ScheduledController
+    from specdesign.validate import prediction_grid
+
+    v = 19.0
+    pitch = rosco_baseline(model, v)
+    atd = control.tf([-0.05, 0.0], [1.0, 0.8])  # rad per m/s of tower-top velocity, high-passed (damps the mode)
+    got = linear_prediction(lt, ScheduledController.fixed(pitch, atd), v)
+    w = prediction_grid()
+    sw = wind.rotor_effective_spectrum(w, v, model.rotor_radius, turbulence_class="B") * wind.record_window(w)
+    loop = closedloop.closed_loop(lt.linearize(v), pitch, atd, warn=False)
+    assert got.del_ == pytest.approx(closedloop.closed_loop_del(loop, w, sw, 4.0), rel=1e-9)
+    # the damper changes the prediction (so the ATD loop was closed), and a zero damper is no damper
+    assert got.del_ != pytest.approx(linear_prediction(lt, pitch, v).del_, rel=1e-3)
+    none = ScheduledController.fixed(pitch, control.tf([0.0], [1.0]))
+    assert none.atd is None and linear_prediction(lt, none, v).del_ == linear_prediction(lt, pitch, v).del_
+
+
 def test_plants_dict_route_equals_model_route(model, lt):
     from specdesign.rosco import rosco_gain_schedule
 

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from loopshaping.freqresp import is_zero
+
 from .._checks import positive_scalar
 from .lti import as_lti, split_integrator, split_slow, tustin_matrices
 from .peak_shaving import PeakShaving
@@ -172,6 +174,40 @@ class ScheduledController:
         return self.pitch[k], (None if self.atd is None else self.atd[k])
 
     @classmethod
+    def fixed(cls, pitch: object, atd: object | None = None, *, name: str = "controller") -> ScheduledController:
+        """One pitch controller and, optionally, its tower damper, not scheduled.
+
+        A single local controller: every pitch blends it with weight 1, so the simulator, the
+        linear predictions and the exported library run ``pitch`` and ``atd`` as they are.
+
+        Parameters
+        ----------
+        pitch : control.LTI or loopshaping Controller
+            C_β on the generator speed (β = −C_β·Ω_g, rad per rad/s).
+        atd : control.LTI, loopshaping Controller or None, optional
+            C_atd on the tower-top velocity (β −= C_atd·ẋ_top, rad per m/s); None, or a zero
+            system (a design without a tower damper), for none.
+        name : str, optional
+            Label used in tables and figures.
+
+        Returns
+        -------
+        ScheduledController
+            The controller, ``form="output"``.
+
+        Examples
+        --------
+        A design's pitch loop and tower damper as one controller (``d = qft.design_qft(...)``):
+
+        >>> import control as ct
+        >>> c = ScheduledController.fixed(ct.tf([-1.0, -0.1], [1.0, 0.0]), ct.tf([0.02], [1.0, 1.0]))
+        >>> c.local(0)[1] is not None
+        True
+        """
+        atd = None if atd is None or is_zero(atd) else (as_lti(atd, "atd"),)
+        return cls(np.zeros(1), (as_lti(pitch, "pitch"),), atd, name=name)
+
+    @classmethod
     def gain_scheduled_pi(cls, schedule_pitch: ArrayLike, kp: ArrayLike, ki: ArrayLike, error_filter: object, *,
                           atd: Sequence | None = None, filter_omega: float = SCHEDULE_FILTER_OMEGA, name: str = "PI",
                           pitch_limits: tuple[float, float] | None = None,
@@ -327,7 +363,7 @@ def _make_bank(controller, dt):
     In ``form="gains"`` the local pitch controllers are not in the blended bank (only the ATD
     locals are); the PI runs as one filter, one integrator and interpolated gains."""
     if not isinstance(controller, ScheduledController):
-        controller = ScheduledController(np.zeros(1), (as_lti(controller, "controller"),), None, name="controller")
+        controller = ScheduledController.fixed(as_lti(controller, "controller"))
     gains = controller.form == "gains"
     none = (np.zeros((0, 0)), np.zeros(0), np.zeros(0), np.zeros(1))
     done = {}  # id → (system, its Tustin matrices): a schedule often holds one ATD at every local

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 
-from loopshaping.freqresp import is_zero
 
 from .._checks import positive_scalar
 from ..controller.lti import as_lti, is_lti_like
@@ -61,11 +60,9 @@ def _as_controller(obj: object, name: str | None):
                              "dataclasses.replace(controller, peak_shaving=None), or run the deck's own ROSCO DISCON")
         return obj, name or obj.name
     if hasattr(obj, "pitch_controller"):  # a design record: QFTDesign, HinfDesign
-        atd = getattr(obj, "atd_controller", None)
-        atd = None if atd is None or is_zero(atd) else (as_lti(atd, "atd_controller"),)
         label = name or f"{type(obj).__name__} at {getattr(obj, 'wind_speed', float('nan')):g} m/s"
-        return ScheduledController(np.zeros(1), (as_lti(obj.pitch_controller, "pitch_controller"),), atd,
-                                   name=label), label
+        return ScheduledController.fixed(as_lti(obj.pitch_controller, "pitch_controller"),
+                                         getattr(obj, "atd_controller", None), name=label), label
     if is_lti_like(obj):
         return obj, name or "controller"
     raise TypeError(f"controller_or_design must be a design (with pitch_controller), a ScheduledController, a "
