@@ -118,6 +118,29 @@ def test_written_case_takes_rated_point_from_the_discon(deck, fst_vt, tmp_path):
     assert back["ServoDyn"]["VSContrl"] == 1 and back["ServoDyn"]["PCMode"] == 0
 
 
+def test_case_and_its_digest_do_not_depend_on_where_the_deck_lies(deck, tmp_path):
+    # the cache is keyed by the case's files: the same deck copied to two folders must write
+    # byte-identical cases, or a second checkout (a worktree, a moved venv) linearises again
+    import shutil
+
+    from specdesign.openfast.deck import Deck
+    from specdesign.openfast.linearize import _digest
+
+    digests, files = [], []
+    for where in ("a", "b/deeper"):
+        folder = tmp_path / where / deck.fst.parent.name
+        shutil.copytree(deck.fst.parent, folder)
+        copy = Deck(folder / deck.fst.name, version=deck.version)
+        case = write_linearization_case(copy, 19.0, tmp_path / f"case_{where.replace('/', '_')}", n_azimuths=2)
+        digests.append(_digest(case.fst.parent, "5.0.0"))
+        files.append({p.relative_to(case.fst.parent): p.read_bytes() for p in case.fst.parent.rglob("*") if p.is_file()})
+    assert files[0].keys() == files[1].keys()
+    assert [k for k in files[0] if files[0][k] != files[1][k]] == []
+    assert digests[0] == digests[1]
+    servodyn = next((tmp_path / "case_a").glob("*ServoDyn.dat")).read_text()
+    assert '"libdiscon.so"' in servodyn and str(tmp_path) not in servodyn  # bare: no mode loads it
+
+
 def _fake_openfast(folder: Path, name: str, body: str) -> OpenFASTInstall:
     """A stand-in ``openfast``: a Python script run in the case folder with the .fst as its argument."""
     exe = folder / name

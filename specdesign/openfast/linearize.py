@@ -336,6 +336,12 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
     sd["VS_Rgn2K"] = min(float(sd.get("VS_Rgn2K", 0.0)), 0.9 * sd["VS_RtTq"] / sd["VS_RtGnSp"] ** 2)
     if not sd.get("VS_SlPc") or float(sd["VS_SlPc"]) <= 0:
         sd["VS_SlPc"] = 2.0
+    for key in ("AfCmode", "CCmode"):  # flap and cable control off (5 would load the library)
+        if key in sd:
+            sd[key] = 0
+    # no mode is 5, so ServoDyn loads no library: its bare name keeps the case (and its
+    # digest) the same wherever the deck lies (openfast-io writes it resolved to an absolute path)
+    sd["DLL_FileName"] = os.path.basename(str(sd.get("DLL_FileName", "unused")))
     for kind in ("BStC", "NStC", "TStC", "SStC"):
         sd[f"Num{kind}"] = 0
         sd[f"{kind}files"] = []
