@@ -17,11 +17,16 @@ The surrogate's a, b are fitted on ROSCO's loads at 19 m/s over windows of the h
 ``clone`` (2 DAgger rounds, each visited state also labelled in one perturbed copy) on seeds
 100-103 at both speeds, never on the evaluation seeds; its held-out R² is on visited states only.
 
-Run: python benchmarks/mpc.py [--seeds 3] [--duration 200] (about 10 minutes on 2 busy cores).
+Also printed: the command, wall time and load average, each controller's sensors, and the
+economic MPC's objective term shares at its optima in the campaign (Eq. 4, speed and move terms).
+
+Run: python benchmarks/mpc.py [--seeds 3] [--duration 200] (40-70 minutes on 2 busy cores).
 """
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import time
 
 import numpy as np
@@ -61,6 +66,8 @@ def campaign_table(model, terms, bc, seeds, duration):
     print(head + " speed SD (rpm) | pitch SD (deg) | mean power (MW) | CPU/step (ms) |")
     print("|" + "---|" * (head.count("|") + 3))
     bdel = {n: _blade_del(camp, n) for n in ctrls} if blade else {}
+    print("sensors (noise-free; the MPCs' Kalman filter and operating point estimated online): "
+          + "; ".join(f"{n}: {sensors(c)}" for n, c in ctrls.items()))
     for n, c in ctrls.items():
         i = camp.index(n)
         ch = camp.change(n, "ROSCO", "tower_del")
@@ -75,6 +82,35 @@ def campaign_table(model, terms, bc, seeds, duration):
                 row += f" {chb.change[w]:+.1f} ± {chb.se[w]:.1f} |"
             cpu_s = "–" if np.isnan(cpu) else f"{cpu:.2f}"
             print(row + f" {sd:.3f} | {psd:.3f} | {pw:.3f} | {cpu_s} |")
+    print(term_shares(ctrls["economic MPC"].term_values))
+
+
+def sensors(c):
+    """What controller ``c`` reads, in words: the MPCs' ``measured`` outputs, else ROSCO's PI's."""
+    if hasattr(c, "measured"):
+        return ", ".join(c.measured) + f" (operating point: {c.operating_point})"
+    # rosco_scheduled / rosco_baseline: the PI on the filtered generator speed, its gains
+    # scheduled on its own filtered pitch command (not a sensor)
+    return "gen_speed"
+
+
+def term_shares(values):
+    """Line of the economic MPC's objective term shares at its optima, per speed and overall.
+
+    ``values`` are ``EconomicMPC.term_values`` after the campaign: ``run_campaign`` without an
+    executor runs the speeds one after the other in ``SPEEDS`` order with the same seeds, so
+    the solves split into ``len(SPEEDS)`` equal consecutive blocks, one per speed.
+    """
+    if not values:
+        return "economic MPC objective: no term values recorded (the controller ran in another process)"
+    p = np.array(values)
+    frac = p / p.sum(axis=1, keepdims=True)
+    parts = [("all", frac)]
+    if len(frac) % len(SPEEDS) == 0:
+        parts += [(f"{v:g} m/s", b) for v, b in zip(SPEEDS, np.split(frac, len(SPEEDS)))]
+    return ("economic MPC objective at its optima (mean shares, Eq. 4 / speed / move term): "
+            + "; ".join(f"{k} {100 * b[:, 0].mean():.0f} / {100 * b[:, 1].mean():.0f} / "
+                        f"{100 * b[:, 2].mean():.0f} % ({len(b)} solves)" for k, b in parts))
 
 
 def open_loop_table(model, terms, terms_mpc, bc, seeds, horizon=100.0, v=19.0):
@@ -100,6 +136,8 @@ def open_loop_table(model, terms, terms_mpc, bc, seeds, horizon=100.0, v=19.0):
              "quadratic MPC (preview)": mpc.QuadraticMPC(model, preview=(held, dt), **known),
              "economic MPC": mpc.EconomicMPC(model, terms_mpc, ts=TS, **known),
              "behavioural cloning": mpc.ClonedController(model, bc.regressors, TS, **known)}
+    print("sensors: " + "; ".join(f"{n}: {'none (replays its record)' if n.startswith('open-loop') else sensors(c)}"
+                                  for n, c in ctrls.items()))
     res = {}
     for name, c in ctrls.items():
         r = simulate(model, c, [v], **kw)
@@ -126,6 +164,9 @@ def main():
     a = ap.parse_args()
     model = turbine.iea15mw()
     t0 = time.perf_counter()
+    load0 = os.getloadavg()
+    print(f"command: python {' '.join(sys.argv)}; load average {load0[0]:.1f} / {load0[1]:.1f} / {load0[2]:.1f} "
+          f"(1/5/15 min) at the start, {os.cpu_count()} cores")
     terms = mpc.fit_fatigue_terms(model, 19.0, 10.0, seeds=(1, 2))
     print("surrogate fits (window 10 s = the MPC's horizon): "
           + ", ".join(f"{t.output}: m={t.fit.m:g} a={t.fit.a:.2f} b={t.fit.b:.1f}" for t in terms))
@@ -140,6 +181,9 @@ def main():
     simulate(model, q, [19.0], seeds=[1], duration=30.0, transient=0.0)
     print(f"\nquadratic MPC with the QP solved at every step (cvxpy + OSQP, no shortcut): "
           f"{1e3 * np.mean(q.solve_times):.2f} ms CPU per step (median {1e3 * np.median(q.solve_times):.2f})")
+    load1 = os.getloadavg()
+    print(f"took {time.perf_counter() - t0:.0f} s wall; load average {load1[0]:.1f} / {load1[1]:.1f} / "
+          f"{load1[2]:.1f} at the end")
 
 
 if __name__ == "__main__":
