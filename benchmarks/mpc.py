@@ -4,7 +4,8 @@
     MPC, the receding-horizon economic MPC and its behavioural clone at 15 and 19 m/s on the
     same paired seeds: tower-base DEL (m = 4) and blade-root DEL (m = 10, when the model has
     that output) change vs ROSCO with the paired-seed SE, generator-speed SD, pitch SD, mean
-    power, and CPU time per control step (the controllers' own ``solve_times``; ROSCO's PI is
+    power, and CPU time per policy evaluation (the controllers' own ``solve_times``: one per run
+    and grid point, two per control sample with the operating point estimated; ROSCO's PI is
     compiled into the simulator and has none).
 (b) Open loop vs closed loop (the *linearised* turbine at 19 m/s, ``simulate(linear=True)``,
     every run from the trim, the wind held over each 0.2 s sample as the optimiser assumes):
@@ -61,13 +62,13 @@ def campaign_table(model, terms, bc, seeds, duration):
                         keep_series=True)
     print(f"(a) campaign: {len(SPEEDS)} speeds × {len(seeds)} paired seeds × {duration:g} s, "
           f"{time.perf_counter() - t0:.0f} s wall")
-    blade = "blade_root_my" in model.output_names
-    head = "| controller | v (m/s) | tower DEL Δ% ± SE |" + (" blade DEL Δ% ± SE |" if blade else "")
-    print(head + " speed SD (rpm) | pitch SD (deg) | mean power (MW) | CPU/step (ms) |")
-    print("|" + "---|" * (head.count("|") + 3))
-    bdel = {n: _blade_del(camp, n) for n in ctrls} if blade else {}
     print("sensors (noise-free; the MPCs' Kalman filter and operating point estimated online): "
           + "; ".join(f"{n}: {sensors(c)}" for n, c in ctrls.items()))
+    blade = "blade_root_my" in model.output_names
+    head = "| controller | v (m/s) | tower DEL Δ% ± SE |" + (" blade DEL Δ% ± SE |" if blade else "")
+    print(head + " speed SD (rpm) | pitch SD (deg) | mean power (MW) | CPU/evaluation (ms) |")
+    print("|" + "---|" * (head.count("|") + 3))
+    bdel = {n: _blade_del(camp, n) for n in ctrls} if blade else {}
     for n, c in ctrls.items():
         i = camp.index(n)
         ch = camp.change(n, "ROSCO", "tower_del")
@@ -180,7 +181,7 @@ def main():
     q = mpc.QuadraticMPC(model, shortcut=False)
     simulate(model, q, [19.0], seeds=[1], duration=30.0, transient=0.0)
     print(f"\nquadratic MPC with the QP solved at every step (cvxpy + OSQP, no shortcut): "
-          f"{1e3 * np.mean(q.solve_times):.2f} ms CPU per step (median {1e3 * np.median(q.solve_times):.2f})")
+          f"{1e3 * np.mean(q.solve_times):.2f} ms CPU per evaluation (median {1e3 * np.median(q.solve_times):.2f})")
     load1 = os.getloadavg()
     print(f"took {time.perf_counter() - t0:.0f} s wall; load average {load1[0]:.1f} / {load1[1]:.1f} / "
           f"{load1[2]:.1f} at the end")
