@@ -21,7 +21,8 @@ The surrogate's a, b are fitted on ROSCO's loads at 19 m/s over windows of the h
 Also printed: the command, wall time and load average, each controller's sensors, and the
 economic MPC's objective term shares at its optima in the campaign (Eq. 4, speed and move terms).
 
-Run: python benchmarks/mpc.py [--seeds 3] [--duration 200] (40-70 minutes on 2 busy cores).
+Run: python benchmarks/mpc.py [--seeds 3] [--duration 200] (22 minutes niced on 2 shared cores at a
+load average of 3-6).
 """
 from __future__ import annotations
 
