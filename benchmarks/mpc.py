@@ -4,7 +4,8 @@
     MPC, the receding-horizon economic MPC and its behavioural clone at 15 and 19 m/s on the
     same paired seeds: tower-base DEL (m = 4) and blade-root DEL (m = 10, when the model has
     that output) change vs ROSCO with the paired-seed SE, generator-speed SD, pitch SD, mean
-    power, and CPU time per control step (the controllers' own ``solve_times``; ROSCO's PI is
+    power, and CPU time per policy evaluation (the controllers' own ``solve_times``: one per run
+    and grid point, two per control sample with the operating point estimated; ROSCO's PI is
     compiled into the simulator and has none).
 (b) Open loop vs closed loop (the *linearised* turbine at 19 m/s, ``simulate(linear=True)``,
     every run from the trim, the wind held over each 0.2 s sample as the optimiser assumes):
@@ -17,11 +18,17 @@ The surrogate's a, b are fitted on ROSCO's loads at 19 m/s over windows of the h
 ``clone`` (2 DAgger rounds, each visited state also labelled in one perturbed copy) on seeds
 100-103 at both speeds, never on the evaluation seeds; its held-out R² is on visited states only.
 
-Run: python benchmarks/mpc.py [--seeds 3] [--duration 200] (about 10 minutes on 2 busy cores).
+Also printed: the command, wall time and load average, each controller's sensors, and the
+economic MPC's objective term shares at its optima in the campaign (Eq. 4, speed and move terms).
+
+Run: python benchmarks/mpc.py [--seeds 3] [--duration 200] (22 minutes niced on 2 shared cores at a
+load average of 3-6).
 """
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import time
 
 import numpy as np
@@ -56,9 +63,11 @@ def campaign_table(model, terms, bc, seeds, duration):
                         keep_series=True)
     print(f"(a) campaign: {len(SPEEDS)} speeds × {len(seeds)} paired seeds × {duration:g} s, "
           f"{time.perf_counter() - t0:.0f} s wall")
+    print("sensors (noise-free; the MPCs' Kalman filter and operating point estimated online): "
+          + "; ".join(f"{n}: {sensors(c)}" for n, c in ctrls.items()))
     blade = "blade_root_my" in model.output_names
     head = "| controller | v (m/s) | tower DEL Δ% ± SE |" + (" blade DEL Δ% ± SE |" if blade else "")
-    print(head + " speed SD (rpm) | pitch SD (deg) | mean power (MW) | CPU/step (ms) |")
+    print(head + " speed SD (rpm) | pitch SD (deg) | mean power (MW) | CPU/evaluation (ms) |")
     print("|" + "---|" * (head.count("|") + 3))
     bdel = {n: _blade_del(camp, n) for n in ctrls} if blade else {}
     for n, c in ctrls.items():
@@ -75,6 +84,35 @@ def campaign_table(model, terms, bc, seeds, duration):
                 row += f" {chb.change[w]:+.1f} ± {chb.se[w]:.1f} |"
             cpu_s = "–" if np.isnan(cpu) else f"{cpu:.2f}"
             print(row + f" {sd:.3f} | {psd:.3f} | {pw:.3f} | {cpu_s} |")
+    print(term_shares(ctrls["economic MPC"].term_values))
+
+
+def sensors(c):
+    """What controller ``c`` reads, in words: the MPCs' ``measured`` outputs, else ROSCO's PI's."""
+    if hasattr(c, "measured"):
+        return ", ".join(c.measured) + f" (operating point: {c.operating_point})"
+    # rosco_scheduled / rosco_baseline: the PI on the filtered generator speed, its gains
+    # scheduled on its own filtered pitch command (not a sensor)
+    return "gen_speed"
+
+
+def term_shares(values):
+    """Line of the economic MPC's objective term shares at its optima, per speed and overall.
+
+    ``values`` are ``EconomicMPC.term_values`` after the campaign: ``run_campaign`` without an
+    executor runs the speeds one after the other in ``SPEEDS`` order with the same seeds, so
+    the solves split into ``len(SPEEDS)`` equal consecutive blocks, one per speed.
+    """
+    if not values:
+        return "economic MPC objective: no term values recorded (the controller ran in another process)"
+    p = np.array(values)
+    frac = p / p.sum(axis=1, keepdims=True)
+    parts = [("all", frac)]
+    if len(frac) % len(SPEEDS) == 0:
+        parts += [(f"{v:g} m/s", b) for v, b in zip(SPEEDS, np.split(frac, len(SPEEDS)))]
+    return ("economic MPC objective at its optima (mean shares, Eq. 4 / speed / move term): "
+            + "; ".join(f"{k} {100 * b[:, 0].mean():.0f} / {100 * b[:, 1].mean():.0f} / "
+                        f"{100 * b[:, 2].mean():.0f} % ({len(b)} solves)" for k, b in parts))
 
 
 def open_loop_table(model, terms, terms_mpc, bc, seeds, horizon=100.0, v=19.0):
@@ -100,6 +138,8 @@ def open_loop_table(model, terms, terms_mpc, bc, seeds, horizon=100.0, v=19.0):
              "quadratic MPC (preview)": mpc.QuadraticMPC(model, preview=(held, dt), **known),
              "economic MPC": mpc.EconomicMPC(model, terms_mpc, ts=TS, **known),
              "behavioural cloning": mpc.ClonedController(model, bc.regressors, TS, **known)}
+    print("sensors: " + "; ".join(f"{n}: {'none (replays its record)' if n.startswith('open-loop') else sensors(c)}"
+                                  for n, c in ctrls.items()))
     res = {}
     for name, c in ctrls.items():
         r = simulate(model, c, [v], **kw)
@@ -126,6 +166,9 @@ def main():
     a = ap.parse_args()
     model = turbine.iea15mw()
     t0 = time.perf_counter()
+    load0 = os.getloadavg()
+    print(f"command: python {' '.join(sys.argv)}; load average {load0[0]:.1f} / {load0[1]:.1f} / {load0[2]:.1f} "
+          f"(1/5/15 min) at the start, {os.cpu_count()} cores")
     terms = mpc.fit_fatigue_terms(model, 19.0, 10.0, seeds=(1, 2))
     print("surrogate fits (window 10 s = the MPC's horizon): "
           + ", ".join(f"{t.output}: m={t.fit.m:g} a={t.fit.a:.2f} b={t.fit.b:.1f}" for t in terms))
@@ -139,7 +182,10 @@ def main():
     q = mpc.QuadraticMPC(model, shortcut=False)
     simulate(model, q, [19.0], seeds=[1], duration=30.0, transient=0.0)
     print(f"\nquadratic MPC with the QP solved at every step (cvxpy + OSQP, no shortcut): "
-          f"{1e3 * np.mean(q.solve_times):.2f} ms CPU per step (median {1e3 * np.median(q.solve_times):.2f})")
+          f"{1e3 * np.mean(q.solve_times):.2f} ms CPU per evaluation (median {1e3 * np.median(q.solve_times):.2f})")
+    load1 = os.getloadavg()
+    print(f"took {time.perf_counter() - t0:.0f} s wall; load average {load1[0]:.1f} / {load1[1]:.1f} / "
+          f"{load1[2]:.1f} at the end")
 
 
 if __name__ == "__main__":
