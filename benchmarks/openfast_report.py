@@ -369,12 +369,15 @@ def fig9(runs, folder, v=19.0, seed=0, span=(100.0, 300.0)) -> Path | None:
         keep = (t >= span[0]) & (t <= span[1])
         for (key, label, k), ax in zip(rows, axes):
             if key in r.series:
-                ax.plot(t[keep], r.series[key][keep] * k, color=_COLOURS.get(r.controller, "k"), lw=0.8,
-                        label=r.controller)
+                x = r.series[key] * k
+                unit = label[label.index("(") + 1:-1]
+                # the SD over the whole 600 s record, as the paper reads its Fig. 9
+                ax.plot(t[keep], x[keep], color=_COLOURS.get(r.controller, "k"), lw=0.8,
+                        label=f"{r.controller}: mean {x.mean():.4g}, SD {x.std():.3g} {unit} (600 s)")
                 ax.set_ylabel(label)
     for ax in axes:
         ax.grid(True, alpha=0.3)
-    axes[0].legend(fontsize=8, ncol=3)
+        ax.legend(fontsize=7, ncol=2, loc="upper right")
     axes[-1].set_xlabel("time after the discarded transient (s)")
     fig.suptitle(f"OpenFAST at {v:g} m/s, seed {seed}: every controller on the same TurbSim field and sea state")
     path = folder / f"openfast_fig9_{v:g}mps.png"
