@@ -31,8 +31,8 @@ import numpy as np
 
 from specdesign import feasibility, qft, spec, turbine, validate
 from specdesign.export import export_discon
-from specdesign.simulate import ScheduledController
 from specdesign.openfast import find_openfast, iea15mw_monopile, linearize_deck
+from specdesign.simulate import ScheduledController
 
 
 #: OpenFAST's linearisations the design model is made of, whatever speeds a call runs: the plant

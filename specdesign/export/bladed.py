@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 
-
 from .._checks import positive_scalar
 from ..controller.lti import as_lti, is_lti_like
 from ..controller.scheduled import ScheduledController, controller_bank, schedule_filter_coefficients
