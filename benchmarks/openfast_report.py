@@ -177,13 +177,14 @@ def campaign_designs(runs, target=25.0):
     return model, made
 
 
-def linear_side(runs, model, made, figures=None) -> tuple[str, dict]:
+def linear_side(runs, model, made, figures=None, reduced=None) -> tuple[str, dict]:
     """Closed-loop damping near the tower mode of the baseline and of each design
     (:func:`campaign_designs`) on OpenFAST's linearisation at each speed, both loops closed
     (:func:`specdesign.closedloop.closed_loop`), and the linear prediction of the tower DEL
     change (%, ``openfast_table3.predicted_del``); with ``figures`` (a folder) the paper's
     Fig. 8 from OpenFAST per speed (the runs' seed-mean Welch spectra, solid, against |T|²S_W
-    on the same linearisation, dashed) and Fig. 10. Returns the table and the predictions
+    on the same linearisation, dashed) and Fig. 10 (with ``reduced``, :func:`reduced_model_changes`,
+    the reduced model's rainflow beside OpenFAST's). Returns the table and the predictions
     {(controller, speed): %}."""
     from openfast_table3 import predicted_del  # on sys.path since campaign_designs
 
@@ -219,7 +220,7 @@ def linear_side(runs, model, made, figures=None) -> tuple[str, dict]:
         if figures is not None:
             _fig8(runs, v, model, predicted, Path(figures))
     if figures is not None:
-        _fig10(runs, preds, Path(figures))
+        _fig10(runs, preds, Path(figures), reduced=reduced)
     return "\n".join(lines), preds
 
 
@@ -391,10 +392,12 @@ def fig9(runs, folder, v=19.0, seed=0, span=(100.0, 300.0)) -> Path | None:
 TOP_PCT = 40.0
 
 
-def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0):
+def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
     """The paper's Fig. 10 from OpenFAST: per design, the tower DEL change against ROSCO's
     predicted on OpenFAST's linearisation (``preds[name, v]``, %) and measured by rainflow in
-    OpenFAST (paired seeds, ± jackknife SE from two seeds up) against the wind speed."""
+    OpenFAST (paired seeds, ± jackknife SE from two seeds up) against the wind speed; with
+    ``reduced`` ({(name, v): (change %, SE pp, seeds)}) the reduced model's rainflow on the same
+    seed numbers as open markers."""
     folder.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(7, 4.2), constrained_layout=True)
     names = sorted({name for name, _ in preds} - {baseline})
@@ -412,10 +415,19 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0):
             ax.errorbar(x, np.minimum(y, TOP_PCT), yerr=se, fmt="s", color=colour, capsize=3,
                         label=f"{name}, OpenFAST rainflow (seeds per speed: "
                               + ", ".join(f"{v:g}: {len(st['seeds'])}" for v, st in got) + ")")
+            if reduced is not None:
+                here = [(xi, reduced[name, v]) for xi, (v, _) in zip(x, got) if (name, v) in reduced]
+                ax.errorbar([xi + 0.16 for xi, _ in here], [r[0] for _, r in here],
+                            yerr=[r[1] if len(r[2]) > 1 else 0.0 for _, r in here], fmt="^", mfc="none",
+                            color=colour, capsize=3, label=f"{name}, reduced model rainflow (same seed numbers)")
             for xi, yi in zip(x, y):
                 if yi > TOP_PCT:  # a limit cycle's hundreds of per cent would flatten the rest: its value, written
                     ax.annotate(f"{yi:+.0f} % (off scale)", (xi, TOP_PCT), xytext=(6, -12), textcoords="offset points",
                                 color=colour, fontsize=8)
+    # the paper's own Table 3 (reductions, so negated): its turbine model, tuning and seeds
+    ax.plot(PAPER_SPEEDS, [-x for x in PAPER_TABLE3["linear prediction"][0]], ":", color="0.45", lw=1.0,
+            label="the paper: linear prediction")
+    ax.plot(PAPER_SPEEDS, [-x for x in PAPER_TABLE3["rainflow"][0]], "x", color="0.45", label="the paper: rainflow")
     ax.axhline(0.0, color="0.5", lw=0.8)
     ax.set_ylim(top=TOP_PCT)
     ax.set_xlabel("mean wind speed (m/s)")
@@ -449,11 +461,12 @@ def main() -> None:
         fig9(runs, Path(args.figures))
     if args.damping or args.table3:
         model, made = campaign_designs(runs)
-        damping, preds = linear_side(runs, model, made, figures=args.figures if args.damping else None)
+        reduced = reduced_model_changes(made, runs) if args.table3 else None
+        damping, preds = linear_side(runs, model, made, figures=args.figures if args.damping else None, reduced=reduced)
         if args.damping:
             print("\n" + damping)
         if args.table3:
-            print("\n" + table3(runs, made, preds, reduced_model_changes(made, runs)))
+            print("\n" + table3(runs, made, preds, reduced))
 
 if __name__ == "__main__":
     main()
