@@ -399,7 +399,7 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
     ``reduced`` ({(name, v): (change %, SE pp, seeds)}) the reduced model's rainflow on the same
     seed numbers as open markers."""
     folder.mkdir(parents=True, exist_ok=True)
-    fig, ax = plt.subplots(figsize=(7, 4.2), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(11, 4.5), constrained_layout=True)
     names = sorted({name for name, _ in preds} - {baseline})
     for k, name in enumerate(names):
         speeds = sorted(v for n, v in preds if n == name)
@@ -415,8 +415,8 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
             ax.errorbar(x, np.minimum(y, TOP_PCT), yerr=se, fmt="s", color=colour, capsize=3,
                         label=f"{name}, OpenFAST rainflow (seeds per speed: "
                               + ", ".join(f"{v:g}: {len(st['seeds'])}" for v, st in got) + ")")
-            if reduced is not None:
-                here = [(xi, reduced[name, v]) for xi, (v, _) in zip(x, got) if (name, v) in reduced]
+            here = [(xi, reduced[name, v]) for xi, (v, _) in zip(x, got) if (name, v) in (reduced or {})]
+            if here:
                 ax.errorbar([xi + 0.16 for xi, _ in here], [r[0] for _, r in here],
                             yerr=[r[1] if len(r[2]) > 1 else 0.0 for _, r in here], fmt="^", mfc="none",
                             color=colour, capsize=3, label=f"{name}, reduced model rainflow (same seed numbers)")
@@ -434,7 +434,7 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
     ax.set_ylabel(f"tower-base DEL change vs {baseline} (%)")
     ax.set_title("Fig. 10 from OpenFAST: linear prediction vs rainflow (± SE over paired seeds)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     path = folder / "openfast_fig10.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
