@@ -98,9 +98,11 @@ def qft_schedule(model, speeds, say=print):
 
 
 def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101, 102, 103), quick=False,
-                      clone_rounds=2, say=print):
+                      clone_rounds=2, say=print, sensors=None):
     """The controllers of the comparison (name → controller), their kinds ("lti"/"mpc") and QFT's DEL
-    targets (%, one per speed)."""
+    targets (%, one per speed). The MPCs' Kalman filters assume the noise of ``sensors`` (the
+    campaign's, ``mpc.base.filter_noise``); the clone keeps its filter's tuning, the one its
+    regressor's features were made with."""
     import control as ct
 
     from specdesign import hinf, mpc
@@ -120,7 +122,7 @@ def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101
                           atd={v: ct.ss(d.atd_controller) for v, d in hd.items() if d.atd_controller is not None} or None,
                           name="H∞")
     say(f"H∞ designs: {time.perf_counter() - t0:.0f} s")
-    out["quadratic MPC"] = mpc.QuadraticMPC(model)  # operating point estimated online (the default)
+    out["quadratic MPC"] = mpc.QuadraticMPC(model, sensors=sensors)  # operating point estimated online (the default)
     t0 = time.perf_counter()
     terms = mpc.fit_fatigue_terms(model, 19.0, 10.0, seeds=(1, 2))
     cs = list(speeds if clone_speeds is None else clone_speeds)
@@ -129,9 +131,9 @@ def build_controllers(model, speeds, *, clone_speeds=None, clone_seeds=(100, 101
     say(f"clone: {demos.targets.size} demonstrations at {cs} m/s, {time.perf_counter() - t0:.0f} s")
     out["behavioural cloning"] = bc
     # the workbench's excursion penalty (health_weight), then Boutrous et al.'s accumulated-moment term alone
-    out["excursion MPC"] = mpc.HealthMPC(model, health_weight=10.0)
-    out["health-aware MPC"] = mpc.health_aware_mpc(model, stress_weight=30.0)
-    out["economic MPC"] = mpc.EconomicMPC(model, terms, ts=0.2)
+    out["excursion MPC"] = mpc.HealthMPC(model, health_weight=10.0, sensors=sensors)
+    out["health-aware MPC"] = mpc.health_aware_mpc(model, stress_weight=30.0, sensors=sensors)
+    out["economic MPC"] = mpc.EconomicMPC(model, terms, ts=0.2, sensors=sensors)
     kinds = {n: ("mpc" if hasattr(c, "solve_times") else "lti") for n, c in out.items()}
     return out, kinds, targets
 
@@ -305,7 +307,7 @@ def economic_only(model, a, econ_speeds, econ_seeds, duration, noise, sensors, l
     from specdesign.rosco import rosco_scheduled
 
     terms = mpc.fit_fatigue_terms(model, 19.0, 10.0, seeds=(1, 2))
-    ctrls = {"ROSCO": rosco_scheduled(model), "economic MPC": mpc.EconomicMPC(model, terms, ts=0.2)}
+    ctrls = {"ROSCO": rosco_scheduled(model), "economic MPC": mpc.EconomicMPC(model, terms, ts=0.2, sensors=noise)}
     camps, cpu, _, solve = run_all(model, ctrls, (), (), duration, econ_speeds=econ_speeds, econ_seeds=econ_seeds,
                                       noise=noise)
     shares = np.array(ctrls["economic MPC"].term_values)
@@ -361,7 +363,8 @@ def main():
     if a.econ_only:
         economic_only(model, a, econ_speeds, econ_seeds, duration, noise, sensors, load, t_all)
         return
-    ctrls, kinds, qft_targets = build_controllers(model, speeds, quick=a.quick, clone_rounds=a.clone_rounds)
+    ctrls, kinds, qft_targets = build_controllers(model, speeds, quick=a.quick, clone_rounds=a.clone_rounds,
+                                                  sensors=noise)
     econ = {"economic MPC": ctrls.pop("economic MPC")}
     camps, cpu, wall, solve = run_all(model, ctrls, speeds, seeds, duration, econ_speeds=econ_speeds,
                                       econ_seeds=econ_seeds, noise=noise)

@@ -118,13 +118,14 @@ def main():
     ctrls["H∞"] = scheduled(model, {v: ct.ss(d.pitch_controller) for v, d in hd.items()},
                             atd={v: ct.ss(d.atd_controller) for v, d in hd.items() if d.atd_controller is not None}
                             or None, name="H∞")
-    # the quadratic MPC also without the tower-top acceleration the baselines lack (speed and pitch only)
+    # the quadratic MPC also without the tower-top acceleration the baselines lack (speed and pitch
+    # only); every MPC's Kalman filter assumes the campaign's sensor noise (mpc.base.filter_noise)
     mpcs = {} if a.no_mpc else {
-        "quadratic MPC": mpc.QuadraticMPC(model),
-        "quadratic MPC (speed, pitch only)": mpc.QuadraticMPC(model, measured=("gen_speed", "pitch"),
+        "quadratic MPC": mpc.QuadraticMPC(model, sensors=noise),
+        "quadratic MPC (speed, pitch only)": mpc.QuadraticMPC(model, measured=("gen_speed", "pitch"), sensors=noise,
                                                               name="quadratic MPC (speed, pitch only)"),
-        "excursion MPC": mpc.HealthMPC(model, health_weight=10.0),
-        "health-aware MPC": mpc.health_aware_mpc(model, stress_weight=30.0)}
+        "excursion MPC": mpc.HealthMPC(model, health_weight=10.0, sensors=noise),
+        "health-aware MPC": mpc.health_aware_mpc(model, stress_weight=30.0, sensors=noise)}
     camps, wall = {}, {}
 
     def run(group):

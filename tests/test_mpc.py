@@ -471,3 +471,34 @@ def test_preview_clone_features_and_reproducible_demonstrations(model, collet_te
     r = simulate(model, bc, [19.0], wind=w[None], wind_dt=0.1, duration=20.0, transient=2.0, linear=True)
     moves = np.abs(np.diff(r["pitch_cmd"][0, 0]))
     assert np.all(np.isfinite(r["gen_speed"])) and moves.max() <= model.pitch_rate_limit * 0.1 * (1 + 1e-9)
+
+
+def test_filter_assumes_the_sensors_noise(model):
+    # filter_noise: each perturbed signal's per-sample SD (SensorNoise.sd, the noise model's own
+    # definition), the 3P line's RMS A/√2 added in quadrature on the speed; the rest keeps the tuning
+    import control
+
+    from specdesign.mpc.base import MEASURED, MEASUREMENT_STD, filter_noise, kalman_gain
+    from specdesign.simulate import IEA15MW_SENSORS as s
+
+    std = filter_noise(s)
+    assert std["gen_speed"] == pytest.approx(np.sqrt(s.speed_sd**2 + s.ripple_3p**2 / 2), rel=1e-15)
+    assert (std["tower_top_acc"], std["tower_top_vel"], std["pitch"]) == (s.acc_sd, s.vel_sd, MEASUREMENT_STD["pitch"])
+    assert filter_noise(s, dt=4 * s.sample_time)["tower_top_acc"] == pytest.approx(s.acc_sd / 2, rel=1e-15)
+    assert filter_noise(None) == MEASUREMENT_STD
+    with pytest.raises(TypeError, match="sensors"):
+        filter_noise({"gen_speed": 0.01})
+    # the MPC's filter is the steady-state Kalman filter for those noises: its current-estimator gain
+    # L times A is the predictor gain python-control's dlqe (slycot's Riccati solver) gives for the
+    # same model, process noise and R = diag(std²); rtol from the two Riccati solvers' residuals
+    mpc = QuadraticMPC(model, sensors=s)
+    dm = mpc.point(19.0)["model"]
+    Aa, _, Ca, L = mpc.point(19.0)["kf"]
+    n = dm.A.shape[0]
+    Q = np.diag(np.append(np.full(n, 1e-8), 0.45 * dm.ts))  # kalman_gain's defaults
+    R = np.diag([std[name] ** 2 for name in MEASURED])
+    Lp, _, _ = control.dlqe(Aa, np.eye(n + 1), Ca, Q, R)
+    np.testing.assert_allclose(Aa @ L, Lp, rtol=1e-6, atol=1e-9 * np.abs(Lp).max())
+    # and it is not the default filter, which trusts the speed sensor 5 times more
+    assert not np.allclose(L, kalman_gain(dm, MEASURED)[3], rtol=1e-3)
+    assert QuadraticMPC(model).measurement_std == MEASUREMENT_STD

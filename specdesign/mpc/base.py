@@ -53,8 +53,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import positive_scalar
+from ..controller.noise import MEASURED as SENSOR_SIGNALS
+from ..controller.noise import SensorNoise
 
-__all__ = ["DiscreteTurbine", "discretize_turbine", "kalman_gain", "operating_wind_speed", "pitch_wind_estimate",
+__all__ = ["DiscreteTurbine", "discretize_turbine", "filter_noise", "kalman_gain", "operating_wind_speed", "pitch_wind_estimate",
            "prediction_matrices", "steps_per_sample", "within_limits", "MEASURED", "MEASUREMENT_STD", "OPERATING_POINTS"]
 
 #: Values of ``operating_point``: the estimate scheduled online (default), the trim of the
@@ -174,6 +176,53 @@ def discretize_turbine(model, wind_speed: float, ts: float) -> DiscreteTurbine:
     y0 = np.asarray(model.evaluate_outputs(op.x, float(wind_speed), op.pitch, op.gen_torque), float)
     return DiscreteTurbine(float(wind_speed), ts, Ad, Bd[:, 1].copy(), Bd[:, 0].copy(), C, D[:, iw].copy(), names,
                            float(op.pitch), float(op.gen_torque), y0)
+
+
+def filter_noise(sensors: SensorNoise | None, dt: float | None = None) -> dict:
+    """The measurement noise SDs a Kalman filter assumes for the sensors a run reads through.
+
+    Parameters
+    ----------
+    sensors : SensorNoise or None
+        The sensors the simulator applies (``simulate(..., noise=sensors)``,
+        ``run_campaign(noise=...)``); None: the filter's own tuning, :data:`MEASUREMENT_STD`.
+    dt : float, optional
+        The step the noisy measurements are drawn at, s: the simulation step, at which a sampled
+        controller reads them (default ``sensors.sample_time``, the simulator's default step).
+
+    Returns
+    -------
+    dict
+        Output name → SD in its SI unit: :data:`MEASUREMENT_STD`, with every signal the sensors
+        perturb set to the SD of one noisy sample (:meth:`SensorNoise.sd` at ``dt``) and, for the
+        generator speed, the 3P line's RMS (amplitude/√2) added in quadrature: the filter then
+        weighs each sensor by the noise it carries. A signal the sensors leave exact keeps its
+        tuning (a filter needs R > 0).
+
+    Raises
+    ------
+    TypeError
+        If ``sensors`` is neither None nor a SensorNoise.
+
+    Examples
+    --------
+    >>> from specdesign.simulate import IEA15MW_SENSORS
+    >>> round(filter_noise(IEA15MW_SENSORS)["gen_speed"], 6)  # 0.005 rad/s white, 4.9e-4 rad/s 3P line
+    0.005012
+    """
+    std = dict(MEASUREMENT_STD)
+    if sensors is None:
+        return std
+    if not isinstance(sensors, SensorNoise):
+        raise TypeError(f"sensors must be a specdesign.simulate.SensorNoise or None, got {type(sensors).__name__}")
+    step = sensors.sample_time if dt is None else positive_scalar(dt, "dt")
+    for signal in SENSOR_SIGNALS:
+        sd = sensors.sd(signal, step)
+        if signal == "gen_speed":
+            sd = float(np.hypot(sd, sensors.ripple_3p / np.sqrt(2.0)))
+        if sd > 0:
+            std[signal] = sd
+    return std
 
 
 def kalman_gain(dm: DiscreteTurbine, measured=MEASURED, *, wind_walk: float = 0.45, state_noise: float = 1e-8,

@@ -403,6 +403,10 @@ class ClonedController(SampledController):
         Label.
     operating_point, wind_speeds : str, array_like
         As :class:`~specdesign.mpc.sampled.SampledController` takes them.
+    sensors : specdesign.simulate.SensorNoise, optional
+        The sensors the runs read through, whose noise the Kalman filter assumes, as
+        :class:`~specdesign.mpc.sampled.SampledController` takes them (default: none, the
+        filter's own tuning).
 
     Attributes
     ----------
@@ -414,7 +418,8 @@ class ClonedController(SampledController):
     """
 
     def __init__(self, model, regressor, ts: float = 0.2, measured=MEASURED, max_gap: float = 5.0,
-                 name: str = "behavioural cloning", operating_point: str = "estimated", wind_speeds=None):
+                 name: str = "behavioural cloning", operating_point: str = "estimated", wind_speeds=None,
+                 sensors=None):
         regs = regressor if isinstance(regressor, dict) else {None: regressor}
         if not regs or not all(isinstance(r, CloningRegressor) and r.linear is not None for r in regs.values()):
             raise TypeError("regressor must be a fitted CloningRegressor (CloningRegressor().fit(demos)) "
@@ -422,7 +427,8 @@ class ClonedController(SampledController):
         self.regressors = {None if k is None else float(k): r for k, r in regs.items()}
         self.max_gap = positive_scalar(max_gap, "max_gap")
         self.saturated = 0
-        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds)
+        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds,
+                         sensors=sensors)
 
     @docstring_of(SampledController, note=('Here the regressor trained nearest the operating point, under ``"regressor"``; '
                                            "a ValueError if none was trained within ``max_gap`` of its wind speed."))

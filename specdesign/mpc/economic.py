@@ -428,6 +428,10 @@ class EconomicMPC(SampledController):
         Label.
     operating_point, wind_speeds : str, array_like
         As :class:`~specdesign.mpc.sampled.SampledController` takes them.
+    sensors : specdesign.simulate.SensorNoise, optional
+        The sensors the runs read through, whose noise the Kalman filter assumes, as
+        :class:`~specdesign.mpc.sampled.SampledController` takes them (default: none, the
+        filter's own tuning).
 
     Attributes
     ----------
@@ -440,7 +444,7 @@ class EconomicMPC(SampledController):
 
     def __init__(self, model, terms, ts: float = 0.2, horizon: int = 50, *, speed_weight: float = 100.0,
                  activity_weight: float = 1.0, measured=MEASURED, name: str = "economic MPC",
-                 operating_point: str = "estimated", wind_speeds=None):
+                 operating_point: str = "estimated", wind_speeds=None, sensors=None):
         self.terms = tuple(terms)
         if not self.terms or not all(isinstance(t, FatigueTerm) for t in self.terms):
             raise TypeError("terms must be a non-empty sequence of FatigueTerm (fit_fatigue_terms)")
@@ -448,7 +452,8 @@ class EconomicMPC(SampledController):
             raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 2")
         self.horizon = int(horizon)
         self.speed_weight, self.activity_weight = float(speed_weight), float(activity_weight)
-        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds)
+        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds,
+                         sensors=sensors)
 
     def _reset_caches(self):
         super()._reset_caches()

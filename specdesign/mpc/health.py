@@ -280,6 +280,10 @@ class HealthMPC(SampledController):
         Start the observer at the trim of the pitch measured at t = 0 (default; from then on
         the LPV observer schedules on its own wind estimate), or at the trim of the run's
         mean wind (:class:`~specdesign.mpc.sampled.SampledController`).
+    sensors : specdesign.simulate.SensorNoise, optional
+        The sensors the runs read through, whose noise the Kalman filter assumes, as
+        :class:`~specdesign.mpc.sampled.SampledController` takes them (default: none, the
+        filter's own tuning).
 
     Attributes
     ----------
@@ -302,7 +306,7 @@ class HealthMPC(SampledController):
                  stress_weight: float = 0.0, blade_m: float = BLADE_M, del_budget: float | None = None,
                  budget_prior: float = 60.0, mean_time: float = 60.0, speed_integral_time: float | None = 30.0,
                  lpv: bool = True, wind_speeds=None, measured=MEASURED,
-                 solver: str = "OSQP", name: str = "excursion MPC", operating_point: str = "estimated"):
+                 solver: str = "OSQP", name: str = "excursion MPC", operating_point: str = "estimated", sensors=None):
         if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 1")
         self.horizon = int(horizon)
@@ -321,7 +325,8 @@ class HealthMPC(SampledController):
                                     else positive_scalar(speed_integral_time, "speed_integral_time"))
         self.lpv = bool(lpv)
         self.solver = str(solver)
-        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds)
+        super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds,
+                         sensors=sensors)
         positive_scalar(model.pitch_rate_limit, "model.pitch_rate_limit")
 
     def _reset_caches(self):

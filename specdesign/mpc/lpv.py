@@ -325,7 +325,7 @@ class LPVObserver:
         return out
 
 
-def lpv_observer(model, ts: float, measured, *, wind_speeds=None) -> LPVObserver:
+def lpv_observer(model, ts: float, measured, *, wind_speeds=None, measurement_std: dict | None = None) -> LPVObserver:
     """Build the :class:`LPVObserver` of ``model`` (vertices at ``wind_speeds``).
 
     Parameters
@@ -338,6 +338,9 @@ def lpv_observer(model, ts: float, measured, *, wind_speeds=None) -> LPVObserver
         Measured outputs (those of :func:`specdesign.mpc.base.kalman_gain`).
     wind_speeds : array_like, optional
         Vertex wind speeds (m/s); default every 1 m/s over the model's range.
+    measurement_std : dict, optional
+        Output name → noise SD the filter assumes (SI), as :func:`kalman_gain` takes it
+        (e.g. :func:`specdesign.mpc.base.filter_noise` of the run's sensors).
 
     Returns
     -------
@@ -355,7 +358,7 @@ def lpv_observer(model, ts: float, measured, *, wind_speeds=None) -> LPVObserver
     parts = {k: [] for k in ("z", "b", "y", "A", "B", "C", "L")}
     for s in v:
         dm = discretize_turbine(model, float(s), ts)
-        Aa, Ba, Ca, L = kalman_gain(dm, measured)
+        Aa, Ba, Ca, L = kalman_gain(dm, measured, measurement_std=measurement_std)
         op = model.trim(float(s))
         for k, val in zip(parts, (np.append(np.asarray(op.x, float), s), float(op.pitch), dm.y0[dm.rows(measured)],
                                   Aa, Ba, Ca, L)):

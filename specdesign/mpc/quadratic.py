@@ -182,6 +182,10 @@ class QuadraticMPC(SampledController):
         Where the model is linearised, as :class:`~specdesign.mpc.sampled.SampledController`
         takes them (default: scheduled on the run's own wind estimate, every 1 m/s over
         ``model.wind_range``; or ``"initial pitch"``, or ``"design point"`` at ``design_speed``, m/s).
+    sensors : specdesign.simulate.SensorNoise, optional
+        The sensors the runs read through, whose noise the Kalman filter assumes, as
+        :class:`~specdesign.mpc.sampled.SampledController` takes them (default: none, the
+        filter's own tuning).
 
     Attributes
     ----------
@@ -201,7 +205,7 @@ class QuadraticMPC(SampledController):
     def __init__(self, model, ts: float = 0.1, horizon: int = 50, *, speed_weight: float = 100.0,
                  tower_weight: float = 100.0, activity_weight: float = 0.1, measured=MEASURED, shortcut: bool = True,
                  solver: str = "OSQP", preview=None, name: str = "quadratic MPC", operating_point: str = "estimated",
-                 wind_speeds=None, design_speed: float | None = None):
+                 wind_speeds=None, design_speed: float | None = None, sensors=None):
         if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
             raise ValueError(f"horizon={horizon!r} must be an integer number of steps >= 1")
         self.horizon = int(horizon)
@@ -223,7 +227,7 @@ class QuadraticMPC(SampledController):
                                  f"{np.shape(preview[0])}")
             self.preview = (w, positive_scalar(preview[1], "preview wind_dt"))
         super().__init__(model, ts, measured, name, operating_point=operating_point, wind_speeds=wind_speeds,
-                         design_speed=design_speed)
+                         design_speed=design_speed, sensors=sensors)
         positive_scalar(model.pitch_rate_limit, "model.pitch_rate_limit")
 
     @docstring_of(SampledController, note='Here the QP of :func:`quadratic_qp`, under ``"qp"``.')

@@ -14,6 +14,7 @@ from .base import (
     OPERATING_POINTS,
     DiscreteTurbine,
     discretize_turbine,
+    filter_noise,
     kalman_gain,
     operating_wind_speed,
     pitch_wind_estimate,
@@ -53,6 +54,11 @@ class SampledController:
         ``model.wind_range``.
     design_speed : float, optional
         The fixed operating point (m/s), with ``operating_point="design point"`` only.
+    sensors : specdesign.simulate.SensorNoise, optional
+        The sensors the runs read through: the Kalman filter assumes their noise
+        (:func:`specdesign.mpc.base.filter_noise`, each sample's SD at the noise's
+        ``sample_time``); None (default): its own tuning, :data:`~specdesign.mpc.base.MEASUREMENT_STD`, which trusts
+        the sensors (a noise-free simulation).
 
     Attributes
     ----------
@@ -63,7 +69,8 @@ class SampledController:
     """
 
     def __init__(self, model, ts: float, measured=MEASURED, name: str = "controller", *,
-                 operating_point: str = "estimated", wind_speeds=None, design_speed: float | None = None):
+                 operating_point: str = "estimated", wind_speeds=None, design_speed: float | None = None,
+                 sensors=None):
         self.model = model
         self.ts = positive_scalar(ts, "ts")
         self.measured = tuple(measured)
@@ -76,6 +83,8 @@ class SampledController:
             raise ValueError('design_speed (m/s) must be given with operating_point="design point", and only then')
         self.design_speed = None if design_speed is None else positive_scalar(design_speed, "design_speed")
         self.wind_speeds = tuple(float(v) for v in check_speeds(model, wind_speeds))
+        self.sensors = sensors
+        self.measurement_std = filter_noise(sensors)
         self.__name__ = self.name = str(name)
         self._reset_caches()
 
@@ -130,7 +139,7 @@ class SampledController:
         key = round(float(wind_speed), 3)
         if key not in self._points:
             dm = discretize_turbine(self.model, key, self.ts)
-            pt = {"model": dm, "kf": kalman_gain(dm, self.measured)}
+            pt = {"model": dm, "kf": kalman_gain(dm, self.measured, measurement_std=self.measurement_std)}
             pt.update(self.build(dm))
             self._points[key] = pt
         return self._points[key]
@@ -186,7 +195,8 @@ class SampledController:
             :func:`specdesign.mpc.lpv.lpv_observer` of the model, the measured outputs and the grid.
         """
         if self._observer is None:
-            self._observer = lpv_observer(self.model, self.ts, self.measured, wind_speeds=self.wind_speeds)
+            self._observer = lpv_observer(self.model, self.ts, self.measured, wind_speeds=self.wind_speeds,
+                                          measurement_std=self.measurement_std)
         return self._observer
 
     def start(self, dt: float, wind: np.ndarray, pitch: np.ndarray, torque: np.ndarray) -> None:
