@@ -107,7 +107,7 @@ def gap(lt, model, v, target=25.0):
     from specdesign import closedloop, spectral
     from specdesign.feasibility import specification_for_target
     from specdesign.feasibility.target import CertificateSearch
-    from specdesign.qft import design_qft
+    from specdesign.qft import design_qft, spec_from_certified
     from specdesign.spec import baseline_analysis
 
     plants = {"OpenFAST": lt, "reduced model": model}

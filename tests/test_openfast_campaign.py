@@ -6,7 +6,6 @@ of another campaign, and the dispatch from run_campaign(plant=Deck)."""
 import math
 import sys
 import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest

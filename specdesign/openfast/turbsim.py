@@ -176,8 +176,6 @@ def turbsim_field(wind_speed: float, seed: int, *, length: float = 660.0, hub_he
 
 def _write_input(path: Path, wind_speed: float, s: dict) -> None:
     """The TurbSim input file, written by openfast-io's TurbsimWriter."""
-    from openfast_io.turbsim_util import TurbsimWriter  # heavy: openfast-io imports ROSCO's toolbox; loaded when a field is made
-
     n = s["grid_points"]
     inputs = SimpleNamespace(
         Echo=False, RandSeed1=s["RandSeed1"], RandSeed2=s["RandSeed2"], WrBHHTP=False, WrFHHTP=False, WrADHH=False,

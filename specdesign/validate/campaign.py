@@ -8,7 +8,6 @@ import dataclasses
 import queue
 import sys
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
 
 import numba
 import numpy as np
@@ -28,7 +27,7 @@ from .campaign_record import Campaign
 from ._point import SPECTRA, campaign_point
 from .metrics import INDICATORS
 from .openfast_campaign import run_openfast_campaign
-from .stats import PairedChange, paired_change, seeds_from
+from .stats import seeds_from
 from .store import CampaignStore, fingerprint
 
 __all__ = ["run_campaign", "concat_campaigns", "check_plant_step", "check_campaign_step"]
