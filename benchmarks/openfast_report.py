@@ -110,8 +110,9 @@ def _pm(st, key, n) -> str:
     return f"{st[key][0]:+.1f} ± {st[key][1]:.1f}" if n > 1 else f"{st[key][0]:+.1f}"
 
 
-def report(folder, baseline="ROSCO", m=4.0) -> str:
-    runs = validate.read_openfast_runs(folder)
+def report(folder, runs, baseline="ROSCO", m=4.0) -> str:
+    """The runs, actuator and band tables of ``runs`` (``validate.read_openfast_runs(folder)``,
+    read once by the caller: the design steps use them too)."""
     if not runs:
         raise SystemExit(f"{folder}: no finished run yet")
     count = defaultdict(int)
@@ -454,9 +455,8 @@ def main() -> None:
                     help="folder for Fig. 9 from OpenFAST (19 m/s, seed 0, where its series were kept) and, with "
                          "--damping, Fig. 8 per speed and Fig. 10")
     args = ap.parse_args()
-    text = report(Path(args.folder))
-    print(text)
     runs = validate.read_openfast_runs(args.folder)
+    print(report(Path(args.folder), runs))
     if args.figures is not None:
         fig9(runs, Path(args.figures))
     if args.damping or args.table3:

@@ -26,7 +26,6 @@ import re
 import time
 from pathlib import Path
 
-
 from specdesign.openfast import OpenFASTRunError, find_openfast, iea15mw_monopile, run_case, write_case
 from specdesign.openfast.turbsim import turbsim_field
 from specdesign.rosco.discon import rosco_library
