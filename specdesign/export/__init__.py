@@ -11,12 +11,16 @@ the Python controller (see ``docs/export.md``).
 - :mod:`specdesign.export.bladed`: :func:`export_discon`, :func:`discon_parameters`.
 - :mod:`specdesign.export.parameters`: the file format (:class:`DisconParameters`,
   :func:`write_parameters`, :func:`read_parameters`).
-- :mod:`specdesign.export.library`: the compiled library (:func:`discon_library`).
+- :mod:`specdesign.export.library`: the compiled libraries (:func:`discon_library`,
+  :func:`forward_library`).
+- :mod:`specdesign.export.forward`: Python controllers (the MPCs) behind the Bladed interface:
+  :func:`forwarded`, :class:`ForwardServer` (``forward.c`` forwards each call to Python).
 """
 from __future__ import annotations
 
 from .bladed import PARAMETER_FILE, DisconExport, discon_parameters, export_discon
-from .library import SOURCE, CompilerNotFoundError, default_cache, discon_library
+from .forward import FORWARD_FORMAT, Forwarded, ForwardError, ForwardServer, forwarded, swap_measurements
+from .library import FORWARD_SOURCE, SOURCE, CompilerNotFoundError, default_cache, discon_library, forward_library
 from .parameters import (
     FORMAT_NAME,
     FORMAT_VERSION,
@@ -35,6 +39,14 @@ __all__ = [
     "write_parameters",
     "read_parameters",
     "discon_library",
+    "forward_library",
+    "forwarded",
+    "Forwarded",
+    "ForwardServer",
+    "ForwardError",
+    "swap_measurements",
+    "FORWARD_FORMAT",
+    "FORWARD_SOURCE",
     "default_cache",
     "CompilerNotFoundError",
     "SOURCE",

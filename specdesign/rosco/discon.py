@@ -128,12 +128,15 @@ def rosco_test_cases() -> Path:
 
 #: First word of a parameter file of :func:`specdesign.export.export_discon` (its own format, not ROSCO's).
 _EXPORTED = "specdesign-discon"
+#: First word of a parameter file of :func:`specdesign.export.forwarded` (read by its forwarding library).
+_FORWARD = "specdesign-forward"
 
 
 def _exported_gearbox_ratio(path: Path) -> float | None:
     """The ``gearbox_ratio`` of an exported controller's parameter file, None for a ROSCO DISCON.IN."""
     with open(path, errors="replace") as f:
-        if f.read(len(_EXPORTED)) != _EXPORTED:
+        # a forwarding file (specdesign-forward) embeds an exported one: the same key
+        if f.read(len(_EXPORTED)) not in (_EXPORTED, _FORWARD[:len(_EXPORTED)]):
             return None
         for line in f:
             words = line.partition("#")[0].split()
