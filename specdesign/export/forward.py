@@ -191,7 +191,7 @@ def forwarded(controller: object, *, dt: float = 0.02, model: TurbineModel | Non
         Seconds (default 60) the library waits to connect and for each reply, and the server
         for each request: a stuck side fails the run instead of hanging it.
     name : str, optional
-        Label (default the controller's ``name``).
+        Label (default the controller's ``name``, else its ``__name__``, else its type's name).
 
     Returns
     -------
@@ -235,7 +235,8 @@ def forwarded(controller: object, *, dt: float = 0.02, model: TurbineModel | Non
         if round(k) < 1 or abs(k - round(k)) > 1e-9 * k:
             raise ValueError(f"the controller's sample time ts = {ts} s is not a whole multiple of dt = {dt} s: give "
                              "dt = ts or a whole fraction of it")
-    label = str(name if name is not None else getattr(controller, "name", getattr(controller, "__name__", "controller")))
+    label = str(name if name is not None else
+                getattr(controller, "name", getattr(controller, "__name__", type(controller).__name__)))
     p = discon_parameters(control.tf([0.0], [1.0]), dt=dt, model=model, torque=torque,
                           pitch_rate_limit=pitch_rate_limit, gearbox_ratio=gearbox_ratio, name=label)
     return Forwarded(controller=controller, parameters=p, timeout=timeout, name=label)
@@ -304,6 +305,8 @@ class ForwardServer:
         Wall time (s) the server spent in each call, from the request read to the reply sent.
     records : list
         With ``record=True``.
+    started : tuple or None
+        The arguments ``(dt, wind, pitch, torque)`` the controller's ``start`` was given.
     """
 
     def __init__(self, forward: Forwarded, socket_path: str | os.PathLike | None = None, *, record: bool = False):
@@ -320,7 +323,7 @@ class ForwardServer:
         self.record = bool(record)
         self.controller = copy.deepcopy(forward.controller)
         self.error, self.finished, self.calls = None, False, 0
-        self.call_times, self.records = [], []
+        self.call_times, self.records, self.started = [], [], None
         self._stop = threading.Event()
         self._thread = None
         self._listener = None
@@ -472,9 +475,10 @@ class ForwardServer:
         p = self.forward.parameters
         gear = p.gearbox_ratio
         if status == 0:
+            self.started = (p.dt, np.array([float(sw[26])]), np.array([float(sw[3])]), np.array([float(sw[22]) * gear]))
             start = getattr(self.controller, "start", None)
             if callable(start):
-                start(p.dt, np.array([float(sw[26])]), np.array([float(sw[3])]), np.array([float(sw[22]) * gear]))
+                start(p.dt, *(a.copy() for a in self.started[1:]))
         elif status != 1:
             raise ValueError(f"avrSWAP(1) = {float(sw[0])!r}: a status of 0, 1 or -1 is expected")
         t = float(sw[1])

@@ -22,6 +22,8 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..controller.discon_file import read_discon
+from ..export.forward import Forwarded, ForwardServer
+from ..export.library import forward_library
 from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
@@ -35,6 +37,7 @@ from ._point import SPECTRA
 from .campaign_record import Campaign
 from .metrics import INDICATORS, indicators
 from .stats import seeds_from, welch_psd
+from .store import fingerprint
 
 __all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES", "OpenFASTRun",
            "read_openfast_runs"]
@@ -171,7 +174,8 @@ def as_discon(controller) -> DisconController:
     ------
     TypeError
         Anything else (e.g. an LTI controller: OpenFAST runs compiled controllers; export it
-        with ``specdesign.export.export_discon`` first).
+        with ``specdesign.export.export_discon`` first; a Python controller such as an MPC
+        runs wrapped in ``specdesign.export.forwarded``).
     FileNotFoundError
         The library or parameter file does not exist.
     """
@@ -183,8 +187,10 @@ def as_discon(controller) -> DisconController:
         lib, par = Path(controller.library), Path(controller.discon_in)
     else:
         raise TypeError(f"an OpenFAST campaign runs Bladed-interface controllers: an object with .library and "
-                        f".parameters (specdesign.export.export_discon), a specdesign.rosco.Discon or a DISCON.IN "
-                        f"path; got {type(controller).__name__} (export it with export_discon first)")
+                        f".parameters (specdesign.export.export_discon), a specdesign.rosco.Discon, a DISCON.IN "
+                        f"path, or a Python controller wrapped in specdesign.export.forwarded; got "
+                        f"{type(controller).__name__} (export an LTI design with export_discon, forward an MPC with "
+                        "forwarded(controller, dt=...))")
     for key, p in (("library", lib), ("parameters", par)):
         if not p.is_file():
             raise FileNotFoundError(f"controller {key} {p} does not exist")
@@ -220,7 +226,12 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
     ----------
     controllers : dict
         Name → Bladed-interface controller (:func:`as_discon`: an exported design's record, a
-        ``specdesign.rosco.Discon``, or a ROSCO ``DISCON.IN`` path).
+        ``specdesign.rosco.Discon``, or a ROSCO ``DISCON.IN`` path), or a Python controller
+        wrapped in :func:`specdesign.export.forwarded` (an MPC): each of its runs gets its own
+        :class:`~specdesign.export.ForwardServer` (a socket and a copy of the controller, in a
+        thread of this process) beside its OpenFAST process, and the forwarding library as
+        ServoDyn's controller. A failure of the Python side is reported as a failed run, with
+        the end of the Python traceback.
     wind_speeds : array_like
         Mean hub-height wind speeds (m/s).
     seeds : int or sequence of int
@@ -285,7 +296,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         raise TypeError("controllers must be a non-empty dict {name: controller}")
     if not isinstance(deck, Deck):
         raise TypeError(f"deck must be a specdesign.openfast.Deck, got {type(deck).__name__}")
-    discon = {str(n): as_discon(c) for n, c in controllers.items()}
+    discon = {str(n): c if isinstance(c, Forwarded) else as_discon(c) for n, c in controllers.items()}
     vs = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
     seeds = seeds_from(seeds)
     for key, val in (("duration", duration), ("record_dt", record_dt)):
@@ -330,12 +341,25 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                              turbulence_class=turbulence_class, install=install)
         c = discon[name]
         init = trim(v) if trim is not None else (None, None)
-        case = write_case(deck, _run_folder(root, run), tmax=transient + duration, wind_speed=v, wind_file=wind.path,
-                          seed=s, library=c.library, parameters=c.parameters, controller_dt=c.dt, dt=dt, dt_out=record_dt,
-                          channels=CAMPAIGN_CHANNELS, initial_pitch=init[0], initial_rotor_speed=init[1],
-                          hydro=hydro, wave_seed=wave_seed_for(v, s) if hydro else None,
-                          name=f"{_slug(name)}_{v:g}mps_seed{s}")
-        out = run_case(case, install, cpu_limit=cpu_limit, timeout=timeout, nice=nice)
+
+        def openfast(library, parameters):
+            case = write_case(deck, _run_folder(root, run), tmax=transient + duration, wind_speed=v,
+                              wind_file=wind.path, seed=s, library=library, parameters=parameters, controller_dt=c.dt,
+                              dt=dt, dt_out=record_dt, channels=CAMPAIGN_CHANNELS, initial_pitch=init[0],
+                              initial_rotor_speed=init[1], hydro=hydro, wave_seed=wave_seed_for(v, s) if hydro else None,
+                              name=f"{_slug(name)}_{v:g}mps_seed{s}")
+            return case, run_case(case, install, cpu_limit=cpu_limit, timeout=timeout, nice=nice)
+
+        if isinstance(c, Forwarded):  # its own server (socket, controller copy) beside this OpenFAST process
+            folder = _run_folder(root, run)
+            folder.mkdir(parents=True, exist_ok=True)
+            with ForwardServer(c) as server:
+                try:
+                    case, out = openfast(c.library, server.write(folder / _FORWARD_FILE))
+                finally:  # the Python traceback says more than OpenFAST's "DISCON failed"
+                    server.raise_error(f"{name} at {v:g} m/s, seed {s}: ")
+        else:
+            case, out = openfast(c.library, c.parameters)
         return _post(case, out, settings, meta, keep=s in kept, wind=wind, rate_limit=rate_limit)
 
     try:
@@ -364,6 +388,10 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
     if tmp is not None:
         tmp.cleanup()
     return camp
+
+
+#: The forwarding library's parameter file in a forwarded controller's run folder.
+_FORWARD_FILE = "DISCON_forward.IN"
 
 
 def _cpus() -> int:
@@ -405,8 +433,15 @@ def _run_folder(root: Path, run) -> Path:
     return root / _slug(name) / f"{v:g}mps_seed{s}"
 
 
-def _meta(run, c: DisconController, settings) -> dict:
+def _meta(run, c: DisconController | Forwarded, settings) -> dict:
     name, v, s = run
+    if isinstance(c, Forwarded):
+        # the controller's pickle and the library's parameters (the socket, which changes per run, aside)
+        text = c.text("socket").encode() + fingerprint(c.controller).encode()
+        return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt,
+                "library_sha": _sha(forward_library()), "parameters_sha": hashlib.sha256(text).hexdigest()[:16],
+                "library": str(forward_library()), "parameters": f"forwarded Python controller {c.name!r}",
+                "settings": settings}
     return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt, "library_sha": _sha(c.library),
             "parameters_sha": _sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
             "settings": settings}

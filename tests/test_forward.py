@@ -1,0 +1,228 @@
+"""The forwarding DISCON library (specdesign.export.forwarded, forward.c) against the Python
+controller it forwards to, and against the exported library of the same design.
+
+Tolerances. The library talks through avrSWAP, a float32 array (as the exported library, see
+tests/test_export.py): the controller reads measurements rounded to float32 and its command is
+rounded to float32 on the way back. So (1) on the same float32 measurements, the forwarded
+controller and the controller stepped directly compute in the same float64 arithmetic: their
+commands are equal bit for bit, and the library writes float32 of them; (2) in closed loop the
+per-step roundings (relative 2**-24) stay bounded in a stable loop: test_export's allowance,
+100·EPS32 of each signal's largest value; (3) an LTI design exported (discon.c's Tustin
+matrices, integrator apart) and the same transfer function stepped in Python (python-control's
+Tustin realisation) are the same discrete system in two realisations: their float64 commands
+differ by round-off (~1e-15 rad), and once written as float32 by at most one float32 spacing
+of the command.
+"""
+import socket
+import threading
+
+import numpy as np
+import pytest
+
+from specdesign.export import ForwardError, ForwardServer, export_discon, forwarded, swap_measurements
+from specdesign.rosco import Discon
+from specdesign.rosco.discon import DisconError
+from specdesign.simulate import simulate
+from specdesign.turbine import iea15mw, rosco_baseline
+
+EPS32 = 2.0**-24
+DT = 0.02
+
+
+@pytest.fixture(scope="module")
+def model():
+    return iea15mw()
+
+
+class _Spy:
+    """A simulator callable around a Discon: what it was given and what it answered, per step."""
+
+    def __init__(self, discon):
+        self.discon, self.y, self.out = discon, [], []
+
+    def start(self, *args):
+        self.discon.start(*args)
+
+    def __call__(self, t, y):
+        self.y.append({k: np.array(v, float) for k, v in y.items()})
+        pitch, torque = self.discon(t, y)
+        self.out.append((pitch.copy(), torque.copy()))
+        return pitch, torque
+
+
+def _mpc(model):
+    from specdesign.mpc import QuadraticMPC
+
+    # the operating point of the run's initial pitch: the cheapest MPC to set up (one linearisation)
+    return QuadraticMPC(model, ts=0.1, operating_point="initial pitch")
+
+
+def test_forwarded_mpc_equals_the_mpc_stepped_directly(model, tmp_path):
+    fwd = forwarded(_mpc(model), dt=DT, model=model, torque="constant")
+    kw = dict(seeds=[1], duration=10.0, transient=2.0)
+    with ForwardServer(fwd, record=True) as srv:
+        spy = _Spy(Discon(srv.write(tmp_path / "fwd.IN"), library=fwd.library))
+        r = simulate(model, spy, [19.0], **kw)
+    assert srv.error is None
+    n = len(spy.out)
+    assert srv.calls == n == len(srv.records) == 600
+    # (1) the server's measurements are the simulator's, through float32 (rotor shaft, ratio 1)
+    for (t, y, _, _), ys in zip(srv.records, spy.y):
+        for k in ("gen_speed", "pitch", "power", "tower_top_acc"):
+            assert y[k] == float(np.float32(ys[k][0])), k
+    # (1) a fresh controller stepped directly on those measurements: the same commands, bit for bit
+    direct = _mpc(model)
+    direct.start(*srv.started)
+    cmds = np.array([float(direct(t, {k: np.array([v]) for k, v in y.items()})[0]) for t, y, _, _ in srv.records])
+    sent = np.array([p for _, _, p, _ in srv.records])
+    assert np.array_equal(cmds, sent)
+    # ... and the library wrote float32 of them (no limit reached), with the rated torque
+    lib = np.array([p[0] for p, _ in spy.out])
+    assert np.all((sent > model.pitch_min) & (sent < model.pitch_max))
+    assert np.array_equal(lib, sent.astype(np.float32).astype(float))
+    assert np.all(np.array([q[0] for _, q in spy.out]) == np.float32(model.rated_generator_torque))
+    # (2) closed loop: the simulator running the MPC directly (trim torque held = rated above rated)
+    d = simulate(model, _mpc(model), [19.0], **kw)
+    for name in ("pitch_cmd", "pitch", "gen_speed", "power", "tower_base_my"):
+        tol = 100 * EPS32 * np.abs(d[name]).max()
+        assert np.abs(r[name] - d[name]).max() <= tol, name
+
+
+class _TustinLTI:
+    """A pitch controller C(s) stepped in Python: python-control's Tustin realisation at dt,
+    β = β₀ + C·e, e = Ω_rated − Ω (the workbench's sign), β₀ the pitch measured at the start."""
+
+    def __init__(self, C, omega_ref, dt):
+        import control as ct
+
+        d = ct.sample_system(ct.ss(C), dt, method="tustin")
+        self.A, self.B, self.C, self.D = (np.asarray(m, float) for m in (d.A, d.B, d.C, d.D))
+        self.omega_ref = omega_ref
+
+    def start(self, dt, wind, pitch, torque):
+        self.x, self.beta0 = np.zeros(self.A.shape[0]), float(pitch[0])
+
+    def __call__(self, t, y):
+        e = self.omega_ref - float(y["gen_speed"][0])
+        u = float(self.C[0] @ self.x + self.D[0, 0] * e)
+        self.x = self.A @ self.x + self.B[:, 0] * e
+        return np.array([self.beta0 + u])
+
+
+def _sequence(model, n):
+    """A swap sequence at 19 m/s: speed, pitch, power and acceleration wandering about the trim."""
+    t = np.arange(n) * DT
+    op = model.trim(19.0)
+    w = model.rated_rotor_speed * (1 + 0.02 * np.sin(0.7 * t) + 0.01 * np.sin(2.3 * t))
+    return t, [{"gen_speed": np.array([w[k]]), "pitch": np.array([op.pitch + 0.01 * np.sin(0.5 * t[k])]),
+                "power": np.array([model.rated_power * (1 + 0.01 * np.sin(0.9 * t[k]))]),
+                "tower_top_acc": np.array([0.2 * np.sin(1.1 * t[k])])} for k in range(n)], op
+
+
+def _drive(discon, t, ys, op):
+    discon.start(DT, np.array([19.0]), np.array([op.pitch]), np.array([op.gen_torque]))
+    out = [discon(tk, y) for tk, y in zip(t, ys)]
+    discon.close()
+    return np.array([p[0] for p, _ in out]), np.array([q[0] for _, q in out])
+
+
+def test_exported_and_forwarded_lti_give_the_same_commands(model, tmp_path):
+    C = rosco_baseline(model, 19.0)
+    t, ys, op = _sequence(model, 3000)
+    rec = export_discon(C, tmp_path / "export", model=model, dt=DT, torque="rosco")
+    p_exp, q_exp = _drive(Discon(rec.parameters, library=rec.library), t, ys, op)
+    fwd = forwarded(_TustinLTI(C, model.rated_rotor_speed, DT), dt=DT, model=model, torque="rosco")
+    with ForwardServer(fwd) as srv:
+        p_fwd, q_fwd = _drive(Discon(srv.write(tmp_path / "fwd.IN"), library=fwd.library), t, ys, op)
+    assert srv.error is None and srv.finished and srv.calls == t.size
+    assert np.all((p_exp > model.pitch_min) & (p_exp < model.pitch_max))  # no limit: the linear map alone
+    assert np.ptp(p_exp) > 1e-3  # the controller acts (rad; 4e-3 measured)
+    spacing = np.spacing(np.abs(p_exp).astype(np.float32)).astype(float)
+    assert np.all(np.abs(p_fwd - p_exp) <= spacing)
+    # the torque: the same C law on the same inputs in both libraries
+    assert np.array_equal(q_fwd, q_exp)
+
+
+def test_unreachable_socket_fails_at_once_naming_it(model, tmp_path):
+    fwd = forwarded(_TustinLTI(rosco_baseline(model, 19.0), model.rated_rotor_speed, DT), dt=DT, model=model)
+    sock = tmp_path / "nobody"
+    par = fwd.write(tmp_path / "fwd.IN", sock)
+    t, ys, op = _sequence(model, 2)
+    with pytest.raises(ValueError, match=f"socket {sock}: cannot connect"):
+        _drive(Discon(par, library=fwd.library), t, ys, op)
+
+
+def _fake_server(path, answer):
+    """A listener at ``path`` that reads one request and answers ``answer`` (bytes or None: silence)."""
+    lst = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    lst.bind(str(path))
+    lst.listen(1)
+
+    def serve():
+        conn, _ = lst.accept()
+        conn.recv(8 + 4 * 165)
+        if answer is not None:
+            conn.sendall(answer)
+        threading.Event().wait(3.0)
+        conn.close()
+        lst.close()
+
+    threading.Thread(target=serve, daemon=True).start()
+
+
+@pytest.mark.parametrize("answer, what", [(None, "no reply within the timeout of 0.5 s"),
+                                          (b"\x00" * 12, "malformed reply")])
+def test_silent_or_foreign_server_fails_instead_of_hanging(model, tmp_path, answer, what):
+    fwd = forwarded(_TustinLTI(rosco_baseline(model, 19.0), model.rated_rotor_speed, DT), dt=DT, model=model,
+                    timeout=0.5)
+    sock = tmp_path / "s"
+    _fake_server(sock, answer)
+    t, ys, op = _sequence(model, 2)
+    with pytest.raises(ValueError, match=what):
+        _drive(Discon(fwd.write(tmp_path / "fwd.IN", sock), library=fwd.library), t, ys, op)
+
+
+class _Failing:
+    def start(self, dt, wind, pitch, torque):
+        self.beta0 = pitch.copy()
+
+    def __call__(self, t, y):
+        if t > 0.09:
+            return 1.0 / 0.0
+        return self.beta0
+
+
+def test_python_exception_reaches_the_library_and_the_caller(model, tmp_path):
+    fwd = forwarded(_Failing(), dt=DT, model=model)
+    t, ys, op = _sequence(model, 20)
+    with ForwardServer(fwd) as srv:
+        with pytest.raises(DisconError, match="(?s)the Python controller failed: .*ZeroDivisionError"):
+            _drive(Discon(srv.write(tmp_path / "fwd.IN"), library=fwd.library), t, ys, op)
+    assert "in __call__" in srv.error and srv.calls == 5  # t = 0, 0.02, ..., 0.08 answered
+    with pytest.raises(ForwardError, match="(?s)run A: the Python controller '_Failing' failed.*ZeroDivisionError"):
+        srv.raise_error("run A: ")
+
+
+def test_missing_signal_is_named():
+    y = swap_measurements(np.zeros(165, np.float32))
+    with pytest.raises(KeyError, match="tower_top_vel.*tower_top_acc"):
+        y["tower_top_vel"]
+
+
+def test_bad_arguments(model, tmp_path):
+    C = rosco_baseline(model, 19.0)
+    with pytest.raises(TypeError, match="export_discon"):
+        forwarded(C)
+    with pytest.raises(TypeError, match="callable"):
+        forwarded(42)
+    with pytest.raises(ValueError, match="whole multiple of dt"):
+        forwarded(_mpc(model), dt=0.03, model=model)
+    with pytest.raises(ValueError, match="timeout"):
+        forwarded(_Failing(), timeout=0.0)
+    fwd = forwarded(_Failing(), model=model)
+    with pytest.raises(ValueError, match="socket_path"):
+        fwd.write(tmp_path / "f.IN", "/tmp/" + "x" * 120)
+    with pytest.raises(ValueError, match="socket_path"):
+        fwd.write(tmp_path / "f.IN", "/tmp/a b")
+    with pytest.raises(TypeError, match="forwarded"):
+        ForwardServer(_Failing())
