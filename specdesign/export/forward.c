@@ -16,6 +16,11 @@
  * is clamped to the same pitch limits and rate limit the exported library applies to its own.
  * The embedded pitch bank is a zero controller; its command is not used.
  *
+ * discon.c is included as it is, not edited: its bytes are the digest of every exported library
+ * (specdesign.export.library) and campaign stores fingerprint that library, so the few lines of
+ * its DISCON this file needs again (reading accINFILE's name, writing the outputs) are repeated
+ * below rather than moved into a function there.
+ *
  * The exchange, in the host's byte order (both ends on one machine), per call:
  *   request: uint32 magic 0x57464453, uint32 n = FORWARD_RECORDS, n float32: avrSWAP(1..n)
  *   reply:   uint32 magic 0x57464453, int32 code, uint32 size, then size bytes:
