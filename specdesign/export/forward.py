@@ -296,7 +296,10 @@ class ForwardServer:
     Attributes
     ----------
     error : str or None
-        The Python traceback (or the protocol error) that stopped the server.
+        The Python traceback (or the malformed request) that stopped the server.
+    link_error : str or None
+        A broken or timed-out connection that stopped it (the library's process ended or
+        stalled: its own error says why; not raised by :meth:`raise_error`).
     finished : bool
         Whether the library's final call arrived.
     calls : int
@@ -322,7 +325,7 @@ class ForwardServer:
         forward.text(self.socket)  # the path's checks, before anything listens
         self.record = bool(record)
         self.controller = copy.deepcopy(forward.controller)
-        self.error, self.finished, self.calls = None, False, 0
+        self.error, self.link_error, self.finished, self.calls = None, None, False, 0
         self.call_times, self.records, self.started = [], [], None
         self._stop = threading.Event()
         self._thread = None
@@ -446,7 +449,7 @@ class ForwardServer:
                     return
                 body = _recv(conn, 4 * n)
                 if body is None:
-                    self.error = "the library closed the connection inside a request"
+                    self.link_error = "the library closed the connection inside a request"
                     return
                 tic = time.perf_counter()
                 sw = np.frombuffer(body, dtype=np.float32)
@@ -466,7 +469,7 @@ class ForwardServer:
                 self.call_times.append(time.perf_counter() - tic)
         except OSError as e:  # a timeout (TimeoutError) or a broken connection, unless close() cut it
             if not self._stop.is_set():
-                self.error = f"the connection with the library failed: {type(e).__name__}: {e}"
+                self.link_error = f"the connection with the library failed: {type(e).__name__}: {e}"
         finally:
             conn.close()
 
