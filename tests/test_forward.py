@@ -226,3 +226,28 @@ def test_bad_arguments(model, tmp_path):
         fwd.write(tmp_path / "f.IN", "/tmp/a b")
     with pytest.raises(TypeError, match="forwarded"):
         ForwardServer(_Failing())
+
+
+class _PitchAndTorque(_Failing):
+    """Commands both: the pitch it started at and 1.5e7 + 1e5·t N·m (rotor shaft)."""
+
+    def __call__(self, t, y):
+        return self.beta0, np.array([1.5e7 + 1e5 * t])
+
+
+def test_a_controller_commanding_torque_overrides_the_law_and_limits_still_apply(model, tmp_path):
+    # the torque goes through as given (float32 of it in avrSWAP(47), ratio 1); the pitch a
+    # controller returns is clamped to the model's limits by the library: a measured start pitch
+    # above the maximum, held by the controller, comes back at the maximum
+    fwd = forwarded(_PitchAndTorque(), dt=DT, model=model)
+    t, ys, op = _sequence(model, 50)
+    for y in ys:
+        y["pitch"] = np.array([model.pitch_max + 0.1])
+    with ForwardServer(fwd) as srv:
+        d = Discon(srv.write(tmp_path / "fwd.IN"), library=fwd.library)
+        d.start(DT, np.array([19.0]), np.array([op.pitch]), np.array([op.gen_torque]))
+        out = [d(tk, y) for tk, y in zip(t, ys)]
+        d.close()
+    q = np.array([o[1][0] for o in out])
+    assert np.array_equal(q, np.float32(1.5e7 + 1e5 * np.float32(t)).astype(float))
+    assert all(o[0][0] == np.float32(model.pitch_max) for o in out)
