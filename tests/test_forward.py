@@ -251,3 +251,16 @@ def test_a_controller_commanding_torque_overrides_the_law_and_limits_still_apply
     q = np.array([o[1][0] for o in out])
     assert np.array_equal(q, np.float32(1.5e7 + 1e5 * np.float32(t)).astype(float))
     assert all(o[0][0] == np.float32(model.pitch_max) for o in out)
+
+
+def test_a_second_connection_restarts_the_controller(model, tmp_path):
+    # ServoDyn builds that load the library twice (status 0, −1, then the run) connect twice:
+    # the server answers both, and the second run, started afresh, repeats the first's commands
+    fwd = forwarded(_TustinLTI(rosco_baseline(model, 19.0), model.rated_rotor_speed, DT), dt=DT, model=model)
+    t, ys, op = _sequence(model, 200)
+    with ForwardServer(fwd) as srv:
+        par = srv.write(tmp_path / "fwd.IN")
+        first = _drive(Discon(par, library=fwd.library), t, ys, op)
+        second = _drive(Discon(par, library=fwd.library), t, ys, op)
+    assert srv.error is None and srv.calls == 400
+    assert np.array_equal(first[0], second[0]) and np.ptp(first[0]) > 0

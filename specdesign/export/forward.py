@@ -277,10 +277,11 @@ class ForwardServer:
     """The Python end of one forwarded run: a socket, a thread, a copy of the controller.
 
     Listens at ``socket_path`` (default ``<new temporary folder>/s``) from :meth:`start` (or
-    entering the ``with`` block); serves one connection, the library's, call by call; stops at
-    the library's final call (status −1), when the connection closes, or on an error, which is
-    kept in :attr:`error` and sent to the library (its call then fails with the traceback's
-    tail). :meth:`close` stops it and removes the socket.
+    entering the ``with`` block) and serves the library's connection call by call, until its
+    final call (status −1) or its end, then waits for another (a ServoDyn that loads the
+    library twice connects twice; each status 0 starts the controller afresh). It stops on an
+    error, which is kept in :attr:`error` and sent to the library (its call then fails with the
+    traceback's tail). :meth:`close` stops it and removes the socket.
 
     Parameters
     ----------
@@ -433,45 +434,53 @@ class ForwardServer:
         return None
 
     def _serve(self) -> None:
-        conn = self._conn = self._accept()
-        if conn is None:
-            return
-        try:
-            conn.settimeout(self.forward.timeout)
-            while True:
-                head = _recv(conn, 8)
-                if head is None:  # the library went (OpenFAST ended or was stopped)
-                    return
-                magic, n = struct.unpack("=II", head)
-                if magic != _MAGIC or not 60 <= n <= 100000:
-                    self.error = f"malformed request (magic 0x{magic:08x}, {n} records): not the forwarding library"
-                    _reply(conn, 1, self.error.encode())
-                    return
-                body = _recv(conn, 4 * n)
-                if body is None:
-                    self.link_error = "the library closed the connection inside a request"
-                    return
-                tic = time.perf_counter()
-                sw = np.frombuffer(body, dtype=np.float32)
-                status = int(round(float(sw[0])))
-                if status == -1:
-                    self.finished = True
-                    _reply(conn, 0, struct.pack("=dd", math.nan, math.nan))
-                    return
-                try:
-                    pitch, torque = self._step(status, sw)
-                except Exception:  # any error of the controller goes back to the library and to the caller
-                    self.error = traceback.format_exc()
-                    _reply(conn, 1, self.error[-_TAIL:].encode(errors="replace"))
-                    return
-                _reply(conn, 0, struct.pack("=dd", pitch, torque))
-                self.calls += 1
-                self.call_times.append(time.perf_counter() - tic)
-        except OSError as e:  # a timeout (TimeoutError) or a broken connection, unless close() cut it
-            if not self._stop.is_set():
-                self.link_error = f"the connection with the library failed: {type(e).__name__}: {e}"
-        finally:
-            conn.close()
+        # connection after connection until close() or an error: a ServoDyn that loads the
+        # library twice (its LOAD_DLL_TWICE_FOR_LOGGING_CHANNELS build: status 0, −1, then the
+        # run) connects twice, and each status 0 starts the controller afresh
+        while self.error is None and self.link_error is None:
+            conn = self._conn = self._accept()
+            if conn is None:
+                return
+            try:
+                conn.settimeout(self.forward.timeout)
+                self._connection(conn)
+            except OSError as e:  # a timeout (TimeoutError) or a broken connection, unless close() cut it
+                if not self._stop.is_set():
+                    self.link_error = f"the connection with the library failed: {type(e).__name__}: {e}"
+            finally:
+                conn.close()
+
+    def _connection(self, conn: socket.socket) -> None:
+        """Answer one connection's calls until its final call, its end or an error."""
+        while True:
+            head = _recv(conn, 8)
+            if head is None:  # the library went (OpenFAST ended or was stopped)
+                return
+            magic, n = struct.unpack("=II", head)
+            if magic != _MAGIC or not 60 <= n <= 100000:
+                self.error = f"malformed request (magic 0x{magic:08x}, {n} records): not the forwarding library"
+                _reply(conn, 1, self.error.encode())
+                return
+            body = _recv(conn, 4 * n)
+            if body is None:
+                self.link_error = "the library closed the connection inside a request"
+                return
+            tic = time.perf_counter()
+            sw = np.frombuffer(body, dtype=np.float32)
+            status = int(round(float(sw[0])))
+            if status == -1:
+                self.finished = True
+                _reply(conn, 0, struct.pack("=dd", math.nan, math.nan))
+                return
+            try:
+                pitch, torque = self._step(status, sw)
+            except Exception:  # any error of the controller goes back to the library and to the caller
+                self.error = traceback.format_exc()
+                _reply(conn, 1, self.error[-_TAIL:].encode(errors="replace"))
+                return
+            _reply(conn, 0, struct.pack("=dd", pitch, torque))
+            self.calls += 1
+            self.call_times.append(time.perf_counter() - tic)
 
     def _step(self, status: int, sw: np.ndarray) -> tuple[float, float]:
         """One call: the controller started (status 0) and stepped; (pitch rad, rotor torque N·m or NaN)."""
