@@ -57,7 +57,9 @@ DEG = 180.0 / math.pi
 #: The baseline's name in the damping table and Fig. 8 (its linear loop is ROSCO's PI placed on
 #: OpenFAST's rotor model; in the runs, ROSCO's compiled DISCON).
 BASELINE = "ROSCO"
-_COLOURS = {"ROSCO": "tab:blue", "QFT": "tab:red", "QFT+ATD": "tab:green"}
+#: ROSCO with its tower damper (``openfast_table3.py --rosco-td``): the second baseline of issue 31.
+SECOND_BASELINE = "ROSCO+TD"
+_COLOURS = {"ROSCO": "tab:blue", "ROSCO+TD": "tab:purple", "QFT": "tab:red", "QFT+ATD": "tab:green"}
 
 
 def openfast_times(run) -> tuple[float, float]:
@@ -110,22 +112,16 @@ def _pm(st, key, n) -> str:
     return f"{st[key][0]:+.1f} ± {st[key][1]:.1f}" if n > 1 else f"{st[key][0]:+.1f}"
 
 
-def report(folder, runs, baseline="ROSCO", m=4.0) -> str:
-    """The runs, actuator and band tables of ``runs`` (``validate.read_openfast_runs(folder)``,
-    read once by the caller: the design steps use them too)."""
-    if not runs:
-        raise SystemExit(f"{folder}: no finished run yet")
-    count = defaultdict(int)
-    for r in runs:
-        count[r.controller, r.wind_speed] += 1
-    lines = [f"Finished runs in {folder}: " + ", ".join(f"{c} {v:g} m/s × {n}" for (c, v), n in sorted(count.items())), ""]
-    names = sorted({r.controller for r in runs} - {baseline})
+def _change_table(runs, baseline, m, skip=()) -> tuple[list, list]:
+    """Every controller's paired changes against ``baseline`` per speed (markdown lines) and
+    the cells' statistics (for the band table)."""
+    names = sorted({r.controller for r in runs} - {baseline} - set(skip))
     speeds = sorted({r.wind_speed for r in runs})
+    lines, bands = [], []
     head = ("| wind (m/s) | controller | paired seeds | tower DEL (%) | gen-speed SD (%) | blade DEL (%) "
             f"| pitch-rate SD (deg/s): {baseline} / design | pitch travel (deg/h): {baseline} / design "
             "| at the rate limit (%): design |")
     lines += [head, "|" + "---|" * (head.count("|") - 1)]
-    bands = []
     for v in speeds:
         for name in names:
             st = _cell_stats(runs, baseline, name, v, m)
@@ -139,6 +135,24 @@ def report(folder, runs, baseline="ROSCO", m=4.0) -> str:
                          f"| {trav[0]} / {trav[1]} "
                          f"| {st['rate_limit_time', 'design'][0]:.2f} |")
             bands.append((v, name, st))
+    return lines, bands
+
+
+def report(folder, runs, baseline="ROSCO", m=4.0) -> str:
+    """The runs, actuator and band tables of ``runs`` (``validate.read_openfast_runs(folder)``,
+    read once by the caller: the design steps use them too)."""
+    if not runs:
+        raise SystemExit(f"{folder}: no finished run yet")
+    count = defaultdict(int)
+    for r in runs:
+        count[r.controller, r.wind_speed] += 1
+    lines = [f"Finished runs in {folder}: " + ", ".join(f"{c} {v:g} m/s × {n}" for (c, v), n in sorted(count.items())), ""]
+    table, bands = _change_table(runs, baseline, m)
+    lines += table
+    if SECOND_BASELINE in {r.controller for r in runs} and baseline != SECOND_BASELINE:
+        # issue 31: every design against ROSCO with its tower damper too, on the same seeds
+        lines += ["", f"Against the second baseline, {SECOND_BASELINE} (ROSCO's compiled DISCON, TD_Mode = 1):", ""]
+        lines += _change_table(runs, SECOND_BASELINE, m, skip={baseline})[0]
     times = np.array([openfast_times(r) for r in runs])
     ok = ~np.isnan(times).any(axis=1)
     if ok.any():
@@ -456,7 +470,7 @@ def main() -> None:
                          "--damping, Fig. 8 per speed and Fig. 10")
     args = ap.parse_args()
     runs = validate.read_openfast_runs(args.folder)
-    print(report(Path(args.folder), runs))
+    print(report(Path(args.folder), runs, baseline=args.baseline))
     if args.figures is not None:
         fig9(runs, Path(args.figures))
     if args.damping or args.table3:

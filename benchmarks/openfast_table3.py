@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from specdesign import feasibility, qft, spec, turbine, validate
+from specdesign import feasibility, qft, rosco, spec, turbine, validate
 from specdesign.export import export_discon
 from specdesign.openfast import find_openfast, iea15mw_monopile, linearize_deck
 from specdesign.simulate import ScheduledController
@@ -45,6 +45,20 @@ def openfast_model(deck, speeds=(), **kwargs):
     """The design model on OpenFAST's linearisations: :data:`LINEARISED` and any other ``speeds``
     (cached by ``linearize_deck``; ``kwargs`` go to it)."""
     return linearize_deck(deck, sorted(set(LINEARISED) | {float(v) for v in speeds}), **kwargs)
+
+
+#: The second baseline's name in the campaign: ROSCO with its tower damper (``--rosco-td``).
+ROSCO_TD = "ROSCO+TD"
+
+
+def rosco_td_discon(discon_in, folder) -> Path:
+    """The deck's DISCON.IN with ROSCO's fore-aft tower damper on (``TD_Mode = 1``), ``FA_KI``
+    from :func:`specdesign.rosco.tune_tower_damper` on the reduced model (the smallest gain giving
+    the first tower mode ζ = 0.2 at every above-rated speed with ROSCO's PI: the rule of
+    ``benchmarks/tower_damper.py`` and docs/comparison.md), written into ``folder``."""
+    damper = rosco.tune_tower_damper(turbine.iea15mw())
+    Path(folder).mkdir(parents=True, exist_ok=True)
+    return rosco.write_discon(discon_in, Path(folder) / "ROSCO_TD_DISCON.IN", **damper.discon_values())
 
 
 #: The designs a campaign can run: controller name, export folder prefix.
@@ -98,6 +112,9 @@ def main() -> None:
                     help="the design: the paper's PI + notch + ATD (QFT+ATD, default) or the certified chain (QFT, pitch "
                          "only: it lowers the tower mode's damping, docs/openfast.md)")
     ap.add_argument("--rosco-only", action="store_true", help="run ROSCO only (no design, no Table 3)")
+    ap.add_argument("--rosco-td", action="store_true",
+                    help=f"also the second baseline {ROSCO_TD!r}: ROSCO's compiled DISCON with its fore-aft tower damper "
+                         "(TD_Mode = 1, FA_KI by rosco.tune_tower_damper's rule on the reduced model)")
     ap.add_argument("--out", default="build/openfast_table3")
     args = ap.parse_args()
     speeds = [float(x) for x in args.speeds.split(",")]
@@ -118,6 +135,8 @@ def main() -> None:
     camps = []
     for v in speeds:
         controllers = {"ROSCO": discon_in}
+        if args.rosco_td:
+            controllers[ROSCO_TD] = rosco_td_discon(discon_in, out)
         if export is not None:
             # the generator torque as the deck's DISCON runs it: ROSCO's law below rated, constant
             # torque above (VS_ConstPower = 0); the pitch rate limited as ROSCO's PC_MaxRat; the

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -29,6 +30,11 @@ from .check import check
 from .controller import Controller
 from .freqresp import check_grid, evaluate
 from .templates import Template
+
+if TYPE_CHECKING:  # annotations only
+    from collections.abc import Sequence
+
+    from .specs import Spec
 
 __all__ = ["InfeasibleError", "RefineResult", "refine", "shape"]
 

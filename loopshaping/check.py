@@ -10,6 +10,7 @@ phase margins.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -18,6 +19,14 @@ from .bounds import as_specs
 from .controller import Controller
 from .freqresp import check_grid, evaluate, is_lti
 from .templates import Template
+
+if TYPE_CHECKING:  # annotations only
+    from collections.abc import Sequence
+
+    import control
+
+    from .bounds import Bounds
+    from .specs import Spec
 
 __all__ = ["CheckResult", "check", "feedback_poles"]
 

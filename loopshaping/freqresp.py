@@ -13,9 +13,13 @@ Frequencies in rad/s, phases in degrees.
 from __future__ import annotations
 
 import numbers
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:  # annotations only
+    import control
 
 
 __all__ = ["DEFAULT_PHASES_DEG", "as_siso", "check_grid", "check_phases", "evaluate", "grid_indices", "is_lti",

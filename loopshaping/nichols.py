@@ -10,6 +10,8 @@ the chart, each design-frequency marker where the bounds are.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -17,6 +19,9 @@ from .bounds import Bounds
 from .controller import Controller
 from .freqresp import check_grid, evaluate
 from .templates import Template
+
+if TYPE_CHECKING:  # annotations only
+    import matplotlib
 
 __all__ = ["draw", "loop_nichols", "m_contour", "plot_templates", "template_nichols", "wrap_phase"]
 

@@ -4,6 +4,7 @@ against indicators computed directly on the same signals, a failed run reported 
 seed and OpenFAST's tail while the rest is kept, resuming without rerunning, refusing a folder
 of another campaign, and the dispatch from run_campaign(plant=Deck)."""
 import math
+import shutil
 import sys
 import textwrap
 
@@ -13,7 +14,7 @@ from numpy.testing import assert_allclose
 
 pytest.importorskip("openfast_io")
 
-from specdesign.openfast import OpenFASTInstall, iea15mw_monopile
+from specdesign.openfast import Deck, OpenFASTInstall, iea15mw_monopile
 from specdesign.validate import indicators, read_openfast_runs, run_campaign
 from specdesign.validate.openfast_campaign import run_openfast_campaign
 
@@ -120,6 +121,14 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
     again = run_openfast_campaign(ctrls, [19.0], [0, 2], **kw)
     assert len(calls.read_text().split()) == n_calls
     assert_allclose(again.values["tower_del"], camp.values["tower_del"], rtol=0)
+    # ... and from a copy of the deck in another folder (a moved checkout, a rebuilt venv): the
+    # runs are found by the deck's digest, not its path
+    moved = tmp_path / "moved"
+    shutil.copytree(iea15mw_monopile().fst.parent, moved)
+    elsewhere = run_openfast_campaign(ctrls, [19.0], [0, 2], **{**kw, "deck": Deck(moved / iea15mw_monopile().fst.name,
+                                                                                      version="5.0")})
+    assert len(calls.read_text().split()) == n_calls
+    assert_allclose(elsewhere.values["tower_del"], camp.values["tower_del"], rtol=0)
     # another controller under a stored name is refused
     with pytest.raises(ValueError, match="other settings or another controller under the name 'A'"):
         run_openfast_campaign({"A": ctrls["B"]}, [19.0], [0], **kw)

@@ -447,9 +447,17 @@ def _meta(run, c: DisconController | Forwarded, settings) -> dict:
             "settings": settings}
 
 
+#: Recorded in run.json for the reader, not compared: where the deck, library and parameter file
+#: lay (their digests are compared), so a checkout moved or a venv rebuilt finds its runs.
+_LOCATIONS = ("deck",)
+
+
 def _same(a: dict, b: dict) -> bool:
     keys = ("controller", "wind_speed", "seed", "controller_dt", "library_sha", "parameters_sha")
-    return all(a.get(k) == b.get(k) for k in keys) and a.get("settings") == b.get("settings")
+
+    def settings(m):
+        return {k: v for k, v in (m.get("settings") or {}).items() if k not in _LOCATIONS}
+    return all(a.get(k) == b.get(k) for k in keys) and settings(a) == settings(b)
 
 
 def _load(root: Path, run, meta):
