@@ -131,3 +131,16 @@ def test_forwarded_controllers_in_a_campaign(tmp_path, fake):
     # another Python controller under a stored name is refused
     with pytest.raises(ValueError, match="another controller under the name 'fwd'"):
         run_openfast_campaign({"fwd": forwarded(Sine(0.02), dt=0.02, model=model)}, [19.0], [0], **kw)
+
+
+def test_a_forwarded_controller_runs_as_itself_on_the_reduced_model(tmp_path):
+    # one controllers dict serves both plants: on the reduced model the wrapper runs the
+    # controller it wraps, the same indicators as the bare controller and the same store entry
+    from specdesign.validate import run_campaign
+
+    model = iea15mw()
+    kw = dict(model=model, duration=20.0, transient=5.0, predict=False)
+    bare = run_campaign({"sine": Sine(0.01)}, [19.0], [1], **kw, store=tmp_path / "store")
+    wrapped = run_campaign({"sine": forwarded(Sine(0.01), model=model)}, [19.0], [1], **kw, store=tmp_path / "store")
+    for k, v in bare.values.items():
+        np.testing.assert_array_equal(wrapped.values[k], v, err_msg=k)

@@ -18,6 +18,7 @@ from .._blas import on_one_blas_thread
 from .._checks import positive_scalar
 from ..controller.noise import SensorNoise
 from ..controller.torque import TorqueLaw
+from ..export.forward import Forwarded
 from ..fatigue import TOWER_M
 from ..simulate import SimulationResult, check_step, turbine_plant
 from ..simulate.checks import checked_loop
@@ -106,7 +107,10 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
     ----------
     controllers : dict
         Name → controller (LTI, Controller, ScheduledController or callable; see
-        :mod:`specdesign.simulate`).
+        :mod:`specdesign.simulate`). A Python controller wrapped for OpenFAST
+        (:func:`specdesign.export.forwarded`) runs as the controller it wraps on the reduced
+        model, so one dict serves both plants (the wrapper's torque law and rate limit are the
+        forwarding library's: the reduced model's callable contract holds the trim torque).
     wind_speeds : array_like
         Mean wind speeds (m/s).
     seeds : int or sequence of int
@@ -220,6 +224,8 @@ def run_campaign(controllers: Mapping, wind_speeds, seeds, *, model=None, durati
                                      record_dt=record_dt, m=m, turbulence_class=turbulence_class,
                                      keep_series=keep_series, nperseg=nperseg, progress=progress, folder=store,
                                      **dict(openfast or {}))
+    # a controller wrapped for the forwarding library runs as itself here (store fingerprints included)
+    controllers = {n: c.controller if isinstance(c, Forwarded) else c for n, c in controllers.items()}
     model, vs, seeds, names, n_keep, settings = _checked_campaign(
         controllers, wind_speeds, seeds, model, duration, dt, record_dt, transient, m, predict, turbulence_class,
         keep_series, linear_twin, volterra, nperseg, torque_control, noise)
