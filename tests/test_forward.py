@@ -264,3 +264,54 @@ def test_a_second_connection_restarts_the_controller(model, tmp_path):
         second = _drive(Discon(par, library=fwd.library), t, ys, op)
     assert srv.error is None and srv.calls == 400
     assert np.array_equal(first[0], second[0]) and np.ptp(first[0]) > 0
+
+
+def _raw_run(library, infile, swaps):
+    """ServoDyn's calls of one run through ctypes: each (R,) swap record set given as a dict
+    {0-based index: value} merged into one float32 array, status 0 then 1, then −1."""
+    import ctypes
+
+    fn = ctypes.CDLL(str(library)).DISCON
+    fn.restype = None
+    name = str(infile).encode() + b"\0"
+    sw = np.zeros(1000, np.float32)
+    fail, msg = ctypes.c_int(0), ctypes.create_string_buffer(1025)
+    sw[2], sw[48], sw[49] = DT, 1024, len(name)
+    out = []
+    for k, rec in enumerate(swaps):
+        for i, v in rec.items():
+            sw[i] = v
+        sw[0], sw[1] = (0 if k == 0 else 1), k * DT
+        fn(sw.ctypes.data_as(ctypes.c_void_p), ctypes.byref(fail), name, b"out\0", msg)
+        assert fail.value == 0, msg.value
+        out.append(float(sw[44]))
+    sw[0] = -1
+    fn(sw.ctypes.data_as(ctypes.c_void_p), ctypes.byref(fail), name, b"out\0", msg)
+    return np.array(out)
+
+
+def test_health_mpc_reads_the_blades_moments_through_the_forwarder(model, tmp_path):
+    # the health-aware MPC reads blade_root_my: the server gives it the mean of the three blades'
+    # out-of-plane moments avrSWAP(30-32) (float32, as ServoDyn writes them), and its commands equal
+    # those of the same MPC stepped directly on those measurements
+    from specdesign.mpc import health_aware_mpc
+
+    op = model.trim(19.0)
+    n = 100
+    t = np.arange(n) * DT
+    moments = 1e7 * (1.0 + 0.05 * np.sin(np.outer(t, [1.0, 1.3, 1.7]) + [0.0, 2.1, 4.2]))
+    swaps = [{3: op.pitch, 14: model.rated_power, 19: model.rated_rotor_speed * (1 + 0.01 * np.sin(t[k])),
+              22: op.gen_torque, 26: 19.0, 29: moments[k, 0], 30: moments[k, 1], 31: moments[k, 2],
+              52: 0.1 * np.sin(1.1 * t[k])} for k in range(n)]
+    fwd = forwarded(health_aware_mpc(model, operating_point="initial pitch"), dt=DT, model=model)
+    with ForwardServer(fwd, record=True) as srv:
+        lib = _raw_run(fwd.library, srv.write(tmp_path / "fwd.IN"), swaps)
+    assert srv.error is None and srv.calls == n
+    m32 = moments.astype(np.float32).astype(float)
+    got = np.array([y["blade_root_my"] for _, y, _, _ in srv.records])
+    assert np.array_equal(got, (m32[:, 0] + m32[:, 1] + m32[:, 2]) / 3.0)
+    direct = health_aware_mpc(model, operating_point="initial pitch")
+    direct.start(*srv.started)
+    cmds = np.array([float(direct(tk, {k: np.array([v]) for k, v in y.items()})[0]) for tk, y, _, _ in srv.records])
+    assert np.array_equal(cmds, [p for _, _, p, _ in srv.records])
+    assert np.array_equal(lib, np.clip(cmds, model.pitch_min, model.pitch_max).astype(np.float32).astype(float))
