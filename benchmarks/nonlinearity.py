@@ -313,16 +313,23 @@ def dev_vs(res, ref):
     return est, float(np.sqrt((S - 1) / S * np.sum((reps - reps.mean()) ** 2)))
 
 
-def prediction(model, ctrls, v, omega=None, plant_speed=None, spectrum_speed=None):
-    """Linear-prediction DELs {name: DEL} (Dirlik); plant linearised at plant_speed (default v)
+def record_spectrum(model, w, v):
+    """S_W at v weighted by the variance a DUR-long record has about its own mean, as
+    ``validate.linear_prediction`` weights it (``wind.record_window``)."""
+    return wmod.rotor_effective_spectrum(w, v, model.rotor_radius) * wmod.record_window(w, DUR)
+
+
+def prediction(model, ctrls, v, omega=None, plant_speed=None, spectrum_speed=None, method="dirlik"):
+    """Linear-prediction DELs {name: DEL} (``method``, default Dirlik) on the record-windowed S_W,
+    as ``validate.linear_prediction`` computes it; plant linearised at plant_speed (default v)
     while the controllers stay those of ``v``; S_W at spectrum_speed (default v)."""
-    w = validate.prediction_grid() if omega is None else omega
+    w = validate.prediction_grid(DUR) if omega is None else omega
     pv = v if plant_speed is None else plant_speed
-    sw = wmod.rotor_effective_spectrum(w, v if spectrum_speed is None else spectrum_speed, model.rotor_radius)
+    sw = record_spectrum(model, w, v if spectrum_speed is None else spectrum_speed)
     out = {}
     for name, c in ctrls.items():
         t = validate.closed_loop_response(model, c, pv, w)
-        out[name] = float(spectral.del_spectral(w, np.abs(t) ** 2 * sw, M))
+        out[name] = float(spectral.del_spectral(w, np.abs(t) ** 2 * sw, M, method=method))
     return out
 
 
@@ -495,24 +502,23 @@ def main(argv=None):
     # F ---------------------------------------------------------------------------------
     wf = wind[0] - v
     rec = wf[:, int(TRANS / RDT):int((TRANS + DUR) / RDT)]
-    g = validate.prediction_grid()
+    g = validate.prediction_grid(DUR)
     g0 = np.geomspace(1e-4, 30, 6000)
     sw_full = np.trapezoid(wmod.rotor_effective_spectrum(g0, v, model.rotor_radius), g0)
-    sw_grid = np.trapezoid(wmod.rotor_effective_spectrum(g, v, model.rotor_radius), g)
+    sw_rec = np.trapezoid(record_spectrum(model, g, v), g)
     print(f"\n### F. wind spectrum and frequency range\n\nrotor-effective wind variance: ∫S_W over (1e-4, 30) rad/s "
-          f"{sw_full:.3f}, over the prediction grid (2π/600, 30) {sw_grid:.3f}, synthesised series (660 s period, "
-          f"mean over seeds) {np.mean(wf.var(axis=-1)):.3f}, within each 600 s record {np.mean(rec.var(axis=-1)):.3f} (m/s)²")
+          f"{sw_full:.3f}, ∫S_W·record window over the prediction grid ({g[0]:.2e}, {g[-1]:g}) {sw_rec:.3f}, "
+          f"synthesised series (660 s period, mean over seeds) {np.mean(wf.var(axis=-1)):.3f}, within each 600 s record "
+          f"{np.mean(rec.var(axis=-1)):.3f} (m/s)²")
     rows = []
-    for lab, om in (("2π/600 … 30 rad/s (default)", g), ("2π/660 … 30", np.geomspace(2 * np.pi / 660, 30, 3000)),
-                    ("1e-3 … 30", np.geomspace(1e-3, 30, 4000)), ("2π/600 … 15", np.geomspace(2 * np.pi / 600, 15, 3000))):
+    for lab, om in ((f"{g[0]:.2e} … 30 rad/s (default, record-windowed S_W)", g),
+                    ("1e-4 … 30", np.geomspace(1e-4, 30, 4000)),
+                    ("2π/660 … 30", np.geomspace(2 * np.pi / 660, 30, 3000)),
+                    ("2π/600 … 30", np.geomspace(2 * np.pi / 600, 30, 3000)),
+                    (f"{g[0]:.2e} … 15", np.geomspace(g[0], 15, 3000))):
         rows.append([lab, f"{pred_red(prediction(model, ctrls, v, omega=om)):.2f}"])
     for meth in ("tovo_benasciutti", "narrowband"):
-        pm = {}
-        for name, c in ctrls.items():
-            t = validate.closed_loop_response(model, c, v, g)
-            pm[name] = float(spectral.del_spectral(g, np.abs(t) ** 2 * wmod.rotor_effective_spectrum(g, v, model.rotor_radius), M,
-                                                   method=meth))
-        rows.append([f"default grid, {meth} instead of Dirlik", f"{pred_red(pm):.2f}"])
+        rows.append([f"default grid, {meth} instead of Dirlik", f"{pred_red(prediction(model, ctrls, v, method=meth)):.2f}"])
     table("F2. prediction vs frequency grid and spectral method (linear sim gives "
           f"{rl:.2f} %)", ["grid", "predicted reduction %"], rows)
 
