@@ -31,9 +31,16 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from specdesign import spectral, validate, wind as wmod
+from specdesign import spectral, validate
 from specdesign import turbine as tb
-from specdesign.simulate import KernelPlant, scheduled, simulate, turbine_plant, wind_series
+from specdesign import wind as wmod
+from specdesign.simulate import (
+    KernelPlant,
+    scheduled,
+    simulate,
+    turbine_plant,
+    wind_series,
+)
 
 M = 4.0
 DUR, TRANS, DT, RDT = 600.0, 60.0, 0.02, 0.1
