@@ -7,6 +7,8 @@ specdesign/data, so only cross-checks against the original files use this fixtur
 from __future__ import annotations
 
 import os
+import sys
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -73,3 +75,57 @@ def rosco_cases():
 def discon_in(rosco_cases):
     """The rosco package's DISCON.IN of the IEA 15 MW monopile (skipped without the package)."""
     return rosco_cases / "IEA-15-240-RWT/IEA-15-240-RWT-Monopile/IEA-15-240-RWT-Monopile_DISCON.IN"
+
+
+# A fake OpenFAST for campaign tests (tests/test_openfast_campaign.py, tests/test_forward_campaign.py):
+# a Python script that counts its calls, reads the case's input files (``keys``: value then
+# name, as OpenFAST's), runs a test's own body (which fills ``ch``: channel → (unit, series) and
+# ``t``) and writes them as a binary .outb (file ID 3) that the campaign reads back. Bodies use
+# str.format's doubled braces.
+_FAKE_HEAD = textwrap.dedent('''\
+    #!{python}
+    import ctypes, math, re, struct, sys
+    from pathlib import Path
+    import numpy as np
+    fst = Path(sys.argv[1]); root = fst.stem
+    with open("{calls}", "a") as f:
+        f.write(root + "\\n")
+    def keys(p):
+        out = {{}}
+        for line in Path(p).read_text().splitlines():
+            t = line.split()
+            if len(t) > 1:
+                out.setdefault(t[1], t[0].strip('"'))
+        return out
+''')
+_FAKE_TAIL = textwrap.dedent('''\
+    names = ["Time"] + list(ch); units = ["(s)"] + [u for u, _ in ch.values()]
+    data = np.column_stack([a for _, a in ch.values()])
+    b = struct.pack("h", 3) + struct.pack("i", data.shape[1]) + struct.pack("i", t.size)
+    b += struct.pack("d", t[0]) + struct.pack("d", dt)
+    b += struct.pack("i", 4) + b"fake"
+    b += b"".join(n.ljust(10).encode() for n in names) + b"".join(u.ljust(10).encode() for u in units)
+    b += data.astype("<f8").tobytes()
+    Path(root + ".outb").write_bytes(b)
+    print("OpenFAST terminated normally.")
+''')
+
+
+@pytest.fixture
+def fake_openfast(tmp_path, monkeypatch):
+    """``make(body) -> (OpenFASTInstall, calls file)``: the fake OpenFAST running ``body`` (a
+    dedented script fragment, see ``_FAKE_HEAD``) and a fake TurbSim; winds cached in tmp_path."""
+    from specdesign.openfast import OpenFASTInstall  # needs openfast_io (optional): only when a test asks
+
+    def make(body: str):
+        calls = tmp_path / "calls.txt"
+        calls.write_text("")
+        exe = tmp_path / "openfast"
+        exe.write_text((_FAKE_HEAD + textwrap.dedent(body) + _FAKE_TAIL).format(python=sys.executable, calls=calls))
+        exe.chmod(0o755)
+        ts = tmp_path / "turbsim"
+        ts.write_text('#!/bin/sh\nroot="${1%.inp}"\necho bts > "$root.bts"\n')
+        ts.chmod(0o755)
+        monkeypatch.setenv("SPECDESIGN_TURBSIM_CACHE", str(tmp_path / "winds"))
+        return OpenFASTInstall(exe, ts, "5.0.0"), calls
+    return make

@@ -5,8 +5,6 @@ controller's command, a Python exception fails its run with the case, seed and t
 the other runs are kept, and the store resumes and refuses another controller under a stored name.
 """
 import math
-import sys
-import textwrap
 
 import numpy as np
 import pytest
@@ -14,27 +12,13 @@ import pytest
 pytest.importorskip("openfast_io")
 
 from specdesign.export import forwarded
-from specdesign.openfast import OpenFASTInstall, iea15mw_monopile
+from specdesign.openfast import iea15mw_monopile
 from specdesign.turbine import iea15mw
 from specdesign.validate.openfast_campaign import run_openfast_campaign
 
 # The fake OpenFAST: ServoDyn's calls of DISCON (the swap records forward.c and the server read),
 # then a binary .outb (file ID 3) of the campaign's channels, BldPitch1 the commanded pitch (deg).
-_FAKE = textwrap.dedent('''\
-    #!{python}
-    import ctypes, math, struct, sys
-    from pathlib import Path
-    import numpy as np
-    fst = Path(sys.argv[1]); root = fst.stem
-    with open("{calls}", "a") as f:
-        f.write(root + "\\n")
-    def keys(p):
-        out = {{}}
-        for line in Path(p).read_text().splitlines():
-            t = line.split()
-            if len(t) > 1:
-                out.setdefault(t[1], t[0].strip('"'))
-        return out
+_FAKE = '''\
     k = keys(fst); sd = keys(k["ServoFile"])
     dt, tmax, ddt = float(k["DT_Out"]), float(k["TMax"]), float(sd["DLL_DT"])
     fn = ctypes.CDLL(sd["DLL_FileName"]).DISCON
@@ -61,30 +45,12 @@ _FAKE = textwrap.dedent('''\
           "GenTq": ("(kN-m)", 2e4 + 0 * t), "GenPwr": ("(kW)", 1.5e4 + 0 * t),
           "TwrBsMyt": ("(kN-m)", 1e5 + 2e4 * np.sin(1.1 * t)), "RootMyb1": ("(kN-m)", 3e4 + 8e3 * np.sin(0.8 * t)),
           "YawBrTAxp": ("(m/s^2)", 0.1 * np.sin(t))}}
-    names = ["Time"] + list(ch); units = ["(s)"] + [u for u, _ in ch.values()]
-    data = np.column_stack([a for _, a in ch.values()])
-    b = struct.pack("h", 3) + struct.pack("i", data.shape[1]) + struct.pack("i", t.size)
-    b += struct.pack("d", t[0]) + struct.pack("d", dt)
-    b += struct.pack("i", 4) + b"fake"
-    b += b"".join(n.ljust(10).encode() for n in names) + b"".join(u.ljust(10).encode() for u in units)
-    b += data.astype("<f8").tobytes()
-    Path(root + ".outb").write_bytes(b)
-    print("OpenFAST terminated normally.")
-''')
+'''
 
 
 @pytest.fixture
-def fake(tmp_path, monkeypatch):
-    calls = tmp_path / "calls.txt"
-    calls.write_text("")
-    exe = tmp_path / "openfast"
-    exe.write_text(_FAKE.format(python=sys.executable, calls=calls))
-    exe.chmod(0o755)
-    ts = tmp_path / "turbsim"
-    ts.write_text('#!/bin/sh\nroot="${1%.inp}"\necho bts > "$root.bts"\n')
-    ts.chmod(0o755)
-    monkeypatch.setenv("SPECDESIGN_TURBSIM_CACHE", str(tmp_path / "winds"))
-    return OpenFASTInstall(exe, ts, "5.0.0"), calls
+def fake(fake_openfast):
+    return fake_openfast(_FAKE)
 
 
 class Sine:

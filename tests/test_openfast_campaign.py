@@ -5,8 +5,6 @@ seed and OpenFAST's tail while the rest is kept, resuming without rerunning, ref
 of another campaign, and the dispatch from run_campaign(plant=Deck)."""
 import math
 import shutil
-import sys
-import textwrap
 
 import numpy as np
 import pytest
@@ -14,28 +12,14 @@ from numpy.testing import assert_allclose
 
 pytest.importorskip("openfast_io")
 
-from specdesign.openfast import Deck, OpenFASTInstall, iea15mw_monopile
+from specdesign.openfast import Deck, iea15mw_monopile
 from specdesign.validate import indicators, read_openfast_runs, run_campaign
 from specdesign.validate.openfast_campaign import run_openfast_campaign
 
 # The fake OpenFAST: reads TMax and DT_Out from the .fst, the seed from the wind file's name,
 # and writes the campaign's 9 channels (OpenFAST's units) as a binary .outb (file ID 3). It
 # fails like OpenFAST when the controller's parameter file says FAIL. Each call is counted.
-_FAKE_OPENFAST = textwrap.dedent('''\
-    #!{python}
-    import math, re, struct, sys
-    from pathlib import Path
-    import numpy as np
-    fst = Path(sys.argv[1]); root = fst.stem
-    with open("{calls}", "a") as f:
-        f.write(root + "\\n")
-    def keys(p):
-        out = {{}}
-        for line in Path(p).read_text().splitlines():
-            t = line.split()
-            if len(t) > 1:
-                out.setdefault(t[1], t[0].strip('"'))
-        return out
+_FAKE_OPENFAST = '''\
     k = keys(fst)
     sd, ifw = keys(k["ServoFile"]), keys(k["InflowFile"])
     if "FAIL" in Path(sd["DLL_InFile"]).read_text():
@@ -52,32 +36,15 @@ _FAKE_OPENFAST = textwrap.dedent('''\
           "GenTq": ("(kN-m)", 2e4 + 0 * t), "GenPwr": ("(kW)", 1.5e4 + 50 * np.sin(t)),
           "TwrBsMyt": ("(kN-m)", 1e5 + gain * 2e4 * np.sin(1.1 * w * t) + 5e3 * np.sin(2.4 * t)),
           "RootMyb1": ("(kN-m)", 3e4 + 8e3 * np.sin(0.8 * t + seed)), "YawBrTAxp": ("(m/s^2)", 0.1 * np.sin(t))}}
-    names = ["Time"] + list(ch); units = ["(s)"] + [u for u, _ in ch.values()]
-    data = np.column_stack([a for _, a in ch.values()])
-    b = struct.pack("h", 3) + struct.pack("i", data.shape[1]) + struct.pack("i", t.size)
-    b += struct.pack("d", t[0]) + struct.pack("d", dt)
-    b += struct.pack("i", 4) + b"fake"
-    b += b"".join(n.ljust(10).encode() for n in names) + b"".join(u.ljust(10).encode() for u in units)
-    b += data.astype("<f8").tobytes()
-    Path(root + ".outb").write_bytes(b)
-    print("OpenFAST terminated normally.")
-''')
+'''
 
 
 @pytest.fixture
-def fake(tmp_path, monkeypatch):
-    calls = tmp_path / "calls.txt"
-    calls.write_text("")
-    exe = tmp_path / "openfast"
-    exe.write_text(_FAKE_OPENFAST.format(python=sys.executable, calls=calls))
-    exe.chmod(0o755)
-    ts = tmp_path / "turbsim"
-    ts.write_text('#!/bin/sh\nroot="${1%.inp}"\necho bts > "$root.bts"\n')
-    ts.chmod(0o755)
-    monkeypatch.setenv("SPECDESIGN_TURBSIM_CACHE", str(tmp_path / "winds"))
+def fake(tmp_path, fake_openfast):
+    inst, calls = fake_openfast(_FAKE_OPENFAST)
     lib = tmp_path / "libfake.so"
     lib.write_bytes(b"\x7fELF")
-    return OpenFASTInstall(exe, ts, "5.0.0"), calls, lib
+    return inst, calls, lib
 
 
 class Exported:
