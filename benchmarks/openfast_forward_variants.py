@@ -130,6 +130,26 @@ def command_rate_bands(log, transient, rate_limit):
     return rate.std(), np.mean(np.abs(rate) > 0.99 * rate_limit), share
 
 
+def route_check(camp, log, transient):
+    """The server's measurements against OpenFAST's outputs of the same run, at the 0.1 s output instants."""
+    rec = [json.loads(line) for line in Path(log).read_text().splitlines()[1:]]
+    t = np.array([r[0] for r in rec])
+    y = {k: np.array([r[1][k] for r in rec]) for k in rec[0][1]}
+    series = next(iter(camp.series.values()))
+    out = {k: np.ravel(v) for k, v in series.outputs.items()}
+    idx = np.searchsorted(np.round(t, 6), np.round(transient + np.asarray(series.time), 6))
+    for k in ("gen_speed", "pitch", "power"):
+        for lag in (0, 1):  # calls: the pitch measured is the actuator's output of the previous step
+            a, b = y[k][idx + lag], out[k]
+            print(f"  route: {k:10s} lag {lag} call(s): mean ratio {np.mean(a / b):.5f}, RMS difference "
+                  f"{100 * np.sqrt(np.mean((a - b) ** 2)) / b.std():.1f} % of its SD")
+    acc = y["tower_top_acc"][idx]
+    bb, aa = signal.butter(2, [0.8 / (2 * np.pi), 1.4 / (2 * np.pi)], btype="band", fs=10.0)
+    r = np.corrcoef(signal.filtfilt(bb, aa, acc), signal.filtfilt(bb, aa, out["tower_base_my"]))[0, 1]
+    print(f"  route: tower-top acceleration mean {acc.mean():.4f} m/s², SD {acc.std():.3f} m/s²; against the "
+          f"tower-base moment in 0.8-1.4 rad/s: correlation {r:.2f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("variant")
@@ -145,7 +165,7 @@ def main():
     t0 = time.perf_counter()
     camp = validate.run_campaign(controllers, [19.0], [0], plant=deck, duration=args.duration,
                                  transient=args.transient, store=store / args.variant, record_dt=0.1,
-                                 openfast={"processes": 1, "nice": 10}, progress=False)
+                                 keep_series=True, openfast={"processes": 1, "nice": 10}, progress=False)
     print(f"{args.variant}: {args.duration:g} s after {args.transient:g} s, 19 m/s, seed 0, wall "
           f"{time.perf_counter() - t0:.0f} s, unstable {bool(camp.unstable[0, 0])}")
     for k in INDICATORS:
@@ -155,6 +175,7 @@ def main():
         print(f"  command (0.1 s samples): rate SD {sd:.4g} rad/s, at the limit {100 * limit:.0f} %; share of the "
               "rate's variance per band (rad/s): " + ", ".join(f"{a:g}-{b:g} {100 * s:.0f} %"
                                                                for a, b, s in zip(BANDS[:-1], BANDS[1:], share)))
+        route_check(camp, log, args.transient)
 
 
 if __name__ == "__main__":
