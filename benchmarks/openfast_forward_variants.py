@@ -28,6 +28,7 @@ import json
 import re
 import time
 from dataclasses import replace
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -73,8 +74,7 @@ class Logged:
 
     def start(self, dt, wind, pitch, torque):
         self._zi = {}
-        self._file = open(self.log, "w", buffering=1)
-        self._file.write(json.dumps({"dt": dt, "wind": float(wind[0]), "pitch": float(pitch[0])}) + "\n")
+        Path(self.log).write_text(json.dumps({"dt": dt, "wind": float(wind[0]), "pitch": float(pitch[0])}) + "\n")
         self.inner.start(dt, wind, pitch, torque)
 
     def __call__(self, t, y):
@@ -86,8 +86,9 @@ class Logged:
             out, self._zi[k] = signal.lfilter(b, a, [x], zi=self._zi[k])
             seen[k] = np.array([out[0]])
         cmd = self.inner(t, seen)
-        self._file.write(json.dumps([t, {k: float(v[0]) for k, v in y.items()},
-                                     {k: float(seen[k][0]) for k in self.filters}, float(np.ravel(cmd)[0])]) + "\n")
+        with open(self.log, "a") as f:  # no handle kept: the server's copy of the controller is never closed
+            f.write(json.dumps([t, {k: float(v[0]) for k, v in y.items()},
+                                {k: float(seen[k][0]) for k in self.filters}, float(np.ravel(cmd)[0])]) + "\n")
         return cmd
 
 
@@ -126,7 +127,7 @@ def command_rate_bands(log, transient, rate_limit):
     rate = np.diff(u) / 0.1
     f, p = signal.welch(rate - rate.mean(), fs=10.0, nperseg=rate.size // 2)
     w = 2 * np.pi * f
-    share = [np.sum(p[(w >= a) & (w < b)]) / np.sum(p) for a, b in zip(BANDS[:-1], BANDS[1:])]
+    share = [np.sum(p[(w >= a) & (w < b)]) / np.sum(p) for a, b in pairwise(BANDS)]
     return rate.std(), np.mean(np.abs(rate) > 0.99 * rate_limit), share
 
 
