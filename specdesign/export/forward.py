@@ -30,8 +30,8 @@ measured torque avrSWAP(23) × gearbox ratio; then at every call, the first incl
 the controller reads them, at every call, as ROSCO filters its generator speed: a first- or
 second-order low-pass (ROSCO's ``F_LPFType`` 1 and 2) discretised by Tustin's rule at the call
 interval, started at steady state on the first sample (ROSCO's ``LPFilter`` and
-``SecLPFilter``). A controller whose model lacks the structural modes OpenFAST measures (the
-MPCs' internal models) otherwise acts on them: docs/openfast.md.
+``SecLPFilter``): the same sensor chain as ROSCO's, for a like-for-like comparison. They do not
+cure the MPCs' riding of the pitch-rate limit in OpenFAST, a loop-gain problem (docs/openfast.md).
 
 The swap array has no tower-top velocity or tower-base moment: a controller that reads them
 fails with a KeyError naming what it does have. The controller is called at every library
