@@ -315,3 +315,64 @@ def test_health_mpc_reads_the_blades_moments_through_the_forwarder(model, tmp_pa
     cmds = np.array([float(direct(tk, {k: np.array([v]) for k, v in y.items()})[0]) for tk, y, _, _ in srv.records])
     assert np.array_equal(cmds, [p for _, _, p, _ in srv.records])
     assert np.array_equal(lib, np.clip(cmds, model.pitch_min, model.pitch_max).astype(np.float32).astype(float))
+
+
+class _Holds(_Failing):
+    """Holds the pitch it started at (the measurements go to the server's records)."""
+
+    def __call__(self, t, y):
+        return self.beta0
+
+
+def test_measurement_filters_low_pass_what_the_controller_reads(model, tmp_path):
+    # a second-order low-pass on the speed and a first-order one on the acceleration, each
+    # started at its first sample: what the controller reads equals scipy.signal's Tustin
+    # discretisation (bilinear, no prewarping, as ROSCO's SecLPFilter/LPFilter) filtering the
+    # float32 swap values from steady state (lfilter_zi), to round-off; the other signals pass
+    from scipy import signal
+
+    op = model.trim(19.0)
+    n, w_s, z_s, w_a = 1500, 1.0081, 0.7, 3.0  # the deck's ROSCO speed filter; an arbitrary corner
+    t = np.arange(n) * DT
+    speed = model.rated_rotor_speed * (1 + 0.02 * np.sin(w_s * t) + 0.01 * (t > 5.0))
+    acc = 0.1 + 0.2 * np.sin(8.0 * t)
+    swaps = [{3: op.pitch, 14: model.rated_power, 19: speed[k], 22: op.gen_torque, 26: 19.0, 52: acc[k]}
+             for k in range(n)]
+    fwd = forwarded(_Holds(), dt=DT, model=model,
+                    measurement_filters={"gen_speed": (w_s, z_s), "tower_top_acc": w_a})
+    assert "gen_speed low-pass 1.0081 rad/s, second order" in fwd.text("/tmp/s")
+    with ForwardServer(fwd, record=True) as srv:
+        _raw_run(fwd.library, srv.write(tmp_path / "fwd.IN"), swaps)
+    assert srv.error is None and srv.calls == n
+    got = {k: np.array([y[k] for _, y, _, _ in srv.records]) for k in ("gen_speed", "tower_top_acc", "pitch")}
+    for name, x, b, a in (("gen_speed", speed, [w_s**2], [1.0, 2 * z_s * w_s, w_s**2]),
+                          ("tower_top_acc", acc, [w_a], [1.0, w_a])):
+        bz, az = signal.bilinear(b, a, fs=1 / DT)
+        x32 = x.astype(np.float32).astype(float)
+        ref, _ = signal.lfilter(bz, az, x32, zi=signal.lfilter_zi(bz, az) * x32[0])
+        assert np.abs(got[name] - ref).max() <= 1e-12 * np.abs(ref).max(), name
+    assert np.all(got["pitch"] == np.float32(op.pitch))
+    # physics: the second-order filter at its corner passes 1/(2ζ) of a sine (0.714; Tustin's
+    # warping at ω·dt = 0.02 moves it by ~1e-4), after the step's transient has died (t > 20 s)
+    late = t > 20.0
+    amp = np.hypot(*np.linalg.lstsq(np.c_[np.sin(w_s * t[late]), np.cos(w_s * t[late]), np.ones(late.sum())],
+                                    got["gen_speed"][late], rcond=None)[0][:2])
+    assert amp / (0.02 * model.rated_rotor_speed) == pytest.approx(1 / (2 * z_s), rel=2e-3)
+    # a first-order filter at 3 rad/s leaves 3/√(3² + 8²) of an 8 rad/s sine (0.351) and the mean
+    amp = np.hypot(*np.linalg.lstsq(np.c_[np.sin(8.0 * t[late]), np.cos(8.0 * t[late]), np.ones(late.sum())],
+                                    got["tower_top_acc"][late], rcond=None)[0][:2])
+    assert amp / 0.2 == pytest.approx(w_a / np.hypot(w_a, 8.0), rel=5e-3)
+    assert np.mean(got["tower_top_acc"][late]) == pytest.approx(0.1, abs=2e-3)
+
+
+def test_measurement_filters_bad_arguments(model):
+    with pytest.raises(ValueError, match="tower_top_vel.*forwarded measurement"):
+        forwarded(_Holds(), measurement_filters={"tower_top_vel": 1.0})
+    with pytest.raises(ValueError, match="Nyquist"):
+        forwarded(_Holds(), dt=DT, measurement_filters={"gen_speed": 200.0})
+    with pytest.raises(ValueError, match="damping"):
+        forwarded(_Holds(), measurement_filters={"gen_speed": (1.0, -0.7)})
+    with pytest.raises(ValueError, match="corner"):
+        forwarded(_Holds(), measurement_filters={"gen_speed": (1.0, 0.7, 3.0)})
+    with pytest.raises(TypeError, match="mapping"):
+        forwarded(_Holds(), measurement_filters=[("gen_speed", 1.0)])

@@ -19,7 +19,16 @@ the Python controller (see ``docs/export.md``).
 from __future__ import annotations
 
 from .bladed import PARAMETER_FILE, DisconExport, discon_parameters, export_discon
-from .forward import FORWARD_FORMAT, Forwarded, ForwardError, ForwardServer, forwarded, swap_measurements
+from .forward import (
+    FORWARD_FORMAT,
+    MEASUREMENT_NAMES,
+    Forwarded,
+    ForwardError,
+    ForwardServer,
+    forwarded,
+    lowpass_coefficients,
+    swap_measurements,
+)
 from .library import FORWARD_SOURCE, SOURCE, CompilerNotFoundError, default_cache, discon_library, forward_library
 from .parameters import (
     FORMAT_NAME,
@@ -45,6 +54,8 @@ __all__ = [
     "ForwardServer",
     "ForwardError",
     "swap_measurements",
+    "lowpass_coefficients",
+    "MEASUREMENT_NAMES",
     "FORWARD_FORMAT",
     "FORWARD_SOURCE",
     "default_cache",

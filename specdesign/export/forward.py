@@ -26,6 +26,13 @@ measured torque avrSWAP(23) × gearbox ratio; then at every call, the first incl
                    the collective moment the reduced model's per-blade output stands for
 =================  =================================================================
 
+``measurement_filters=`` (of :func:`forwarded`; default none) low-passes chosen signals before
+the controller reads them, at every call, as ROSCO filters its generator speed: a first- or
+second-order low-pass (ROSCO's ``F_LPFType`` 1 and 2) discretised by Tustin's rule at the call
+interval, started at steady state on the first sample (ROSCO's ``LPFilter`` and
+``SecLPFilter``): the same sensor chain as ROSCO's, for a like-for-like comparison. They do not
+cure the MPCs' riding of the pitch-rate limit in OpenFAST, a loop-gain problem (docs/openfast.md).
+
 The swap array has no tower-top velocity or tower-base moment: a controller that reads them
 fails with a KeyError naming what it does have. The controller is called at every library
 call, as the simulator calls it at every step: a sampled controller (the MPCs' ``ts``) samples
@@ -60,8 +67,8 @@ from .bladed import discon_parameters
 from .library import forward_library
 from .parameters import DisconParameters, write_parameters
 
-__all__ = ["FORWARD_FORMAT", "FORWARD_RECORDS", "Forwarded", "ForwardServer", "ForwardError", "forwarded",
-           "swap_measurements"]
+__all__ = ["FORWARD_FORMAT", "FORWARD_RECORDS", "MEASUREMENT_NAMES", "Forwarded", "ForwardServer", "ForwardError",
+           "forwarded", "lowpass_coefficients", "swap_measurements"]
 
 #: First words of a forwarding parameter file (format name and version).
 FORWARD_FORMAT = ("specdesign-forward", 1)
@@ -73,6 +80,8 @@ _MAGIC = 0x57464453
 _MAX_SOCKET = 107
 #: Characters of a Python traceback's tail sent back to the library (its message buffer is 1024).
 _TAIL = 700
+#: The measurements a forwarded controller reads (:func:`swap_measurements`), in its order.
+MEASUREMENT_NAMES = ("gen_speed", "pitch", "power", "tower_top_acc", "blade_root_my")
 
 
 class ForwardError(RuntimeError):
@@ -97,12 +106,17 @@ class Forwarded:
         Seconds either side waits for the other (connect, each reply, each request).
     name : str
         Label.
+    measurement_filters : tuple, default ()
+        ``(signal, corner rad/s, damping or None)`` per low-passed measurement (second order
+        with a damping, first order without), applied by the server before the controller
+        reads it (:func:`forwarded`).
     """
 
     controller: object
     parameters: DisconParameters
     timeout: float
     name: str
+    measurement_filters: tuple = ()
 
     @property
     def dt(self) -> float:
@@ -138,9 +152,13 @@ class Forwarded:
                              "put it in a short folder such as tempfile.mkdtemp()")
         with tempfile.TemporaryDirectory() as tmp:
             body = write_parameters(self.parameters, Path(tmp) / "p", comment=f"forwarded: {self.name}").read_text()
+        # the measurement filters run in Python: comment lines for the reader (and in the file's digest)
+        filt = "".join(f"# measurement filter (Python side): {k} low-pass {w!r} rad/s, "
+                       f"{'first order' if z is None else f'second order, damping {z!r}'}\n"
+                       for k, w, z in self.measurement_filters)
         head = (f"{FORWARD_FORMAT[0]} {FORWARD_FORMAT[1]}\n"
                 "# specdesign.export.forwarded: each DISCON call goes to the Python server at this socket\n"
-                f"socket {path}\ntimeout {self.timeout!r}\n")
+                f"{filt}socket {path}\ntimeout {self.timeout!r}\n")
         return head + body
 
     def write(self, path: str | os.PathLike, socket_path: str | os.PathLike) -> Path:
@@ -165,7 +183,7 @@ class Forwarded:
 
 def forwarded(controller: object, *, dt: float = 0.02, model: TurbineModel | None = None,
               torque: str | TorqueLaw | None = None, pitch_rate_limit: float = math.inf, gearbox_ratio: float = 1.0,
-              timeout: float = 60.0, name: str | None = None) -> Forwarded:
+              timeout: float = 60.0, name: str | None = None, measurement_filters=None) -> Forwarded:
     """A Python controller made runnable through the forwarding DISCON library.
 
     Parameters
@@ -192,6 +210,13 @@ def forwarded(controller: object, *, dt: float = 0.02, model: TurbineModel | Non
         for each request: a stuck side fails the run instead of hanging it.
     name : str, optional
         Label (default the controller's ``name``, else its ``__name__``, else its type's name).
+    measurement_filters : mapping, optional
+        Signal name (of :data:`MEASUREMENT_NAMES`) → low-pass the server applies to it at every
+        call before the controller reads it: a corner frequency (rad/s, first order) or
+        ``(corner rad/s, damping)`` (second order), ROSCO's ``F_LPFType`` 1 and 2 and its
+        discretisation (:func:`lowpass_coefficients`). E.g. ``{"gen_speed": (1.0081, 0.7)}``
+        is the IEA 15 MW deck's ROSCO speed filter. Default None: the signals as OpenFAST
+        measures them.
 
     Returns
     -------
@@ -206,7 +231,8 @@ def forwarded(controller: object, *, dt: float = 0.02, model: TurbineModel | Non
         with :func:`~specdesign.export.export_discon`: they run in C).
     ValueError
         For a non-positive ``dt``, ``timeout`` or ``pitch_rate_limit``, or a controller whose
-        sample time ``ts`` is not a whole multiple of ``dt``; the checks of
+        sample time ``ts`` is not a whole multiple of ``dt``; a measurement filter on an unknown
+        signal, with a corner not in (0, π/dt) rad/s or a non-positive damping; the checks of
         :func:`~specdesign.export.discon_parameters`.
 
     Examples
@@ -237,9 +263,83 @@ def forwarded(controller: object, *, dt: float = 0.02, model: TurbineModel | Non
                              "dt = ts or a whole fraction of it")
     label = str(name if name is not None else
                 getattr(controller, "name", getattr(controller, "__name__", type(controller).__name__)))
+    filters = _filter_specs(measurement_filters, dt)
     p = discon_parameters(control.tf([0.0], [1.0]), dt=dt, model=model, torque=torque,
                           pitch_rate_limit=pitch_rate_limit, gearbox_ratio=gearbox_ratio, name=label)
-    return Forwarded(controller=controller, parameters=p, timeout=timeout, name=label)
+    return Forwarded(controller=controller, parameters=p, timeout=timeout, name=label, measurement_filters=filters)
+
+
+def _filter_specs(filters, dt: float) -> tuple:
+    """``forwarded``'s ``measurement_filters`` checked: ((signal, corner rad/s, damping or None), ...)."""
+    if filters is None:
+        return ()
+    if not hasattr(filters, "items"):
+        raise TypeError(f"measurement_filters must be a mapping signal -> corner (rad/s) or (corner, damping), got "
+                        f"{type(filters).__name__}")
+    out = []
+    for key, spec in filters.items():
+        if key not in MEASUREMENT_NAMES:
+            raise ValueError(f"measurement_filters: {key!r} is not a forwarded measurement; give one of "
+                             f"{MEASUREMENT_NAMES}")
+        corner, damping = (spec, None) if np.ndim(spec) == 0 else tuple(spec) if len(spec) == 2 else (None, None)
+        if corner is None:
+            raise ValueError(f"measurement_filters[{key!r}] = {spec!r}: give a corner (rad/s, first order) or "
+                             "(corner rad/s, damping) (second order)")
+        corner = positive_scalar(corner, f"measurement_filters[{key!r}] corner (rad/s)")
+        if corner >= math.pi / dt:
+            raise ValueError(f"measurement_filters[{key!r}]: corner {corner} rad/s is not below the Nyquist frequency "
+                             f"pi/dt = {math.pi / dt:.4g} rad/s of the call interval")
+        if damping is not None:
+            damping = positive_scalar(damping, f"measurement_filters[{key!r}] damping")
+        out.append((str(key), corner, damping))
+    return tuple(out)
+
+
+def lowpass_coefficients(corner: float, damping: float | None, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Discrete low-pass of a measurement filter: ROSCO's ``LPFilter`` / ``SecLPFilter``.
+
+    Tustin's rule (no prewarping, as ROSCO) at ``dt`` of ω/(s + ω) (``damping`` None) or
+    ω²/(s² + 2ζωs + ω²); unit gain at zero frequency.
+
+    Parameters
+    ----------
+    corner : float
+        ω (rad/s).
+    damping : float or None
+        ζ (-), or None for the first-order filter.
+    dt : float
+        Sample interval (s).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(b, a)`` with ``a[0] = 1``, as :func:`scipy.signal.lfilter` takes them.
+    """
+    wd = corner * dt
+    if damping is None:
+        b, a = np.array([wd, wd]), np.array([2.0 + wd, wd - 2.0])
+    else:
+        b = wd * wd * np.array([1.0, 2.0, 1.0])
+        a = np.array([wd * wd + 4.0 + 4.0 * damping * wd, 2.0 * wd * wd - 8.0, wd * wd + 4.0 - 4.0 * damping * wd])
+    return b / a[0], a / a[0]
+
+
+class _LowPass:
+    """One measurement's filter (transposed direct form II), at steady state on its first sample."""
+
+    def __init__(self, corner: float, damping: float | None, dt: float):
+        self.b, self.a = (tuple(float(c) for c in v) for v in lowpass_coefficients(corner, damping, dt))
+        self.z = None
+
+    def __call__(self, x: float) -> float:
+        b, a = self.b, self.a
+        if self.z is None:  # steady state at x (unit gain at zero frequency): as ROSCO starts its filters
+            self.z = [sum(b[j] - a[j] for j in range(i, len(b))) * x for i in range(1, len(b))]
+        y = b[0] * x + self.z[0]
+        n = len(self.z)
+        for i in range(n):
+            self.z[i] = b[i + 1] * x - a[i + 1] * y + (self.z[i + 1] if i + 1 < n else 0.0)
+        return y
 
 
 class _Measurements(dict):
@@ -290,9 +390,9 @@ class ForwardServer:
     socket_path : str or os.PathLike, optional
         Where to listen (at most 107 bytes); default a new temporary folder's ``s``.
     record : bool, default False
-        Keep every call's ``(t, y, pitch, torque)`` in :attr:`records` (the command as the
-        controller returned it, before the library's limits; torque NaN when the library's
-        law gives it).
+        Keep every call's ``(t, y, pitch, torque)`` in :attr:`records` (``y`` as the controller
+        read it, after the measurement filters; the command as the controller returned it,
+        before the library's limits; torque NaN when the library's law gives it).
 
     Attributes
     ----------
@@ -328,6 +428,7 @@ class ForwardServer:
         self.controller = copy.deepcopy(forward.controller)
         self.error, self.link_error, self.finished, self.calls = None, None, False, 0
         self.call_times, self.records, self.started = [], [], None
+        self._filters = {}
         self._stop = threading.Event()
         self._thread = None
         self._listener = None
@@ -491,10 +592,14 @@ class ForwardServer:
             start = getattr(self.controller, "start", None)
             if callable(start):
                 start(p.dt, *(a.copy() for a in self.started[1:]))
+            # fresh filters: each connection's run starts them at its own first sample
+            self._filters = {k: _LowPass(w, z, p.dt) for k, w, z in self.forward.measurement_filters}
         elif status != 1:
             raise ValueError(f"avrSWAP(1) = {float(sw[0])!r}: a status of 0, 1 or -1 is expected")
         t = float(sw[1])
         y = swap_measurements(sw, gear)
+        for k, f in self._filters.items():
+            y[k] = np.array([f(float(y[k][0]))])
         out = self.controller(t, y)
         pitch, torque = out if isinstance(out, tuple) else (out, math.nan)
         pitch = np.asarray(pitch, dtype=float).reshape(-1)
