@@ -26,7 +26,6 @@ from .forward import (
     ForwardError,
     ForwardServer,
     forwarded,
-    lowpass_coefficients,
     swap_measurements,
 )
 from .library import FORWARD_SOURCE, SOURCE, CompilerNotFoundError, default_cache, discon_library, forward_library
@@ -54,7 +53,6 @@ __all__ = [
     "ForwardServer",
     "ForwardError",
     "swap_measurements",
-    "lowpass_coefficients",
     "MEASUREMENT_NAMES",
     "FORWARD_FORMAT",
     "FORWARD_SOURCE",

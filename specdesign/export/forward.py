@@ -61,14 +61,14 @@ import numpy as np
 from .._checks import positive_scalar
 from ..controller.lti import is_lti_like
 from ..controller.scheduled import ScheduledController
-from ..controller.torque import TorqueLaw
+from ..controller.torque import TorqueLaw, rosco_lpf1, rosco_lpf2
 from ..turbine import TurbineModel
 from .bladed import discon_parameters
 from .library import forward_library
 from .parameters import DisconParameters, write_parameters
 
 __all__ = ["FORWARD_FORMAT", "FORWARD_RECORDS", "MEASUREMENT_NAMES", "Forwarded", "ForwardServer", "ForwardError",
-           "forwarded", "lowpass_coefficients", "swap_measurements"]
+           "forwarded", "swap_measurements"]
 
 #: First words of a forwarding parameter file (format name and version).
 FORWARD_FORMAT = ("specdesign-forward", 1)
@@ -213,8 +213,9 @@ def forwarded(controller: object, *, dt: float = 0.02, model: TurbineModel | Non
     measurement_filters : mapping, optional
         Signal name (of :data:`MEASUREMENT_NAMES`) → low-pass the server applies to it at every
         call before the controller reads it: a corner frequency (rad/s, first order) or
-        ``(corner rad/s, damping)`` (second order), ROSCO's ``F_LPFType`` 1 and 2 and its
-        discretisation (:func:`lowpass_coefficients`). E.g. ``{"gen_speed": (1.0081, 0.7)}``
+        ``(corner rad/s, damping)`` (second order): ROSCO's ``F_LPFType`` 1 and 2, stepped as the
+        simulator's ROSCO steps them (:func:`~specdesign.controller.torque.rosco_lpf1`,
+        ``rosco_lpf2``). E.g. ``{"gen_speed": (1.0081, 0.7)}``
         is the IEA 15 MW deck's ROSCO speed filter. Default None: the signals as OpenFAST
         measures them.
 
@@ -295,51 +296,21 @@ def _filter_specs(filters, dt: float) -> tuple:
     return tuple(out)
 
 
-def lowpass_coefficients(corner: float, damping: float | None, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """Discrete low-pass of a measurement filter: ROSCO's ``LPFilter`` / ``SecLPFilter``.
-
-    Tustin's rule (no prewarping, as ROSCO) at ``dt`` of ω/(s + ω) (``damping`` None) or
-    ω²/(s² + 2ζωs + ω²); unit gain at zero frequency.
-
-    Parameters
-    ----------
-    corner : float
-        ω (rad/s).
-    damping : float or None
-        ζ (-), or None for the first-order filter.
-    dt : float
-        Sample interval (s).
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        ``(b, a)`` with ``a[0] = 1``, as :func:`scipy.signal.lfilter` takes them.
-    """
-    wd = corner * dt
-    if damping is None:
-        b, a = np.array([wd, wd]), np.array([2.0 + wd, wd - 2.0])
-    else:
-        b = wd * wd * np.array([1.0, 2.0, 1.0])
-        a = np.array([wd * wd + 4.0 + 4.0 * damping * wd, 2.0 * wd * wd - 8.0, wd * wd + 4.0 - 4.0 * damping * wd])
-    return b / a[0], a / a[0]
-
-
 class _LowPass:
-    """One measurement's filter (transposed direct form II), at steady state on its first sample."""
+    """One measurement's filter: ROSCO's ``LPFilter`` (``damping`` None) or ``SecLPFilter``, the
+    simulator's own steps (:func:`~specdesign.controller.torque.rosco_lpf1`, ``rosco_lpf2``:
+    Tustin without prewarping, started at the first sample as ROSCO starts its filters)."""
 
     def __init__(self, corner: float, damping: float | None, dt: float):
-        self.b, self.a = (tuple(float(c) for c in v) for v in lowpass_coefficients(corner, damping, dt))
-        self.z = None
+        self.corner, self.damping, self.dt = corner, damping, dt
+        self.state = np.zeros(4)  # last outputs and inputs
+        self.first = True
 
     def __call__(self, x: float) -> float:
-        b, a = self.b, self.a
-        if self.z is None:  # steady state at x (unit gain at zero frequency): as ROSCO starts its filters
-            self.z = [sum(b[j] - a[j] for j in range(i, len(b))) * x for i in range(1, len(b))]
-        y = b[0] * x + self.z[0]
-        n = len(self.z)
-        for i in range(n):
-            self.z[i] = b[i + 1] * x - a[i + 1] * y + (self.z[i + 1] if i + 1 < n else 0.0)
-        return y
+        first, self.first = self.first, False
+        if self.damping is None:
+            return float(rosco_lpf1(self.state, 0, 1, x, self.corner, self.dt, first))
+        return float(rosco_lpf2(self.state, 0, 1, 2, 3, x, self.corner, self.damping, self.dt, first))
 
 
 class _Measurements(dict):
