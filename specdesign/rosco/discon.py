@@ -136,7 +136,7 @@ def _exported_gearbox_ratio(path: Path) -> float | None:
     """The ``gearbox_ratio`` of an exported controller's parameter file, None for a ROSCO DISCON.IN."""
     with open(path, errors="replace") as f:
         # a forwarding file (specdesign-forward) embeds an exported one: the same key
-        if f.read(len(_EXPORTED)) not in (_EXPORTED, _FORWARD[:len(_EXPORTED)]):
+        if f.readline().split()[:1] not in ([_EXPORTED], [_FORWARD]):
             return None
         for line in f:
             words = line.partition("#")[0].split()

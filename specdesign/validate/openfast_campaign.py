@@ -23,7 +23,6 @@ from tqdm.auto import tqdm
 
 from ..controller.discon_file import read_discon
 from ..export.forward import Forwarded, ForwardServer
-from ..export.library import forward_library
 from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
@@ -438,9 +437,10 @@ def _meta(run, c: DisconController | Forwarded, settings) -> dict:
     if isinstance(c, Forwarded):
         # the controller's pickle and the library's parameters (the socket, which changes per run, aside)
         text = c.text("socket").encode() + fingerprint(c.controller).encode()
+        lib = c.library
         return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt,
-                "library_sha": _sha(forward_library()), "parameters_sha": hashlib.sha256(text).hexdigest()[:16],
-                "library": str(forward_library()), "parameters": f"forwarded Python controller {c.name!r}",
+                "library_sha": _sha(lib), "parameters_sha": hashlib.sha256(text).hexdigest()[:16],
+                "library": str(lib), "parameters": f"forwarded Python controller {c.name!r}",
                 "settings": settings}
     return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt, "library_sha": _sha(c.library),
             "parameters_sha": _sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
