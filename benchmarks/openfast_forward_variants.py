@@ -17,7 +17,14 @@ or ``base`` or any combination of:
 - ``noacc``: the Kalman filter reads generator speed and pitch only;
 - ``qw<x>``: speed weight q_Ω = x (default 100); ``act<x>``: pitch-activity weight q_Δ = x (0.1);
 - ``wa<w>``: the MPC's internal model with a pitch actuator of natural frequency w rad/s (the
-  reduced model's is 3.14 rad/s, ROSCO's PA_CornerFreq; the deck simulates none, PA_Mode = 0).
+  reduced model's is 3.14 rad/s, ROSCO's PA_CornerFreq; the deck simulates none, PA_Mode = 0);
+- ``oflin``: the MPC's internal model (prediction and LPV Kalman filter, scheduled on its own wind
+  estimate over the linearised speeds) is OpenFAST's linearisation of the deck at 15-25 m/s
+  (:func:`openfast_linear_model`: no pitch actuator, as the deck), with the reduced model's pitch
+  limits and rate limit.
+
+With ``--reduced`` the same controller runs on the reduced model instead (``run_campaign`` without
+``plant``: its own rotor-effective wind of seed 0, 19 m/s), no log.
 
 E.g. ``... act10`` (q_Δ = 10) or ``... spd1.0081`` (ROSCO's speed filter).
 """
@@ -37,7 +44,7 @@ from scipy import signal
 from specdesign import validate
 from specdesign.export import forwarded
 from specdesign.mpc import QuadraticMPC
-from specdesign.openfast import iea15mw_monopile
+from specdesign.openfast import iea15mw_monopile, linearize_deck
 from specdesign.turbine import iea15mw
 
 #: The call interval (s), ServoDyn's DLL_DT.
@@ -47,6 +54,18 @@ BANDS = (0.0, 1.5, 3.0, 5.0, 8.0, 12.0, 31.4)
 #: The campaign's indicators printed.
 INDICATORS = ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd", "pitch_rate_sd", "pitch_travel",
               "rate_limit_time")
+
+
+#: OpenFAST's linearisations of the deck the ``oflin`` MPC is built on (those of
+#: benchmarks/openfast_table3.py, read from linearize_deck's cache).
+LINEARISED = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
+
+
+def openfast_linear_model(deck, model):
+    """OpenFAST's linearisations of ``deck`` at :data:`LINEARISED` (cached by ``linearize_deck``) with
+    ``model``'s pitch limits and rate limit, which a linearisation does not carry."""
+    lt = linearize_deck(deck, LINEARISED)
+    return replace(lt, pitch_min=model.pitch_min, pitch_max=model.pitch_max, pitch_rate_limit=model.pitch_rate_limit)
 
 
 class Logged:
@@ -115,6 +134,9 @@ def controllers_of(variant, model, deck, log):
     m = re.search(r"wa([0-9.]+)", variant)
     if m:
         mdl = replace(model, actuator_omega=float(m.group(1)))
+    if "oflin" in variant:
+        mdl = openfast_linear_model(deck, model)
+        kw["wind_speeds"] = mdl.wind_speeds
     ctl = Logged(QuadraticMPC(mdl, ts=0.1, **kw), log, filters)
     return {"MPC_" + variant: forwarded(ctl, dt=DT, model=model, pitch_rate_limit=model.pitch_rate_limit)}
 
@@ -157,21 +179,27 @@ def main():
     ap.add_argument("--duration", type=float, default=40.0)
     ap.add_argument("--transient", type=float, default=20.0)
     ap.add_argument("--store", default="/tmp/specdesign_openfast_variants")
+    ap.add_argument("--reduced", action="store_true", help="run on the reduced model instead of OpenFAST")
     args = ap.parse_args()
     model, deck = iea15mw(), iea15mw_monopile()
     store = Path(args.store)
     store.mkdir(parents=True, exist_ok=True)
-    log = store / f"{args.variant}.log"
+    log = store / f"{args.variant}{'_reduced' if args.reduced else ''}.log"
     controllers = controllers_of(args.variant, model, deck, log)
     t0 = time.perf_counter()
-    camp = validate.run_campaign(controllers, [19.0], [0], plant=deck, duration=args.duration,
-                                 transient=args.transient, store=store / args.variant, record_dt=0.1,
-                                 keep_series=True, openfast={"processes": 1, "nice": 10}, progress=False)
-    print(f"{args.variant}: {args.duration:g} s after {args.transient:g} s, 19 m/s, seed 0, wall "
-          f"{time.perf_counter() - t0:.0f} s, unstable {bool(camp.unstable[0, 0])}")
+    if args.reduced:
+        camp = validate.run_campaign(controllers, [19.0], [0], duration=args.duration, transient=args.transient,
+                                     progress=False)
+    else:
+        camp = validate.run_campaign(controllers, [19.0], [0], plant=deck, duration=args.duration,
+                                     transient=args.transient, store=store / args.variant, record_dt=0.1,
+                                     keep_series=True, openfast={"processes": 1, "nice": 10}, progress=False)
+    print(f"{args.variant}: {args.duration:g} s after {args.transient:g} s, 19 m/s, seed 0, "
+          f"{'reduced model' if args.reduced else 'OpenFAST'}, wall {time.perf_counter() - t0:.0f} s, unstable "
+          f"{bool(camp.unstable[0, 0])}")
     for k in INDICATORS:
         print(f"  {k:16s} {camp.values[k][0, 0, 0]:.4g}")
-    if args.variant != "rosco" and log.exists():
+    if args.variant != "rosco" and not args.reduced and log.exists():
         sd, limit, share = command_rate_bands(log, args.transient, model.pitch_rate_limit)
         print(f"  command (0.1 s samples): rate SD {sd:.4g} rad/s, at the limit {100 * limit:.0f} %; share of the "
               "rate's variance per band (rad/s): " + ", ".join(f"{a:g}-{b:g} {100 * s:.0f} %"

@@ -339,3 +339,62 @@ def test_design_hinf_on_linear_turbine(model, cases_lt):
     got, ref = design_hinf(cases_lt, 19.0), design_hinf(model, 19.0)
     assert got.predicted_del_reduction == pytest.approx(ref.predicted_del_reduction, rel=1e-6)
     assert got.gamma == pytest.approx(ref.gamma, rel=1e-6)
+
+
+# ----------------------------------------------------------------------------- operating-point states, pickling
+def test_lin_file_operating_point_states_and_outputs(sample, floating):
+    """x and y of the operating point are the file's x_op and y_op (read here from the raw file's
+    averaged data by description), a d/dt output is 0, and evaluate_outputs at the trim returns y."""
+    data = read_linearization(sample)
+    op = floating.trim(19.0)
+    plant = floating.plants[0]
+    desc = [d.replace(".", "_") for d in data.x_desc]
+    assert len(op.x) == plant.nstates and len(op.y) == plant.noutputs
+    for name, x in zip(plant.state_labels, op.x):
+        assert x == data.x_op[desc.index(name)]
+    y = dict(zip(plant.output_labels, op.y))
+    for name, channel in (("gen_speed", "GenSpeed"), ("tower_base_my", "TwrBsMyt"), ("pitch", "BldPitch1")):
+        i = next(i for i, d in enumerate(data.y_desc) if channel in d)
+        assert y[name] == data.y_op[i]
+    assert y["tower_top_vel"] == 0.0 and abs(y["gen_speed"] - op.rotor_speed) < 1e-3  # direct drive: GenSpeed = rotor
+    assert_allclose(floating.evaluate_outputs(op.x, 19.0, op.pitch, op.gen_torque), op.y, rtol=0, atol=0)
+    # off the trim: the plant's own linear map (a pitch step reaches the measured pitch 1:1 in OpenFAST)
+    dy = floating.evaluate_outputs(op.x, 19.0, op.pitch + 0.01, op.gen_torque) - np.asarray(op.y)
+    assert_allclose(dy, 0.01 * np.asarray(plant.D)[:, plant.input_labels.index("pitch_cmd")], rtol=1e-12)
+    assert abs(dy[plant.output_labels.index("pitch")] - 0.01) < 1e-5
+
+
+def test_from_model_operating_points_are_the_models_trims(model, lt):
+    """from_model's states and outputs are the reduced model's trim and its outputs there; the
+    actuator limits are the model's; between two speeds they interpolate linearly."""
+    for v in SPEEDS:
+        op, ref = lt.trim(v), model.trim(v)
+        assert_allclose(op.x, ref.x, rtol=0, atol=0)
+        assert_allclose(lt.evaluate_outputs(ref.x, v, ref.pitch, ref.gen_torque),
+                        model.evaluate_outputs(ref.x, v, ref.pitch, ref.gen_torque), rtol=1e-12)
+    assert (lt.pitch_min, lt.pitch_max, lt.pitch_rate_limit) == (model.pitch_min, model.pitch_max, model.pitch_rate_limit)
+    assert_allclose(lt.trim(18.0).x, 0.5 * (np.asarray(model.trim(17.0).x) + np.asarray(model.trim(19.0).x)), rtol=1e-12)
+
+
+def test_evaluate_outputs_needs_operating_point_states():
+    lt = LinearTurbine.from_plants({19.0: iea15mw().linearize(19.0)}, rotor_radius=120.0)
+    with pytest.raises(ValueError, match="no states and outputs"):
+        lt.evaluate_outputs(np.zeros(5), 19.0, 0.3, 1e7)
+    with pytest.raises(ValueError, match="has 2 states"):
+        LinearTurbine.from_plants({19.0: iea15mw().linearize(19.0)}, rotor_radius=120.0,
+                                  operating_points={19.0: LinearOperatingPoint(19.0, 0.79, 0.3, 1e7, (0.0, 0.0))})
+
+
+def test_pickle_round_trip(floating):
+    """python-control systems do not pickle; a LinearTurbine does (a forwarded MPC built on one is
+    pickled to its server), and its default schedule is rebound to the copy."""
+    import pickle
+
+    copy = pickle.loads(pickle.dumps(floating))
+    a, b = copy.linearize(19.0), floating.linearize(19.0)
+    for k in "ABCD":
+        assert_allclose(getattr(a, k), getattr(b, k), rtol=0, atol=0)
+    assert (a.input_labels, a.output_labels, a.state_labels) == (b.input_labels, b.output_labels, b.state_labels)
+    assert copy.trim(19.0) == floating.trim(19.0) and copy.sources == floating.sources
+    assert copy.schedule.turbine is copy
+    assert_allclose(copy.schedule.gains(19.0), floating.schedule.gains(19.0), rtol=0, atol=0)

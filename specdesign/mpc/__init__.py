@@ -73,7 +73,7 @@ from .health import (
 )
 from .health_report import TradeoffPoint, health_tradeoff, plot_tradeoff
 from .lpv import PREDICTED, LPVObserver, LPVTurbine, lpv_observer, lpv_turbine
-from .quadratic import QuadraticMPC, quadratic_qp
+from .quadratic import QuadraticMPC, loop_gain, quadratic_qp, unconstrained_law
 from .sampled import SampledController
 
 __all__ = [
@@ -88,6 +88,8 @@ __all__ = [
     "tune_rho",
     "QuadraticMPC",
     "quadratic_qp",
+    "unconstrained_law",
+    "loop_gain",
     "EconomicMPC",
     "FatigueTerm",
     "fit_fatigue_terms",

@@ -10,6 +10,11 @@ both the pitch command u and the wind deviation d over the sample time T_s)::
     x_{k+1} = A x_k + B_u u_k + B_w d_k,     y_k = C x_k + D_w d_k
 
 with x the five states of :data:`specdesign.turbine.STATE_NAMES` (pitch actuator included).
+A model whose pitch command reaches an output directly (a feedthrough D_u ≠ 0: OpenFAST's
+linearisations, which have no pitch actuator, so the measured pitch is the command and the
+tower-top acceleration answers it at once) gets one more state, the command held over the
+last sample, s_{k+1} = u_k, and y_k = C x_k + D_u s_k + D_w d_k: what is measured at a sample
+comes before the command computed from it (:func:`discretize_turbine`).
 
 Observer: the state is augmented with the wind deviation as a random walk,
 d_{k+1} = d_k + η_k, and a steady-state (time-invariant) Kalman filter in "current estimator"
@@ -95,6 +100,9 @@ class DiscreteTurbine:
         Trim pitch (rad) and generator torque (N·m).
     y0 : numpy.ndarray
         (p,) outputs at the trim (SI).
+    x0 : numpy.ndarray
+        (n,) the states at the trim, absolute (SI; the held command's is ``pitch0``): what a
+        filter in absolute values is about (:mod:`specdesign.mpc.lpv`).
     """
 
     wind_speed: float
@@ -108,6 +116,7 @@ class DiscreteTurbine:
     pitch0: float
     torque0: float
     y0: np.ndarray = field(repr=False)
+    x0: np.ndarray = field(repr=False)
 
     def rows(self, names) -> np.ndarray:
         """Indices of the outputs ``names`` in ``C``.
@@ -138,10 +147,16 @@ class DiscreteTurbine:
 def discretize_turbine(model, wind_speed: float, ts: float) -> DiscreteTurbine:
     """``model.linearize(wind_speed)`` discretised by zero-order hold at ``ts``.
 
+    When the pitch command has a feedthrough to an output (D_u ≠ 0), the state is augmented
+    with the command held over the previous sample (module docstring): a measurement at a
+    sample instant reads the command held up to it, the zero-order hold's left limit.
+
     Parameters
     ----------
-    model : TurbineModel
-        The turbine (e.g. :func:`specdesign.turbine.iea15mw`).
+    model : TurbineModel or LinearTurbine
+        The turbine (e.g. :func:`specdesign.turbine.iea15mw`), or OpenFAST's linearisations
+        with their operating points' states and outputs
+        (:class:`specdesign.openfast.LinearTurbine`).
     wind_speed : float
         Mean wind speed (m/s).
     ts : float
@@ -172,10 +187,18 @@ def discretize_turbine(model, wind_speed: float, ts: float) -> DiscreteTurbine:
     iw, iu = list(sys.input_labels).index("wind"), list(sys.input_labels).index("pitch_cmd")
     A, B, C, D = (np.asarray(m, float) for m in (sys.A, sys.B, sys.C, sys.D))
     Ad, Bd, *_ = scipy.signal.cont2discrete((A, B[:, [iw, iu]], C, D[:, [iw, iu]]), ts, method="zoh")
+    Bu, Bw = Bd[:, 1], Bd[:, 0]
     op = model.trim(float(wind_speed))
+    x0 = np.asarray(op.x, float)
+    if np.any(D[:, iu]):  # the held command as a state: s_{k+1} = u_k, y_k = C x_k + D_u s_k
+        n = Ad.shape[0]
+        Ad = np.block([[Ad, np.zeros((n, 1))], [np.zeros((1, n + 1))]])
+        Bu, Bw = np.append(Bu, 1.0), np.append(Bw, 0.0)
+        C = np.hstack([C, D[:, [iu]]])
+        x0 = np.append(x0, op.pitch)
     y0 = np.asarray(model.evaluate_outputs(op.x, float(wind_speed), op.pitch, op.gen_torque), float)
-    return DiscreteTurbine(float(wind_speed), ts, Ad, Bd[:, 1].copy(), Bd[:, 0].copy(), C, D[:, iw].copy(), names,
-                           float(op.pitch), float(op.gen_torque), y0)
+    return DiscreteTurbine(float(wind_speed), ts, Ad, Bu.copy(), Bw.copy(), C, D[:, iw].copy(), names,
+                           float(op.pitch), float(op.gen_torque), y0, x0)
 
 
 def filter_noise(sensors: SensorNoise | None, dt: float | None = None) -> dict:

@@ -359,9 +359,7 @@ def lpv_observer(model, ts: float, measured, *, wind_speeds=None, measurement_st
     for s in v:
         dm = discretize_turbine(model, float(s), ts)
         Aa, Ba, Ca, L = kalman_gain(dm, measured, measurement_std=measurement_std)
-        op = model.trim(float(s))
-        for k, val in zip(parts, (np.append(np.asarray(op.x, float), s), float(op.pitch), dm.y0[dm.rows(measured)],
-                                  Aa, Ba, Ca, L)):
+        for k, val in zip(parts, (np.append(dm.x0, s), dm.pitch0, dm.y0[dm.rows(measured)], Aa, Ba, Ca, L)):
             parts[k].append(val)
     st = {k: np.stack(val) if k != "b" else np.array(val) for k, val in parts.items()}
     return LPVObserver(v, measured, st["z"], st["b"], st["y"], st["A"], st["B"], st["C"], st["L"])
@@ -404,9 +402,8 @@ def lpv_turbine(model, ts: float, horizon: int, *, wind_speeds=None, outputs=PRE
         mats.append(prediction_matrices(dm, outputs, horizon))
         cs.append(dm.C[dm.rows(outputs)])
         ds.append(dm.Dw[dm.rows(outputs)])
-        op = model.trim(float(s))
-        xs.append(np.asarray(op.x, float))
-        bs.append(float(op.pitch))
+        xs.append(dm.x0)
+        bs.append(dm.pitch0)
         ys.append(dm.y0[dm.rows(outputs)])
     Phi, Gam, Psi = (np.stack([m[k] for m in mats]) for k in range(3))
     return LPVTurbine(v, ts, int(horizon), outputs, np.stack(xs), np.array(bs), np.stack(ys), Phi, Gam, Psi,

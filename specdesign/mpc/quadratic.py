@@ -30,10 +30,10 @@ import numpy as np
 
 from .._checks import positive_scalar
 from .._docs import docstring_of
-from .base import MEASURED, DiscreteTurbine, prediction_matrices
+from .base import MEASURED, DiscreteTurbine, discretize_turbine, prediction_matrices
 from .sampled import SampledController
 
-__all__ = ["QuadraticMPC", "quadratic_qp", "preview_matrix", "OSQP_OPTIONS"]
+__all__ = ["QuadraticMPC", "quadratic_qp", "preview_matrix", "unconstrained_law", "loop_gain", "OSQP_OPTIONS"]
 
 #: OSQP settings of the constrained QP: tolerances well under the 1e-6 relative accuracy the
 #: first move needs, and solution polishing (an active-set refinement: exact active constraints).
@@ -312,3 +312,97 @@ class QuadraticMPC(SampledController):
             out[g] = u0
             self.solve_times.append(time.process_time() - t0)
         return out
+
+
+def unconstrained_law(mpc: QuadraticMPC, wind_speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The MPC's linear law at one operating point when no constraint is active.
+
+    Its Kalman filter at ``wind_speed`` (the vertex model, time-invariant) and the QP's
+    unconstrained minimiser's first move, u_k = K_x x̂_{k|k} + K_u u_{k−1}, written as one
+    discrete system at ``mpc.ts`` with state (x̂_{k|k−1}, u_{k−1}) from the measured outputs'
+    deviations y_k (``mpc.measured``, SI) to the command deviation u_k (rad)::
+
+        x̂_{k|k}   = F x̂_{k|k−1} + L y_k,   F = I − L C_a
+        u_k       = K_x x̂_{k|k} + K_u u_{k−1}
+        x̂_{k+1|k} = A_a x̂_{k|k} + B_a u_k
+
+    Parameters
+    ----------
+    mpc : QuadraticMPC
+        The controller (without preview: the law reads its wind estimate held).
+    wind_speed : float
+        The operating point (m/s), a speed its model linearises at.
+
+    Returns
+    -------
+    A, B, C, D : numpy.ndarray
+        (n+2, n+2), (n+2, q), (n+2,), (q,): u_k = C s_k + D y_k, s_{k+1} = A s_k + B y_k, with
+        n+1 the filter's states (the model's and the wind) and q the measured outputs.
+
+    Raises
+    ------
+    ValueError
+        For an MPC with a wind preview.
+    """
+    if mpc.preview is not None:
+        raise ValueError("mpc has a wind preview: its law reads the previewed wind, not a linear function of the "
+                         "measurements; build the MPC without preview=")
+    pt = mpc.point(wind_speed)
+    Aa, Ba, Ca, L = pt["kf"]
+    K = pt["qp"]["K"][0]
+    n = Aa.shape[0]
+    Kx, Ku = K[:n], K[n]
+    F = np.eye(n) - L @ Ca
+    A = np.zeros((n + 1, n + 1))
+    A[:n, :n] = Aa @ F + np.outer(Ba, Kx @ F)
+    A[:n, n] = Ba * Ku
+    A[n, :n] = Kx @ F
+    A[n, n] = Ku
+    B = np.vstack([Aa @ L + np.outer(Ba, Kx @ L), (Kx @ L)[None, :]])
+    return A, B, np.r_[Kx @ F, Ku], Kx @ L
+
+
+def loop_gain(mpc: QuadraticMPC, wind_speed: float, omega, plant=None) -> np.ndarray:
+    """The sampled loop's gain L(e^{jωT_s}) broken at the pitch command, MPC unconstrained.
+
+    L = C(z)·P(z) with C the :func:`unconstrained_law` and P the plant from the command to
+    the measured outputs, both discrete at ``mpc.ts`` (zero-order hold: exact at the sample
+    instants). The loop is u = C P u, positive feedback, so the return difference is 1 − L and
+    min_ω |1 − L| is the modulus margin (the distance of the Nyquist curve from +1; 0.5 is
+    the usual robustness requirement, |S| ≤ 2).
+
+    Parameters
+    ----------
+    mpc : QuadraticMPC
+        The controller.
+    wind_speed : float
+        The operating point (m/s) of the law and of the plant.
+    omega : array_like
+        Frequencies (rad/s), up to the Nyquist frequency π/T_s.
+    plant : TurbineModel or LinearTurbine, optional
+        The plant the loop is closed on; default the MPC's own model (its internal model is the
+        plant).
+
+    Returns
+    -------
+    numpy.ndarray
+        L at ``omega`` (complex, shaped as ``omega``).
+
+    Examples
+    --------
+    >>> from specdesign.turbine import iea15mw
+    >>> mpc = QuadraticMPC(iea15mw(), operating_point="initial pitch")
+    >>> bool(abs(loop_gain(mpc, 19.0, 0.0) - 1.0) < 1e-6)  # integral action on the wind estimate: L(1) = 1
+    True
+    """
+    A, B, C, D = unconstrained_law(mpc, wind_speed)
+    dm = mpc.point(wind_speed)["model"] if plant is None else discretize_turbine(plant, wind_speed, mpc.ts)
+    rows = dm.rows(mpc.measured)
+    w = np.asarray(omega, float)
+    out = np.empty(w.shape, complex)
+    for i, wi in np.ndenumerate(w):
+        z = np.exp(1j * wi * mpc.ts)
+        p = dm.C[rows] @ np.linalg.solve(z * np.eye(dm.A.shape[0]) - dm.A, dm.Bu)
+        c = C @ np.linalg.solve(z * np.eye(A.shape[0]) - A, B) + D
+        out[i] = c @ p
+    return out

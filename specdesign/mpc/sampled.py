@@ -246,7 +246,7 @@ class SampledController:
             self.observer()  # built before the first sample, not inside the timed policy
             z = np.empty((pitch.size, n1))
             for v, idx in groups.items():
-                z[idx] = np.append(np.asarray(self.model.trim(v).x, float), v)
+                z[idx] = np.append(pts[v]["model"].x0, v)
             self._run["zprior"] = z
 
     def __call__(self, t: float, y: dict) -> np.ndarray:

@@ -61,12 +61,21 @@ class LinearOperatingPoint:
         Collective blade pitch (rad).
     gen_torque : float
         Generator torque (N·m; nan when unknown).
+    x : tuple of float, optional
+        The plant's states at the operating point (SI, in the order of the plant's states;
+        OpenFAST's ``x_op``): the trim a model predicting in absolute values is about (the
+        MPCs' scheduled Kalman filter). Empty when unknown.
+    y : tuple of float, optional
+        The plant's outputs at the operating point (SI, in the order of its outputs;
+        OpenFAST's ``y_op``, zero for a ``d/dt`` output). Empty when unknown.
     """
 
     wind_speed: float
     rotor_speed: float
     pitch: float
     gen_torque: float = float("nan")
+    x: tuple = ()
+    y: tuple = ()
 
 
 def rotor_speed_model(plant) -> tuple[float, float, float]:
@@ -204,16 +213,30 @@ class LinearTurbine:
         Label.
     schedule : object, optional
         The baseline PI gains: anything with ``gains(wind_speed) -> (Kp, Ki)`` in ROSCO's sign
-        (a :class:`specdesign.rosco.RoscoSchedule`); default :class:`RotorModelSchedule`.
+        (a :class:`specdesign.rosco.RoscoSchedule`); default :class:`RotorModelSchedule`. A
+        :class:`RotorModelSchedule` is always placed on this turbine's plants (its ``turbine``
+        rebound: on a copy made by ``dataclasses.replace``, the copy's).
     sources : tuple of str, optional
         Where the plants came from (file paths), for the record.
+    pitch_min, pitch_max : float, optional
+        Pitch position limits (rad) of the turbine's actuator, which a linearisation does not
+        carry (nan: unknown): what a controller that constrains its commands reads, as it reads a
+        :class:`~specdesign.turbine.TurbineModel`'s (``dataclasses.replace(lt, pitch_min=...)``).
+    pitch_rate_limit : float, optional
+        Pitch-rate limit (rad/s) of the actuator; nan: unknown.
 
     Raises
     ------
     ValueError
         Speeds not strictly increasing (repeated speeds named), counts that differ, plants
         without the required signals or with other signals or states than the first, a
-        non-positive rotor radius.
+        non-positive rotor radius, operating-point states or outputs of another length than the
+        plant's.
+
+    Notes
+    -----
+    Picklable (python-control's systems are not): the plants are pickled as their matrices and
+    signal names, and the default schedule is rebuilt on the unpickled turbine.
     """
 
     wind_speeds: np.ndarray
@@ -223,6 +246,9 @@ class LinearTurbine:
     name: str = "linear turbine"
     schedule: object = field(default=None, repr=False)
     sources: tuple = ()
+    pitch_min: float = float("nan")
+    pitch_max: float = float("nan")
+    pitch_rate_limit: float = float("nan")
 
     def __post_init__(self):
         v = np.atleast_1d(np.asarray(self.wind_speeds, float))
@@ -248,6 +274,9 @@ class LinearTurbine:
             if not isinstance(op, LinearOperatingPoint) or not math.isclose(op.wind_speed, s, rel_tol=_SAME_SPEED):
                 raise ValueError(f"operating_points must be LinearOperatingPoint records at the wind speeds, got {op!r} "
                                  f"at {s:g} m/s")
+            if len(op.x) not in (0, plants[0].nstates) or len(op.y) not in (0, plants[0].noutputs):
+                raise ValueError(f"the operating point at {s:g} m/s has {len(op.x)} states and {len(op.y)} outputs; the "
+                                 f"plant has {plants[0].nstates} and {plants[0].noutputs} (or give none: unknown)")
         v.flags.writeable = False
         object.__setattr__(self, "wind_speeds", v)
         object.__setattr__(self, "plants", plants)
@@ -255,6 +284,21 @@ class LinearTurbine:
         object.__setattr__(self, "rotor_radius", positive_scalar(self.rotor_radius, "rotor_radius"))
         if self.schedule is None:
             object.__setattr__(self, "schedule", RotorModelSchedule(self))
+        elif isinstance(self.schedule, RotorModelSchedule) and self.schedule.turbine is not self:
+            # pole placement on *these* plants (a copy by dataclasses.replace, an unpickled turbine)
+            object.__setattr__(self, "schedule", RotorModelSchedule(self, self.schedule.omega_pc, self.schedule.zeta_pc))
+        for k in ("pitch_min", "pitch_max", "pitch_rate_limit"):
+            object.__setattr__(self, k, float(getattr(self, k)))
+
+    def __reduce__(self):
+        plants = tuple((np.asarray(p.A, float), np.asarray(p.B, float), np.asarray(p.C, float), np.asarray(p.D, float),
+                        tuple(p.input_labels), tuple(p.output_labels), tuple(p.state_labels)) for p in self.plants)
+        schedule = self.schedule
+        if isinstance(schedule, RotorModelSchedule):  # refers back to this turbine: rebound by __post_init__
+            schedule = RotorModelSchedule(None, schedule.omega_pc, schedule.zeta_pc)
+        return _unpickle_linear_turbine, (self.wind_speeds.copy(), plants, self.operating_points, self.rotor_radius,
+                                          self.name, schedule, self.sources, self.pitch_min, self.pitch_max,
+                                          self.pitch_rate_limit)
 
     # -- the TurbineModel interface the design loop uses ------------------------------------
     @property
@@ -339,7 +383,8 @@ class LinearTurbine:
         Returns
         -------
         LinearOperatingPoint
-            Rotor speed, pitch and generator torque there.
+            Rotor speed, pitch and generator torque there, and the states and outputs when the
+            operating points carry them.
 
         Raises
         ------
@@ -350,7 +395,51 @@ class LinearTurbine:
         a, b = self.operating_points[i], self.operating_points[j]
         mix = [(1 - t) * x + t * y if t else x for x, y in ((a.rotor_speed, b.rotor_speed), (a.pitch, b.pitch),
                                                              (a.gen_torque, b.gen_torque))]
-        return LinearOperatingPoint(float(wind_speed), *(float(m) for m in mix))
+        vec = [tuple(float(e) for e in ((1 - t) * np.asarray(x, float) + t * np.asarray(y, float)))
+               if len(x) and len(y) else () for x, y in ((a.x, b.x), (a.y, b.y))]
+        return LinearOperatingPoint(float(wind_speed), *(float(m) for m in mix), *vec)
+
+    def evaluate_outputs(self, x, wind_speed: float, pitch: float, gen_torque: float) -> np.ndarray:
+        """The linear model's outputs at state ``x`` about the operating point at ``wind_speed``.
+
+        y = ȳ + C (x − x̄) + D_β (β − β̄) + D_τ (τ − τ̄), the wind at its mean: what
+        :meth:`specdesign.turbine.TurbineModel.evaluate_outputs` is for the reduced model, so a
+        controller that predicts in absolute values (:func:`specdesign.mpc.base.discretize_turbine`)
+        takes this turbine.
+
+        Parameters
+        ----------
+        x : array_like
+            (n,) absolute state (SI, the plant's states).
+        wind_speed : float
+            Mean wind speed (m/s) within ``wind_range``.
+        pitch : float
+            Pitch command (rad).
+        gen_torque : float
+            Generator torque (N·m); ignored by a plant without a ``gen_torque`` input.
+
+        Returns
+        -------
+        numpy.ndarray
+            (p,) outputs in the order of :attr:`output_names` (SI).
+
+        Raises
+        ------
+        ValueError
+            Outside ``wind_range``, or operating points without their states and outputs
+            (``x``, ``y``: :meth:`from_lin_files` reads them, :meth:`from_model` computes them).
+        """
+        op, sys = self.trim(wind_speed), self.linearize(wind_speed)
+        if not op.x or not op.y:
+            raise ValueError(f"the operating points of {self.name!r} carry no states and outputs (x, y), so absolute "
+                             "outputs are unknown; build it with from_lin_files or from_model")
+        C, D = np.asarray(sys.C, float), np.asarray(sys.D, float)
+        ins = list(sys.input_labels)
+        y = np.asarray(op.y, float) + C @ (np.asarray(x, float) - np.asarray(op.x, float))
+        y += D[:, ins.index("pitch_cmd")] * (float(pitch) - op.pitch)
+        if "gen_torque" in ins:
+            y += D[:, ins.index("gen_torque")] * (float(gen_torque) - op.gen_torque)
+        return y
 
     def baseline_controller(self, wind_speed: float):
         """ROSCO's baseline PI at ``wind_speed``: C(s) = (Kp + Ki/s)·F_lpf(s), gains from ``schedule``.
@@ -470,14 +559,22 @@ class LinearTurbine:
         Returns
         -------
         LinearTurbine
-            Plants ``model.linearize(v)``, operating points of ``model.trim(v)``.
+            Plants ``model.linearize(v)``, operating points of ``model.trim(v)`` (with its states
+            and outputs), the model's pitch limits and pitch-rate limit.
         """
         vs = [float(v) for v in wind_speeds]
         sched = rosco_gain_schedule(model) if isinstance(schedule, str) and schedule == "rosco" else schedule
-        ops = {v: LinearOperatingPoint(v, *(float(getattr(model.trim(v), k)) for k in ("rotor_speed", "pitch", "gen_torque")))
-               for v in vs}
-        return cls.from_plants({v: model.linearize(v) for v in vs}, rotor_radius=model.rotor_radius, operating_points=ops,
-                               name=model.name, schedule=sched)
+        ops = {}
+        for v in vs:
+            op = model.trim(v)
+            ops[v] = LinearOperatingPoint(v, float(op.rotor_speed), float(op.pitch), float(op.gen_torque),
+                                          tuple(float(e) for e in op.x),
+                                          tuple(float(e) for e in model.evaluate_outputs(op.x, v, op.pitch, op.gen_torque)))
+        lt = cls.from_plants({v: model.linearize(v) for v in vs}, rotor_radius=model.rotor_radius, operating_points=ops,
+                             name=model.name, schedule=sched)
+        for k in ("pitch_min", "pitch_max", "pitch_rate_limit"):  # the reduced model's actuator limits
+            object.__setattr__(lt, k, float(getattr(model, k)))
+        return lt
 
     @classmethod
     def from_lin_files(cls, paths, signals: dict | None = None, *, rotor_radius: float | None = None,
@@ -532,11 +629,17 @@ class LinearTurbine:
         plants, ops, radius = {}, {}, rotor_radius
         for v, group in groups.items():
             data = read_linearization(group)
-            plants[v], _ = plant_from_linearization(data, signals)
+            plants[v], used = plant_from_linearization(data, signals)
             u = dict(zip(data.u_desc, data.u_op))
             pitch = next((x for d, x in u.items() if "collective blade-pitch" in d.lower()), float("nan"))
             torque = next((x for d, x in u.items() if "generator torque" in d.lower()), float("nan"))
-            ops[v] = LinearOperatingPoint(float(v), data.rotor_speed, float(pitch), float(torque))
+            # the kept states by description (plant_from_linearization's names); a d/dt output is 0 at the
+            # operating point (a steady state, averaged over the azimuths)
+            xd = [d.replace(".", "_") for d in data.x_desc]
+            x_op = tuple(float(data.x_op[xd.index(s)]) for s in plants[v].state_labels)
+            y_op = tuple(0.0 if used[n].startswith("d/dt ") else float(data.y_op[data.y_desc.index(used[n])])
+                         for n in plants[v].output_labels)
+            ops[v] = LinearOperatingPoint(float(v), data.rotor_speed, float(pitch), float(torque), x_op, y_op)
             if radius is None:
                 area = [x for d, x in zip(data.y_desc, data.y_op) if d.startswith("AD RtArea")]
                 if not area:
@@ -546,3 +649,13 @@ class LinearTurbine:
         lt = cls.from_plants(plants, rotor_radius=radius, operating_points=ops, name=label, schedule=schedule)
         object.__setattr__(lt, "sources", tuple(files))
         return lt
+
+
+def _unpickle_linear_turbine(wind_speeds, plants, operating_points, rotor_radius, name, schedule, sources, pitch_min,
+                             pitch_max, pitch_rate_limit):
+    """A :class:`LinearTurbine` from its :meth:`LinearTurbine.__reduce__` record."""
+    import control
+
+    systems = tuple(control.ss(A, B, C, D, inputs=list(i), outputs=list(o), states=list(x)) for A, B, C, D, i, o, x in plants)
+    return LinearTurbine(wind_speeds, systems, operating_points, rotor_radius, name, schedule, sources, pitch_min,
+                         pitch_max, pitch_rate_limit)
