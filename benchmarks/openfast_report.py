@@ -6,7 +6,7 @@ store) with :func:`specdesign.validate.read_openfast_runs` and prints, per wind 
 controller against the baseline on the seeds both have finished:
 
 - the tower-base DEL change (1 Hz, m = 4; seeds pooled by damage, jackknife SE over the
-  paired seeds), generator-speed SD and blade-root DEL changes;
+  paired seeds), generator-speed SD, blade-root DEL and mean-power changes;
 - the actuator's cost, absolute: pitch-rate SD (deg/s), pitch travel (deg/h) and the time at
   the pitch-rate limit (% of the record), where the runs carry them (runs stored before an
   indicator existed lack it and are left out of its mean, never filled in);
@@ -93,7 +93,7 @@ def _cell_stats(runs, base, name, v, m):
     if not seeds:
         return None
     out = {"seeds": seeds}
-    for ind in ("tower_del", "gen_speed_sd", "blade_del"):
+    for ind in ("tower_del", "gen_speed_sd", "blade_del", "mean_power"):
         ch = validate.paired_change([d[s].values[ind] for s in seeds], [b[s].values[ind] for s in seeds], ind, m=m)
         out[ind] = (float(ch.change[0]), float(ch.se[0]))
     for ind, f in (("pitch_rate_sd", DEG), ("pitch_travel", DEG), ("rate_limit_time", 100.0)):
@@ -118,7 +118,7 @@ def _change_table(runs, baseline, m, skip=()) -> tuple[list, list]:
     names = sorted({r.controller for r in runs} - {baseline} - set(skip))
     speeds = sorted({r.wind_speed for r in runs})
     lines, bands = [], []
-    head = ("| wind (m/s) | controller | paired seeds | tower DEL (%) | gen-speed SD (%) | blade DEL (%) "
+    head = ("| wind (m/s) | controller | paired seeds | tower DEL (%) | gen-speed SD (%) | blade DEL (%) | power (%) "
             f"| pitch-rate SD (deg/s): {baseline} / design | pitch travel (deg/h): {baseline} / design "
             "| at the rate limit (%): design |")
     lines += [head, "|" + "---|" * (head.count("|") - 1)]
@@ -130,7 +130,7 @@ def _change_table(runs, baseline, m, skip=()) -> tuple[list, list]:
             n = len(st["seeds"])
             trav = [f"{x:.0f}" if k else "not recorded" for x, k in (st["pitch_travel", "base"], st["pitch_travel", "design"])]
             lines.append(f"| {v:g} | {name} | {n} ({', '.join(map(str, st['seeds']))}) | {_pm(st, 'tower_del', n)} "
-                         f"| {_pm(st, 'gen_speed_sd', n)} | {_pm(st, 'blade_del', n)} "
+                         f"| {_pm(st, 'gen_speed_sd', n)} | {_pm(st, 'blade_del', n)} | {_pm(st, 'mean_power', n)} "
                          f"| {st['pitch_rate_sd', 'base'][0]:.3f} / {st['pitch_rate_sd', 'design'][0]:.3f} "
                          f"| {trav[0]} / {trav[1]} "
                          f"| {st['rate_limit_time', 'design'][0]:.2f} |")

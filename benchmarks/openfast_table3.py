@@ -89,6 +89,16 @@ def designs(model, speeds, target, structure="certificate") -> dict:
     return res
 
 
+def export_design(design, folder, name, reduced):
+    """``design`` exported as a DISCON library in ``folder`` (the ``DisconExport``), as the
+    campaign runs it: the generator torque as the deck's DISCON runs it (ROSCO's law below rated,
+    constant torque above: VS_ConstPower = 0), the pitch rate limited as ROSCO's PC_MaxRat (the
+    reduced model's), the tower-top velocity of an ATD loop high-passed (OpenFAST's acceleration
+    has a bias), at DT = 0.01 s."""
+    return export_discon(design, folder, dt=0.01, model=reduced, torque="rosco", pitch_rate_limit=reduced.pitch_rate_limit,
+                         atd_highpass=0.05, name=name)
+
+
 def predicted_del(model, v, design=None) -> float:
     """The linear prediction of the tower-base DEL (1 Hz, N·m) on the design model at ``v`` m/s
     (:func:`specdesign.validate.linear_prediction`): ``design``'s pitch loop and tower damper
@@ -125,7 +135,7 @@ def main() -> None:
     deck = iea15mw_monopile()
     model = reduced = turbine.iea15mw()
     discon_in = deck.fst.with_name(f"{deck.name}_DISCON.IN")
-    export = None if args.rosco_only else export_discon
+    export = None if args.rosco_only else export_design
     if export is not None and args.plant == "openfast":
         # cached in ~/.cache/specdesign/linearizations (keyed by the case's files and the OpenFAST
         # version): a resumed run, or examples/openfast_chain.py, reads them back
@@ -138,12 +148,7 @@ def main() -> None:
         if args.rosco_td:
             controllers[ROSCO_TD] = rosco_td_discon(discon_in, out)
         if export is not None:
-            # the generator torque as the deck's DISCON runs it: ROSCO's law below rated, constant
-            # torque above (VS_ConstPower = 0); the pitch rate limited as ROSCO's PC_MaxRat; the
-            # tower-top velocity of an ATD loop high-passed (OpenFAST's acceleration has a bias)
-            controllers[label] = export(made[v]["design"], out / f"{prefix}{v:g}", dt=0.01, model=reduced,
-                                        torque="rosco", pitch_rate_limit=reduced.pitch_rate_limit,
-                                        atd_highpass=0.05, name=f"{label} {v:g} m/s")
+            controllers[label] = export(made[v]["design"], out / f"{prefix}{v:g}", f"{label} {v:g} m/s", reduced)
         camps.append(validate.run_campaign(
             controllers, [v], args.seeds, plant=deck, duration=args.duration, transient=args.transient,
             store=out / "runs", progress=True, keep_series=1,  # seed 0's records: Fig. 9 (openfast_report.py)

@@ -100,9 +100,10 @@ class DiscreteTurbine:
         Trim pitch (rad) and generator torque (N·m).
     y0 : numpy.ndarray
         (p,) outputs at the trim (SI).
-    x0 : numpy.ndarray
+    x0 : numpy.ndarray, optional
         (n,) the states at the trim, absolute (SI; the held command's is ``pitch0``): what a
-        filter in absolute values is about (:mod:`specdesign.mpc.lpv`).
+        filter in absolute values is about (:mod:`specdesign.mpc.lpv`). :func:`discretize_turbine`
+        sets it; None (default) for a model built by hand, whose trim no filter reads.
     """
 
     wind_speed: float
@@ -116,7 +117,7 @@ class DiscreteTurbine:
     pitch0: float
     torque0: float
     y0: np.ndarray = field(repr=False)
-    x0: np.ndarray = field(repr=False)
+    x0: np.ndarray | None = field(default=None, repr=False)
 
     def rows(self, names) -> np.ndarray:
         """Indices of the outputs ``names`` in ``C``.

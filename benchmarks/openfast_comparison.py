@@ -1,0 +1,139 @@
+"""Issue 31's comparison in OpenFAST: ROSCO, ROSCO with its tower damper, the QFT+ATD designs and
+the quadratic MPC whose internal model is OpenFAST's linearisation of the deck, at 2 speeds × 4
+seeds × 600 s by default, against both baselines with paired SEs.
+
+    nohup nice -n 10 python benchmarks/openfast_comparison.py --processes 2 > comparison.log 2>&1 &
+    python benchmarks/openfast_comparison.py --speeds 19 --seeds 1 --duration 60 --transient 20   # a smoke run
+    python benchmarks/openfast_comparison.py --rule-only    # the MPC's activity weight by its rule, no run
+
+The shipped IEA 15 MW monopile deck with TurbSim winds (IEC Kaimal NTM class B), every controller
+on the same seeds, ``run_campaign(..., plant=deck)``; resumable: every finished run is kept in
+``--out``/runs (a folder per run) and a second call runs only what is missing. The controllers:
+
+- ``ROSCO``: ROSCO's compiled DISCON with the deck's DISCON.IN (its tower damper off, as shipped);
+- ``ROSCO+TD``: the same with ROSCO's fore-aft tower damper on (``TD_Mode = 1``, ``FA_KI`` by the
+  rule of ``benchmarks/openfast_table3.py``'s :func:`rosco_td_discon`);
+- ``QFT+ATD``: the paper's structure (PI + notch + low-pass and a tower damper on the tower-top
+  velocity) designed per speed on the reduced model to the DEL target and exported as a DISCON
+  library, exactly as ``openfast_table3.py`` makes and exports it (its functions are called);
+- ``MPC-OFlin``: :class:`specdesign.mpc.QuadraticMPC` (ts = 0.1 s, horizon 5 s, the class's weights)
+  whose prediction model and LPV Kalman filter are OpenFAST's linearisations of the deck at
+  15-25 m/s (:func:`openfast_forward_variants.openfast_linear_model`; no pitch actuator, as the
+  deck; the operating point estimated from its own wind estimate, never told the mean wind),
+  forwarded to Python at DLL_DT = 0.02 s with the turbine's pitch-rate limit;
+- ``MPC-OFlin-rule``: the same with the pitch-activity weight q_Δ chosen by :func:`activity_weight_rule`
+  on that model (docs/openfast.md, "The MPC on OpenFAST's linearisation").
+
+The printed tables are ``benchmarks/openfast_report.py``'s: per speed and controller the paired
+changes against ROSCO and against ROSCO+TD (tower-base and blade-root DEL, generator-speed SD,
+mean power; jackknife SE over the paired seeds from two seeds up), the pitch-rate SD, pitch travel
+and time at the rate limit, OpenFAST's CPU and wall time per run, and the tower-base moment's
+variance by band.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parent))  # the sibling scripts whose functions are reused
+
+from openfast_forward_variants import openfast_linear_model  # noqa: E402
+from openfast_report import report  # noqa: E402
+from openfast_table3 import ROSCO_TD, designs, export_design, rosco_td_discon  # noqa: E402
+
+from specdesign import turbine, validate  # noqa: E402
+from specdesign.export import forwarded  # noqa: E402
+from specdesign.mpc import QuadraticMPC, loop_gain  # noqa: E402
+from specdesign.openfast import find_openfast, iea15mw_monopile  # noqa: E402
+
+#: The activity weights the rule tries, smallest first (half decades from the class's 0.1).
+RULE_GRID = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
+#: The rule's requirements on the MPC's unconstrained loop on OpenFAST's linearisation, at every
+#: linearised speed: modulus margin min|1 − L| ≥ 0.5 (|S| ≤ 2), and |L| ≤ 0.5 above 1.5 rad/s,
+#: where the linearisation (the rotor, the foundation and the first tower fore-aft mode at
+#: 1.07 rad/s; no blade modes, quasi-steady aerodynamics) is not OpenFAST's response to the pitch
+#: (3P at 2.4 rad/s, the blades' first flap modes, unsteady aerodynamics: docs/openfast.md).
+MODULUS_MARGIN, BAND, BAND_GAIN = 0.5, 1.5, 0.5
+#: The sample time (s) and forwarding interval (s, ServoDyn's DLL_DT) of the MPCs.
+TS, DT = 0.1, 0.02
+
+
+def activity_weight_rule(lt, grid=RULE_GRID) -> tuple[float, list]:
+    """The smallest q_Δ of ``grid`` whose unconstrained loop on ``lt`` meets :data:`MODULUS_MARGIN`
+    and :data:`BAND_GAIN` above :data:`BAND` at every linearised speed (the last of the grid if none
+    does), and the rows (q_Δ, speed m/s, min|1 − L|, max |L| above the band) it looked at."""
+    w = np.linspace(0.01, np.pi / TS, 3000)  # rad/s, up to the sampled loop's Nyquist frequency
+    rows = []
+    for q in grid:
+        mpc = QuadraticMPC(lt, ts=TS, activity_weight=q, wind_speeds=lt.wind_speeds)
+        ok = True
+        for v in lt.wind_speeds:
+            L = loop_gain(mpc, float(v), w)
+            margin, band = float(np.abs(1 - L).min()), float(np.abs(L[w >= BAND]).max())
+            rows.append((q, float(v), margin, band))
+            ok &= margin >= MODULUS_MARGIN and band <= BAND_GAIN
+        if ok:
+            return q, rows
+    return grid[-1], rows
+
+
+def mpcs(lt, reduced, q_rule) -> dict:
+    """The forwarded MPCs on OpenFAST's linearisation: the class's weights and q_Δ by the rule."""
+    out = {}
+    for label, q in (("MPC-OFlin", 0.1), ("MPC-OFlin-rule", q_rule)):
+        mpc = QuadraticMPC(lt, ts=TS, activity_weight=q, wind_speeds=lt.wind_speeds,
+                           name=f"quadratic MPC on OpenFAST's linearisation, q_Δ = {q:g}")
+        out[label] = forwarded(mpc, dt=DT, model=reduced, pitch_rate_limit=reduced.pitch_rate_limit)
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--speeds", default="17,21", help="wind speeds, m/s (default: %(default)s)")
+    ap.add_argument("--seeds", type=int, default=4)
+    ap.add_argument("--duration", type=float, default=600.0, help="recorded s per run")
+    ap.add_argument("--transient", type=float, default=60.0, help="discarded s per run")
+    ap.add_argument("--target", type=float, default=25.0, help="DEL reduction target of the QFT+ATD designs, %%")
+    ap.add_argument("--processes", type=int, default=None, help="OpenFAST processes at a time (default: CPUs)")
+    ap.add_argument("--nice", type=int, default=0, help="niceness added to OpenFAST (on top of this process's)")
+    ap.add_argument("--out", default="build/openfast_comparison")
+    ap.add_argument("--rule-only", action="store_true", help="print the MPC's activity-weight rule and stop")
+    args = ap.parse_args()
+    speeds = [float(x) for x in args.speeds.split(",")]
+    t0 = time.monotonic()
+    deck, reduced = iea15mw_monopile(), turbine.iea15mw()
+    lt = openfast_linear_model(deck, reduced)
+    q_rule, rows = activity_weight_rule(lt)
+    print(f"activity weight by the rule (modulus margin >= {MODULUS_MARGIN:g}, |L| <= {BAND_GAIN:g} above {BAND:g} "
+          f"rad/s at every linearised speed): q_Δ = {q_rule:g}")
+    print("| q_Δ | wind (m/s) | min abs(1 − L) | max abs(L) above the band |\n|---|---|---|---|")
+    for q, v, margin, band in rows:
+        print(f"| {q:g} | {v:g} | {margin:.2f} | {band:.2f} |")
+    if args.rule_only:
+        return
+    out = Path(args.out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    install = find_openfast()
+    discon_in = deck.fst.with_name(f"{deck.name}_DISCON.IN")
+    made = designs(reduced, speeds, args.target, "atd")
+    forwarded_mpcs = mpcs(lt, reduced, q_rule)
+    for v in speeds:
+        qft = export_design(made[v]["design"], out / f"export_atd_{v:g}", f"QFT+ATD {v:g} m/s", reduced)
+        controllers = {"ROSCO": discon_in, ROSCO_TD: rosco_td_discon(discon_in, out), "QFT+ATD": qft, **forwarded_mpcs}
+        validate.run_campaign(controllers, [v], args.seeds, plant=deck, duration=args.duration,
+                              transient=args.transient, store=out / "runs", progress=True,
+                              openfast={"processes": args.processes, "nice": args.nice, "install": install})
+    runs = validate.read_openfast_runs(out / "runs")
+    runs = [r for r in runs if r.wind_speed in speeds and r.meta["settings"]["duration"] == args.duration
+            and r.meta["settings"]["transient"] == args.transient]
+    print(f"\nOpenFAST v{install.version}, {len(speeds)} speeds × {args.seeds} seeds × "
+          f"{args.duration + args.transient:g} s: {(time.monotonic() - t0) / 60:.1f} min wall\n")
+    print(report(out / "runs", runs, baseline="ROSCO"))
+
+
+if __name__ == "__main__":
+    main()
