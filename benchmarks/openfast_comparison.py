@@ -41,14 +41,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # the sibling scripts whose functions are reused
 
-from openfast_forward_variants import openfast_linear_model  # noqa: E402
-from openfast_report import report  # noqa: E402
-from openfast_table3 import ROSCO_TD, designs, export_design, rosco_td_discon  # noqa: E402
+from openfast_forward_variants import openfast_linear_model
+from openfast_report import report
+from openfast_table3 import ROSCO_TD, designs, export_design, rosco_td_discon
 
-from specdesign import turbine, validate  # noqa: E402
-from specdesign.export import forwarded  # noqa: E402
-from specdesign.mpc import QuadraticMPC, loop_gain  # noqa: E402
-from specdesign.openfast import find_openfast, iea15mw_monopile  # noqa: E402
+from specdesign import turbine, validate
+from specdesign.export import forwarded
+from specdesign.mpc import QuadraticMPC, loop_gain
+from specdesign.openfast import find_openfast, iea15mw_monopile
 
 #: The activity weights the rule tries, smallest first (half decades from the class's 0.1).
 RULE_GRID = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)

@@ -15,6 +15,9 @@ linearize(19.0)``, pitch-command input), and the loop gain L(jω) = C(jω)·H(j�
 command, C the MPC's unconstrained control law at 19 m/s (its Kalman filter and the QP's
 minimiser, a linear discrete system at ts = 0.1 s, with the hold of its command): the closed loop
 is 1/(1 − L) (positive feedback as written: u = C y), so |1 − L| is the distance to instability.
+The same beside OpenFAST's own linearisation of the deck (``linearize_deck``'s cache: the rotor,
+the foundation and the first tower fore-aft mode, quasi-steady aerodynamics, no pitch actuator) and
+for the MPC whose internal model it is (docs/openfast.md, "The MPC on OpenFAST's linearisation").
 The record goes to --store (JSON) and is read back when there.
 """
 from __future__ import annotations
@@ -24,9 +27,10 @@ import json
 from pathlib import Path
 
 import numpy as np
+from openfast_forward_variants import openfast_linear_model
 
 from specdesign.export import ForwardServer, forwarded
-from specdesign.mpc import QuadraticMPC
+from specdesign.mpc import QuadraticMPC, unconstrained_law
 from specdesign.openfast import iea15mw_monopile, run_case, write_case
 from specdesign.turbine import iea15mw
 
@@ -86,24 +90,12 @@ def phasors(t, x, blade_passing):
 def control_law(model, activity_weight):
     """C(jω) of QuadraticMPC at 19 m/s, unconstrained, from its measurements to its command (with the hold)."""
     mpc = QuadraticMPC(model, ts=0.1, operating_point="initial pitch", activity_weight=activity_weight)
-    pt = mpc.point(19.0)
-    Aa, Ba, Ca, L = pt["kf"]
-    K = pt["qp"]["K"][0]
-    n = Aa.shape[0]
-    Kx, Ku = K[:n], K[n]  # u_k = Kx x̂_k|k + Ku u_{k−1} (the QP's minimiser's first move)
-    F = np.eye(n) - L @ Ca  # x̂_k|k = F x̂_k|k−1 + L y_k
-    A = np.zeros((n + 1, n + 1))
-    A[:n, :n] = Aa @ F + np.outer(Ba, Kx @ F)
-    A[:n, n] = Ba * Ku
-    A[n, :n] = Kx @ F
-    A[n, n] = Ku
-    B = np.vstack([Aa @ L + np.outer(Ba, Kx @ L), (Kx @ L)[None, :]])
-    C, D = np.r_[Kx @ F, Ku], Kx @ L
+    A, B, C, D = unconstrained_law(mpc, 19.0)
 
     def at(w):
         z = np.exp(1j * w * mpc.ts)
         hold = (1 - 1 / z) / (1j * w * mpc.ts)
-        return (C @ np.linalg.solve(z * np.eye(n + 1) - A, B) + D) * hold
+        return (C @ np.linalg.solve(z * np.eye(A.shape[0]) - A, B) + D) * hold
     return mpc.measured, at
 
 
@@ -121,25 +113,30 @@ def main():
     inside = (t >= WINDOW[0]) & (t < WINDOW[1])
     bp = np.array([3.0, 6.0]) * np.mean(y["gen_speed"][inside])  # rotor speed (gearbox ratio 1)
     U = phasors(t, np.array([r[2] for r in rows]), bp)
-    P = model.linearize(19.0)
+    lin = openfast_linear_model(iea15mw_monopile(), model)  # OpenFAST's linearisation of the deck
+    P, PL = model.linearize(19.0), lin.linearize(19.0)
     H = {}
-    print("response to the pitch command: OpenFAST (multisine, steady 19 m/s) | reduced model; |H| and phase (deg)")
+    print("response to the pitch command: OpenFAST (multisine, steady 19 m/s) | reduced model | OpenFAST's "
+          "linearisation; |H| and phase (deg)")
     for k in ("gen_speed", "tower_top_acc", "pitch"):
         H[k] = phasors(t, y[k], bp) / U
         print(k)
         for i, w in enumerate(OMEGA):
-            p = P(1j * w)[P.output_labels.index(k), 1]
+            p, pl = (S(1j * w)[S.output_labels.index(k), S.input_labels.index("pitch_cmd")] for S in (P, PL))
             print(f"  {w:5.2f} rad/s | {abs(H[k][i]):8.3g} {np.degrees(np.angle(H[k][i])):5.0f} | "
-                  f"{abs(p):8.3g} {np.degrees(np.angle(p)):5.0f}")
-    for q in (float(x) for x in args.activity_weights.split(",")):
-        measured, C = control_law(model, q)
-        print(f"QuadraticMPC, q_Δ = {q:g}: loop gain L = C·H, |L| phase (deg), |1 − L|: reduced model | OpenFAST")
-        for i, w in enumerate(OMEGA):
-            c = C(w)
-            lr = c @ np.array([P(1j * w)[P.output_labels.index(o), 1] for o in measured])
-            lo = c @ np.array([H[o][i] for o in measured])
-            print(f"  {w:5.2f} rad/s | {abs(lr):6.2f} {np.degrees(np.angle(lr)):5.0f} {abs(1 - lr):5.2f} | "
-                  f"{abs(lo):6.2f} {np.degrees(np.angle(lo)):5.0f} {abs(1 - lo):5.2f}")
+                  f"{abs(p):8.3g} {np.degrees(np.angle(p)):5.0f} | {abs(pl):8.3g} {np.degrees(np.angle(pl)):5.0f}")
+    for internal, S in (("reduced model", P), ("OpenFAST's linearisation", PL)):
+        for q in (float(x) for x in args.activity_weights.split(",")):
+            measured, C = control_law(model if S is P else lin, q)
+            print(f"QuadraticMPC on the {internal}, q_Δ = {q:g}: loop gain L = C·H, |L| phase (deg), |1 − L|: "
+                  f"its model | OpenFAST")
+            for i, w in enumerate(OMEGA):
+                c = C(w)
+                lr = c @ np.array([S(1j * w)[S.output_labels.index(o), S.input_labels.index("pitch_cmd")]
+                                   for o in measured])
+                lo = c @ np.array([H[o][i] for o in measured])
+                print(f"  {w:5.2f} rad/s | {abs(lr):6.2f} {np.degrees(np.angle(lr)):5.0f} {abs(1 - lr):5.2f} | "
+                      f"{abs(lo):6.2f} {np.degrees(np.angle(lo)):5.0f} {abs(1 - lo):5.2f}")
 
 
 if __name__ == "__main__":

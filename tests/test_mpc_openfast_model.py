@@ -18,7 +18,12 @@ import pytest
 import scipy.integrate
 from numpy.testing import assert_allclose
 
-from specdesign.mpc import QuadraticMPC, discretize_turbine, loop_gain, unconstrained_law
+from specdesign.mpc import (
+    QuadraticMPC,
+    discretize_turbine,
+    loop_gain,
+    unconstrained_law,
+)
 from specdesign.openfast import LinearTurbine
 from specdesign.simulate import simulate
 from specdesign.turbine import iea15mw
