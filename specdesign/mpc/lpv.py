@@ -6,8 +6,10 @@ combination of vertex matrices, Σ α_i = 1, α_i ∈ [0, 1] (its Eqs. 9-11), an
 scheduling parameters over the horizon at their current estimate θ̂ (so the MPC stays a QP).
 Here the vertices are the linearisations of the reduced model (:meth:`TurbineModel.linearize`,
 the Jacobian of the simulated equations) at a grid of mean wind speeds v_1 < … < v_K,
-discretised by zero-order hold (:func:`specdesign.mpc.base.discretize_turbine`). Each vertex
-is kept in absolute (affine) form about its own trim (x̄_i, β̄_i, ȳ_i), so vertices about
+discretised by zero-order hold (:func:`specdesign.mpc.base.discretize_turbine`), or OpenFAST's
+linearisations of a deck (a :class:`specdesign.openfast.LinearTurbine` whose operating points
+carry their states and outputs). Each vertex is kept in absolute (affine) form about its own
+trim (x̄_i, β̄_i, ȳ_i: ``DiscreteTurbine.x0``, ``pitch0``, ``y0``), so vertices about
 different trims can be blended::
 
     z_i = ȳ_i + Φ_i (x − x̄_i) + Γ_i (U − β̄_i) + Ψ_i (v̂ − v_i)        (vertex i, N steps)
