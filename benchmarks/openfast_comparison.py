@@ -32,7 +32,6 @@ variance by band.
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
@@ -43,7 +42,13 @@ sys.path.insert(0, str(Path(__file__).parent))  # the sibling scripts whose func
 
 from openfast_forward_variants import openfast_linear_model
 from openfast_report import report
-from openfast_table3 import ROSCO_TD, designs, export_design, rosco_td_discon
+from openfast_table3 import (
+    ROSCO_TD,
+    campaign_arguments,
+    designs,
+    export_design,
+    rosco_td_discon,
+)
 
 from specdesign import turbine, validate
 from specdesign.export import forwarded
@@ -92,14 +97,7 @@ def mpcs(lt, reduced, q_rule) -> dict:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--speeds", default="17,21", help="wind speeds, m/s (default: %(default)s)")
-    ap.add_argument("--seeds", type=int, default=4)
-    ap.add_argument("--duration", type=float, default=600.0, help="recorded s per run")
-    ap.add_argument("--transient", type=float, default=60.0, help="discarded s per run")
-    ap.add_argument("--target", type=float, default=25.0, help="DEL reduction target of the QFT+ATD designs, %%")
-    ap.add_argument("--processes", type=int, default=None, help="OpenFAST processes at a time (default: CPUs)")
-    ap.add_argument("--nice", type=int, default=0, help="niceness added to OpenFAST (on top of this process's)")
+    ap = campaign_arguments(__doc__.split("\n")[0], "17,21")
     ap.add_argument("--out", default="build/openfast_comparison")
     ap.add_argument("--rule-only", action="store_true", help="print the MPC's activity-weight rule and stop")
     args = ap.parse_args()

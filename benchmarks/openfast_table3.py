@@ -108,15 +108,22 @@ def predicted_del(model, v, design=None) -> float:
     return validate.linear_prediction(model, c, v).del_
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--speeds", default="15,17,19,21,23,25", help="wind speeds, m/s (default: %(default)s)")
+def campaign_arguments(description: str, speeds: str) -> argparse.ArgumentParser:
+    """The command line an OpenFAST campaign script shares: speeds (default ``speeds``), seeds, record
+    and transient lengths, the designs' DEL target, OpenFAST processes and niceness."""
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("--speeds", default=speeds, help="wind speeds, m/s (default: %(default)s)")
     ap.add_argument("--seeds", type=int, default=4)
     ap.add_argument("--duration", type=float, default=600.0, help="recorded s per run")
     ap.add_argument("--transient", type=float, default=60.0, help="discarded s per run")
-    ap.add_argument("--target", type=float, default=25.0, help="DEL reduction target of the specification, %%")
+    ap.add_argument("--target", type=float, default=25.0, help="DEL reduction target of the designs' specification, %%")
     ap.add_argument("--processes", type=int, default=None, help="OpenFAST processes at a time (default: CPUs)")
     ap.add_argument("--nice", type=int, default=0, help="niceness added to OpenFAST (on top of this process's)")
+    return ap
+
+
+def main() -> None:
+    ap = campaign_arguments(__doc__.split("\n")[0], "15,17,19,21,23,25")
     ap.add_argument("--plant", choices=("reduced", "openfast"), default="reduced")
     ap.add_argument("--structure", choices=tuple(STRUCTURES), default="atd",
                     help="the design: the paper's PI + notch + ATD (QFT+ATD, default) or the certified chain (QFT, pitch "
