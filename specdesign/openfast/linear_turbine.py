@@ -654,7 +654,7 @@ class LinearTurbine:
 def _unpickle_linear_turbine(wind_speeds, plants, operating_points, rotor_radius, name, schedule, sources, pitch_min,
                              pitch_max, pitch_rate_limit):
     """A :class:`LinearTurbine` from its :meth:`LinearTurbine.__reduce__` record."""
-    import control
+    import control  # imported where used, as this module's other builders of systems do (heavy)
 
     systems = tuple(control.ss(A, B, C, D, inputs=list(i), outputs=list(o), states=list(x)) for A, B, C, D, i, o, x in plants)
     return LinearTurbine(wind_speeds, systems, operating_points, rotor_radius, name, schedule, sources, pitch_min,
