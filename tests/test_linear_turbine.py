@@ -5,6 +5,7 @@ plants as the model, so every step of the loop (baseline, ΔD%, shaping, linear 
 must give the model's own numbers through the other route. The .lin route is checked on
 the shipped floating IEA 15 MW linearisation against the file's own matrices.
 """
+import dataclasses
 import warnings
 
 import control
@@ -398,3 +399,6 @@ def test_pickle_round_trip(floating):
     assert copy.trim(19.0) == floating.trim(19.0) and copy.sources == floating.sources
     assert copy.schedule.turbine is copy
     assert_allclose(copy.schedule.gains(19.0), floating.schedule.gains(19.0), rtol=0, atol=0)
+    limited = dataclasses.replace(floating, pitch_rate_limit=0.0349)  # the actuator limits a linearisation lacks
+    assert limited.schedule.turbine is limited and limited.pitch_rate_limit == 0.0349
+    assert np.isnan(floating.pitch_rate_limit)
