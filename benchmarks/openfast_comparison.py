@@ -3,19 +3,24 @@ the quadratic MPC whose internal model is OpenFAST's linearisation of the deck, 
 seeds × 600 s by default, against both baselines with paired SEs.
 
     nohup nice -n 10 python benchmarks/openfast_comparison.py --processes 2 > comparison.log 2>&1 &
-    python benchmarks/openfast_comparison.py --speeds 19 --seeds 1 --duration 60 --transient 20   # a smoke run
+    python benchmarks/openfast_comparison.py --speeds 19 --seeds 1 --duration 60 --transient 20 --out /tmp/smoke  # a smoke run (its own store: other settings)
     python benchmarks/openfast_comparison.py --rule-only    # the MPC's activity weight by its rule, no run
 
 The shipped IEA 15 MW monopile deck with TurbSim winds (IEC Kaimal NTM class B), every controller
 on the same seeds, ``run_campaign(..., plant=deck)``; resumable: every finished run is kept in
-``--out``/runs (a folder per run) and a second call runs only what is missing. The controllers:
+``--out``/runs (a folder per run) and a second call runs only what is missing. ``--out`` is by
+default Table 3's store (``build/openfast_table3``): the ROSCO and QFT+ATD runs that
+``openfast_table3.py --plant openfast`` made on the same seeds are found there (by their
+libraries' and parameter files' digests and the run settings) and not run again. The controllers:
 
 - ``ROSCO``: ROSCO's compiled DISCON with the deck's DISCON.IN (its tower damper off, as shipped);
 - ``ROSCO+TD``: the same with ROSCO's fore-aft tower damper on (``TD_Mode = 1``, ``FA_KI`` by the
   rule of ``benchmarks/openfast_table3.py``'s :func:`rosco_td_discon`);
 - ``QFT+ATD``: the paper's structure (PI + notch + low-pass and a tower damper on the tower-top
-  velocity) designed per speed on the reduced model to the DEL target and exported as a DISCON
-  library, exactly as ``openfast_table3.py`` makes and exports it (its functions are called);
+  velocity) designed per speed to the DEL target on OpenFAST's linearisations of the deck (the
+  model the MPCs below predict with: both sides know the plant equally) and exported as a DISCON
+  library, exactly as ``openfast_table3.py --plant openfast`` makes and exports it (its functions
+  are called), so these are Table 3's runs;
 - ``MPC-OFlin``: :class:`specdesign.mpc.QuadraticMPC` (ts = 0.1 s, horizon 5 s, the class's weights)
   whose prediction model and LPV Kalman filter are OpenFAST's linearisations of the deck at
   15-25 m/s (:func:`openfast_forward_variants.openfast_linear_model`; no pitch actuator, as the
@@ -44,9 +49,11 @@ from openfast_forward_variants import openfast_linear_model
 from openfast_report import report
 from openfast_table3 import (
     ROSCO_TD,
+    STRUCTURES,
     campaign_arguments,
     designs,
     export_design,
+    openfast_model,
     rosco_td_discon,
 )
 
@@ -98,7 +105,8 @@ def mpcs(lt, reduced, q_rule) -> dict:
 
 def main() -> None:
     ap = campaign_arguments(__doc__.split("\n")[0], "17,21")
-    ap.add_argument("--out", default="build/openfast_comparison")
+    ap.add_argument("--out", default="build/openfast_table3",
+                    help="store (default: Table 3's, whose ROSCO and QFT+ATD runs are reused)")
     ap.add_argument("--rule-only", action="store_true", help="print the MPC's activity-weight rule and stop")
     args = ap.parse_args()
     speeds = [float(x) for x in args.speeds.split(",")]
@@ -117,11 +125,13 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     install = find_openfast()
     discon_in = deck.fst.with_name(f"{deck.name}_DISCON.IN")
-    made = designs(reduced, speeds, args.target, "atd")
+    # Table 3's designs: on OpenFAST's linearisations, named and exported as openfast_table3.py does
+    label, prefix = STRUCTURES["atd"]
+    made = designs(openfast_model(deck, speeds), speeds, args.target, "atd")
     forwarded_mpcs = mpcs(lt, reduced, q_rule)
     for v in speeds:
-        qft = export_design(made[v]["design"], out / f"export_atd_{v:g}", f"QFT+ATD {v:g} m/s", reduced)
-        controllers = {"ROSCO": discon_in, ROSCO_TD: rosco_td_discon(discon_in, out), "QFT+ATD": qft, **forwarded_mpcs}
+        qft = export_design(made[v]["design"], out / f"{prefix}{v:g}", f"{label} {v:g} m/s", reduced)
+        controllers = {"ROSCO": discon_in, ROSCO_TD: rosco_td_discon(discon_in, out), label: qft, **forwarded_mpcs}
         validate.run_campaign(controllers, [v], args.seeds, plant=deck, duration=args.duration,
                               transient=args.transient, store=out / "runs", progress=True,
                               openfast={"processes": args.processes, "nice": args.nice, "install": install})
