@@ -107,9 +107,9 @@ def _cell_stats(runs, base, name, v, m):
     return out
 
 
-def _pm(st, key, n) -> str:
-    """A paired change ± its SE (the SE only from two seeds up)."""
-    return f"{st[key][0]:+.1f} ± {st[key][1]:.1f}" if n > 1 else f"{st[key][0]:+.1f}"
+def _pm(st, key, n, digits=1) -> str:
+    """A paired change ± its SE (the SE only from two seeds up), to ``digits`` decimals."""
+    return f"{st[key][0]:+.{digits}f} ± {st[key][1]:.{digits}f}" if n > 1 else f"{st[key][0]:+.{digits}f}"
 
 
 def _change_table(runs, baseline, m, skip=()) -> tuple[list, list]:
@@ -118,7 +118,7 @@ def _change_table(runs, baseline, m, skip=()) -> tuple[list, list]:
     names = sorted({r.controller for r in runs} - {baseline} - set(skip))
     speeds = sorted({r.wind_speed for r in runs})
     lines, bands = [], []
-    head = ("| wind (m/s) | controller | paired seeds | tower DEL (%) | gen-speed SD (%) | blade DEL (%) | power (%) "
+    head = ("| wind (m/s) | controller | paired seeds | tower DEL (%) | gen-speed SD (%) | blade DEL (%) | mean power (%) "
             f"| pitch-rate SD (deg/s): {baseline} / design | pitch travel (deg/h): {baseline} / design "
             "| at the rate limit (%): design |")
     lines += [head, "|" + "---|" * (head.count("|") - 1)]
@@ -130,7 +130,7 @@ def _change_table(runs, baseline, m, skip=()) -> tuple[list, list]:
             n = len(st["seeds"])
             trav = [f"{x:.0f}" if k else "not recorded" for x, k in (st["pitch_travel", "base"], st["pitch_travel", "design"])]
             lines.append(f"| {v:g} | {name} | {n} ({', '.join(map(str, st['seeds']))}) | {_pm(st, 'tower_del', n)} "
-                         f"| {_pm(st, 'gen_speed_sd', n)} | {_pm(st, 'blade_del', n)} | {_pm(st, 'mean_power', n)} "
+                         f"| {_pm(st, 'gen_speed_sd', n)} | {_pm(st, 'blade_del', n)} | {_pm(st, 'mean_power', n, 2)} "
                          f"| {st['pitch_rate_sd', 'base'][0]:.3f} / {st['pitch_rate_sd', 'design'][0]:.3f} "
                          f"| {trav[0]} / {trav[1]} "
                          f"| {st['rate_limit_time', 'design'][0]:.2f} |")
