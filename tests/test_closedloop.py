@@ -5,9 +5,11 @@ import control
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+from scipy.signal import cont2discrete
 from scipy.special import gamma
 
 from specdesign import closedloop as cl
+from specdesign.closedloop.maps import state_space_response
 from specdesign.turbine import OUTPUT_NAMES, iea15mw, rosco_baseline
 from specdesign.wind import rotor_effective_spectrum
 
@@ -225,6 +227,28 @@ def test_batched_siso_response_equals_python_controls():
     assert np.array_equal(cl.siso_response(tf, w, method="batched"), cl.siso_response(tf, w))
     with pytest.raises(ValueError, match="method"):
         cl.siso_response(sys, w, method="modal")
+
+
+def test_state_space_response_of_a_discrete_system_equals_python_controls():
+    # sample_time=T evaluates C(zI − A)⁻¹B + D at z = e^{jωT}; python-control's evaluation of the
+    # same discrete system at those points is the oracle. A zero-order-hold discretisation of a
+    # damped system, T = 0.1 s, up to the Nyquist frequency π/T.
+    a = np.array([[0.0, 1.0, 0.0], [-4.0, -0.4, 1.0], [0.0, 0.0, -2.0]])
+    b, c, d = np.array([[0.0], [0.0], [1.0]]), np.array([[1.0, 0.5, 0.0]]), np.array([[0.2]])
+    T = 0.1
+    ad, bd, cd, dd, _ = cont2discrete((a, b, c, d), T, method="zoh")
+    w = np.linspace(0.01, np.pi / T, 200)
+    got = state_space_response(ad, bd, cd, dd, w, sample_time=T)[:, 0, 0]
+    ref = np.array([complex(np.squeeze(control.ss(ad, bd, cd, dd, dt=T)(np.exp(1j * wk * T)))) for wk in w])
+    # tolerance from the conditioning, as the continuous case above (n = 3, the factor 10)
+    eye = np.eye(3)
+    kappa = np.array([np.linalg.cond(np.exp(1j * wk * T) * eye - ad) for wk in w])
+    xnorm = np.array([np.linalg.norm(np.linalg.solve(np.exp(1j * wk * T) * eye - ad, bd)) for wk in w])
+    bound = 2 * 10 * 3 * np.finfo(float).eps * kappa * np.linalg.norm(cd) * xnorm
+    assert np.all(np.abs(got - ref) <= bound)
+    assert np.all(bound < 1e-9 * np.abs(ref))
+    with pytest.raises(ValueError, match="sample_time"):
+        state_space_response(ad, bd, cd, dd, w, sample_time=0.0)
 
 
 def test_refine_grid_points_per_width_samples_every_peak_finely_and_no_more():

@@ -555,10 +555,12 @@ def _batched(P, w, outputs):
     return {(o, i): y[:, k, j] for k, o in enumerate(outputs) for j, i in enumerate(PLANT_INPUTS)}
 
 
-def state_space_response(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, omega: ArrayLike) -> np.ndarray:
-    """C(jωI − A)⁻¹B + D at every ω at once (python-control solves one frequency at a time).
+def state_space_response(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, omega: ArrayLike, *,
+                         sample_time: float | None = None) -> np.ndarray:
+    """C(sI − A)⁻¹B + D at every ω at once (python-control solves one frequency at a time), at
+    s = jω, or at z = e^{jωT} for a discrete system of sample time T (``sample_time``).
 
-    Modal when A's eigenvectors are well conditioned (C·V·diag(1/(jω − λ))·V⁻¹·B), else one
+    Modal when A's eigenvectors are well conditioned (C·V·diag(1/(s − λ))·V⁻¹·B), else one
     batched solve per frequency.
 
     Parameters
@@ -567,6 +569,8 @@ def state_space_response(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike,
         (n, n), (n, m), (p, n), (p, m) state-space matrices (SI units of the system).
     omega : array_like
         (nw,) frequencies, rad/s.
+    sample_time : float, optional
+        T (s, > 0) of a discrete system; None (default): continuous.
 
     Returns
     -------
@@ -582,13 +586,16 @@ def state_space_response(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike,
     """
     a, b, c, d = (np.atleast_2d(np.asarray(x, float)) for x in (a, b, c, d))
     w = np.asarray(omega, float)
+    if sample_time is not None and not (np.isfinite(sample_time) and sample_time > 0):
+        raise ValueError(f"sample_time={sample_time!r} must be a sample time > 0 (s), or None for a continuous system")
     if a.size == 0:  # a static gain
         return np.broadcast_to(d, (w.size,) + d.shape).astype(complex)
+    s = 1j * w if sample_time is None else np.exp(1j * w * sample_time)
     lam, v = np.linalg.eig(a)
     if np.linalg.cond(v) < 1e6:  # diagonalisable, well-conditioned
         cv, vb = c @ v, np.linalg.solve(v, b)
-        return (cv[None, :, :] * (1.0 / (1j * w[:, None] - lam[None, :]))[:, None, :]) @ vb + d
-    x = np.linalg.solve(1j * w[:, None, None] * np.eye(a.shape[0]) - a, np.broadcast_to(b, (w.size,) + b.shape))
+        return (cv[None, :, :] * (1.0 / (s[:, None] - lam[None, :]))[:, None, :]) @ vb + d
+    x = np.linalg.solve(s[:, None, None] * np.eye(a.shape[0]) - a, np.broadcast_to(b, (w.size,) + b.shape))
     return c @ x + d
 
 

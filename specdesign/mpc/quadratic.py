@@ -30,6 +30,7 @@ import numpy as np
 
 from .._checks import positive_scalar
 from .._docs import docstring_of
+from ..closedloop.maps import state_space_response
 from .base import MEASURED, DiscreteTurbine, discretize_turbine, prediction_matrices
 from .sampled import SampledController
 
@@ -400,10 +401,7 @@ def loop_gain(mpc: QuadraticMPC, wind_speed: float, omega, plant=None) -> np.nda
     dm = mpc.point(wind_speed)["model"] if plant is None else discretize_turbine(plant, wind_speed, mpc.ts)
     rows = dm.rows(mpc.measured)
     w = np.asarray(omega, float)
-    out = np.empty(w.shape, complex)
-    for i, wi in np.ndenumerate(w):
-        z = np.exp(1j * wi * mpc.ts)
-        p = dm.C[rows] @ np.linalg.solve(z * np.eye(dm.A.shape[0]) - dm.A, dm.Bu)
-        c = C @ np.linalg.solve(z * np.eye(A.shape[0]) - A, B) + D
-        out[i] = c @ p
-    return out
+    p = state_space_response(dm.A, dm.Bu[:, None], dm.C[rows], np.zeros((rows.size, 1)), w.ravel(),
+                             sample_time=mpc.ts)[:, :, 0]
+    c = state_space_response(A, B, C[None, :], D[None, :], w.ravel(), sample_time=mpc.ts)[:, 0, :]
+    return np.sum(c * p, axis=1).reshape(w.shape)
