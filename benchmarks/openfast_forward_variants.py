@@ -39,12 +39,13 @@ from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
+from openfast_table3 import openfast_model
 from scipy import signal
 
 from specdesign import validate
 from specdesign.export import forwarded
 from specdesign.mpc import QuadraticMPC
-from specdesign.openfast import iea15mw_monopile, linearize_deck
+from specdesign.openfast import iea15mw_monopile
 from specdesign.turbine import iea15mw
 
 #: The call interval (s), ServoDyn's DLL_DT.
@@ -56,16 +57,12 @@ INDICATORS = ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd"
               "rate_limit_time")
 
 
-#: OpenFAST's linearisations of the deck the ``oflin`` MPC is built on (those of
-#: benchmarks/openfast_table3.py, read from linearize_deck's cache).
-LINEARISED = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
-
-
 def openfast_linear_model(deck, model):
-    """OpenFAST's linearisations of ``deck`` at :data:`LINEARISED` (cached by ``linearize_deck``) with
-    ``model``'s pitch limits and rate limit, which a linearisation does not carry."""
-    lt = linearize_deck(deck, LINEARISED)
-    return replace(lt, pitch_min=model.pitch_min, pitch_max=model.pitch_max, pitch_rate_limit=model.pitch_rate_limit)
+    """Table 3's design model, OpenFAST's linearisations of ``deck`` (:func:`openfast_table3.openfast_model`,
+    read from ``linearize_deck``'s cache), with ``model``'s pitch limits and rate limit, which a
+    linearisation does not carry: the model the ``oflin`` MPC is built on."""
+    return replace(openfast_model(deck), pitch_min=model.pitch_min, pitch_max=model.pitch_max,
+                   pitch_rate_limit=model.pitch_rate_limit)
 
 
 class Logged:
