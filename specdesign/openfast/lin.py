@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["LinearizationData", "read_linearization", "read_lin_file", "mbc_transform"]
+__all__ = ["LinearizationData", "read_linearization", "read_lin_file", "mbc_transform", "signal_label"]
 
 # Output units written by OpenFAST → factor to SI.
 _SI = {
@@ -123,7 +123,7 @@ class LinearizationData:
     def _select(self, which, wanted):
         desc = {"inputs": self.u_desc, "outputs": self.y_desc}[which]
         if wanted is None:
-            return list(range(len(desc))), [_short(d) for d in desc]
+            return list(range(len(desc))), [signal_label(d) for d in desc]
         items = list(wanted.items()) if isinstance(wanted, dict) else [(w, w) for w in ([wanted] if isinstance(wanted, str) else wanted)]
         idx, names = [], []
         for name, sub in items:
@@ -168,9 +168,21 @@ class LinearizationData:
         return control.ss(self.A, self.B[:, iu], self.C[iy], self.D[np.ix_(iy, iu)], inputs=un, outputs=yn, states=states)
 
 
-def _short(desc):
-    """A signal name python-control accepts (no '.'): the description without its unit tail."""
-    return desc.replace(".", "_")
+def signal_label(description: str) -> str:
+    """The name of an OpenFAST signal or state in a python-control system.
+
+    Parameters
+    ----------
+    description : str
+        OpenFAST's description of the signal or state (a .lin file's row label).
+
+    Returns
+    -------
+    str
+        The description with "." replaced by "_" (python-control reads a "." in a name as a
+        subsystem's).
+    """
+    return description.replace(".", "_")
 
 
 class _Lines:

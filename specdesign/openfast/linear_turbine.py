@@ -38,7 +38,7 @@ from ..rosco import rosco_baseline, rosco_gain_schedule
 from ..simulate import KernelPlant
 from ..simulate.kernels import linear_outputs, linear_plant_params, linear_rhs
 from ..turbine import TurbineModel
-from .lin import read_lin_file, read_linearization
+from .lin import read_lin_file, read_linearization, signal_label
 from .signals import plant_from_linearization
 
 __all__ = ["LinearOperatingPoint", "RotorModelSchedule", "LinearTurbine", "rotor_speed_model"]
@@ -633,9 +633,9 @@ class LinearTurbine:
             u = dict(zip(data.u_desc, data.u_op))
             pitch = next((x for d, x in u.items() if "collective blade-pitch" in d.lower()), float("nan"))
             torque = next((x for d, x in u.items() if "generator torque" in d.lower()), float("nan"))
-            # the kept states by description (plant_from_linearization's names); a d/dt output is 0 at the
+            # the kept states by their labels (plant_from_linearization's); a d/dt output is 0 at the
             # operating point (a steady state, averaged over the azimuths)
-            xd = [d.replace(".", "_") for d in data.x_desc]
+            xd = [signal_label(d) for d in data.x_desc]
             x_op = tuple(float(data.x_op[xd.index(s)]) for s in plants[v].state_labels)
             y_op = tuple(0.0 if used[n].startswith("d/dt ") else float(data.y_op[data.y_desc.index(used[n])])
                          for n in plants[v].output_labels)

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .lin import signal_label
+
 __all__ = ["DEFAULT_SIGNALS", "REQUIRED_SIGNALS", "INPUT_SIGNALS", "AZIMUTH_STATE", "resolve_signals",
            "plant_from_linearization"]
 
@@ -199,6 +201,6 @@ def plant_from_linearization(data, signals=None):
         used[n] = data.u_desc[sel[n][1]]
     C, D = np.array(rows_c).reshape(len(outs), -1), np.array(rows_d).reshape(len(outs), len(ins))
     keep = _reduced_states(data.A, C, data.x_desc)
-    states = [data.x_desc[k].replace(".", "_") for k in keep]
+    states = [signal_label(data.x_desc[k]) for k in keep]
     plant = control.ss(data.A[np.ix_(keep, keep)], B[keep], C[:, keep], D, inputs=ins, outputs=outs, states=states)
     return plant, {n: used[n] for n in ins + outs}
