@@ -101,6 +101,27 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
         run_openfast_campaign({"A": ctrls["B"]}, [19.0], [0], **kw)
 
 
+def test_a_parameter_file_counts_by_the_files_it_names_not_by_their_place(tmp_path, fake):
+    # a DISCON.IN written with absolute file names (rosco.write_discon makes PerfFileName absolute,
+    # as benchmarks/openfast_table3.py's ROSCO+TD file has it) is the same controller from another
+    # checkout, so the repository's store is found there; a changed table is another controller
+    inst, calls, lib = fake
+
+    def controller(folder, table):
+        folder.mkdir()
+        (folder / "Cp_Ct_Cq.txt").write_text(table)
+        return _controller(folder, lib, "a", f'1.0\n"{folder / "Cp_Ct_Cq.txt"}"  ! PerfFileName\n')
+
+    kw = dict(deck=iea15mw_monopile(), duration=20.0, transient=5.0, record_dt=0.05, install=inst, processes=1,
+              folder=tmp_path / "camp", initial_conditions=False)
+    run_openfast_campaign({"A": controller(tmp_path / "one", "the table")}, [19.0], [0], **kw)
+    n_calls = len(calls.read_text().split())
+    run_openfast_campaign({"A": controller(tmp_path / "two", "the table")}, [19.0], [0], **kw)
+    assert len(calls.read_text().split()) == n_calls  # found, not run again
+    with pytest.raises(ValueError, match="other settings or another controller under the name 'A'"):
+        run_openfast_campaign({"A": controller(tmp_path / "three", "another table")}, [19.0], [0], **kw)
+
+
 def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake):
     # read_openfast_runs gives back what run_openfast_campaign stored, value for value and
     # spectrum for spectrum; a run whose result.npz is not written yet (a run in progress) is

@@ -11,6 +11,7 @@ import concurrent.futures as cf
 import hashlib
 import json
 import os
+import re
 import sys
 import tempfile
 import warnings
@@ -199,6 +200,23 @@ def as_discon(controller) -> DisconController:
 
 def _sha(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+
+
+#: A quoted token of a parameter file (a file name, in ROSCO's DISCON.IN format and the workbench's).
+_QUOTED = re.compile(rb'"([^"\r\n]+)"')
+
+
+def _parameters_sha(path: Path) -> str:
+    """The digest of a controller's parameter file by what it says, not where it lies: every quoted
+    name of an existing file in it (absolute, or relative to the parameter file, as ROSCO reads
+    ``PerfFileName``) counts by that file's digest instead of its path. A DISCON.IN written with
+    absolute names (``rosco.write_discon``) then gives the same digest from any checkout, so a
+    store's runs are found again there, and a changed performance table is a new run."""
+    def content(m):
+        name = Path(m.group(1).decode(errors="replace"))
+        f = name if name.is_absolute() else path.parent / name
+        return b'"sha256:' + _sha(f).encode() + b'"' if f.is_file() else m.group(0)
+    return hashlib.sha256(_QUOTED.sub(content, path.read_bytes())).hexdigest()[:16]
 
 
 def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Deck, duration: float = RECORD_LENGTH,
@@ -443,7 +461,7 @@ def _meta(run, c: DisconController | Forwarded, settings) -> dict:
                 "library": str(lib), "parameters": f"forwarded Python controller {c.name!r}",
                 "settings": settings}
     return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt, "library_sha": _sha(c.library),
-            "parameters_sha": _sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
+            "parameters_sha": _parameters_sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
             "settings": settings}
 
 
