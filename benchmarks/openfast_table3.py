@@ -176,10 +176,12 @@ def main() -> None:
     # the linear predictions of both controllers on the design model, per speed: the design's own
     # baseline is ROSCO's PI on the design plant (on OpenFAST's linearisations, LinearTurbine's pole
     # placement; turbine.rosco_baseline takes a TurbineModel only)
-    pred = np.full((2, len(speeds)), np.nan)
+    # (ROSCO+TD, when run, has no linear form here: its row stays NaN, Table 3 compares the other two)
+    pred = np.full((len(camp.controllers), len(speeds)), np.nan)
     for wi, v in enumerate(speeds):
-        pred[:, wi] = predicted_del(model, v), predicted_del(model, v, made[v]["design"])
-    camp = dataclasses.replace(camp, predicted_del=pred[[camp.index("ROSCO"), camp.index(label)]])
+        pred[camp.index("ROSCO"), wi] = predicted_del(model, v)
+        pred[camp.index(label), wi] = predicted_del(model, v, made[v]["design"])
+    camp = dataclasses.replace(camp, predicted_del=pred)
     t3 = validate.table3(camp, label, "ROSCO", promised={v: made[v]["promise"] for v in speeds})
     text = t3.to_markdown() if hasattr(t3, "to_markdown") else str(t3)
     (out / "table3.md").write_text(text + "\n")
