@@ -9,7 +9,7 @@ seeds × 600 s by default, against both baselines with paired SEs.
 The shipped IEA 15 MW monopile deck with TurbSim winds (IEC Kaimal NTM class B), every controller
 on the same seeds, ``run_campaign(..., plant=deck)``; resumable: every finished run is kept in
 ``--out``/runs (a folder per run) and a second call runs only what is missing. ``--out`` is by
-default Table 3's store (``build/openfast_table3``): the ROSCO and QFT+ATD runs that
+default Table 3's store (``openfast_table3.STORE``, in the repository): the ROSCO and QFT+ATD runs that
 ``openfast_table3.py --plant openfast`` made on the same seeds are found there (by their
 libraries' and parameter files' digests and the run settings) and not run again. The controllers:
 
@@ -49,6 +49,7 @@ from openfast_forward_variants import openfast_linear_model
 from openfast_report import report
 from openfast_table3 import (
     ROSCO_TD,
+    STORE,
     STRUCTURES,
     campaign_arguments,
     designs,
@@ -105,7 +106,7 @@ def mpcs(lt, reduced, q_rule) -> dict:
 
 def main() -> None:
     ap = campaign_arguments(__doc__.split("\n")[0], "17,21")
-    ap.add_argument("--out", default="build/openfast_table3",
+    ap.add_argument("--out", default=str(STORE),
                     help="store (default: Table 3's, whose ROSCO and QFT+ATD runs are reused)")
     ap.add_argument("--rule-only", action="store_true", help="print the MPC's activity-weight rule and stop")
     args = ap.parse_args()

@@ -27,8 +27,8 @@ both loops closed, the OpenFAST rainflow reduction over the paired seeds (± SE)
 the reduced model's rainflow for the same controllers on the same seed numbers (the workbench's
 simulator, its own rotor-effective wind: a few seconds per run) and the pitch-rate SDs.
 
-    python benchmarks/openfast_report.py --folder build/openfast_table3/runs
-    python benchmarks/openfast_report.py --folder build/openfast_table3/runs --damping --table3 --figures docs/figures
+    python benchmarks/openfast_report.py      # the repository's store, benchmarks/results/openfast_table3/runs
+    python benchmarks/openfast_report.py --damping --table3 --figures docs/figures
 """
 from __future__ import annotations
 
@@ -458,7 +458,8 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--folder", default="build/openfast_table3/runs", help="the campaign's run folder")
+    ap.add_argument("--folder", default=str(Path(__file__).resolve().parent / "results" / "openfast_table3" / "runs"),
+                    help="the campaign's run folder (default: openfast_table3.STORE's, in the repository)")
     ap.add_argument("--baseline", default="ROSCO")
     ap.add_argument("--damping", action="store_true",
                     help="also the closed-loop tower-mode damping on OpenFAST's linearisations (designs again)")

@@ -8,10 +8,11 @@ rainflow DELs, the specification's promise and the linear prediction side by sid
 
 A long run (~1.3 s of CPU per simulated second per run: 2 controllers × 6 speeds × 4 seeds ×
 660 s ≈ 7 h of CPU), resumable and background-friendly: every finished run is kept in
-``--out`` (a folder per run), a second call runs only what is missing; OpenFAST runs niced.
+``--out`` (a folder per run; default :data:`STORE`, in the repository), a second call runs only
+what is missing; OpenFAST runs niced.
 
     nohup nice -n 10 python benchmarks/openfast_table3.py --processes 2 > table3.log 2>&1 &
-    python benchmarks/openfast_table3.py --speeds 19 --seeds 1 --duration 30 --transient 10  # a smoke run
+    python benchmarks/openfast_table3.py --speeds 19 --seeds 1 --duration 30 --transient 10 --out /tmp/smoke  # a smoke run (its own store: other settings)
 
 Designs are made on the reduced model (``--plant reduced``, default) or on OpenFAST's
 linearisations of the deck (``--plant openfast``: always those at :data:`LINEARISED`, so the
@@ -39,6 +40,13 @@ from specdesign.simulate import ScheduledController
 #: cases (v ± 0.5, ± 1 m/s) are interpolated between them, so a design depends on this set, and a
 #: campaign resumed or extended speed by speed must design on the same model to find its runs.
 LINEARISED = (15.0, 17.0, 19.0, 21.0, 23.0, 25.0)
+
+#: The campaign's store, kept in the repository: of each finished run only what
+#: ``benchmarks/openfast_report.py`` reads (``run.json``, ``result.npz``, OpenFAST's log; the
+#: folder's ``.gitignore`` leaves out the case files OpenFAST ran). A clone tabulates the documented
+#: runs in seconds, a campaign resumed from it runs only what is missing (a run is recognised by its
+#: settings and its controller files' digests), and a machine lost does not lose its CPU hours.
+STORE = Path(__file__).resolve().parent / "results" / "openfast_table3"
 
 
 def openfast_model(deck, speeds=(), **kwargs):
@@ -132,7 +140,7 @@ def main() -> None:
     ap.add_argument("--rosco-td", action="store_true",
                     help=f"also the second baseline {ROSCO_TD!r}: ROSCO's compiled DISCON with its fore-aft tower damper "
                          "(TD_Mode = 1, FA_KI by rosco.tune_tower_damper's rule on the reduced model)")
-    ap.add_argument("--out", default="build/openfast_table3")
+    ap.add_argument("--out", default=str(STORE), help="the campaign's store (default: the repository's, %(default)s)")
     args = ap.parse_args()
     speeds = [float(x) for x in args.speeds.split(",")]
     out = Path(args.out).resolve()

@@ -1,0 +1,65 @@
+"""The OpenFAST campaign's store kept in the repository (``benchmarks/results/openfast_table3``):
+the runs the documented OpenFAST tables come from. Nothing here runs OpenFAST: the store is read
+as ``benchmarks/openfast_report.py`` reads it."""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+from specdesign import validate
+from specdesign.openfast import iea15mw_monopile
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNS = ROOT / "benchmarks" / "results" / "openfast_table3" / "runs"
+
+
+def _benchmark(name):
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    return module
+
+
+@pytest.fixture(scope="module")
+def runs():
+    found = validate.read_openfast_runs(RUNS)
+    assert found, f"{RUNS} holds no finished run: the documented OpenFAST tables have nothing behind them"
+    return found
+
+
+def test_the_scripts_default_to_the_repository_store():
+    assert _benchmark("openfast_table3").STORE / "runs" == RUNS
+
+
+def test_the_stored_runs_were_made_on_the_shipped_deck(runs):
+    # a deck changed after its runs would leave tables that no longer follow from the shipped files:
+    # the campaign must run again (into an emptied store)
+    deck = iea15mw_monopile()
+    sha = hashlib.sha256(deck.fst.read_bytes()).hexdigest()[:16]
+    stale = sorted({f"{r.controller} {r.wind_speed:g} m/s seed {r.seed}" for r in runs
+                    if r.meta["settings"]["deck_sha"] != sha})
+    assert not stale, f"runs of another deck than {deck.fst}: {stale}"
+    # Table 3's setting (the paper's): 600 s recorded after 60 s discarded, class B, m = 4
+    settings = {(s["duration"], s["transient"], s["turbulence_class"], s["m"]) for s in (r.meta["settings"] for r in runs)}
+    assert settings == {(600.0, 60.0, "B", 4.0)}
+
+
+def test_every_change_the_store_gives_is_in_the_docs_as_printed(runs):
+    # docs/openfast.md's tables of paired changes are openfast_report.py's output spliced in: every row
+    # the repository's store gives (per speed, controller and paired seeds, against ROSCO and against
+    # ROSCO+TD) must stand there to the printed digit, or the docs were not regenerated from the store
+    report = _benchmark("openfast_report").report(RUNS, runs)
+    rows = [line for line in report.splitlines() if re.match(r"\| \d+(\.\d+)? \| ", line)]
+    assert rows
+    docs = (ROOT / "docs" / "openfast.md").read_text()
+    missing = [row for row in rows if row not in docs]
+    assert not missing, "rows of `python benchmarks/openfast_report.py` not in docs/openfast.md:\n" + "\n".join(missing)
