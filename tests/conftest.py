@@ -33,6 +33,26 @@ def package_data() -> Path:
 
 
 @pytest.fixture(scope="session")
+def benchmark_script():
+    """``load(name)``: the script ``benchmarks/<name>.py`` as a module (not run as ``__main__``),
+    with its folder on ``sys.path`` while it loads: the scripts import their neighbours."""
+    import importlib.util
+
+    def load(name):
+        folder = str(ROOT / "benchmarks")
+        sys.path.insert(0, folder)
+        try:
+            spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+        finally:
+            sys.path.remove(folder)
+        return module
+
+    return load
+
+
+@pytest.fixture(scope="session")
 def openfast():
     """OpenFAST for the tests that run it (``specdesign.openfast.OpenFASTInstall``).
 

@@ -83,7 +83,7 @@ def test_one_default_for_the_bound_in_every_entry_point():
     assert fz.MAX_HF_GAIN_RATIO == HF_GAIN_RATIO  # issue 28 item 1: the bound is part of every design by default
 
 
-def test_the_constant_is_the_documented_measurement():
+def test_the_constant_is_the_documented_measurement(benchmark_script):
     """HF_GAIN_RATIO is what benchmarks/hf_bound.py printed into docs/feasibility.md, and, where
     its OpenFAST runs are cached on this machine, what the rule gives from them again."""
     doc = (ROOT / "docs" / "feasibility.md").read_text()
@@ -96,17 +96,8 @@ def test_the_constant_is_the_documented_measurement():
     cached = Path.home() / ".cache" / "specdesign" / "hf_bound" / "rosco_19mps_seed1_120s.npz"
     if not cached.exists():
         pytest.skip("benchmarks/hf_bound.py's OpenFAST run at 19 m/s is not cached on this machine")
-    import importlib.util
-    import sys
-
-    sys.path.insert(0, str(ROOT / "benchmarks"))  # hf_bound.py imports its neighbour comparison.py
-    try:
-        loader = importlib.util.spec_from_file_location("hf_bound", ROOT / "benchmarks" / "hf_bound.py")
-        hf = importlib.util.module_from_spec(loader)
-        loader.loader.exec_module(hf)
-        row = hf.measure(iea15mw(), 19.0, 1, 120.0)  # from the cached run: the rule again, independently of the doc
-    finally:
-        sys.path.remove(str(ROOT / "benchmarks"))
+    hf = benchmark_script("hf_bound")  # it imports its neighbour comparison.py
+    row = hf.measure(iea15mw(), 19.0, 1, 120.0)  # from the cached run: the rule again, independently of the doc
     assert round(row["kappa"]) == rows[19.0]
 
 

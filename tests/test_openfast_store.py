@@ -4,9 +4,7 @@ as ``benchmarks/openfast_report.py`` reads it."""
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import re
-import sys
 from pathlib import Path
 
 import pytest
@@ -18,17 +16,6 @@ ROOT = Path(__file__).resolve().parents[1]
 RUNS = ROOT / "benchmarks" / "results" / "openfast_table3" / "runs"
 
 
-def _benchmark(name):
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    try:
-        spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(ROOT / "benchmarks"))
-    return module
-
-
 @pytest.fixture(scope="module")
 def runs():
     found = validate.read_openfast_runs(RUNS)
@@ -36,8 +23,8 @@ def runs():
     return found
 
 
-def test_the_scripts_default_to_the_repository_store():
-    assert _benchmark("openfast_table3").STORE / "runs" == RUNS
+def test_the_scripts_default_to_the_repository_store(benchmark_script):
+    assert benchmark_script("openfast_table3").STORE / "runs" == RUNS
 
 
 def test_the_stored_runs_were_made_on_the_shipped_deck(runs):
@@ -53,11 +40,11 @@ def test_the_stored_runs_were_made_on_the_shipped_deck(runs):
     assert settings == {(600.0, 60.0, "B", 4.0)}
 
 
-def test_every_change_the_store_gives_is_in_the_docs_as_printed(runs):
+def test_every_change_the_store_gives_is_in_the_docs_as_printed(runs, benchmark_script):
     # docs/openfast.md's tables of paired changes are openfast_report.py's output spliced in: every row
     # the repository's store gives (per speed, controller and paired seeds, against ROSCO and against
     # ROSCO+TD) must stand there to the printed digit, or the docs were not regenerated from the store
-    report = _benchmark("openfast_report").report(RUNS, runs)
+    report = benchmark_script("openfast_report").report(RUNS, runs)
     rows = [line for line in report.splitlines() if re.match(r"\| \d+(\.\d+)? \| ", line)]
     assert rows
     docs = (ROOT / "docs" / "openfast.md").read_text()

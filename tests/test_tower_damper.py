@@ -100,24 +100,13 @@ def test_workbench_damper_agrees_with_the_compiled_discon(tmp_path, model, dampe
     assert d_on < 0.95 * d_off and s_on < 0.95 * s_off, out
 
 
-def test_openfast_second_baseline_is_the_deck_discon_with_the_tuned_damper(tmp_path, damper):
+def test_openfast_second_baseline_is_the_deck_discon_with_the_tuned_damper(tmp_path, damper, benchmark_script):
     # benchmarks/openfast_table3.py --rosco-td: the OpenFAST deck's own DISCON.IN with only the
     # damper's four entries changed (issue 31's second baseline in OpenFAST)
-    import importlib.util
-    import sys
-    from pathlib import Path
-
     from specdesign.openfast import iea15mw_monopile
     from specdesign.rosco import read_discon
 
-    root = Path(__file__).resolve().parents[1]
-    sys.path.insert(0, str(root / "benchmarks"))
-    try:
-        spec = importlib.util.spec_from_file_location("openfast_table3", root / "benchmarks" / "openfast_table3.py")
-        t3 = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(t3)
-    finally:
-        sys.path.remove(str(root / "benchmarks"))
+    t3 = benchmark_script("openfast_table3")
     deck = iea15mw_monopile()
     source = deck.fst.with_name(f"{deck.name}_DISCON.IN")
     written = t3.rosco_td_discon(source, tmp_path)
