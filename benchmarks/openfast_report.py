@@ -46,6 +46,11 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 from specdesign import closedloop, spec, validate, wind  # noqa: E402
+from specdesign.openfast import iea15mw_monopile  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).parent))  # the campaign's script beside this one
+# its store, model and design step: the controllers it ran
+from openfast_table3 import STORE, STRUCTURES, designs, openfast_model, predicted_del  # noqa: E402
 
 #: Bands of the tower-base moment's variance, rad/s: (label, low, high).
 BANDS = (("wind 0.05-0.6", 0.05, 0.6), ("0.6-0.85", 0.6, 0.85), ("tower mode 0.85-1.5", 0.85, 1.5),
@@ -178,12 +183,6 @@ def campaign_designs(runs, target=25.0):
     makes them: ``QFT`` the certified chain, ``QFT+ATD`` the paper's structure), each only at
     the speeds where it ran (a certified pitch-only design may be refused at a speed the
     campaign never ran it at): (model, {label: {speed: {"design", "promise"}}})."""
-    from specdesign.openfast import iea15mw_monopile  # OpenFAST's side only with --damping/--table3
-
-    sys.path.insert(0, str(Path(__file__).parent))
-    # the campaign's own model and design step: the controllers it ran
-    from openfast_table3 import STRUCTURES, designs, openfast_model
-
     speeds = sorted({r.wind_speed for r in runs})
     names = {r.controller for r in runs}
     model = openfast_model(iea15mw_monopile(), speeds, processes=1)
@@ -201,7 +200,6 @@ def linear_side(runs, model, made, figures=None, reduced=None) -> tuple[str, dic
     on the same linearisation, dashed) and Fig. 10 (with ``reduced``, :func:`reduced_model_changes`,
     the reduced model's rainflow beside OpenFAST's). Returns the table and the predictions
     {(controller, speed): %}."""
-    from openfast_table3 import predicted_del  # on sys.path since campaign_designs
 
     speeds = sorted({v for m in made.values() for v in m})
     label, lo, hi = BANDS[2]
@@ -458,7 +456,7 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--folder", default=str(Path(__file__).resolve().parent / "results" / "openfast_table3" / "runs"),
+    ap.add_argument("--folder", default=str(STORE / "runs"),
                     help="the campaign's run folder (default: openfast_table3.STORE's, in the repository)")
     ap.add_argument("--baseline", default="ROSCO")
     ap.add_argument("--damping", action="store_true",
