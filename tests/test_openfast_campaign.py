@@ -13,6 +13,7 @@ from numpy.testing import assert_allclose
 pytest.importorskip("openfast_io")
 
 from specdesign.openfast import Deck, iea15mw_monopile
+from specdesign.openfast.deck import named_digest
 from specdesign.validate import indicators, read_openfast_runs, run_campaign
 from specdesign.validate.openfast_campaign import run_openfast_campaign
 
@@ -120,6 +121,34 @@ def test_a_parameter_file_counts_by_the_files_it_names_not_by_their_place(tmp_pa
     assert len(calls.read_text().split()) == n_calls  # found, not run again
     with pytest.raises(ValueError, match="other settings or another controller under the name 'A'"):
         run_openfast_campaign({"A": controller(tmp_path / "three", "another table")}, [19.0], [0], **kw)
+
+
+def test_a_deck_counts_by_every_file_it_names_not_by_its_place(tmp_path, fake):
+    # the .fst alone names its modules: a changed ElastoDyn (or airfoil) file under the same .fst
+    # must be another deck, else a campaign silently reuses runs of the old turbine; a deck copied
+    # to another folder (a clone) is the same deck, so its stored runs are found there
+    inst, calls, lib = fake
+    shipped = iea15mw_monopile()
+    copies = []
+    for name in ("one", "two"):
+        shutil.copytree(shipped.fst.parent, tmp_path / name)
+        copies.append(Deck(tmp_path / name / shipped.fst.name, shipped.version))
+    assert copies[0].digest == copies[1].digest == shipped.digest
+    ed = tmp_path / "two" / "IEA-15-240-RWT-Monopile_ElastoDyn_tower.dat"  # named by ElastoDyn, not by the .fst
+    ed.write_text(ed.read_text().replace("1.0                    TwrFADmp(1)", "2.0                    TwrFADmp(1)", 1))
+    assert "2.0                    TwrFADmp(1)" in ed.read_text()  # 2 % tower damping, not 1 %
+    assert copies[1].fst.read_bytes() == shipped.fst.read_bytes() and copies[1].digest != shipped.digest
+    # a file naming itself (or an ancestor) counts by its name: no endless recursion
+    loop = tmp_path / "loop.dat"
+    loop.write_text(f'"{loop}" this file\n"{shipped.fst}" a deck\n')
+    assert len(named_digest(loop)) == 16
+
+    ctrl = _controller(tmp_path, lib, "a", "1.0\n")
+    kw = dict(duration=20.0, transient=5.0, record_dt=0.05, install=inst, processes=1, folder=tmp_path / "camp",
+              initial_conditions=False)
+    run_openfast_campaign({"A": ctrl}, [19.0], [0], deck=copies[0], **kw)
+    with pytest.raises(ValueError, match="other settings"):
+        run_openfast_campaign({"A": ctrl}, [19.0], [0], deck=copies[1], **kw)
 
 
 def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake):

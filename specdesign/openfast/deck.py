@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import hashlib
 import io
 import math
 import numbers
 import os
+import re
 import resource
 import signal
 import subprocess
@@ -28,7 +30,7 @@ from .install import OpenFASTInstall, check_deck_version, find_openfast, run_env
 from .outputs import OpenFASTOutput, read_outputs
 
 __all__ = ["Deck", "Case", "OpenFASTRunError", "iea15mw_monopile", "write_case", "run_case", "CAMPAIGN_CHANNELS", "wave_seed_for",
-           "WAVE_SEED_OFFSET"]
+           "WAVE_SEED_OFFSET", "named_digest"]
 
 _SHIPPED = Path(__file__).resolve().parents[1] / "data" / "openfast" / "IEA-15-240-RWT-Monopile" / "IEA-15-240-RWT-Monopile.fst"
 
@@ -78,6 +80,58 @@ class Deck:
     def name(self) -> str:
         """The deck's name: its ``.fst`` without the suffix."""
         return self.fst.stem
+
+    @property
+    def digest(self) -> str:
+        """16 hex digits of the deck's content: the ``.fst`` and every file it names, in turn
+        (:func:`named_digest`), so that a changed ElastoDyn, AeroDyn or airfoil file is a changed
+        deck, and a deck copied elsewhere is the same deck."""
+        return named_digest(self.fst)
+
+
+#: A quoted token of an input file: OpenFAST's, ROSCO's DISCON.IN and the workbench's name their
+#: files in double quotes.
+_QUOTED = re.compile(rb'"([^"\r\n\x00]+)"')
+
+
+def named_digest(path) -> str:
+    """16 hex digits of an input file by what it says, not where it lies.
+
+    Every quoted name of an existing file in it (absolute, or relative to the naming file, as
+    OpenFAST and ROSCO read them) counts by that file's own digest, in turn, instead of its
+    path: a deck's ``.fst`` covers its modules, their blade, tower and airfoil files; a
+    DISCON.IN its Cp table. A file whose text names no file digests as its bytes.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The input file.
+
+    Returns
+    -------
+    str
+        The first 16 hex digits of the SHA-256.
+
+    Examples
+    --------
+    >>> named_digest(iea15mw_monopile().fst) == iea15mw_monopile().digest
+    True
+    """
+    def digest(path: Path, within: frozenset) -> str:
+        within = within | {path}
+
+        def content(m):
+            try:
+                name = Path(m.group(1).decode())
+                f = (name if name.is_absolute() else path.parent / name).resolve()
+                found = f.is_file() and f not in within  # a file naming itself, or an ancestor, counts by its name
+            except (OSError, UnicodeDecodeError, ValueError):  # bytes of a binary file, not a name
+                return m.group(0)
+            return b'"sha256:' + digest(f, within).encode() + b'"' if found else m.group(0)
+
+        return hashlib.sha256(_QUOTED.sub(content, path.read_bytes())).hexdigest()[:16]
+
+    return digest(Path(path).resolve(), frozenset())
 
 
 def iea15mw_monopile() -> Deck:

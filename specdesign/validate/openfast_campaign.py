@@ -11,7 +11,6 @@ import concurrent.futures as cf
 import hashlib
 import json
 import os
-import re
 import sys
 import tempfile
 import warnings
@@ -25,7 +24,7 @@ from tqdm.auto import tqdm
 from ..controller.discon_file import read_discon
 from ..export.forward import Forwarded, ForwardServer
 from ..fatigue import TOWER_M
-from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, run_case, wave_seed_for, write_case
+from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, named_digest, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
 from ..openfast.series import series_from_openfast
 from ..openfast.turbsim import TURBSIM_GRID, turbsim_field
@@ -202,23 +201,6 @@ def _sha(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
 
 
-#: A quoted token of a parameter file (a file name, in ROSCO's DISCON.IN format and the workbench's).
-_QUOTED = re.compile(rb'"([^"\r\n]+)"')
-
-
-def _parameters_sha(path: Path) -> str:
-    """The digest of a controller's parameter file by what it says, not where it lies: every quoted
-    name of an existing file in it (absolute, or relative to the parameter file, as ROSCO reads
-    ``PerfFileName``) counts by that file's digest instead of its path. A DISCON.IN written with
-    absolute names (``rosco.write_discon``) then gives the same digest from any checkout, so a
-    store's runs are found again there, and a changed performance table is a new run."""
-    def content(m):
-        name = Path(m.group(1).decode(errors="replace"))
-        f = name if name.is_absolute() else path.parent / name
-        return b'"sha256:' + _sha(f).encode() + b'"' if f.is_file() else m.group(0)
-    return hashlib.sha256(_QUOTED.sub(content, path.read_bytes())).hexdigest()[:16]
-
-
 def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Deck, duration: float = RECORD_LENGTH,
                           transient: float = 60.0, dt: float | None = None, record_dt: float = 0.05, m: float = TOWER_M,
                           folder=None, processes: int | None = None, progress: bool | None = None,
@@ -324,7 +306,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
     install = install or find_openfast()
     check_deck_version(install, deck.version, deck.fst)
     n_keep = len(seeds) if keep_series is True else int(keep_series)
-    settings = {"deck": str(deck.fst), "deck_sha": _sha(deck.fst), "duration": float(duration),
+    settings = {"deck": str(deck.fst), "deck_sha": deck.digest, "duration": float(duration),
                 "transient": float(transient), "dt": dt, "record_dt": float(record_dt), "m": float(m),
                 "turbulence_class": turbulence_class, "grid_points": int(grid_points), "grid_size": float(grid_size),
                 "hydro": bool(hydro), "openfast": install.version, "initial_conditions": bool(initial_conditions),
@@ -461,7 +443,7 @@ def _meta(run, c: DisconController | Forwarded, settings) -> dict:
                 "library": str(lib), "parameters": f"forwarded Python controller {c.name!r}",
                 "settings": settings}
     return {"controller": name, "wind_speed": v, "seed": s, "controller_dt": c.dt, "library_sha": _sha(c.library),
-            "parameters_sha": _parameters_sha(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
+            "parameters_sha": named_digest(c.parameters), "library": str(c.library), "parameters": str(c.parameters),
             "settings": settings}
 
 
