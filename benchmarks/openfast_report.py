@@ -27,13 +27,19 @@ both loops closed, the OpenFAST rainflow reduction over the paired seeds (± SE)
 the reduced model's rainflow for the same controllers on the same seed numbers (the workbench's
 simulator, its own rotor-effective wind: a few seconds per run) and the pitch-rate SDs.
 
+With ``--docs docs/openfast.md`` the (wind, controller) tables are written into the page: each
+row of the page's table of the same header is replaced by the store's, new ones inserted; rows
+the store does not give are kept and listed (Table 3 is printed, not written).
+
     python benchmarks/openfast_report.py      # the repository's store, benchmarks/results/openfast_table3/runs
+    python benchmarks/openfast_report.py --docs docs/openfast.md
     python benchmarks/openfast_report.py --damping --table3 --figures docs/figures
 """
 from __future__ import annotations
 
 import argparse
 import math
+import re
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -454,6 +460,46 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
     print(f"wrote {path}", file=sys.stderr)
 
 
+def _row_tables(lines) -> list:
+    """(header, first row, end) of every table keyed by wind speed and controller in ``lines``."""
+    found, i = [], 0
+    while i < len(lines):
+        if lines[i].startswith("| wind (m/s) | controller |") and lines[i + 1 : i + 2] and lines[i + 1].startswith("|---"):
+            j = i + 2
+            while j < len(lines) and re.match(r"\| \d+(\.\d+)? \| ", lines[j]):
+                j += 1
+            found.append((lines[i], i + 2, j))
+            i = j
+        else:
+            i += 1
+    return found
+
+
+def splice(docs: str, printed: str) -> tuple[str, list]:
+    """``docs`` with every row of ``printed``'s (wind, controller) tables in the table of the same
+    header: a row of the same wind and controller replaced, a new one inserted in order of wind,
+    then controller. Rows the report does not give (runs of another store) are kept and returned,
+    so that the caller can say which rows are not from this store."""
+    lines = docs.splitlines()
+    kept = []
+    for header, a, b in _row_tables(printed.splitlines()):
+        rows = {_row_key(r): r for r in printed.splitlines()[a:b]}
+        target = [t for t in _row_tables(lines) if t[0] == header]
+        if len(target) != 1:
+            raise SystemExit(f"--docs: {len(target)} tables headed {header[:60]}... there, 1 expected")
+        _, da, db = target[0]
+        merged = {_row_key(r): r for r in lines[da:db]}
+        kept += [r for k, r in merged.items() if k not in rows]
+        merged.update(rows)
+        lines[da:db] = [merged[k] for k in sorted(merged)]
+    return "\n".join(lines) + ("\n" if docs.endswith("\n") else ""), kept
+
+
+def _row_key(row: str) -> tuple[float, str]:
+    wind, controller = (c.strip() for c in row.split("|")[1:3])
+    return float(wind), controller
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--folder", default=str(STORE / "runs"),
@@ -464,12 +510,16 @@ def main() -> None:
     ap.add_argument("--table3", action="store_true",
                     help="also Table 3 per design beside the paper's: specification, linear prediction, OpenFAST and "
                          "reduced-model rainflow, deviation (designs again, runs the reduced model on the same seeds)")
+    ap.add_argument("--docs", default=None, metavar="PAGE",
+                    help="also write the (wind, controller) tables into PAGE (docs/openfast.md): each row replaced "
+                         "by the store's or inserted; rows the store does not give are kept and listed")
     ap.add_argument("--figures", default=None,
                     help="folder for Fig. 9 from OpenFAST (19 m/s, seed 0, where its series were kept) and, with "
                          "--damping, Fig. 8 per speed and Fig. 10")
     args = ap.parse_args()
     runs = validate.read_openfast_runs(args.folder)
-    print(report(Path(args.folder), runs, baseline=args.baseline))
+    printed = [report(Path(args.folder), runs, baseline=args.baseline)]
+    print(printed[0])
     if args.figures is not None:
         fig9(runs, Path(args.figures))
     if args.damping or args.table3:
@@ -478,8 +528,14 @@ def main() -> None:
         damping, preds = linear_side(runs, model, made, figures=args.figures if args.damping else None, reduced=reduced)
         if args.damping:
             print("\n" + damping)
+            printed.append(damping)
         if args.table3:
             print("\n" + table3(runs, made, preds, reduced))
+    if args.docs is not None:
+        page = Path(args.docs)
+        text, kept = splice(page.read_text(), "\n\n".join(printed))
+        page.write_text(text)
+        print(f"\n{page}: the store's rows written" + "".join(f"\n  kept, not from this store: {r[:70]}..." for r in kept))
 
 if __name__ == "__main__":
     main()

@@ -49,3 +49,21 @@ def test_every_change_the_store_gives_is_in_the_docs_as_printed(runs, benchmark_
     docs = (ROOT / "docs" / "openfast.md").read_text()
     missing = [row for row in rows if row not in docs]
     assert not missing, "rows of `python benchmarks/openfast_report.py` not in docs/openfast.md:\n" + "\n".join(missing)
+    # ... and each in its own table (the runs', the second baseline's, the bands'), in order:
+    # the page is what `openfast_report.py --docs docs/openfast.md` leaves it
+    assert benchmark_script("openfast_report").splice(docs, report)[0] == docs
+
+
+def test_the_docs_splice_replaces_inserts_in_order_and_keeps_what_the_store_lacks(benchmark_script):
+    # a row of the same (wind, controller) is replaced, a new one goes where wind then controller
+    # order puts it, and a row the store does not give stays and is returned (said by --docs)
+    splice = benchmark_script("openfast_report").splice
+    head = "| wind (m/s) | controller | tower DEL (%) |\n|---|---|---|\n"
+    page = "text\n\n" + head + "| 15 | QFT+ATD | -1.0 |\n| 21 | QFT+ATD | -3.0 |\n\nafter\n"
+    printed = "Finished\n\n" + head + "| 15 | QFT+ATD | -2.0 |\n| 19 | ROSCO+TD | -8.2 |\n| 19 | QFT | +0.0 |\n"
+    text, kept = splice(page, printed)
+    assert text == ("text\n\n" + head + "| 15 | QFT+ATD | -2.0 |\n| 19 | QFT | +0.0 |\n| 19 | ROSCO+TD | -8.2 |\n"
+                    "| 21 | QFT+ATD | -3.0 |\n\nafter\n")
+    assert kept == ["| 21 | QFT+ATD | -3.0 |"]
+    with pytest.raises(SystemExit, match="0 tables headed"):
+        splice("no table here\n", printed)
