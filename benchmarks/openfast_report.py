@@ -480,10 +480,10 @@ def splice(docs: str, printed: str) -> tuple[str, list]:
     header: a row of the same wind and controller replaced, a new one inserted in order of wind,
     then controller. Rows the report does not give (runs of another store) are kept and returned,
     so that the caller can say which rows are not from this store."""
-    lines = docs.splitlines()
+    lines, printed = docs.splitlines(), printed.splitlines()
     kept = []
-    for header, a, b in _row_tables(printed.splitlines()):
-        rows = {_row_key(r): r for r in printed.splitlines()[a:b]}
+    for header, a, b in _row_tables(printed):
+        rows = {_row_key(r): r for r in printed[a:b]}
         target = [t for t in _row_tables(lines) if t[0] == header]
         if len(target) != 1:
             raise SystemExit(f"--docs: {len(target)} tables headed {header[:60]}... there, 1 expected")

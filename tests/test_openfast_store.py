@@ -31,8 +31,9 @@ def test_the_stored_runs_were_made_on_the_shipped_deck(runs):
     # the campaign must run again (into an emptied store)
     # (its digest covers every file the .fst names, in turn: Deck.digest)
     deck = iea15mw_monopile()
+    sha = deck.digest
     stale = sorted({f"{r.controller} {r.wind_speed:g} m/s seed {r.seed}" for r in runs
-                    if r.meta["settings"]["deck_sha"] != deck.digest})
+                    if r.meta["settings"]["deck_sha"] != sha})
     assert not stale, f"runs of another deck than {deck.fst}: {stale}"
     # Table 3's setting (the paper's): 600 s recorded after 60 s discarded, class B, m = 4
     settings = {(s["duration"], s["transient"], s["turbulence_class"], s["m"]) for s in (r.meta["settings"] for r in runs)}
