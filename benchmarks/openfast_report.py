@@ -296,9 +296,9 @@ def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
         speeds = [v for v in speeds if stats[v] is not None]
         if not speeds:
             continue
+        store = table3_store_rows(stats, speeds, baseline)
         cols = " | ".join(f"{v:g}" for v in speeds)
-        lines = [f"**{name}** (tower-base DEL reduction against {baseline}; seeds per speed: "
-                 + ", ".join(f"{v:g} m/s: {len(stats[v]['seeds'])}" for v in speeds) + ")", "",
+        lines = [store["title"].format(name=name), "",
                  f"| tower DEL reduction | {cols} | mean |", "|---|" + "---|" * (len(speeds) + 1)]
 
         def se(v):
@@ -310,15 +310,15 @@ def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
         dev = {v: pred[v] - rain[v] for v in speeds}
         row = {"specification (this workbench)": [f"{by_v[v]['promise']:.1f} %" for v in speeds] + [""],
                "linear prediction (OpenFAST's linearisation)": [f"{pred[v]:.1f} %" for v in speeds] + [""],
-               "rainflow, OpenFAST": [f"{rain[v]:.1f}{se(v)} %" for v in speeds] + [""],
+               "rainflow, OpenFAST": store["rainflow, OpenFAST"],
                "deviation, prediction − rainflow": [f"{dev[v]:+.1f}{se(v)} pp" for v in speeds]
                + [f"{np.mean(list(dev.values())):+.1f} pp (\\|·\\| {np.mean(np.abs(list(dev.values()))):.1f})"]}
         if reduced is not None:
             row["rainflow, reduced model (same seed numbers)"] = [
                 (f"{-reduced[name, v][0]:.1f}" + (f" ± {reduced[name, v][1]:.1f}" if len(reduced[name, v][2]) > 1 else "")
                  + " %") if (name, v) in reduced else "" for v in speeds] + [""]
-        row[f"pitch-rate SD (deg/s): {baseline} / design"] = [
-            f"{stats[v]['pitch_rate_sd', 'base'][0]:.3f} / {stats[v]['pitch_rate_sd', 'design'][0]:.3f}" for v in speeds] + [""]
+        pitch = f"pitch-rate SD (deg/s): {baseline} / design"
+        row[pitch] = store[pitch]
         for key, (vals, mean) in PAPER_TABLE3.items():
             paper = dict(zip(PAPER_SPEEDS, vals))
             unit = " %" if key != "deviation" else " pp"
@@ -327,6 +327,48 @@ def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
         lines += [f"| {k} | " + " | ".join(cells) + " |" for k, cells in row.items()]
         blocks.append("\n".join(lines))
     return "\n\n".join(blocks)
+
+
+def table3_store_rows(stats, speeds, baseline=BASELINE) -> dict:
+    """The parts of a Table 3 block that the runs alone give (no design made again): its title
+    (``{name}`` left to fill), the OpenFAST rainflow row and the pitch-rate SD row, each a list
+    of cells (the mean column last). ``stats`` per speed as :func:`_cell_stats` gives them."""
+    def se(v):
+        return f" ± {stats[v]['tower_del'][1]:.1f}" if len(stats[v]["seeds"]) > 1 else ""
+
+    return {"title": "**{name}** (tower-base DEL reduction against " + f"{baseline}; seeds per speed: "
+            + ", ".join(f"{v:g} m/s: {len(stats[v]['seeds'])}" for v in speeds) + ")",
+            "rainflow, OpenFAST": [f"{-stats[v]['tower_del'][0]:.1f}{se(v)} %" for v in speeds] + [""],
+            f"pitch-rate SD (deg/s): {baseline} / design": [
+                f"{stats[v]['pitch_rate_sd', 'base'][0]:.3f} / {stats[v]['pitch_rate_sd', 'design'][0]:.3f}"
+                for v in speeds] + [""]}
+
+
+def splice_table3(docs: str, printed: str) -> str:
+    """``docs`` with each Table 3 block of ``printed`` (:func:`table3`: its bold title line, a
+    blank line, its table) in place of the block of the same design and baseline."""
+    lines, printed = docs.splitlines(), printed.splitlines()
+    for start in (i for i, line in enumerate(printed) if _TABLE3_TITLE.match(line)):
+        key = _TABLE3_TITLE.match(printed[start]).group(1)
+        block = printed[start:_table_end(printed, start)]
+        where = [i for i, line in enumerate(lines) if (t := _TABLE3_TITLE.match(line)) and t.group(1) == key]
+        if len(where) != 1:
+            raise SystemExit(f"--docs: {len(where)} Table 3 blocks titled {key!r} there, 1 expected")
+        lines[where[0]:_table_end(lines, where[0])] = block
+    return "\n".join(lines) + ("\n" if docs.endswith("\n") else "")
+
+
+_TABLE3_TITLE = re.compile(r"(\*\*[^*]+\*\* \(tower-base DEL reduction against [^;]+);")
+
+
+def _table_end(lines, title) -> int:
+    """The index after the table that follows the title line ``title`` (blank lines between)."""
+    i = title + 1
+    while i < len(lines) and not lines[i].startswith("|"):
+        i += 1
+    while i < len(lines) and lines[i].startswith("|"):
+        i += 1
+    return i
 
 
 def _fig8(runs, v, model, loops, folder):
@@ -512,7 +554,8 @@ def main() -> None:
                          "reduced-model rainflow, deviation (designs again, runs the reduced model on the same seeds)")
     ap.add_argument("--docs", default=None, metavar="PAGE",
                     help="also write the (wind, controller) tables into PAGE (docs/openfast.md): each row replaced "
-                         "by the store's or inserted; rows the store does not give are kept and listed")
+                         "by the store's or inserted; rows the store does not give are kept and listed; with --table3, "
+                         "each design's Table 3 block replaced whole")
     ap.add_argument("--figures", default=None,
                     help="folder for Fig. 9 from OpenFAST (19 m/s, seed 0, where its series were kept) and, with "
                          "--damping, Fig. 8 per speed and Fig. 10")
@@ -530,10 +573,13 @@ def main() -> None:
             print("\n" + damping)
             printed.append(damping)
         if args.table3:
-            print("\n" + table3(runs, made, preds, reduced))
+            printed_t3 = table3(runs, made, preds, reduced)
+            print("\n" + printed_t3)
     if args.docs is not None:
         page = Path(args.docs)
         text, kept = splice(page.read_text(), "\n\n".join(printed))
+        if args.table3:
+            text = splice_table3(text, printed_t3)
         page.write_text(text)
         print(f"\n{page}: the store's rows written" + "".join(f"\n  kept, not from this store: {r[:70]}..." for r in kept))
 

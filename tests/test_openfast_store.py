@@ -68,3 +68,36 @@ def test_the_docs_splice_replaces_inserts_in_order_and_keeps_what_the_store_lack
     assert kept == ["| 21 | QFT+ATD | -3.0 |"]
     with pytest.raises(SystemExit, match="0 tables headed"):
         splice("no table here\n", printed)
+
+
+def test_table3_as_far_as_the_runs_give_it_is_in_the_docs_as_printed(runs, benchmark_script):
+    # Table 3's title (seeds per speed), OpenFAST rainflow and pitch-rate rows follow from the runs
+    # alone (the other rows need the designs made again: `openfast_report.py --table3 --docs`);
+    # a block whose speeds or seeds the store does not back was not regenerated from it
+    rep = benchmark_script("openfast_report")
+    docs = (ROOT / "docs" / "openfast.md").read_text().splitlines()
+    titles = [i for i, line in enumerate(docs) if rep._TABLE3_TITLE.match(line)]
+    assert titles, "docs/openfast.md has no Table 3 block"
+    for i in titles:
+        name = re.match(r"\*\*([^*]+)\*\*", docs[i]).group(1)
+        speeds = sorted({r.wind_speed for r in runs if r.controller == name})
+        stats = {v: rep._cell_stats(runs, rep.BASELINE, name, v, 4.0) for v in speeds}
+        speeds = [v for v in speeds if stats[v] is not None]
+        want = rep.table3_store_rows(stats, speeds)
+        assert docs[i] == want.pop("title").format(name=name)
+        block = {row.split(" | ")[0][2:]: row for row in docs[i:rep._table_end(docs, i)] if row.startswith("| ")}
+        assert block["tower DEL reduction"] == "| tower DEL reduction | " + " | ".join(f"{v:g}" for v in speeds) + " | mean |"
+        for label, cells in want.items():
+            assert block[label] == f"| {label} | " + " | ".join(cells) + " |", f"{name}: {label}"
+
+
+def test_the_table3_splice_replaces_a_designs_block_whole(benchmark_script):
+    splice = benchmark_script("openfast_report").splice_table3
+    title = "**QFT+ATD** (tower-base DEL reduction against ROSCO; seeds per speed: {})"
+    block = title + "\n\n| tower DEL reduction | {} | mean |\n|---|---|---|\n| rainflow, OpenFAST | {} |  |\n"
+    page = ("intro\n\n" + block.format("15 m/s: 3", "15", "20.0 %") + "\nbetween\n\n"
+            + block.replace("QFT+ATD", "QFT").format("19 m/s: 1", "19", "0.0 %") + "\nafter\n")
+    printed = block.format("15 m/s: 4, 17 m/s: 4", "15 | 17", "21.0 % | 22.0 %")
+    assert splice(page, printed) == page.replace(block.format("15 m/s: 3", "15", "20.0 %"), printed)
+    with pytest.raises(SystemExit, match="0 Table 3 blocks"):
+        splice("intro\n", printed)

@@ -1,4 +1,5 @@
-"""Issue 28 item 4: the default (transfer-function) design path is reproducible under 1e-9 m/s.
+"""Issue 28 item 4: the default (transfer-function) design path is reproducible under 1e-9 m/s
+(the paper's structure, `spec_notch`, is not yet: a strict xfail, last).
 
 At 17 and 17 − 1e-9 m/s, and at 23 and 23 + 1e-9 m/s (the two cases the issue measured: the
 promise moved by 7.9 pp and the controller order by 7 states), ``design_qft(model, v, 25.0)``
@@ -24,7 +25,7 @@ import pytest
 
 from specdesign.closedloop import siso_response
 from specdesign.feasibility import shape_whole_band
-from specdesign.qft import design_qft, spec_from_certified
+from specdesign.qft import design_qft, spec_from_certified, spec_notch
 from specdesign.spec import baseline_analysis
 from specdesign.turbine import iea15mw
 
@@ -73,3 +74,17 @@ def test_a_nudged_wind_speed_gives_the_same_element_specification_and_design(mod
     assert da.success and db.success
     assert db.parameters["order"] == da.parameters["order"]
     assert abs(db.del_reduction - da.del_reduction) <= 0.01
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="the paper's structure (spec_notch, fixed PI + notch + low-pass and ATD) is tuned "
+                   "by searches that decide by a hair: under 23 − 1e-9 m/s its parameters moved by 1.1e-3 relative on "
+                   "the reduced model, and on OpenFAST's 25 m/s linearisation the tuning returned another design "
+                   "(tower-mode ζ 0.112 vs 0.124; docs/openfast.md)")
+def test_a_nudged_wind_speed_gives_the_same_paper_structure_design(model):
+    # what Table 3's designs (openfast_table3.py's "atd" structure) must meet, as the default path does
+    a, b = (design_qft(model, x, spec=spec_notch(25.0)) for x in (23.0, 23.0 - 1e-9))
+    assert a.success and b.success
+    assert abs(b.del_reduction - a.del_reduction) <= 0.01
+    for key, value in a.parameters.items():
+        assert b.parameters[key] == pytest.approx(value, rel=1e-6), key
