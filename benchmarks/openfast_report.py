@@ -291,27 +291,21 @@ def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
     as the paper prints them."""
     blocks = []
     for name, by_v in made.items():
-        speeds = sorted(by_v)
-        stats = {v: _cell_stats(runs, baseline, name, v, m) for v in speeds}
-        speeds = [v for v in speeds if stats[v] is not None]
+        stats = table3_stats(runs, name, by_v, baseline, m)
+        speeds = list(stats)
         if not speeds:
             continue
-        store = table3_store_rows(stats, speeds, baseline)
+        store = table3_store_rows(name, stats, baseline)
         cols = " | ".join(f"{v:g}" for v in speeds)
-        lines = [store["title"].format(name=name), "",
+        lines = [store.pop("title"), "",
                  f"| tower DEL reduction | {cols} | mean |", "|---|" + "---|" * (len(speeds) + 1)]
-
-        def se(v):
-            n = len(stats[v]["seeds"])
-            return f" ± {stats[v]['tower_del'][1]:.1f}" if n > 1 else ""
-
         rain = {v: -stats[v]["tower_del"][0] for v in speeds}
         pred = {v: -preds[name, v] for v in speeds}
         dev = {v: pred[v] - rain[v] for v in speeds}
         row = {"specification (this workbench)": [f"{by_v[v]['promise']:.1f} %" for v in speeds] + [""],
                "linear prediction (OpenFAST's linearisation)": [f"{pred[v]:.1f} %" for v in speeds] + [""],
                "rainflow, OpenFAST": store["rainflow, OpenFAST"],
-               "deviation, prediction − rainflow": [f"{dev[v]:+.1f}{se(v)} pp" for v in speeds]
+               "deviation, prediction − rainflow": [f"{dev[v]:+.1f}{_tower_se(stats[v])} pp" for v in speeds]
                + [f"{np.mean(list(dev.values())):+.1f} pp (\\|·\\| {np.mean(np.abs(list(dev.values()))):.1f})"]}
         if reduced is not None:
             row["rainflow, reduced model (same seed numbers)"] = [
@@ -329,19 +323,28 @@ def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
     return "\n\n".join(blocks)
 
 
-def table3_store_rows(stats, speeds, baseline=BASELINE) -> dict:
-    """The parts of a Table 3 block that the runs alone give (no design made again): its title
-    (``{name}`` left to fill), the OpenFAST rainflow row and the pitch-rate SD row, each a list
-    of cells (the mean column last). ``stats`` per speed as :func:`_cell_stats` gives them."""
-    def se(v):
-        return f" ± {stats[v]['tower_del'][1]:.1f}" if len(stats[v]["seeds"]) > 1 else ""
+def table3_stats(runs, name, speeds, baseline=BASELINE, m=4.0) -> dict:
+    """:func:`_cell_stats` of design ``name`` per speed of ``speeds``, in order, where it and
+    ``baseline`` have paired runs: the speeds of its Table 3 block."""
+    stats = {v: _cell_stats(runs, baseline, name, v, m) for v in sorted(speeds)}
+    return {v: st for v, st in stats.items() if st is not None}
 
-    return {"title": "**{name}** (tower-base DEL reduction against " + f"{baseline}; seeds per speed: "
-            + ", ".join(f"{v:g} m/s: {len(stats[v]['seeds'])}" for v in speeds) + ")",
-            "rainflow, OpenFAST": [f"{-stats[v]['tower_del'][0]:.1f}{se(v)} %" for v in speeds] + [""],
+
+def _tower_se(st) -> str:
+    """" ± SE" of the tower DEL change, from two paired seeds up."""
+    return f" ± {st['tower_del'][1]:.1f}" if len(st["seeds"]) > 1 else ""
+
+
+def table3_store_rows(name, stats, baseline=BASELINE) -> dict:
+    """The parts of design ``name``'s Table 3 block that the runs alone give (no design made
+    again): its title line, and the OpenFAST rainflow and pitch-rate SD rows as lists of cells (the
+    mean column last). ``stats`` as :func:`table3_stats` gives them."""
+    return {"title": f"**{name}** (tower-base DEL reduction against {baseline}; seeds per speed: "
+            + ", ".join(f"{v:g} m/s: {len(st['seeds'])}" for v, st in stats.items()) + ")",
+            "rainflow, OpenFAST": [f"{-st['tower_del'][0]:.1f}{_tower_se(st)} %" for st in stats.values()] + [""],
             f"pitch-rate SD (deg/s): {baseline} / design": [
-                f"{stats[v]['pitch_rate_sd', 'base'][0]:.3f} / {stats[v]['pitch_rate_sd', 'design'][0]:.3f}"
-                for v in speeds] + [""]}
+                f"{st['pitch_rate_sd', 'base'][0]:.3f} / {st['pitch_rate_sd', 'design'][0]:.3f}"
+                for st in stats.values()] + [""]}
 
 
 def splice_table3(docs: str, printed: str) -> str:

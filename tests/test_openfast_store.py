@@ -80,13 +80,11 @@ def test_table3_as_far_as_the_runs_give_it_is_in_the_docs_as_printed(runs, bench
     assert titles, "docs/openfast.md has no Table 3 block"
     for i in titles:
         name = re.match(r"\*\*([^*]+)\*\*", docs[i]).group(1)
-        speeds = sorted({r.wind_speed for r in runs if r.controller == name})
-        stats = {v: rep._cell_stats(runs, rep.BASELINE, name, v, 4.0) for v in speeds}
-        speeds = [v for v in speeds if stats[v] is not None]
-        want = rep.table3_store_rows(stats, speeds)
-        assert docs[i] == want.pop("title").format(name=name)
+        stats = rep.table3_stats(runs, name, {r.wind_speed for r in runs if r.controller == name})
+        want = rep.table3_store_rows(name, stats)
+        assert docs[i] == want.pop("title")
         block = {row.split(" | ")[0][2:]: row for row in docs[i:rep._table_end(docs, i)] if row.startswith("| ")}
-        assert block["tower DEL reduction"] == "| tower DEL reduction | " + " | ".join(f"{v:g}" for v in speeds) + " | mean |"
+        assert block["tower DEL reduction"] == "| tower DEL reduction | " + " | ".join(f"{v:g}" for v in stats) + " | mean |"
         for label, cells in want.items():
             assert block[label] == f"| {label} | " + " | ".join(cells) + " |", f"{name}: {label}"
 
