@@ -71,6 +71,8 @@ RULE_GRID = (0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
 #: 1.07 rad/s; no blade modes, quasi-steady aerodynamics) is not OpenFAST's response to the pitch
 #: (3P at 2.4 rad/s, the blades' first flap modes, unsteady aerodynamics: docs/openfast.md).
 MODULUS_MARGIN, BAND, BAND_GAIN = 0.5, 1.5, 0.5
+#: The controllers the campaign runs, in the order it runs them at each speed.
+CONTROLLERS = ("ROSCO", ROSCO_TD, STRUCTURES["atd"][0], "MPC-OFlin", "MPC-OFlin-rule")
 #: The sample time (s) and forwarding interval (s, ServoDyn's DLL_DT) of the MPCs.
 TS, DT = 0.1, 0.02
 
@@ -109,7 +111,14 @@ def main() -> None:
     ap.add_argument("--out", default=str(STORE),
                     help="store (default: Table 3's, whose ROSCO and QFT+ATD runs are reused)")
     ap.add_argument("--rule-only", action="store_true", help="print the MPC's activity-weight rule and stop")
+    ap.add_argument("--controllers", default=",".join(CONTROLLERS),
+                    help="the controllers to run, comma-separated (default: all, %(default)s); the report covers "
+                         "every run in the store at these speeds")
     args = ap.parse_args()
+    chosen = [c.strip() for c in args.controllers.split(",") if c.strip()]
+    unknown = sorted(set(chosen) - set(CONTROLLERS))
+    if unknown or not chosen:
+        ap.error(f"--controllers: unknown {unknown or 'none given'}; choose from {', '.join(CONTROLLERS)}")
     speeds = [float(x) for x in args.speeds.split(",")]
     t0 = time.monotonic()
     deck, reduced = iea15mw_monopile(), turbine.iea15mw()
@@ -133,6 +142,7 @@ def main() -> None:
     for v in speeds:
         qft = export_design(made[v]["design"], out / f"{prefix}{v:g}", f"{label} {v:g} m/s", reduced)
         controllers = {"ROSCO": discon_in, ROSCO_TD: rosco_td_discon(discon_in, out), label: qft, **forwarded_mpcs}
+        controllers = {name: c for name, c in controllers.items() if name in chosen}
         validate.run_campaign(controllers, [v], args.seeds, plant=deck, duration=args.duration,
                               transient=args.transient, store=out / "runs", progress=True,
                               openfast={"processes": args.processes, "nice": args.nice, "install": install})
