@@ -273,3 +273,19 @@ def test_refine_grid_points_per_width_samples_every_peak_finely_and_no_more():
             assert band.size == band0.size               # 2ζ/50 = 4e-5 < rel_step: rel_step's spacing
     with pytest.raises(ValueError, match="points_per_width"):
         cl.refine_grid(w, systems[0], points_per_width=0.0)
+
+
+def test_merge_frequencies_keeps_one_point_per_root_computed_twice():
+    # the tower mode as a pole of two maps differs by round-off: one design frequency, whichever
+    # copy comes first, while points 1e-4 apart (refine_grid's spacing) stay distinct
+    from specdesign.closedloop import FREQUENCY_RTOL, merge_frequencies
+
+    w = 1.0699516312
+    got = merge_frequencies([w, 2.0], [w * (1 + 1e-12), w * (1 - 1e-13), w * (1 + 1e-4)])
+    assert got.tolist() == [w * (1 - 1e-13), w * (1 + 1e-4), 2.0]
+    assert merge_frequencies([1.0, 1.0 + 10 * FREQUENCY_RTOL]).size == 2
+    assert merge_frequencies().size == 0
+    with pytest.raises(ValueError, match="finite positive"):
+        merge_frequencies([1.0, np.nan])
+    with pytest.raises(ValueError, match="rtol"):
+        merge_frequencies([1.0], rtol=0.1)

@@ -31,7 +31,7 @@ Every closed-loop construction of the workbench lives here, one module a concern
 """
 from __future__ import annotations
 
-from .grid import case_speeds, lightly_damped, refine_grid, system_roots
+from .grid import FREQUENCY_RTOL, case_speeds, lightly_damped, merge_frequencies, refine_grid, system_roots
 from .interconnect import (
                            PLANT_INPUTS,
                            check_stability,
@@ -125,6 +125,8 @@ __all__ = [
     "system_roots",
     "lightly_damped",
     "refine_grid",
+    "merge_frequencies",
+    "FREQUENCY_RTOL",
     "case_speeds",
     "ORIGIN_TOL",
     "UNSTABLE_CONTROLLER_RATE",

@@ -10,10 +10,57 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:
     import control
 
-__all__ = ["CASE_TOLERANCE", "case_speeds", "lightly_damped", "refine_grid", "system_roots"]
+__all__ = ["CASE_TOLERANCE", "FREQUENCY_RTOL", "case_speeds", "lightly_damped", "merge_frequencies", "refine_grid",
+           "system_roots"]
 
 #: Plant cases closer than this (m/s) to another one are the same operating point.
 CASE_TOLERANCE = 1e-6
+#: Frequencies closer than this, relative, are one grid point: the same root computed twice (the
+#: tower mode as a pole of the wind → speed and of the wind → tower-load map) differs by round-off
+#: (≈ 1e-12 relative), and a grid that keeps both copies or one by that round-off is a different
+#: problem for a tuner whose constraints are one per grid point.
+FREQUENCY_RTOL = 1e-8
+
+
+def merge_frequencies(*grids: ArrayLike, rtol: float = FREQUENCY_RTOL) -> np.ndarray:
+    """The union of frequency grids (rad/s), with points closer than ``rtol`` relative merged.
+
+    Sorted, then every run of points whose neighbours are within ``rtol``·ω of each other is
+    kept as its smallest point, which moves continuously with the data (``np.unique`` would keep
+    copies that differ by round-off and merge those that happen to be equal).
+
+    Parameters
+    ----------
+    *grids : array_like
+        Frequencies, rad/s (any order, positive).
+    rtol : float
+        Relative distance (-) under which two neighbouring points are one.
+
+    Returns
+    -------
+    numpy.ndarray
+        Increasing frequencies, rad/s.
+
+    Raises
+    ------
+    ValueError
+        If a frequency is not finite and positive, or ``rtol`` is not in [0, 1e-3].
+
+    Examples
+    --------
+    >>> from specdesign.closedloop import merge_frequencies
+    >>> merge_frequencies([1.0, 2.0], [1.0 + 1e-13, 3.0])
+    array([1., 2., 3.])
+    """
+    if not 0 <= rtol <= 1e-3:
+        raise ValueError(f"rtol={rtol!r} must be in [0, 1e-3] (a relative distance under which frequencies are one)")
+    w = np.sort(np.concatenate([np.atleast_1d(np.asarray(g, float)).reshape(-1) for g in grids]) if grids else np.zeros(0))
+    if w.size and not (np.all(np.isfinite(w)) and w[0] > 0):
+        raise ValueError("grids must hold finite positive frequencies in rad/s")
+    if w.size < 2:
+        return w
+    new_run = np.r_[True, np.diff(w) > rtol * w[1:]]
+    return w[new_run]
 
 
 def system_roots(sys: control.LTI) -> np.ndarray:

@@ -25,6 +25,7 @@ from ..closedloop import (
     case_speeds,
     closed_loop,
     lightly_damped,
+    merge_frequencies,
     refine_grid,
 )
 from ..feasibility import (
@@ -69,7 +70,7 @@ def _sharp_frequencies(prob, enabled=True, zeta_max=0.3, spread=(0.99, 1.0, 1.01
                     if r.imag > 0:
                         out.extend(abs(r) * np.asarray(spread))
     w = np.asarray(out)
-    return np.unique(w[(w >= 0.005) & (w <= 20.0)])
+    return merge_frequencies(w[(w >= 0.005) & (w <= 20.0)])
 
 
 def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float = TARGET_REDUCTION, *,
@@ -386,7 +387,7 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
     kappa = hf_ratio(max_hf_gain_ratio)
     bound = None if kappa is None else (lambda w: hf_gain_bound(model, v, w, kappa), (HF_OMEGA, HF_END))
     if bound is not None:  # the bound's check includes its band's ends and 3P
-        wdense = np.union1d(wdense, hf_check_omega(model, wdense))
+        wdense = merge_frequencies(wdense, hf_check_omega(model, wdense))
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, speed_relax_db, max_sensitivity, base,
                          speed_shaping=speed_shaping, controller_bound=bound)
     # Sharp features of the specs (the lightly damped tower-mode poles and zeros of every case's
@@ -400,12 +401,12 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
         # 1.3 dB violation
         roots = np.concatenate([spec_roots(x_) for x_ in given])
         light = lightly_damped(roots)
-        sharp = np.unique(np.r_[sharp, np.abs(light[light.imag > 0])])
+        sharp = merge_frequencies(sharp, np.abs(light[light.imag > 0]))
         sharp = sharp[(sharp >= 0.005) & (sharp <= 20.0)]
         wdense = refine_grid(wdense, light)
     if sharp.size:
-        prob.set_design(np.unique(np.r_[prob.wd, sharp]))
-        wdense = np.unique(np.r_[wdense, sharp[(sharp >= wdense[0]) & (sharp <= wdense[-1])]])
+        prob.set_design(merge_frequencies(prob.wd, sharp))
+        wdense = merge_frequencies(wdense, sharp[(sharp >= wdense[0]) & (sharp <= wdense[-1])])
     x = rosco_start(prob.rosco[nom])
     rounds = 0
     while True:
@@ -416,7 +417,7 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
         # more design frequencies cannot rescue a design that already fails on the ones it has
         if not bad or not feasible or rounds >= refine:
             break
-        new = np.unique(np.r_[prob.wd, [w[0] for w in bad]])
+        new = merge_frequencies(prob.wd, [w[0] for w in bad])
         if new.size == prob.wd.size:
             break
         prob.set_design(new)
