@@ -1,5 +1,9 @@
-"""Issue 28 item 4: the default (transfer-function) design path is reproducible under 1e-9 m/s
-(the paper's structure, `spec_notch`, is not yet: a strict xfail, last).
+"""Issue 28 item 4: the design paths are reproducible under 1e-9 m/s.
+
+The paper's structure (``spec_notch``, Table 3's designs) takes the same decisions (ladder rung,
+dense-check rounds, order) and promises and predicts the same to 0.01 pp at every speed of
+Table 3; its controllers agree to 1e-6 relative at 19-25 m/s, not yet at 15 and 17 m/s (a
+strict xfail, last).
 
 At 17 and 17 − 1e-9 m/s, and at 23 and 23 + 1e-9 m/s (the two cases the issue measured: the
 promise moved by 7.9 pp and the controller order by 7 states), ``design_qft(model, v, 25.0)``
@@ -17,6 +21,7 @@ decided by a hair.
 """
 from __future__ import annotations
 
+import functools
 import warnings
 from dataclasses import astuple
 
@@ -76,15 +81,49 @@ def test_a_nudged_wind_speed_gives_the_same_element_specification_and_design(mod
     assert abs(db.del_reduction - da.del_reduction) <= 0.01
 
 
+#: The paper's structure at each speed of Table 3 and its nudge (Table 3's designs:
+#: openfast_table3.py's "atd" structure, on the reduced model here).
+NOTCH_CASES = [(15.0, 15.0 - 1e-9), (17.0, 17.0 - 1e-9), (19.0, 19.0 + 1e-9), (21.0, 21.0 - 1e-9),
+               (23.0, 23.0 + 1e-9), (25.0, 25.0 - 1e-9)]
+
+
+@functools.cache
+def _notch_pair(v, nudged):
+    model = iea15mw()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a rung's miss, said once per design
+        return design_qft(model, v, spec=spec_notch(25.0)), design_qft(model, nudged, spec=spec_notch(25.0))
+
+
+def _relative_response_change(a, b, name):
+    # relative to |C| at each frequency, but for the dips of C (below 1 % of its peak): as above
+    w = np.geomspace(0.005, 10.0, 800)
+    ca, cb = siso_response(getattr(a, name), w), siso_response(getattr(b, name), w)
+    return float(np.max(np.abs(cb - ca) / np.maximum(np.abs(ca), 1e-2 * np.max(np.abs(ca)))))
+
+
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="the paper's structure (spec_notch, fixed PI + notch + low-pass and ATD) is tuned "
-                   "by searches that decide by a hair: under 23 − 1e-9 m/s its parameters moved by 1.1e-3 relative on "
-                   "the reduced model, and on OpenFAST's 25 m/s linearisation the tuning returned another design "
-                   "(tower-mode ζ 0.112 vs 0.124; docs/openfast.md)")
-def test_a_nudged_wind_speed_gives_the_same_paper_structure_design(model):
-    # what Table 3's designs (openfast_table3.py's "atd" structure) must meet, as the default path does
-    a, b = (design_qft(model, x, spec=spec_notch(25.0)) for x in (23.0, 23.0 - 1e-9))
+@pytest.mark.parametrize("v, nudged", NOTCH_CASES)
+def test_a_nudged_wind_speed_takes_the_same_decisions_in_the_paper_structure(v, nudged):
+    # before qft.tuner's phase one and KKT refinement: 1.1e-3 relative in the parameters at
+    # 23 m/s, and another local optimum on OpenFAST's 25 m/s linearisation (docs/openfast.md)
+    a, b = _notch_pair(v, nudged)
     assert a.success and b.success
+    assert b.options["speed_relax_db"] == a.options["speed_relax_db"]  # the same rung of the ladder
+    assert b.options["refine_rounds"] == a.options["refine_rounds"]  # the same dense-check rounds
+    assert b.n_states == a.n_states
+    assert abs(b.promise.exact_del - a.promise.exact_del) <= 0.01
     assert abs(b.del_reduction - a.del_reduction) <= 0.01
-    for key, value in a.parameters.items():
-        assert b.parameters[key] == pytest.approx(value, rel=1e-6), key
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("v, nudged", [pytest.param(*c, marks=pytest.mark.xfail(
+    strict=True, reason="the KKT point of these active sets (14-15 constraints on 10-11 free parameters, one "
+    "near-dependent pair) moves with round-off: 1.7e-6 (17 m/s) and 7e-6 (15 m/s) relative in C_beta under the "
+    "nudge, 1e-5 to 3e-5 in one damping ratio, not linear in the nudge (docs/qft_turbine.md)"))
+    if c[0] in (15.0, 17.0) else c for c in NOTCH_CASES])
+def test_a_nudged_wind_speed_gives_the_same_paper_structure_controllers(v, nudged):
+    # issue 28 item 4: responses within 1e-6 relative
+    a, b = _notch_pair(v, nudged)
+    assert _relative_response_change(a, b, "pitch_controller") <= 1e-6
+    assert _relative_response_change(a, b, "atd_controller") <= 1e-6

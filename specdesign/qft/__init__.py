@@ -69,11 +69,11 @@ minimise (σ_β̇/σ_β̇,ROSCO)² + 0.1·(σ_Ω/σ_Ω,ROSCO)² subject to a pre
 reduction ≥ ``target_reduction`` (Dirlik on |T|²S_W, nominal case), every bound at every
 design frequency for every case with a safety margin (0.1 dB on the stability specs, 0.02 dB
 on the performance specs), and every closed loop (full interconnection, every case) with
-poles left of −``min_decay`` 1/s. scipy's Powell method explores on exterior penalties, SLSQP
-polishes the Powell end point and the start to KKT points of the constrained problem, and the
-best candidate is kept by a total order (feasible first, then the smaller objective): a
-polished optimum moves continuously with the data, so the design does not jump when the
-wind speed moves by round-off (Powell's end point alone did). The two loops' bounds are then computed exactly with
+poles left of −``min_decay`` 1/s. A phase one (SLSQP on the least uniform violation) reaches a
+feasible point from ROSCO's infeasible start, SLSQP polishes it and Newton's method refines it
+to the KKT point (:mod:`specdesign.qft.tuner`): local methods from a start that moves
+continuously with the data, so the design does not jump when the wind speed moves by round-off
+(the earlier Powell exploration's end point did). The two loops' bounds are then computed exactly with
 :func:`loopshaping.qft.bounds` for the final controllers and the design is checked on a dense
 grid over all cases with :func:`loopshaping.check.check`; frequencies where the dense check
 fails are added to the design set and the tuning repeated (up to ``refine`` times).
