@@ -56,7 +56,7 @@ from specdesign.openfast import iea15mw_monopile  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))  # the campaign's script beside this one
 # its store, model and design step: the controllers it ran
-from openfast_table3 import STORE, STRUCTURES, designs, openfast_model, predicted_del  # noqa: E402
+from openfast_table3 import STORE, STRUCTURES, designs, export_design, openfast_model, predicted_del  # noqa: E402
 
 #: Bands of the tower-base moment's variance, rad/s: (label, low, high).
 BANDS = (("wind 0.05-0.6", 0.05, 0.6), ("0.6-0.85", 0.6, 0.85), ("tower mode 0.85-1.5", 0.85, 1.5),
@@ -194,7 +194,31 @@ def campaign_designs(runs, target=25.0):
     model = openfast_model(iea15mw_monopile(), speeds, processes=1)
     made = {label: designs(model, sorted({r.wind_speed for r in runs if r.controller == label}), target, structure)
             for structure, (label, _) in STRUCTURES.items() if label in names}
+    for label, speed, digests in stale_designs(runs, made):
+        print(f"WARNING: the {label} runs at {speed:g} m/s ran a parameter file of digest {', '.join(sorted(digests))}; "
+              f"this code's design exports another: the damping table, the linear predictions and Table 3's "
+              f"prediction rows are this code's design, the rainflow rows the runs' (rerun the campaign)", file=sys.stderr)
     return model, made
+
+
+def stale_designs(runs, made) -> list:
+    """(label, speed, the runs' parameter digests) where the designs ``made`` (:func:`campaign_designs`),
+    exported as the campaigns export them (``openfast_table3.export_design``), give another parameter
+    file than the runs of that controller and speed ran: runs of an earlier design code."""
+    import tempfile
+
+    from specdesign import turbine
+    from specdesign.openfast.deck import named_digest
+
+    reduced, out = turbine.iea15mw(), []
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, by_speed in made.items():
+            for v, entry in by_speed.items():
+                ran = {r.meta["parameters_sha"] for r in runs if r.controller == label and r.wind_speed == v}
+                export = export_design(entry["design"], Path(tmp) / f"{label}{v:g}", f"{label} {v:g} m/s", reduced)
+                if ran and named_digest(export.parameters) not in ran:
+                    out.append((label, v, ran))
+    return out
 
 
 def linear_side(runs, model, made, figures=None, reduced=None) -> tuple[str, dict]:
@@ -550,6 +574,9 @@ def main() -> None:
     ap.add_argument("--folder", default=str(STORE / "runs"),
                     help="the campaign's run folder (default: openfast_table3.STORE's, in the repository)")
     ap.add_argument("--baseline", default="ROSCO")
+    ap.add_argument("--speeds", default=None,
+                    help="only the runs at these wind speeds, m/s, comma-separated (docs/comparison.md: "
+                         "openfast_comparison.py's, --speeds 17,19); default: every run of the store")
     ap.add_argument("--damping", action="store_true",
                     help="also the closed-loop tower-mode damping on OpenFAST's linearisations (designs again)")
     ap.add_argument("--table3", action="store_true",
@@ -564,6 +591,11 @@ def main() -> None:
                          "--damping, Fig. 8 per speed and Fig. 10")
     args = ap.parse_args()
     runs = validate.read_openfast_runs(args.folder)
+    if args.speeds is not None:
+        speeds = {float(x) for x in args.speeds.split(",")}
+        runs = [r for r in runs if r.wind_speed in speeds]
+        if not runs:
+            ap.error(f"--speeds {args.speeds}: no run of the store at these wind speeds")
     printed = [report(Path(args.folder), runs, baseline=args.baseline)]
     print(printed[0])
     if args.figures is not None:

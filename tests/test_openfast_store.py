@@ -99,3 +99,31 @@ def test_the_table3_splice_replaces_a_designs_block_whole(benchmark_script):
     assert splice(page, printed) == page.replace(block.format("15 m/s: 3", "15", "20.0 %"), printed)
     with pytest.raises(SystemExit, match="0 Table 3 blocks"):
         splice("intro\n", printed)
+
+
+def test_runs_of_another_design_than_the_code_makes_are_named(benchmark_script, monkeypatch, tmp_path):
+    # the report's linear side (damping table, predictions, Table 3's prediction row) designs
+    # again; runs made with an earlier design code must be named, not silently paired with it
+    report = benchmark_script("openfast_report")
+    written = {}
+
+    def fake_export(design, folder, name, reduced):
+        folder.mkdir(parents=True)
+        f = folder / "DISCON.IN"
+        f.write_text(f"{name} {design}\n")
+        written[name] = f
+        return type("Export", (), {"parameters": f})()
+
+    monkeypatch.setattr(report, "export_design", fake_export)
+
+    class Run:
+        def __init__(self, speed, sha):
+            self.controller, self.wind_speed, self.meta = "QFT+ATD", speed, {"parameters_sha": sha}
+
+    made = {"QFT+ATD": {19.0: {"design": "a"}, 21.0: {"design": "b"}}}
+    from specdesign.openfast.deck import named_digest
+
+    same = tmp_path / "same.IN"
+    same.write_text("QFT+ATD 19 m/s a\n")  # what the fake export writes for the 19 m/s design
+    runs = [Run(19.0, named_digest(same)), Run(21.0, "0123456789abcdef")]
+    assert report.stale_designs(runs, made) == [("QFT+ATD", 21.0, {"0123456789abcdef"})]
