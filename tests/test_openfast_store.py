@@ -127,3 +127,16 @@ def test_runs_of_another_design_than_the_code_makes_are_named(benchmark_script, 
     same.write_text("QFT+ATD 19 m/s a\n")  # what the fake export writes for the 19 m/s design
     runs = [Run(19.0, named_digest(same)), Run(21.0, "0123456789abcdef")]
     assert report.stale_designs(runs, made) == [("QFT+ATD", 21.0, {"0123456789abcdef"})]
+
+
+def test_the_comparison_page_carries_the_stores_rows_at_its_speeds(runs, benchmark_script):
+    # docs/comparison.md's OpenFAST section is `openfast_report.py --speeds 17,19 --docs
+    # docs/comparison.md`: every row the store gives at openfast_comparison.SPEEDS stands there,
+    # each in its own table, and nothing else does
+    speeds = benchmark_script("openfast_comparison").SPEEDS
+    report = benchmark_script("openfast_report")
+    printed = report.report(RUNS, [r for r in runs if r.wind_speed in speeds])
+    docs = (ROOT / "docs" / "comparison.md").read_text()
+    text, kept = report.splice(docs, printed)
+    assert text == docs
+    assert not kept, f"rows in docs/comparison.md that the store does not give: {kept}"
