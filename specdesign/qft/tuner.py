@@ -422,10 +422,13 @@ def kkt_refine(prob: TuningProblem, x: ArrayLike, target: float | None, min_deca
     A polish ends where its line search or its tolerance stops it, which moves with round-off
     along a shallow valley of the objective (1e-5 relative in the parameters). From that point,
     with the active constraints (value < :data:`ACTIVE_TOL`) as equalities and the parameters on
-    their box limits fixed, Newton's method on ∇f = Jᵀλ, g_A = 0 (central-difference gradients,
-    the Lagrangian's Hessian by central differences of its gradient) converges to the KKT point
-    itself. It is kept only if it converges (step below 1e-10), every multiplier is ≥ 0 and every
-    constraint stays met; else ``x`` is returned unchanged.
+    (within 1e-5 of) their box limits fixed, Newton's method on ∇f = Jᵀλ, g_A = 0 (f the objective
+    with the tie-break, :func:`tied_objective`; central-difference gradients with a 1e-4 step, the
+    Lagrangian's Hessian by central differences of its gradient) converges to the KKT point
+    itself, to the gradients' round-off (≈ 1e-8 in the parameters where the active set is not
+    near-degenerate). It is kept only if it converges (at least three steps, the last below
+    :data:`STEP_TOL`), every multiplier is ≥ 0 and every constraint stays met; else ``x`` is
+    returned unchanged.
 
     Parameters
     ----------
@@ -473,7 +476,6 @@ def kkt_refine(prob: TuningProblem, x: ArrayLike, target: float | None, min_deca
 
     def grad_f(y):  # the objective's, plus the tie-break's 2·TIE_BREAK·(y − anchor), exact
         return _central_jacobian(lambda u: np.array([prob.objective(full(u))]), y)[0] + 2 * TIE_BREAK * (y - a)
-
 
     def jac_a(y):
         return _central_jacobian(lambda u: cons(u)[active], y).reshape(int(active.sum()), y.size)
