@@ -41,6 +41,7 @@ import argparse
 import math
 import re
 import sys
+import tempfile
 from collections import defaultdict
 from pathlib import Path
 
@@ -51,8 +52,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
-from specdesign import closedloop, spec, validate, wind  # noqa: E402
+from specdesign import closedloop, spec, turbine, validate, wind  # noqa: E402
 from specdesign.openfast import iea15mw_monopile  # noqa: E402
+from specdesign.openfast.deck import named_digest  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))  # the campaign's script beside this one
 # its store, model and design step: the controllers it ran
@@ -205,11 +207,6 @@ def stale_designs(runs, made) -> list:
     """(label, speed, the runs' parameter digests) where the designs ``made`` (:func:`campaign_designs`),
     exported as the campaigns export them (``openfast_table3.export_design``), give another parameter
     file than the runs of that controller and speed ran: runs of an earlier design code."""
-    import tempfile
-
-    from specdesign import turbine
-    from specdesign.openfast.deck import named_digest
-
     reduced, out = turbine.iea15mw(), []
     with tempfile.TemporaryDirectory() as tmp:
         for label, by_speed in made.items():

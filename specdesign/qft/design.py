@@ -158,7 +158,7 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
         refine : int, default 2
             Rounds adding the dense check's failing frequencies to the design set.
         maxfev : int, default 3000
-            Function evaluations per tuning round.
+            Iterations at most of each SLSQP run of the tuning (phase one and polish).
 
     Returns
     -------

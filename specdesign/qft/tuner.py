@@ -378,9 +378,10 @@ TIE_BREAK = 1e-4
 PHASE1_ROOM = 0.01
 #: Newton's steps end when no parameter moves by more than this (log-scale and damping-ratio units).
 STEP_TOL = 1e-6
-#: The SLSQP polish: central-difference gradients (accurate to ≈ 1e-10, where forward differences
-#: stop a polish 1e-5 from where another round-off would) and iterations enough to converge.
-POLISH_OPTIONS = {"maxiter": 3000, "ftol": 1e-14}
+#: SLSQP's options in :func:`tune` (its ``maxfev`` sets the iterations): a tolerance that lets it
+#: converge, with central-difference gradients (accurate to ≈ 1e-10, where forward differences
+#: stop a polish 1e-5 from where another round-off would).
+POLISH_OPTIONS = {"ftol": 1e-14}
 
 
 def tied_objective(prob: TuningProblem, x: ArrayLike, anchor: ArrayLike) -> float:
@@ -524,12 +525,14 @@ def kkt_refine(prob: TuningProblem, x: ArrayLike, target: float | None, min_deca
 def tune(prob: TuningProblem, x0: ArrayLike, target: float | None, min_decay: float, maxfev: int) -> tuple[np.ndarray, bool]:
     """Tune from ``x0``: every step a local method whose end moves continuously with the data.
 
-    1. Polish: SLSQP on the constrained problem (the objective plus the tie-break
-       :data:`TIE_BREAK`·|x − x0|², subject to :meth:`TuningProblem.constraints` ≥ 0), from ``x0``.
-    2. If that ends infeasible, phase one: SLSQP on min t subject to constraints + t ≥ 0 (the
-       least uniform violation, t in dB / pp / 1/s), from ``x0``, stopped at t = −:data:`PHASE1_ROOM`;
-       when it ends with t ≤ −:data:`PHASE1_ROOM`/2 (feasible with room, so no hair decides), the
-       polish again from its end.
+    1. Phase one, unless ``x0`` meets every constraint with :data:`PHASE1_ROOM`/2 of room (ROSCO's
+       start never does): SLSQP on min t subject to constraints + t ≥ 0 (the least uniform
+       violation, t in dB / pp / 1/s) from ``x0``, stopped at t = −:data:`PHASE1_ROOM`; it counts
+       as feasible only with t ≤ −:data:`PHASE1_ROOM`/2 (room, so no hair decides), else ``tune``
+       returns its end as infeasible. SLSQP on the objective straight from an infeasible start
+       ended feasible or not by round-off.
+    2. Polish: SLSQP on the constrained problem (the objective plus the tie-break
+       :data:`TIE_BREAK`·|x − x0|², subject to :meth:`TuningProblem.constraints` ≥ 0) from there.
     3. A feasible polish is refined to its KKT point (:func:`kkt_refine`).
 
     No derivative-free exploration and no choice among candidates by a strict order: those
