@@ -27,7 +27,13 @@ libraries' and parameter files' digests and the run settings) and not run again.
   deck; the operating point estimated from its own wind estimate, never told the mean wind),
   forwarded to Python at DLL_DT = 0.02 s with the turbine's pitch-rate limit;
 - ``MPC-OFlin-rule``: the same with the pitch-activity weight q_Δ chosen by :func:`activity_weight_rule`
-  on that model (docs/openfast.md, "The MPC on OpenFAST's linearisation").
+  on that model (docs/openfast.md, "The MPC on OpenFAST's linearisation");
+- ``H∞``: :func:`specdesign.hinf.design_hinf` at the speed with its defaults (the certified pair
+  for the DEL target, pitch only, under the high-frequency gain bound: the reduced-model
+  comparison's H∞, docs/comparison.md) on OpenFAST's linearisations, exported as QFT+ATD is;
+- ``H∞+ATD``: ``design_hinf`` on exactly the specifications the QFT+ATD design met
+  (:func:`specdesign.hinf.spec_from_qft`), generator speed and tower-top velocity measured (the
+  paper's structure's sensors), exported the same way.
 
 The printed tables are ``benchmarks/openfast_report.py``'s: per speed and controller the paired
 changes against ROSCO and against ROSCO+TD (tower-base and blade-root DEL, generator-speed SD,
@@ -58,7 +64,7 @@ from openfast_table3 import (
     rosco_td_discon,
 )
 
-from specdesign import turbine, validate
+from specdesign import hinf, turbine, validate
 from specdesign.export import forwarded
 from specdesign.mpc import QuadraticMPC, loop_gain
 from specdesign.openfast import find_openfast, iea15mw_monopile
@@ -75,7 +81,9 @@ MODULUS_MARGIN, BAND, BAND_GAIN = 0.5, 1.5, 0.5
 #: campaign also ran ROSCO's tower damper; 17 m/s the one below it.
 SPEEDS = (17.0, 19.0)
 #: The controllers the campaign runs, in the order it runs them at each speed.
-CONTROLLERS = ("ROSCO", ROSCO_TD, STRUCTURES["atd"][0], "MPC-OFlin", "MPC-OFlin-rule")
+CONTROLLERS = ("ROSCO", ROSCO_TD, STRUCTURES["atd"][0], "MPC-OFlin", "MPC-OFlin-rule", "H∞", "H∞+ATD")
+#: The H∞ designs (name: export folder prefix in the store).
+HINF = {"H∞": "export_hinf_", "H∞+ATD": "export_hinf_atd_"}
 #: The sample time (s) and forwarding interval (s, ServoDyn's DLL_DT) of the MPCs.
 TS, DT = 0.1, 0.02
 
@@ -109,6 +117,23 @@ def mpcs(lt, reduced, q_rule) -> dict:
     return out
 
 
+def hinf_designs(model, v, qft_atd, chosen) -> dict:
+    """The chosen :data:`HINF` designs at ``v`` m/s on ``model``: ``H∞`` by ``design_hinf``'s
+    defaults, ``H∞+ATD`` on the specifications ``qft_atd`` (the QFT+ATD design at ``v``) met."""
+    out = {}
+    if "H∞" in chosen:
+        out["H∞"] = hinf.design_hinf(model, v)
+    if "H∞+ATD" in chosen:
+        out["H∞+ATD"] = hinf.design_hinf(model, v, spec=hinf.spec_from_qft(qft_atd),
+                                         measurements=("gen_speed", "tower_top_vel"))
+    for name, d in out.items():
+        print(f"{name} at {v:g} m/s on OpenFAST's linearisation: {d.controller.nstates} states, promise "
+              f"{d.promised_del_reduction:.1f} %, linear prediction {d.predicted_del_reduction:.1f} % tower DEL reduction, "
+              f"tower mode ζ {d.tower_damping_ratio:.3f} (ROSCO {d.baseline_tower_damping_ratio:.3f}), peak sensitivity "
+              f"at the actuator {d.peak_sensitivity:.2f}", flush=True)
+    return out
+
+
 def main() -> None:
     ap = campaign_arguments(__doc__.split("\n")[0], ",".join(f"{v:g}" for v in SPEEDS))
     ap.add_argument("--out", default=str(STORE),
@@ -125,27 +150,39 @@ def main() -> None:
     speeds = [float(x) for x in args.speeds.split(",")]
     t0 = time.monotonic()
     deck, reduced = iea15mw_monopile(), turbine.iea15mw()
-    lt = openfast_linear_model(deck, reduced)
-    q_rule, rows = activity_weight_rule(lt)
-    print(f"activity weight by the rule (modulus margin >= {MODULUS_MARGIN:g}, |L| <= {BAND_GAIN:g} above {BAND:g} "
-          f"rad/s at every linearised speed): q_Δ = {q_rule:g}")
-    print("| q_Δ | wind (m/s) | min abs(1 − L) | max abs(L) above the band |\n|---|---|---|---|")
-    for q, v, margin, band in rows:
-        print(f"| {q:g} | {v:g} | {margin:.2f} | {band:.2f} |")
-    if args.rule_only:
-        return
+    mpc_names = {"MPC-OFlin", "MPC-OFlin-rule"} & set(chosen)
+    if mpc_names or args.rule_only:
+        lt = openfast_linear_model(deck, reduced)
+        q_rule, rows = activity_weight_rule(lt)
+        print(f"activity weight by the rule (modulus margin >= {MODULUS_MARGIN:g}, |L| <= {BAND_GAIN:g} above {BAND:g} "
+              f"rad/s at every linearised speed): q_Δ = {q_rule:g}")
+        print("| q_Δ | wind (m/s) | min abs(1 − L) | max abs(L) above the band |\n|---|---|---|---|")
+        for q, v, margin, band in rows:
+            print(f"| {q:g} | {v:g} | {margin:.2f} | {band:.2f} |")
+        if args.rule_only:
+            return
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
     install = find_openfast()
     discon_in = deck.fst.with_name(f"{deck.name}_DISCON.IN")
     # Table 3's designs: on OpenFAST's linearisations, named and exported as openfast_table3.py does
+    # (only what a chosen controller needs is designed, exported or written: a library another
+    # campaign's runs have loaded is never touched for nothing)
     label, prefix = STRUCTURES["atd"]
-    made = designs(openfast_model(deck, speeds), speeds, args.target, "atd")
-    forwarded_mpcs = mpcs(lt, reduced, q_rule)
+    design_model = openfast_model(deck, speeds) if {label, "H∞", "H∞+ATD"} & set(chosen) else None
+    made = designs(design_model, speeds, args.target, "atd") if {label, "H∞+ATD"} & set(chosen) else {}
+    forwarded_mpcs = mpcs(lt, reduced, q_rule) if mpc_names else {}
     for v in speeds:
-        qft = export_design(made[v]["design"], out / f"{prefix}{v:g}", f"{label} {v:g} m/s", reduced)
-        controllers = {"ROSCO": discon_in, ROSCO_TD: rosco_td_discon(discon_in, out), label: qft, **forwarded_mpcs}
-        controllers = {name: c for name, c in controllers.items() if name in chosen}
+        controllers = {name: c for name, c in forwarded_mpcs.items() if name in chosen}
+        if "ROSCO" in chosen:
+            controllers["ROSCO"] = discon_in
+        if ROSCO_TD in chosen:
+            controllers[ROSCO_TD] = rosco_td_discon(discon_in, out)
+        if label in chosen:
+            controllers[label] = export_design(made[v]["design"], out / f"{prefix}{v:g}", f"{label} {v:g} m/s", reduced)
+        for name, d in hinf_designs(design_model, v, made.get(v, {}).get("design"), chosen).items():
+            controllers[name] = export_design(d, out / f"{HINF[name]}{v:g}", f"{name} {v:g} m/s", reduced)
+        controllers = {name: controllers[name] for name in CONTROLLERS if name in controllers}  # the run order
         validate.run_campaign(controllers, [v], args.seeds, plant=deck, duration=args.duration,
                               transient=args.transient, store=out / "runs", progress=True,
                               openfast={"processes": args.processes, "nice": args.nice, "install": install})

@@ -83,8 +83,42 @@ def openfast_times(run) -> tuple[float, float]:
         for line in log.read_text(errors="replace").splitlines():
             for i, key in enumerate(("Total CPU Time:", "Total Real Time:")):
                 if key in line:
-                    out[i] = float(line.split(key)[1].split()[0])
+                    # OpenFAST says seconds, minutes or hours, whichever reads best
+                    value, unit = line.split(key)[1].split()[:2]
+                    out[i] = float(value) * _MINUTES_PER[unit.rstrip("s")]
     return out[0], out[1]
+
+
+#: OpenFAST's time units in its closing lines, in minutes.
+_MINUTES_PER = {"second": 1 / 60, "minute": 1.0, "hour": 60.0, "day": 1440.0}
+
+
+def forwarded_costs(runs) -> list[str]:
+    """Lines on the forwarded Python controllers' cost per control step (run.json's
+    ``forwarded_calls``, recorded by the campaign since 2026-11-28; runs before have none):
+    per controller and speed, the median over runs of each run's median and its largest 99th
+    percentile, CPU of the server's thread and wall, ms."""
+    cells = defaultdict(list)
+    for r in runs:
+        st = r.meta.get("forwarded_calls")
+        if st and "cpu_median_s" in st:
+            cells[r.controller, r.wind_speed].append(st)
+    if not cells:
+        return []
+    lines = ["", "Forwarded Python controllers, cost per control step (ms; median over runs of each run's "
+                 "median, largest 99th percentile):", "",
+             "| controller | wind (m/s) | runs | calls per run | CPU median | CPU p99 | wall median | wall p99 |",
+             "|---|---|---|---|---|---|---|---|"]
+    for (name, v), sts in sorted(cells.items()):
+        def med(k):
+            return 1e3 * float(np.median([st[k] for st in sts]))
+
+        def top(k):
+            return 1e3 * max(st[k] for st in sts)
+        lines.append(f"| {name} | {v:g} | {len(sts)} | {int(np.median([st['calls'] for st in sts]))} "
+                     f"| {med('cpu_median_s'):.2f} | {top('cpu_p99_s'):.2f} | {med('wall_median_s'):.2f} "
+                     f"| {top('wall_p99_s'):.2f} |")
+    return lines
 
 
 def wind_psd(model, v, omega):
@@ -174,6 +208,7 @@ def report(folder, runs, baseline="ROSCO", m=4.0) -> str:
                       f"{times[ok, 0].max():.1f} min (median {np.median(times[ok, 0]):.1f}; "
                       f"{60 * np.median(times[ok, 0]) / length:.2f} s of CPU per simulated second), wall "
                       f"{times[ok, 1].min():.1f}-{times[ok, 1].max():.1f} min (the load of the machine)"]
+    lines += forwarded_costs(runs)
     lines += ["", "Tower-base moment variance by band, mean over the paired seeds (MN²·m²); design / baseline:", ""]
     head = "| wind (m/s) | controller | " + " | ".join(f"{b[0]} rad/s" for b in BANDS) + " |"
     lines += [head, "|" + "---|" * (head.count("|") - 1)]

@@ -338,6 +338,24 @@ def test_library_is_compiled_once_and_shipped(tmp_path, monkeypatch):
     assert any(fnmatch.fnmatch(rel, p) for p in patterns)
 
 
+def test_a_library_in_use_is_never_rewritten_in_place(model, tmp_path):
+    """An export into a folder whose library a running OpenFAST has mapped (a campaign exporting
+    beside a running one) must not truncate that file: the same library is left alone (same inode,
+    same mtime), another one is renamed over it (a new inode; the old file stays whole for its reader)."""
+    c = rosco_baseline(model, 19.0)
+    lib = export_discon(c, tmp_path, model=model).library
+    before = lib.stat()
+    assert export_discon(c, tmp_path, model=model, name="again").library == lib
+    assert (lib.stat().st_ino, lib.stat().st_mtime_ns) == (before.st_ino, before.st_mtime_ns)
+    lib.unlink()
+    lib.write_bytes(b"another build")  # stands for the library of another source digest, in use
+    with open(lib, "rb") as reader:
+        export_discon(c, tmp_path, model=model)
+        assert reader.read() == b"another build"
+    assert lib.read_bytes() == discon_library().read_bytes()
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
 def test_bad_arguments(model, tmp_path):
     c = rosco_baseline(model, 19.0)
     with pytest.raises(TypeError, match="controller_or_design"):

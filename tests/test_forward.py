@@ -143,6 +143,38 @@ def test_exported_and_forwarded_lti_give_the_same_commands(model, tmp_path):
     assert np.array_equal(q_fwd, q_exp)
 
 
+class _Costly(_TustinLTI):
+    """The LTI above, spending ``busy`` s of its thread's CPU and then sleeping ``idle`` s per call."""
+
+    def __init__(self, C, omega_ref, dt, busy, idle):
+        super().__init__(C, omega_ref, dt)
+        self.busy, self.idle = busy, idle
+
+    def __call__(self, t, y):
+        import time
+
+        t0 = time.thread_time()
+        while time.thread_time() - t0 < self.busy:
+            pass
+        time.sleep(self.idle)
+        return super().__call__(t, y)
+
+
+def test_the_server_records_the_controllers_cpu_and_wall_time_per_call(model, tmp_path):
+    # issue 31 item 5, CPU per control step: a controller known to spend 2 ms of CPU and 5 ms
+    # asleep per call is recorded at >= 2 ms of CPU (not the sleep: thread time) and >= 7 ms of wall
+    busy, idle = 2e-3, 5e-3
+    t, ys, op = _sequence(model, 40)
+    fwd = forwarded(_Costly(rosco_baseline(model, 19.0), model.rated_rotor_speed, DT, busy, idle), dt=DT, model=model)
+    with ForwardServer(fwd) as srv:
+        _drive(Discon(srv.write(tmp_path / "fwd.IN"), library=fwd.library), t, ys, op)
+    st = srv.call_statistics()
+    assert st["calls"] == t.size == len(srv.call_cpu_times)
+    assert busy <= st["cpu_median_s"] < busy + idle
+    assert st["wall_median_s"] >= busy + idle
+    assert st["cpu_median_s"] <= st["cpu_p99_s"] <= st["cpu_max_s"]
+
+
 def test_unreachable_socket_fails_at_once_naming_it(model, tmp_path):
     fwd = forwarded(_TustinLTI(rosco_baseline(model, 19.0), model.rated_rotor_speed, DT), dt=DT, model=model)
     sock = tmp_path / "nobody"

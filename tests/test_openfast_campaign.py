@@ -102,6 +102,17 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
         run_openfast_campaign({"A": ctrls["B"]}, [19.0], [0], **kw)
 
 
+def test_a_controller_named_outside_ascii_runs_under_an_ascii_folder(tmp_path, fake):
+    # OpenFAST opens its case files by name: "H∞+ATD" runs as Hinf_ATD, and is read back by its name
+    inst, calls, lib = fake
+    camp = run_openfast_campaign({"H∞+ATD": _controller(tmp_path, lib, "h", "1.0")}, [19.0], [0],
+                                 deck=iea15mw_monopile(), duration=20.0, transient=5.0, record_dt=0.05, install=inst,
+                                 processes=1, folder=tmp_path / "camp", initial_conditions=False)
+    assert camp.controllers == ("H∞+ATD",)
+    assert (tmp_path / "camp" / "Hinf_ATD" / "19mps_seed0" / "run.json").is_file()
+    assert [r.controller for r in read_openfast_runs(tmp_path / "camp")] == ["H∞+ATD"]
+
+
 def test_a_parameter_file_counts_by_the_files_it_names_not_by_their_place(tmp_path, fake):
     # a DISCON.IN written with absolute file names (rosco.write_discon makes PerfFileName absolute,
     # as benchmarks/openfast_table3.py's ROSCO+TD file has it) is the same controller from another

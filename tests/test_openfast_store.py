@@ -140,3 +140,30 @@ def test_the_comparison_page_carries_the_stores_rows_at_its_speeds(runs, benchma
     text, kept = report.splice(docs, printed)
     assert text == docs
     assert not kept, f"rows in docs/comparison.md that the store does not give: {kept}"
+
+
+def test_the_forwarded_controllers_cost_per_step_is_tabulated_from_the_runs(benchmark_script):
+    # issue 31 item 5 (CPU per control step): run.json's forwarded_calls (ForwardServer.call_statistics),
+    # median over runs of the runs' medians and the largest 99th percentile, in ms; runs made
+    # before the campaign recorded it (no forwarded_calls) are left out, and no table without any
+    costs = benchmark_script("openfast_report").forwarded_costs
+
+    class Run:
+        def __init__(self, name, speed, cpu=None):
+            st = None if cpu is None else {"calls": 33000, "cpu_median_s": cpu, "cpu_p99_s": 3 * cpu,
+                                           "wall_median_s": 2 * cpu, "wall_p99_s": 5 * cpu}
+            self.controller, self.wind_speed, self.meta = name, speed, {"forwarded_calls": st} if st else {}
+
+    assert costs([Run("ROSCO", 19.0), Run("MPC", 19.0)]) == []
+    lines = costs([Run("MPC", 19.0, 1e-3), Run("MPC", 19.0, 3e-3), Run("MPC", 19.0, 2e-3), Run("MPC", 19.0)])
+    assert lines[-1] == "| MPC | 19 | 3 | 33000 | 2.00 | 9.00 | 4.00 | 15.00 |"
+
+
+@pytest.mark.parametrize("said, minutes", [("45.155 seconds", 45.155 / 60), ("14.237 minutes", 14.237),
+                                           ("1.5 hours", 90.0)])
+def test_openfast_times_read_the_unit_openfast_prints(benchmark_script, tmp_path, said, minutes):
+    # OpenFAST closes with "Total CPU Time: <x> <seconds|minutes|hours>" by the run's length
+    # (a 40 s run says seconds, a 660 s one minutes): the report's times are minutes whatever it says
+    (tmp_path / "case.log").write_text(f"  Total Real Time:       {said}\n  Total CPU Time:        {said}\n")
+    run = type("Run", (), {"folder": tmp_path})()
+    assert benchmark_script("openfast_report").openfast_times(run) == pytest.approx((minutes, minutes), rel=1e-12)

@@ -127,3 +127,21 @@ def test_a_nudged_wind_speed_gives_the_same_paper_structure_controllers(v, nudge
     a, b = _notch_pair(v, nudged)
     assert _relative_response_change(a, b, "pitch_controller") <= 1e-6
     assert _relative_response_change(a, b, "atd_controller") <= 1e-6
+
+
+def test_the_benchmark_prints_what_these_tests_assert(benchmark_script):
+    # benchmarks/reproducible.py prints the values docs/qft_turbine.md quotes: the same nudges as
+    # NOTCH_CASES and the same response measure as _relative_response_change (checked on two
+    # controllers with a dip, where the floor matters: a notch and the same notch moved by 1e-3)
+    import control as ct
+
+    bench = benchmark_script("reproducible")
+    assert sorted((v, v + dv) for v, dv in bench.NUDGE.items()) == sorted(NOTCH_CASES)
+
+    def notch(w0):
+        return ct.tf([1, 0.002 * w0, w0**2], [1, 0.5 * w0, w0**2]) * ct.tf([1, 0.1], [1, 0])
+
+    a, b = (type("D", (), {"pitch_controller": notch(w)})() for w in (0.8, 0.8 * (1 + 1e-3)))
+    want = _relative_response_change(a, b, "pitch_controller")
+    assert bench.response_change(a.pitch_controller, b.pitch_controller) == pytest.approx(want, rel=1e-12)
+    assert bench.response_change(ct.tf([0], [1]), ct.tf([0], [1])) == 0.0

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -248,7 +249,13 @@ def export_discon(controller_or_design: object, folder: str | Path, *, dt: float
     folder.mkdir(parents=True, exist_ok=True)
     built = discon_library(cache=cache, compiler=compiler)
     lib = folder / built.name
-    lib.write_bytes(built.read_bytes())
+    data = built.read_bytes()
+    if not lib.is_file() or lib.read_bytes() != data:
+        # renamed into place, never rewritten: an OpenFAST run with this folder's library loaded
+        # (a campaign exporting beside a running one) would crash on a truncated mapped file
+        tmp = folder / f".{lib.name}.{os.getpid()}.tmp"
+        tmp.write_bytes(data)
+        os.replace(tmp, lib)
     mode = {v: k for k, v in TORQUE_MODES.items()}[p.torque_mode]
     params = write_parameters(p, folder / PARAMETER_FILE,
                               comment=f"written by specdesign.export.export_discon for {lib.name}")

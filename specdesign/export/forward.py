@@ -378,6 +378,9 @@ class ForwardServer:
         Calls answered.
     call_times : list of float
         Wall time (s) the server spent in each call, from the request read to the reply sent.
+    call_cpu_times : list of float
+        CPU time (s) of the server's thread in each call, the same span (the controller's cost
+        per control step, whatever else the machine runs).
     records : list
         With ``record=True``.
     started : tuple or None
@@ -398,7 +401,7 @@ class ForwardServer:
         self.record = bool(record)
         self.controller = copy.deepcopy(forward.controller)
         self.error, self.link_error, self.finished, self.calls = None, None, False, 0
-        self.call_times, self.records, self.started = [], [], None
+        self.call_times, self.call_cpu_times, self.records, self.started = [], [], [], None
         self._filters = {}
         self._stop = threading.Event()
         self._thread = None
@@ -537,7 +540,7 @@ class ForwardServer:
             if body is None:
                 self.link_error = "the library closed the connection inside a request"
                 return
-            tic = time.perf_counter()
+            tic, tic_cpu = time.perf_counter(), time.thread_time()
             sw = np.frombuffer(body, dtype=np.float32)
             status = int(round(float(sw[0])))
             if status == -1:
@@ -553,6 +556,18 @@ class ForwardServer:
             _reply(conn, 0, struct.pack("=dd", pitch, torque))
             self.calls += 1
             self.call_times.append(time.perf_counter() - tic)
+            self.call_cpu_times.append(time.thread_time() - tic_cpu)
+
+    def call_statistics(self) -> dict:
+        """The calls answered and their cost (s): mean, median, 99th percentile and largest of
+        :attr:`call_cpu_times` (``cpu_*``) and :attr:`call_times` (``wall_*``); {"calls": 0} before any."""
+        out = {"calls": self.calls}
+        for key, times in (("cpu", self.call_cpu_times), ("wall", self.call_times)):
+            if times:
+                t = np.asarray(times)
+                out |= {f"{key}_mean_s": float(t.mean()), f"{key}_median_s": float(np.median(t)),
+                        f"{key}_p99_s": float(np.percentile(t, 99)), f"{key}_max_s": float(t.max())}
+        return out
 
     def _step(self, status: int, sw: np.ndarray) -> tuple[float, float]:
         """One call: the controller started (status 0) and stepped; (pitch rad, rotor torque N·m or NaN)."""

@@ -357,6 +357,8 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                     case, out = openfast(c.library, server.write(folder / _FORWARD_FILE))
                 finally:  # the Python traceback says more than OpenFAST's "DISCON failed"
                     server.raise_error(f"{name} at {v:g} m/s, seed {s}: ")
+                # the controller's cost per control step, recorded beside the run (not compared)
+                meta = dict(meta, forwarded_calls=server.call_statistics())
         else:
             case, out = openfast(c.library, c.parameters)
         return _post(case, out, settings, meta, keep=s in kept, wind=wind, rate_limit=rate_limit)
@@ -424,7 +426,9 @@ def _rate_limit(deck: Deck) -> float | None:
 
 
 def _slug(name: str) -> str:
-    return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in name)
+    """``name`` as an ASCII file name: "H∞+ATD" → "Hinf_ATD" (OpenFAST's Fortran opens the case's files by name)."""
+    name = name.replace("∞", "inf")
+    return "".join(ch if (ch.isascii() and ch.isalnum()) or ch in "-_." else "_" for ch in name)
 
 
 def _run_folder(root: Path, run) -> Path:
