@@ -559,8 +559,15 @@ class ForwardServer:
             self.call_cpu_times.append(time.thread_time() - tic_cpu)
 
     def call_statistics(self) -> dict:
-        """The calls answered and their cost (s): mean, median, 99th percentile and largest of
-        :attr:`call_cpu_times` (``cpu_*``) and :attr:`call_times` (``wall_*``); {"calls": 0} before any."""
+        """The calls answered and their cost per call.
+
+        Returns
+        -------
+        dict
+            ``calls`` (int) and, once there is one, ``cpu_mean_s``, ``cpu_median_s``,
+            ``cpu_p99_s``, ``cpu_max_s`` of :attr:`call_cpu_times` and the same ``wall_*`` of
+            :attr:`call_times` (s); ``{"calls": 0}`` before any call.
+        """
         out = {"calls": self.calls}
         for key, times in (("cpu", self.call_cpu_times), ("wall", self.call_times)):
             if times:
