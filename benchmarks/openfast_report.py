@@ -343,8 +343,8 @@ def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
     (``preds``), the OpenFAST rainflow reduction over the paired seeds (± jackknife SE from two
     seeds up), the deviation (rainflow − prediction, pp; its SE is the rainflow's, the
     prediction being exact), the reduced model's rainflow on the same seed numbers
-    (:func:`reduced_model_changes`, when given) and the pitch-rate SDs; reductions are positive,
-    as the paper prints them."""
+    (:func:`reduced_model_changes`, when given) and the actuator's cost (pitch-rate SD, pitch
+    travel, time at the rate limit); reductions are positive, as the paper prints them."""
     blocks = []
     for name, by_v in made.items():
         stats = table3_stats(runs, name, by_v, baseline, m)
@@ -367,8 +367,7 @@ def table3(runs, made, preds, reduced=None, baseline=BASELINE, m=4.0) -> str:
             row["rainflow, reduced model (same seed numbers)"] = [
                 (f"{-reduced[name, v][0]:.1f}" + (f" ± {reduced[name, v][1]:.1f}" if len(reduced[name, v][2]) > 1 else "")
                  + " %") if (name, v) in reduced else "" for v in speeds] + [""]
-        pitch = f"pitch-rate SD (deg/s): {baseline} / design"
-        row[pitch] = store[pitch]
+        row.update(store)  # the actuator's cost, after the fatigue rows
         for key, (vals, mean) in PAPER_TABLE3.items():
             paper = dict(zip(PAPER_SPEEDS, vals))
             unit = " %" if key != "deviation" else " pp"
@@ -393,14 +392,21 @@ def _tower_se(st) -> str:
 
 def table3_store_rows(name, stats, baseline=BASELINE) -> dict:
     """The parts of design ``name``'s Table 3 block that the runs alone give (no design made
-    again): its title line, and the OpenFAST rainflow and pitch-rate SD rows as lists of cells (the
-    mean column last). ``stats`` as :func:`table3_stats` gives them."""
+    again): its title line, the OpenFAST rainflow row and the actuator's cost (pitch-rate SD,
+    pitch travel, time at the rate limit) as lists of cells (the mean column last). ``stats`` as
+    :func:`table3_stats` gives them."""
+    def travel(st, who):
+        x, k = st["pitch_travel", who]
+        return f"{x:.0f}" if k else "not recorded"
     return {"title": f"**{name}** (tower-base DEL reduction against {baseline}; seeds per speed: "
             + ", ".join(f"{v:g} m/s: {len(st['seeds'])}" for v, st in stats.items()) + ")",
             "rainflow, OpenFAST": [f"{-st['tower_del'][0]:.1f}{_tower_se(st)} %" for st in stats.values()] + [""],
             f"pitch-rate SD (deg/s): {baseline} / design": [
                 f"{st['pitch_rate_sd', 'base'][0]:.3f} / {st['pitch_rate_sd', 'design'][0]:.3f}"
-                for st in stats.values()] + [""]}
+                for st in stats.values()] + [""],
+            f"pitch travel (deg/h): {baseline} / design": [
+                f"{travel(st, 'base')} / {travel(st, 'design')}" for st in stats.values()] + [""],
+            "at the rate limit (%): design": [f"{st['rate_limit_time', 'design'][0]:.2f}" for st in stats.values()] + [""]}
 
 
 def splice_table3(docs: str, printed: str) -> str:
