@@ -70,7 +70,7 @@ PATHS = {
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--paths", default="notch,default", help=f"comma-separated, of {', '.join(PATHS)} (default: %(default)s)")
-    ap.add_argument("--speeds", default="15,17,19,21,23,25", help="wind speeds, m/s, of %s" % sorted(NUDGE))
+    ap.add_argument("--speeds", default="15,17,19,21,23,25", help=f"wind speeds, m/s, of {sorted(NUDGE)}")
     ap.add_argument("--plant", choices=("reduced", "openfast"), default="reduced",
                     help="the reduced model, or OpenFAST's linearisations of the shipped deck (openfast_table3.openfast_model)")
     args = ap.parse_args()

@@ -104,7 +104,7 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
 
 def test_a_controller_named_outside_ascii_runs_under_an_ascii_folder(tmp_path, fake):
     # OpenFAST opens its case files by name: "H∞+ATD" runs as Hinf_ATD, and is read back by its name
-    inst, calls, lib = fake
+    inst, _, lib = fake
     camp = run_openfast_campaign({"H∞+ATD": _controller(tmp_path, lib, "h", "1.0")}, [19.0], [0],
                                  deck=iea15mw_monopile(), duration=20.0, transient=5.0, record_dt=0.05, install=inst,
                                  processes=1, folder=tmp_path / "camp", initial_conditions=False)

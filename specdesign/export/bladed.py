@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .._checks import positive_scalar
+from .._files import atomic_write
 from ..controller.lti import as_lti, is_lti_like
 from ..controller.scheduled import ScheduledController, controller_bank, schedule_filter_coefficients
 from ..controller.torque import TORQUE_PARAMS, TorqueLaw
@@ -253,9 +253,7 @@ def export_discon(controller_or_design: object, folder: str | Path, *, dt: float
     if not lib.is_file() or lib.read_bytes() != data:
         # renamed into place, never rewritten: an OpenFAST run with this folder's library loaded
         # (a campaign exporting beside a running one) would crash on a truncated mapped file
-        tmp = folder / f".{lib.name}.{os.getpid()}.tmp"
-        tmp.write_bytes(data)
-        os.replace(tmp, lib)
+        atomic_write(lib, lambda tmp: tmp.write_bytes(data))
     mode = {v: k for k, v in TORQUE_MODES.items()}[p.torque_mode]
     params = write_parameters(p, folder / PARAMETER_FILE,
                               comment=f"written by specdesign.export.export_discon for {lib.name}")

@@ -57,13 +57,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import atomic_write as _atomic_write
 from .metrics import INDICATORS
 
 __all__ = ["CampaignStore", "fingerprint"]
 
 #: version of the layout above; a store of another version is refused (3: per-cell checksums)
 FORMAT = 3
-#: A temporary file of :func:`_atomic_write`: ``.<name>.<pid>.tmp``.
+#: A temporary file of :func:`specdesign._files.atomic_write`: ``.<name>.<pid>.tmp``.
 _TMP = re.compile(r"^\..+\.(\d+)\.tmp$")
 
 
@@ -94,17 +95,6 @@ def fingerprint(obj) -> str:
         return hashlib.sha256(pickle.dumps(obj, protocol=4)).hexdigest()
     except (pickle.PicklingError, TypeError, AttributeError):
         return "unpicklable:" + type(obj).__qualname__
-
-
-def _atomic_write(path: Path, write) -> None:
-    """Write through ``write(tmp_path)`` then rename: the file is there whole or not at all."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
 
 
 class CampaignStore:
