@@ -159,6 +159,9 @@ def test_design_hinf_meets_the_bound_and_is_strictly_proper(model, v):
     assert d.case_check.met and d.case_check.proper
     assert d.case_check.hf_excess_db <= 0.0
     assert gain_ratio(model, v, d.pitch_controller, HF_GAIN_RATIO) <= 1.0
+    # the design's own measure at the nominal plant, and a controller a turbine can carry
+    assert d.hf_excess_db <= 0.0
+    assert d.controller_unstable_poles.size == 0 and d.speed_integral_sign == 1
     assert direct_term(d.pitch_controller) == 0.0
     assert d.promised_del_reduction >= TARGET_REDUCTION
 

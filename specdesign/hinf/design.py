@@ -11,7 +11,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from itertools import pairwise
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import control as ct
@@ -28,7 +28,8 @@ from .._checks import finite_system, spec_made_at
 from ..closedloop import MIN_DECAY_RATE, closed_loop_mimo, refine_grid
 from ..closedloop.maps import state_space_response
 from ..fatigue import TOWER_M
-from ..feasibility import MAX_HF_GAIN_RATIO
+from ..feasibility import HF_END, HF_OMEGA, MAX_HF_GAIN_RATIO, hf_check_omega, hf_gain_bound
+from ..feasibility.achievable import hf_ratio
 from .cases import CaseCheck, refine_on_cases
 from .plant import DEFAULT_INTEGRAL_CORNER, generalized_plant
 from ..feasibility.target import TARGET_REDUCTION
@@ -131,7 +132,8 @@ class HinfDesign:
         Damping ratio (-) of the first tower fore-aft mode in the reduced loop
         (:func:`specdesign.closedloop.tower_damping`); below
         :data:`~specdesign.closedloop.MIN_TOWER_DAMPING_FRACTION` of ROSCO's the design warns
-        (:class:`~specdesign.closedloop.TowerDampingWarning`).
+        (:class:`~specdesign.closedloop.TowerDampingWarning`); nan when the loop has moved the
+        mode out of :func:`~specdesign.closedloop.tower_pole`'s span (``notes`` says so).
     baseline_tower_damping_ratio : float
         The same with ROSCO's PI (-).
     peak_sensitivity : float
@@ -164,6 +166,19 @@ class HinfDesign:
         With a certified pair (a TargetSpecification) and pitch only: the explicit check of
         ``pitch_controller`` at every plant case the pair was certified on
         (:func:`specdesign.hinf.check_pair`); None otherwise.
+    hf_excess_db : float
+        Maximum of 20·log10(|C_β|/(κ·|C_ROSCO|)) on HF_OMEGA-HF_END (the grid's points there, the
+        band's ends and 3P; :func:`specdesign.feasibility.hf_gain_bound`) at the nominal plant,
+        dB (≤ 0 means the high-frequency gain bound is met; +inf with a direct term, −inf
+        without a bound, κ = None).
+    controller_unstable_poles : numpy.ndarray
+        The reduced K's poles with Re > 0, 1/s (empty for a stable controller). The closed
+        loop may be stable all the same (a conditionally stable loop): saturation, a rate limit or
+        a start-up transient can then make it diverge.
+    speed_integral_sign : int
+        Sign of Re(C_β/C_ROSCO) at the grid's lowest frequency: +1 when the generator-speed channel
+        regulates the speed with ROSCO's sign, −1 when it is reversed (the loop then holds the
+        speed through another channel, e.g. an integrated tower-top velocity).
 
     Examples
     --------
@@ -208,6 +223,9 @@ class HinfDesign:
     tower_notch_excess_db: float = float("nan")
     speed_excess_baseline_db: float = float("nan")
     case_check: CaseCheck | None = None
+    hf_excess_db: float = -np.inf
+    controller_unstable_poles: np.ndarray = field(default_factory=lambda: np.zeros(0, complex))
+    speed_integral_sign: int = 1
 
 
 def _qft_check(plant, pitch_controller, w_tower, w_speed, omega):
@@ -325,13 +343,16 @@ def design_hinf(
         (:func:`generalized_plant`). Default: 0.1 rad/s when ``decay_rate`` > 0 (without it
         the shift would move the controller's integral action to −α), none otherwise.
     max_hf_gain_ratio : float or None
-        κ of the high-frequency gain bound without ``spec``: the pair is made under it
-        (``specification_for_target(max_hf_gain_ratio=...)``, which refuses a target it makes
-        infeasible, naming it), and the multi-model step holds |C_β| ≤ κ·|C_ROSCO| on
-        HF_OMEGA-HF_END (2-10 rad/s, 3P included) with C_β strictly proper (``case_check``'s
-        ``hf_excess_db`` and ``proper``). A TargetSpecification carries its own. Default
-        :data:`specdesign.feasibility.MAX_HF_GAIN_RATIO`, the measured κ
-        (:data:`specdesign.feasibility.HF_GAIN_RATIO`); None switches it off.
+        κ of the high-frequency gain bound, |C_β| ≤ κ·|C_ROSCO| on HF_OMEGA-HF_END (2-10 rad/s,
+        3P included) with C_β strictly proper (``hf_excess_db``). Without ``spec`` the pair is
+        made under it (``specification_for_target(max_hf_gain_ratio=...)``, which refuses a
+        target it makes infeasible, naming it) and the multi-model step holds it at every plant
+        case (``case_check``'s ``hf_excess_db`` and ``proper``); a TargetSpecification carries
+        its own. On given specifications without the multi-model step (pitch + ATD, or a pair) the
+        synthesis does not hold it: the design is measured against it and warns when it misses
+        it (docs/hinf.md: raising the synthesis' sensor noise until it holds gives unstable,
+        sign-reversed controllers). Default :data:`specdesign.feasibility.MAX_HF_GAIN_RATIO`, the
+        measured κ (:data:`specdesign.feasibility.HF_GAIN_RATIO`); None switches it off.
     **plant_options
         ``noise``, ``noise_band``, ``rolloff``, ``shift`` for :func:`generalized_plant`.
 
@@ -399,6 +420,7 @@ def design_hinf(
     if measurements is None:
         measurements = ("gen_speed",) if spec.target is not None else ("gen_speed", "tower_top_vel")
     orders = _orders(order)
+    kappa = spec.target.max_hf_gain_ratio if spec.target is not None else hf_ratio(max_hf_gain_ratio)
     base = sp.baseline_analysis(model, v, m=m, omega=omega)
     design = None
     for k, ((wt, ws), relax) in enumerate(zip(spec.pairs, spec.speed_relax_db)):
@@ -407,7 +429,8 @@ def design_hinf(
             design = _lowest_order(orders, lambda o, wt=wt, ws=ws, relax=relax: _design_once(
                 model, v, base, wt, ws, spec.notch, spec.kind, relax, spec.target, measurements=measurements, order=o,
                 w_pitch=w_pitch, m=m, suboptimality=suboptimality, reduction_method=reduction_method, dt=dt,
-                min_damping=min_damping, decay_rate=decay_rate, integral_corner=integral_corner, **plant_options),
+                min_damping=min_damping, decay_rate=decay_rate, integral_corner=integral_corner, kappa=kappa,
+                **plant_options),
                 min_decay=_STEP_DECAY_ROOM * max(decay_rate, _STEP_MIN_DECAY))
         except RuntimeError:
             if last:
@@ -421,12 +444,42 @@ def design_hinf(
             f"specs='{spec.kind}': speed spec relaxed by {design.speed_relax_db:g} dB, the smallest of "
             f"{spec.speed_relax_db} with both specs met on the refined grid" if met else
             f"specs='{spec.kind}': no relaxation of {spec.speed_relax_db} met both specs; the last is returned",))
+        if not met:
+            warnings.warn(f"design_hinf at {v:g} m/s: no relaxation of {spec.speed_relax_db} dB met both "
+                          f"specifications; the last is returned, generator speed {design.speed_excess_db:+.2f} dB "
+                          f"and tower load {design.tower_band_excess_db:+.2f} dB (tower-mode band) over them; "
+                          "try pitch + ATD or a certified pair (the default)", RuntimeWarning,
+                          stacklevel=2)
     # said of the design returned only (the orders and relaxations passed over are not the result)
     weak = closedloop.tower_damping_message("design_hinf", v, design.tower_damping_ratio,
                                             design.baseline_tower_damping_ratio)
     if weak is not None:
         warnings.warn(weak, closedloop.TowerDampingWarning, stacklevel=2)
+    for said in _carry_messages(design, v, kappa):
+        warnings.warn(said, RuntimeWarning, stacklevel=2)
     return design
+
+
+def _carry_messages(d, v, kappa):
+    """What keeps the returned design off a real turbine: an unstable or sign-reversed controller, a
+    high-frequency gain over the bound (the multi-model step's misses are said by it)."""
+    out = []
+    if d.controller_unstable_poles.size or d.speed_integral_sign < 0:
+        poles = ", ".join(f"{p:.3g}" for p in d.controller_unstable_poles)
+        what = [f"has unstable poles ({poles} 1/s): the loop is conditionally stable"] if poles else []
+        if d.speed_integral_sign < 0:
+            what.append("its generator-speed channel's integral action has the opposite sign of ROSCO's (with "
+                        "pitch + ATD the speed is then held through the integrated tower-top velocity)")
+        out.append(f"design_hinf at {v:g} m/s: the reduced controller {'; '.join(what)}. Saturation, the "
+                   "pitch-rate limit or a start-up transient can make such a loop diverge: validate in OpenFAST "
+                   "before use, or design on a certified pair with pitch only (the default)")
+    if kappa is not None and d.case_check is None and d.hf_excess_db > 0:
+        out.append(
+            f"design_hinf at {v:g} m/s: C_β exceeds the high-frequency gain bound (κ = {kappa:g} × ROSCO's |C| on "
+            f"{HF_OMEGA:g}-{HF_END:g} rad/s) by {d.hf_excess_db:.1f} dB: pitch-actuator wear and excited modes on a "
+            "turbine with 3P and noise in the speed signal. The synthesis on given specifications does not hold the "
+            "bound; the certified pair with pitch only (design_hinf's default) does")
+    return out
 
 
 def _orders(order):
@@ -489,7 +542,8 @@ def _met_with_room(check, min_decay):
 
 
 def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, target, *, measurements, order, w_pitch, m,
-                 suboptimality, reduction_method, dt, min_damping, decay_rate, integral_corner, **plant_options):
+                 suboptimality, reduction_method, dt, min_damping, decay_rate, integral_corner, kappa,
+                 **plant_options):
     """One synthesis, reduction and assessment of :func:`design_hinf` on fixed specifications."""
     plant = model.linearize(v)
     Wt, Ws = siso_weight(w_tower, "w_tower"), siso_weight(w_speed, "w_speed")
@@ -592,7 +646,22 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
                   "qft.design_qft(spec=...), see docs/hinf.md")
         notes = notes + (missed,)
         warnings.warn(missed, RuntimeWarning, stacklevel=3)
-    zeta_tower, zeta_rosco = closedloop.tower_damping(plant, cl)[1], closedloop.tower_damping(plant, cl0)[1]
+    hf_excess = -np.inf
+    if kappa is not None:  # the bound's band on the grid, its ends and 3P; a direct term breaks it above
+        w_hf = hf_check_omega(model, omega)
+        c = parts[0]
+        c_hf = np.abs(state_space_response(c.A, c.B, c.C, c.D, w_hf)[:, 0, 0])
+        hf_excess = np.inf if np.any(c.D) else float(np.max(20 * np.log10(c_hf / hf_gain_bound(model, v, w_hf, kappa))))
+    kp = np.linalg.eigvals(np.asarray(K.A, float)) if K.nstates else np.zeros(0, complex)
+    k_unstable = np.sort_complex(kp[kp.real > 1e-9])
+    c_lo = state_space_response(parts[0].A, parts[0].B, parts[0].C, parts[0].D, omega[:1])[0, 0, 0]
+    sign = 1 if np.real(c_lo / _response(rosco, omega[:1])[0]) > 0 else -1
+    zeta_rosco = closedloop.tower_damping(plant, cl0)[1]
+    try:
+        zeta_tower = closedloop.tower_damping(plant, cl)[1]
+    except ValueError as e:  # the loop moved the mode out of tower_pole's span: say so, keep the design
+        zeta_tower = float("nan")
+        notes = notes + (f"tower mode's damping not located in the reduced loop ({e})",)
     p = np.asarray(cl.poles())
     osc = p[np.abs(p.imag) > 1e-6]
     zeta = -osc.real / np.abs(osc)
@@ -617,4 +686,5 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
         notch_spec=notch_spec if notch_spec is not None else w_tower,
         notch_promised_del_reduction=float(notch_promise.exact_del),
         tower_notch_excess_db=notch_excess, speed_excess_baseline_db=speed_excess0, case_check=case_check,
+        hf_excess_db=hf_excess, controller_unstable_poles=k_unstable, speed_integral_sign=sign,
     )
