@@ -8,8 +8,12 @@ the reduced controller's unstable poles, the sign of its generator-speed integra
 ROSCO's). ``--noise-scan`` adds the pitch + ATD design on QFT's specifications with the
 synthesis' generator-speed noise raised ×2 per step (``noise={"gen_speed": ...}``): what rolling
 C_β off that way costs. The table is printed and spliced into docs/hinf.md between its markers.
+``--openfast 19`` prints instead, on OpenFAST's linearisation of the IEA 15 MW monopile deck at that
+speed (the cached one, ``openfast_table3.openfast_model``), the gain of the exported H∞ design
+(``design_hinf``'s default) and of the QFT+ATD design over ROSCO's, 20·log10|C_β/C_ROSCO|, at
+0.5-10 rad/s, with each design's linear pitch SD against ROSCO's (docs/comparison.md, "In OpenFAST").
 
-Run: python benchmarks/hinf_structures.py [--noise-scan] [--no-docs]   (≈ 1 min, 3 with the scan)
+Run: python benchmarks/hinf_structures.py [--noise-scan] [--no-docs] [--openfast 19]   (≈ 1 min, 3 with the scan)
 """
 from __future__ import annotations
 
@@ -17,9 +21,10 @@ import argparse
 import warnings
 from pathlib import Path
 
-from comparison import splice
-
 from specdesign import hinf, turbine
+from specdesign.feasibility import MAX_HF_GAIN_RATIO
+
+from comparison import splice
 
 V = 19.0
 DOC = Path(__file__).resolve().parents[1] / "docs" / "hinf.md"
@@ -74,11 +79,43 @@ def table(model, noise_scan=False) -> str:
     return "\n".join(out)
 
 
+def openfast_gains(v: float) -> str:
+    """|C_β/C_ROSCO| (dB) of the exported H∞ and QFT+ATD designs on OpenFAST's linearisation at ``v`` m/s."""
+    import numpy as np
+    from specdesign import spec
+    from specdesign.closedloop import siso_response
+    from specdesign.openfast import iea15mw_monopile
+
+    from openfast_table3 import designs, openfast_model
+
+    model = openfast_model(iea15mw_monopile(), [v])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        h = hinf.design_hinf(model, v)
+        q = designs(model, [v], 25.0, "atd")[v]["design"]
+    w = np.array([0.5, 1.0, 1.5, 2.0, 3.0 * model.rated_rotor_speed, 3.0, 4.0, 6.0, 8.0, 10.0])
+    rosco = np.abs(siso_response(spec.baseline_controller(model, v), w))
+    out = ["| design | " + " | ".join(f"{x:.3g}" for x in w) + " rad/s | pitch SD / ROSCO's (linear) |",
+           "|" + "---|" * (w.size + 2)]
+    for name, c, ratio in (("H∞ (design_hinf's default)", h.pitch_controller, h.pitch_std / h.pitch_std_baseline),
+                           ("QFT+ATD", q.pitch_controller, 1 + q.pitch_sd_change / 100)):
+        gain = 20 * np.log10(np.abs(siso_response(c, w)) / rosco)
+        out.append(f"| {name} | " + " | ".join(f"{g:+.1f}" for g in gain) + f" | {ratio:.2f} |")
+    out.append(f"\n20·log10|C_β/C_ROSCO| in dB at {v:g} m/s; the bound's κ = {MAX_HF_GAIN_RATIO:g} is "
+               f"{20 * np.log10(MAX_HF_GAIN_RATIO):.1f} dB on {w[3]:g}-{w[-1]:g} rad/s.")
+    return "\n".join(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--noise-scan", action="store_true", help="add the 1×2 design with more generator-speed noise")
     ap.add_argument("--no-docs", action="store_true", help="print only; do not splice docs/hinf.md")
+    ap.add_argument("--openfast", type=float, default=None, metavar="SPEED",
+                    help="print the H∞ and QFT+ATD designs' gains on OpenFAST's linearisation at SPEED m/s instead")
     args = ap.parse_args()
+    if args.openfast is not None:
+        print(openfast_gains(args.openfast))
+        return
     text = table(turbine.iea15mw(), args.noise_scan)
     print(text)
     if not args.no_docs:
