@@ -21,10 +21,14 @@ import argparse
 import warnings
 from pathlib import Path
 
-from specdesign import hinf, turbine
-from specdesign.feasibility import MAX_HF_GAIN_RATIO
-
+import numpy as np
 from comparison import splice
+from openfast_table3 import designs, openfast_model
+
+from specdesign import hinf, spec, turbine
+from specdesign.closedloop import siso_response
+from specdesign.feasibility import MAX_HF_GAIN_RATIO
+from specdesign.openfast import iea15mw_monopile
 
 V = 19.0
 DOC = Path(__file__).resolve().parents[1] / "docs" / "hinf.md"
@@ -64,8 +68,8 @@ def table(model, noise_scan=False) -> str:
     ]
     out = [HEAD, "|" + "---|" * HEAD.count(" | ") + "---|"]
     d = None
-    for label, spec, meas, kw in cases:
-        d = _design(model, spec, meas, **kw)
+    for label, given, meas, kw in cases:
+        d = _design(model, given, meas, **kw)
         out.append(row(label, d))
     baseline = d.pitch_std_baseline
     if noise_scan:
@@ -81,13 +85,6 @@ def table(model, noise_scan=False) -> str:
 
 def openfast_gains(v: float) -> str:
     """|C_β/C_ROSCO| (dB) of the exported H∞ and QFT+ATD designs on OpenFAST's linearisation at ``v`` m/s."""
-    import numpy as np
-    from specdesign import spec
-    from specdesign.closedloop import siso_response
-    from specdesign.openfast import iea15mw_monopile
-
-    from openfast_table3 import designs, openfast_model
-
     model = openfast_model(iea15mw_monopile(), [v])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

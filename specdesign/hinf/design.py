@@ -646,16 +646,15 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
                   "qft.design_qft(spec=...), see docs/hinf.md")
         notes = notes + (missed,)
         warnings.warn(missed, RuntimeWarning, stacklevel=3)
+    c_beta = parts[0]
     hf_excess = -np.inf
     if kappa is not None:  # the bound's band on the grid, its ends and 3P; a direct term breaks it above
         w_hf = hf_check_omega(model, omega)
-        c = parts[0]
-        c_hf = np.abs(state_space_response(c.A, c.B, c.C, c.D, w_hf)[:, 0, 0])
-        hf_excess = np.inf if np.any(c.D) else float(np.max(20 * np.log10(c_hf / hf_gain_bound(model, v, w_hf, kappa))))
+        hf_excess = np.inf if np.any(c_beta.D) else float(np.max(
+            20 * np.log10(np.abs(_response(c_beta, w_hf)) / hf_gain_bound(model, v, w_hf, kappa))))
     kp = np.linalg.eigvals(np.asarray(K.A, float)) if K.nstates else np.zeros(0, complex)
     k_unstable = np.sort_complex(kp[kp.real > 1e-9])
-    c_lo = state_space_response(parts[0].A, parts[0].B, parts[0].C, parts[0].D, omega[:1])[0, 0, 0]
-    sign = 1 if np.real(c_lo / _response(rosco, omega[:1])[0]) > 0 else -1
+    sign = 1 if np.real(_response(c_beta, omega[:1])[0] / _response(rosco, omega[:1])[0]) > 0 else -1
     zeta_rosco = closedloop.tower_damping(plant, cl0)[1]
     try:
         zeta_tower = closedloop.tower_damping(plant, cl)[1]
