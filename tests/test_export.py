@@ -196,6 +196,27 @@ def test_parameter_file_round_trips_the_simulators_matrices(model, qft19, tmp_pa
     assert not back.same(discon_parameters(sc, model=model, dt=0.01))
 
 
+
+def test_response_change_compares_what_the_controller_does_not_its_realisation(model):
+    # the report's test of "runs of this code's design" (benchmarks/openfast_report.py
+    # SAME_DESIGN_RTOL): a controller is compared by its discrete responses, so an equivalent
+    # realisation is 0 apart, a gain change of 1e-7 is 1e-7 apart (the responses are linear in it),
+    # and anything else than the controller (here the sample time) is another export
+    c = ct.tf([-2.0, -0.9, -0.1], [1.0, 1.2, 0.0]) * ct.tf([1.0], [0.2, 1.0])
+    p = discon_parameters(c, model=model)
+    assert p.response_change(p) == 0.0
+    T = np.array([[2.0, 1.0, 0.0], [0.0, 1.0, 3.0], [1.0, 0.0, 1.0]])[: p.A.shape[1], : p.A.shape[1]]
+    Ti = np.linalg.inv(T)
+    similar = dataclasses.replace(p, A=np.array([T @ a @ Ti for a in p.A]), B=np.array([T @ b for b in p.B]),
+                                  C=np.array([c_ @ Ti for c_ in p.C]))
+    assert not similar.same(p)
+    # the realisation's round-off: the similarity transform's condition number times eps
+    assert p.response_change(similar) < 1e3 * np.linalg.cond(T) * np.finfo(float).eps
+    nudged = dataclasses.replace(p, C=p.C * (1 + 1e-7), D=p.D * (1 + 1e-7))
+    assert p.response_change(nudged) == pytest.approx(1e-7, rel=1e-3)
+    assert p.response_change(dataclasses.replace(p, integrator_gain=p.integrator_gain * 1.01)) == pytest.approx(0.01)
+    assert p.response_change(discon_parameters(c, model=model, dt=0.01)) == math.inf
+
 # ----------------------------------------------------------------------------- the library through ctypes
 def _swap(dt=0.02, infile=b"", pitch=0.3, speed=0.79, torque=1.9e7, power=1.5e7, acc=0.0):
     sw = np.zeros(300, dtype=np.float32)

@@ -101,6 +101,23 @@ def test_the_constant_is_the_documented_measurement(benchmark_script):
     assert round(row["kappa"]) == rows[19.0]
 
 
+
+def test_the_bounds_check_points_are_refined_around_the_controllers_own_resonances(model):
+    # a lightly damped pole pair of C midway between the check grid's points near 4 rad/s (ζ =
+    # 0.002, half-power width 0.4 %, points 1.1 % apart): the base points miss its peak by dB,
+    # the points refined around the controller's poles (what design_hinf and the multi-model
+    # step's check use) reach it; the peak's height is the second-order one, 1/(2ζ√(1−ζ²))
+    base = np.geomspace(0.005, 10.0, 700)
+    i = int(np.searchsorted(base, 4.0))
+    wn, z = float(np.sqrt(base[i] * base[i + 1])), 0.002
+    c = ct.tf([wn**2], [1.0, 2 * z * wn, wn**2])
+    coarse, fine = fz.hf_check_omega(model, base), fz.hf_check_omega(model, base, c.poles())
+    peak = 20 * np.log10(1 / (2 * z * np.sqrt(1 - z**2)))
+    assert peak - 20 * np.log10(np.max(np.abs(c(1j * coarse)))) > 3.0
+    assert 20 * np.log10(np.max(np.abs(c(1j * fine)))) == pytest.approx(peak, abs=0.01)
+    # refinement only adds points: the base check's points are all still there
+    assert np.all(np.isin(coarse, fine))
+
 def test_a_target_the_bound_makes_infeasible_is_refused_naming_it(model):
     with pytest.raises(ValueError, match=r"high-frequency gain bound .*max_hf_gain_ratio="):
         fz.specification_for_target(model, 19.0, 60.0, max_relax_db=3.0, max_hf_gain_ratio=HF_GAIN_RATIO)

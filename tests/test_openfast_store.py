@@ -10,6 +10,7 @@ import pytest
 
 from specdesign import validate
 from specdesign.openfast import iea15mw_monopile
+from specdesign.turbine import iea15mw
 
 ROOT = Path(__file__).resolve().parents[1]
 RUNS = ROOT / "benchmarks" / "results" / "openfast_table3" / "runs"
@@ -25,6 +26,23 @@ def runs():
 def test_the_scripts_default_to_the_repository_store(benchmark_script):
     assert benchmark_script("openfast_table3").STORE / "runs" == RUNS
 
+
+
+def test_every_exported_controller_a_run_ran_is_kept_by_its_digest(runs):
+    # what the report compares a changed design against (stale_designs): the parameter file each
+    # run of an exported controller ran, kept once per digest; a file whose digest is not its name
+    # would be compared as something it is not
+    from specdesign.export import read_parameters
+    from specdesign.openfast.deck import named_digest
+    from specdesign.validate.openfast_campaign import ran_parameters
+
+    kept = sorted(RUNS.glob("*/parameters/*.IN"))
+    assert kept, "no parameter file kept in the store"
+    assert [f for f in kept if named_digest(f) != f.stem] == []
+    exported = [r for r in runs if r.controller in ("QFT", "QFT+ATD", "H∞")]
+    assert exported and [f"{r.controller} {r.wind_speed:g} seed {r.seed}" for r in exported if ran_parameters(r) is None] == []
+    for f in kept:
+        read_parameters(f)  # the workbench's format, readable
 
 def test_the_stored_runs_were_made_on_the_shipped_deck(runs):
     # a deck changed after its runs would leave tables that no longer follow from the shipped files:
@@ -103,30 +121,48 @@ def test_the_table3_splice_replaces_a_designs_block_whole(benchmark_script):
 
 def test_runs_of_another_design_than_the_code_makes_are_named(benchmark_script, monkeypatch, tmp_path):
     # the report's linear side (damping table, predictions, Table 3's prediction row) designs
-    # again; runs made with an earlier design code must be named, not silently paired with it
+    # again; runs made with an earlier design code must be named, not silently paired with it,
+    # unless the file they ran (kept in the store by the campaign) holds the same controller to
+    # SAME_DESIGN_RTOL: a change of the design code's last digits is not another experiment
+    import dataclasses
+
+    import control as ct
+
+    from specdesign.export import discon_parameters, write_parameters
+    from specdesign.openfast.deck import named_digest
+
     report = benchmark_script("openfast_report")
-    written = {}
+    base = discon_parameters(ct.tf([-2.0, -0.9, -0.1], [1.0, 1.2, 0.0]), model=iea15mw())
+
+    def params(scale):  # the controller's output scaled: its responses change by scale − 1
+        return dataclasses.replace(base, C=base.C * scale, D=base.D * scale, integrator_gain=base.integrator_gain * scale)
 
     def fake_export(design, folder, name, reduced):
         folder.mkdir(parents=True)
-        f = folder / "DISCON.IN"
-        f.write_text(f"{name} {design}\n")
-        written[name] = f
-        return type("Export", (), {"parameters": f})()
+        return type("Export", (), {"parameters": write_parameters(params(design), folder / "DISCON.IN")})()
 
     monkeypatch.setattr(report, "export_design", fake_export)
+    store = tmp_path / "runs" / "QFT_ATD"
 
     class Run:
-        def __init__(self, speed, sha):
+        def __init__(self, speed, ran_scale, kept=True):
+            f = write_parameters(params(ran_scale), tmp_path / f"ran{speed:g}.IN")
+            sha = named_digest(f)
+            if kept:  # as the campaign keeps it: <controller>/parameters/<digest>.IN
+                (store / "parameters").mkdir(parents=True, exist_ok=True)
+                (store / "parameters" / f"{sha}.IN").write_bytes(f.read_bytes())
             self.controller, self.wind_speed, self.meta = "QFT+ATD", speed, {"parameters_sha": sha}
+            self.folder = store / f"{speed:g}mps_seed0"
 
-    made = {"QFT+ATD": {19.0: {"design": "a"}, 21.0: {"design": "b"}}}
-    from specdesign.openfast.deck import named_digest
-
-    same = tmp_path / "same.IN"
-    same.write_text("QFT+ATD 19 m/s a\n")  # what the fake export writes for the 19 m/s design
-    runs = [Run(19.0, named_digest(same)), Run(21.0, "0123456789abcdef")]
-    assert report.stale_designs(runs, made) == [("QFT+ATD", 21.0, {"0123456789abcdef"})]
+    rtol = report.SAME_DESIGN_RTOL
+    made = {"QFT+ATD": {v: {"design": 1.0} for v in (19.0, 21.0, 23.0, 25.0)}}
+    runs = [Run(19.0, 1.0),  # the same file
+            Run(21.0, 1.0 + rtol / 10),  # an earlier export within the tolerance: counted
+            Run(23.0, 1.0 + rtol * 10),  # beyond it: another design
+            Run(25.0, 1.0 + rtol / 5, kept=False)]  # the file it ran is not in the store: cannot tell
+    stale = report.stale_designs(runs, made)
+    assert [(label, v) for label, v, _ in stale] == [("QFT+ATD", 23.0), ("QFT+ATD", 25.0)]
+    assert stale[0][2] == {runs[2].meta["parameters_sha"]}
 
 
 def test_the_comparison_page_carries_the_stores_rows_at_its_speeds(runs, benchmark_script):

@@ -107,6 +107,19 @@ def test_shape_to_target_19ms_15pct_damage(base19):
     assert res.promise.exact_del == pytest.approx(100 * (1 - 0.85 ** 0.25), abs=0.2)
 
 
+
+@pytest.mark.parametrize("v", [15.0, 17.0])
+def test_shape_to_target_gives_the_same_notches_for_a_nudged_wind_speed(model, v):
+    # issue 28 item 4: SLSQP's end moved the notch by 1.7e-7 relative (17 m/s, the width) under a
+    # 1e-9 m/s nudge, which the QFT tuning amplified to 2.4e-6 in its controller; refined to the
+    # KKT point the notch moves by what the data do, ~1e-10 relative measured (9e-11 at 17 m/s,
+    # 4e-10 at 15 m/s); the bound keeps 10x room below and 17x below the unrefined end's move
+    a, b = (spec.shape_to_target(spec.baseline_analysis(model, x), 25.0, quantity="del").notches for x in (v, v - 1e-9))
+    assert len(a) == len(b)
+    for na, nb in zip(a, b):
+        pa, pb = np.array([na.omega_n, na.depth_db, na.width]), np.array([nb.omega_n, nb.depth_db, nb.width])
+        assert np.max(np.abs(pb / pa - 1)) <= 1e-8, (na, nb)
+
 def test_shape_to_target_on_del(base19):
     res = spec.shape_to_target(base19, 4.0, quantity="del")  # the paper's notches on a DEL target
     assert res.success

@@ -143,6 +143,68 @@ class DisconParameters:
         return True
 
 
+    def response_change(self, other: DisconParameters, omega: np.ndarray | None = None) -> float:
+        """How far ``other``'s controller is from this one: the largest relative change of a response.
+
+        Every field that is not the controller (sample time, limits, torque law, filters,
+        scheduling pitches, the count of slow states) must be equal bit for bit, else the answer
+        is ``inf``. The controller is compared by what it does, not by its realisation: each local
+        controller's discrete responses from e and from −v at z = exp(jω·dt) (and the PI part's
+        speed-error filter, when there is one), as |H' − H| / max(|H|, 1 % of max|H| over ω) (a
+        dip of the response is compared to the response's size, not to itself), and the
+        integrator and PI gains relatively.
+
+        Parameters
+        ----------
+        other : DisconParameters
+            Another parameter set, e.g. an earlier export of the same design.
+        omega : numpy.ndarray, optional
+            Frequencies, rad/s (default 400 from 0.005 rad/s to 10 rad/s or 0.9 of Nyquist).
+
+        Returns
+        -------
+        float
+            The largest relative change (-); 0.0 for :meth:`same` sets, ``inf`` for sets that
+            differ in anything but the controller's numbers.
+        """
+        if self.same(other):
+            return 0.0
+        exact = ("dt", "gearbox_ratio", "rated_speed", "pitch_limits", "pitch_rate_limit", "torque_mode", "rated_torque",
+                 "max_torque", "rated_power", "generator_efficiency", "speed_filter", "torque_law", "schedule_filter",
+                 "atd_highpass", "schedule_pitch", "slow_states", "pi_limits")
+        for name in exact:
+            a, b = np.asarray(getattr(self, name), float), np.asarray(getattr(other, name), float)
+            if a.shape != b.shape or a.tobytes() != b.tobytes():
+                return math.inf
+        if (self.pi_kp is None) != (other.pi_kp is None) or self.A.shape[0] != other.A.shape[0]:
+            return math.inf
+        w = np.geomspace(0.005, min(10.0, 0.9 * math.pi / self.dt), 400) if omega is None else np.asarray(omega, float)
+        z = np.exp(1j * w * self.dt)
+
+        def relative(a, b):  # a, b: (n_omega, n_channels) responses, or gains
+            a, b = np.atleast_1d(a), np.atleast_1d(b)
+            floor = 1e-2 * np.max(np.abs(a), axis=0) if a.ndim > 1 else np.zeros(a.shape)
+            scale = np.maximum(np.abs(a), floor)
+            d = np.abs(b - a)
+            return float(np.max(np.where(scale > 0, d / np.where(scale > 0, scale, 1.0), np.where(d > 0, np.inf, 0.0))))
+
+        def bank(p, q):
+            n = p.A.shape[1]
+            H = [p.C[q] @ np.linalg.solve(zk * np.eye(n) - p.A[q], p.B[q]) + p.D[q] for zk in z] if n else [p.D[q]] * z.size
+            return np.array(H)
+
+        def pi_filter(p):
+            m = p.pi_A.shape[0]
+            return np.array([[p.pi_C @ np.linalg.solve(zk * np.eye(m) - p.pi_A, p.pi_B) + p.pi_D[0]] for zk in z])
+
+        changes = [relative(self.integrator_gain, other.integrator_gain)]
+        changes += [relative(bank(self, q), bank(other, q)) for q in range(self.A.shape[0])]
+        if self.pi_kp is not None:
+            changes += [relative(self.pi_kp, other.pi_kp), relative(self.pi_ki, other.pi_ki),
+                        relative(pi_filter(self), pi_filter(other))]
+        return max(changes)
+
+
 def _num(x: float) -> str:
     # repr: the shortest decimal that reads back to the same double (C's strtod included)
     return repr(float(x))

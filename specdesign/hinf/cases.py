@@ -162,7 +162,8 @@ class _Cases:
         self.plants = plants
         kappa = target.max_hf_gain_ratio
         # the high-frequency gain bound of the pair's certificate: its band's points of the base
-        # grid, its ends and 3P
+        # grid, its ends and 3P (refined around each checked controller's poles by _check)
+        self.model = model
         self.hf_base = hf_check_omega(model, base)
         self._hf_bound = None if kappa is None else (lambda w: 20 * np.log10(hf_gain_bound(model, v, w, kappa)))
         self.hf = None
@@ -258,9 +259,7 @@ def _check(cases, k):
     rt, rs, sens = cases.ratios(siso_response(k, grid))
     hf, proper = -np.inf, True
     if cases.hf is not None:
-        # the bound's grid refined around the controller's own narrow resonances (a peak of |C|
-        # between the base grid's points, 1.3 % apart, hid a 0.8 dB excess at 15 m/s)
-        hf_grid = refine_grid(cases.hf_base, np.linalg.eigvals(a)) if a.size else cases.hf_base
+        hf_grid = hf_check_omega(cases.model, cases.base, np.linalg.eigvals(a) if a.size else ())
         if hf_grid.size != cases.hf[0].size or np.any(hf_grid != cases.hf[0].imag):
             cases.regrid_hf(hf_grid)
         s_hf, log_bound = cases.hf

@@ -649,7 +649,7 @@ def _design_once(model, v, base, w_tower, w_speed, notch_spec, label, relax, tar
     c_beta = parts[0]
     hf_excess = -np.inf
     if kappa is not None:  # the bound's band on the grid, its ends and 3P; a direct term breaks it above
-        w_hf = hf_check_omega(model, omega)
+        w_hf = hf_check_omega(model, omega, np.linalg.eigvals(np.asarray(c_beta.A, float)) if c_beta.nstates else ())
         hf_excess = np.inf if np.any(c_beta.D) else float(np.max(
             20 * np.log10(np.abs(_response(c_beta, w_hf)) / hf_gain_bound(model, v, w_hf, kappa))))
     kp = np.linalg.eigvals(np.asarray(K.A, float)) if K.nstates else np.zeros(0, complex)

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import spectral
+from .._kkt import central_jacobian, kkt_point
 from ..closedloop import closed_map, plant_responses, siso_response
 from .structure import controller_polys, vector_bounds
 
@@ -405,31 +406,20 @@ def tied_objective(prob: TuningProblem, x: ArrayLike, anchor: ArrayLike) -> floa
     return float(prob.objective(x) + TIE_BREAK * (d @ d))
 
 
-def _central_jacobian(f: Callable[[np.ndarray], np.ndarray], y: np.ndarray, step: float = 1e-4) -> np.ndarray:
-    """d f/d y by central differences (step relative to max(1, |y|)), shape (len(f(y)), len(y))."""
-    cols = []
-    for i in range(y.size):
-        h = step * max(1.0, abs(y[i]))
-        e = np.zeros_like(y)
-        e[i] = h
-        cols.append((np.atleast_1d(f(y + e)) - np.atleast_1d(f(y - e))) / (2 * h))
-    return np.stack(cols, axis=-1)
-
-
 def kkt_refine(prob: TuningProblem, x: ArrayLike, target: float | None, min_decay: float, anchor: ArrayLike,
                iterations: int = 15) -> tuple[np.ndarray, dict]:
-    """Newton's method on the KKT conditions of the constraints active at ``x``.
+    """Newton's method on the KKT conditions of the constraints active at ``x`` (``specdesign._kkt.kkt_point``).
 
     A polish ends where its line search or its tolerance stops it, which moves with round-off
     along a shallow valley of the objective (1e-5 relative in the parameters). From that point,
     with the active constraints (value < :data:`ACTIVE_TOL`) as equalities and the parameters on
     (within 1e-5 of) their box limits fixed, Newton's method on ∇f = Jᵀλ, g_A = 0 (f the objective
-    with the tie-break, :func:`tied_objective`; central-difference gradients with a 1e-4 step, the
-    Lagrangian's Hessian by central differences of its gradient) converges to the KKT point
-    itself, to the gradients' round-off (≈ 1e-8 in the parameters where the active set is not
-    near-degenerate). It is kept only if it converges (at least three steps, the last below
-    :data:`STEP_TOL`), every multiplier is ≥ 0 and every constraint stays met; else ``x`` is
-    returned unchanged.
+    with the tie-break, :func:`tied_objective`; the objective's gradient by central differences with
+    a 1e-4 step, the tie-break's exactly, the Lagrangian's Hessian by central differences of its
+    gradient) converges to the KKT point itself, to the gradients' round-off (≈ 1e-8 in the
+    parameters where the active set is not near-degenerate). It is kept only if it converges (at
+    least three steps, the last below :data:`STEP_TOL`), every multiplier is ≥ 0 and every
+    constraint stays met; else ``x`` is returned unchanged.
 
     Parameters
     ----------
@@ -456,70 +446,19 @@ def kkt_refine(prob: TuningProblem, x: ArrayLike, target: float | None, min_deca
     """
     lo, hi = vector_bounds()
     x = np.asarray(x, float).copy()
-    free = (x > lo + 1e-5) & (x < hi - 1e-5)
+    anchor = np.asarray(anchor, float)
 
-    def full(y):
-        z = x.copy()
-        z[free] = y
-        return z
+    def gradient(y, free):  # the tie-break's part exactly: its central difference only adds round-off
+        def f(u):
+            z = x.copy()
+            z[free] = u
+            return np.array([prob.objective(z)])
 
-    def cons(y):
-        return prob.constraints(full(y), target, min_decay)
+        return central_jacobian(f, y)[0] + 2 * TIE_BREAK * (y - anchor[free])
 
-    active = cons(x[free]) < ACTIVE_TOL
-    info = {"converged": False, "steps": 0, "active": int(active.sum()), "free": int(free.sum()),
-            "kkt_residual": float("nan"), "reason": ""}
-    if not free.any():
-        info.update(converged=True, reason="every parameter on a limit")
-        return x, info
-
-    a = np.asarray(anchor, float)[free]
-
-    def grad_f(y):  # the objective's, plus the tie-break's 2·TIE_BREAK·(y − anchor), exact
-        return _central_jacobian(lambda u: np.array([prob.objective(full(u))]), y)[0] + 2 * TIE_BREAK * (y - a)
-
-    def jac_a(y):
-        return _central_jacobian(lambda u: cons(u)[active], y).reshape(int(active.sum()), y.size)
-
-    y = x[free].copy()
-    with np.errstate(all="ignore"):
-        for it in range(iterations):
-            gf, J, gA = grad_f(y), jac_a(y), cons(y)[active]
-            lam = np.linalg.lstsq(J.T, gf, rcond=None)[0] if J.size else np.zeros(0)
-            info["kkt_residual"] = float(np.linalg.norm(gf - J.T @ lam))
-
-            def grad_l(u, lam=lam):
-                return grad_f(u) - jac_a(u).T @ lam
-
-            H = _central_jacobian(grad_l, y, step=1e-3)
-            H = 0.5 * (H + H.T)
-            n, m = y.size, J.shape[0]
-            K = np.block([[H, -J.T], [J, np.zeros((m, m))]])
-            rhs = -np.r_[gf - J.T @ lam, gA]
-            step = np.linalg.lstsq(K, rhs, rcond=None)[0][:n]
-            if not np.all(np.isfinite(step)):
-                info["reason"] = "non-finite Newton step"
-                return x, info
-            y = y + step
-            info["steps"] = it + 1
-            if np.max(np.abs(step)) < STEP_TOL and it >= 2:
-                break
-        else:
-            info["reason"] = f"no convergence in {iterations} Newton steps"
-            return x, info
-    out = full(y)
-    gf, J = grad_f(y), jac_a(y)
-    lam = np.linalg.lstsq(J.T, gf, rcond=None)[0] if J.size else np.zeros(0)
-    info["kkt_residual"] = float(np.linalg.norm(gf - J.T @ lam))
-    g = prob.constraints(out, target, min_decay)
-    if lam.size and lam.min() < -1e-8 * max(1.0, np.abs(lam).max()):
-        info["reason"] = "a negative multiplier (the active set is not the optimum's)"
-        return x, info
-    if not (np.all(np.isfinite(g)) and g.min() >= -FEASIBLE_TOL and np.all(out >= lo) and np.all(out <= hi)):
-        info["reason"] = "the refined point breaks a constraint"
-        return x, info
-    info.update(converged=True, reason="KKT point")
-    return out, info
+    return kkt_point(lambda z: tied_objective(prob, z, anchor), lambda z: prob.constraints(z, target, min_decay),
+                     x, lo, hi, active_tol=ACTIVE_TOL, feasible_tol=FEASIBLE_TOL, step_tol=STEP_TOL,
+                     iterations=iterations, objective_gradient=gradient)
 
 
 def tune(prob: TuningProblem, x0: ArrayLike, target: float | None, min_decay: float, maxfev: int) -> tuple[np.ndarray, bool]:

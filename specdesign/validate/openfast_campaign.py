@@ -23,6 +23,7 @@ from tqdm.auto import tqdm
 
 from ..controller.discon_file import read_discon
 from ..export.forward import Forwarded, ForwardServer
+from ..export.parameters import FORMAT_NAME
 from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, named_digest, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
@@ -39,7 +40,7 @@ from .stats import seeds_from, welch_psd
 from .store import fingerprint
 
 __all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES", "OpenFASTRun",
-           "read_openfast_runs"]
+           "read_openfast_runs", "ran_parameters"]
 
 #: OpenFAST channel → workbench series of an OpenFAST campaign (SI after reading).
 OPENFAST_SERIES = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power",
@@ -361,6 +362,7 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                 meta = dict(meta, forwarded_calls=server.call_statistics())
         else:
             case, out = openfast(c.library, c.parameters)
+            _archive(root, name, Path(c.parameters), meta["parameters_sha"])
         return _post(case, out, settings, meta, keep=s in kept, wind=wind, rate_limit=rate_limit)
 
     try:
@@ -423,6 +425,38 @@ def _rate_limit(deck: Deck) -> float | None:
         return None
     entry = read_discon(path)[0].get("PC_MaxRat")
     return None if entry is None else float(entry.values[0])
+
+
+def _archive(root: Path, name: str, parameters: Path, sha: str) -> None:
+    # a parameter file of the workbench's format, kept once per controller and digest beside its
+    # runs: what ran stays readable after the design code changes (ran_parameters)
+    if parameters.read_text(errors="replace").split(maxsplit=1)[:1] != [FORMAT_NAME]:
+        return
+    out = root / _slug(name) / "parameters" / f"{sha}.IN"
+    if not out.exists():
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_bytes(parameters.read_bytes())
+
+
+def ran_parameters(run: OpenFASTRun) -> Path | None:
+    """The parameter file ``run`` ran, as the campaign kept it beside its runs, or None.
+
+    Kept for controllers exported by :func:`specdesign.export.export_discon` (the workbench's
+    format, read by :func:`specdesign.export.read_parameters`), by the digest in the run's
+    ``run.json``; ROSCO's own files and forwarded Python controllers are not kept.
+
+    Parameters
+    ----------
+    run : OpenFASTRun
+        A run of :func:`read_openfast_runs`.
+
+    Returns
+    -------
+    pathlib.Path or None
+        ``<controller>/parameters/<digest>.IN`` in the store, if it is there.
+    """
+    f = Path(run.folder).parent / "parameters" / f"{run.meta.get('parameters_sha')}.IN"
+    return f if f.is_file() else None
 
 
 def _slug(name: str) -> str:
