@@ -28,7 +28,8 @@ _FAKE_OPENFAST = '''\
         print("Aborting OpenFAST.")
         sys.exit(1)
     seed = int(re.search(r"seed(\\d+)", ifw["FileName_BTS"]).group(1))
-    gain = float(Path(sd["DLL_InFile"]).read_text().split()[0])
+    words = Path(sd["DLL_InFile"]).read_text().split()
+    gain = 1.0 if words[0] == "specdesign-discon" else float(words[0])
     dt, tmax = float(k["DT_Out"]), float(k["TMax"])
     t = np.arange(int(round(tmax / dt)) + 1) * dt
     w = 1.0 + 0.1 * seed
@@ -101,6 +102,30 @@ def test_campaign_in_fake_openfast(tmp_path, fake):
     with pytest.raises(ValueError, match="other settings or another controller under the name 'A'"):
         run_openfast_campaign({"A": ctrls["B"]}, [19.0], [0], **kw)
 
+
+
+def test_the_exported_parameter_file_a_run_ran_is_kept_once_by_its_digest(tmp_path, fake):
+    # what benchmarks/openfast_report.py compares a changed design against (ran_parameters): the
+    # workbench's own parameter files are kept beside the runs, once per digest, and put back
+    # when a resumed campaign finds the runs without them; another format (ROSCO's DISCON.IN) is not
+    from specdesign.validate.openfast_campaign import ran_parameters
+
+    inst, calls, lib = fake
+    ctrls = {"QFT+ATD": _controller(tmp_path, lib, "q", "specdesign-discon 2\n# a design\ndt 0.01\n"),
+             "ROSCO": _controller(tmp_path, lib, "r", "1.0\n")}
+    kw = dict(deck=iea15mw_monopile(), duration=20.0, transient=5.0, record_dt=0.05, install=inst, processes=1,
+              folder=tmp_path / "camp", initial_conditions=False)
+    run_openfast_campaign(ctrls, [19.0], [0, 1], **kw)
+    sha = named_digest(ctrls["QFT+ATD"].parameters)
+    kept = tmp_path / "camp" / "QFT_ATD" / "parameters" / f"{sha}.IN"
+    assert kept.read_bytes() == ctrls["QFT+ATD"].parameters.read_bytes()
+    assert sorted((tmp_path / "camp").glob("*/parameters/*")) == [kept]  # once for both seeds, none for ROSCO
+    runs = read_openfast_runs(tmp_path / "camp")
+    assert {r.controller: ran_parameters(r) for r in runs} == {"QFT+ATD": kept, "ROSCO": None}
+    kept.unlink()
+    n_calls = len(calls.read_text().split())
+    run_openfast_campaign(ctrls, [19.0], [0, 1], **kw)
+    assert len(calls.read_text().split()) == n_calls and kept.is_file()
 
 def test_a_controller_named_outside_ascii_runs_under_an_ascii_folder(tmp_path, fake):
     # OpenFAST opens its case files by name: "H∞+ATD" runs as Hinf_ATD, and is read back by its name

@@ -142,7 +142,6 @@ class DisconParameters:
                 return False
         return True
 
-
     def response_change(self, other: DisconParameters, omega: np.ndarray | None = None) -> float:
         """How far ``other``'s controller is from this one: the largest relative change of a response.
 

@@ -327,6 +327,8 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
         done = _load(root, run, meta)
         if done is not None:
             results[run] = done
+            if not isinstance(discon[run[0]], Forwarded):  # the same digest: the file that ran, kept if it was not
+                _archive(root, run[0], Path(discon[run[0]].parameters), meta["parameters_sha"])
         else:
             todo.append((run, meta))
     show = sys.stderr.isatty() if progress is None else bool(progress)
@@ -360,10 +362,11 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
                     server.raise_error(f"{name} at {v:g} m/s, seed {s}: ")
                 # the controller's cost per control step, recorded beside the run (not compared)
                 meta = dict(meta, forwarded_calls=server.call_statistics())
-        else:
-            case, out = openfast(c.library, c.parameters)
-            _archive(root, name, Path(c.parameters), meta["parameters_sha"])
-        return _post(case, out, settings, meta, keep=s in kept, wind=wind, rate_limit=rate_limit)
+            return _post(case, out, settings, meta, keep=s in kept, wind=wind, rate_limit=rate_limit)
+        case, out = openfast(c.library, c.parameters)
+        res = _post(case, out, settings, meta, keep=s in kept, wind=wind, rate_limit=rate_limit)
+        _archive(root, name, Path(c.parameters), meta["parameters_sha"])
+        return res
 
     try:
         with cf.ThreadPoolExecutor(processes or _cpus()) as pool:  # threads wait on OpenFAST processes
@@ -429,13 +432,18 @@ def _rate_limit(deck: Deck) -> float | None:
 
 def _archive(root: Path, name: str, parameters: Path, sha: str) -> None:
     # a parameter file of the workbench's format, kept once per controller and digest beside its
-    # runs: what ran stays readable after the design code changes (ran_parameters)
-    if parameters.read_text(errors="replace").split(maxsplit=1)[:1] != [FORMAT_NAME]:
-        return
+    # runs: what ran stays readable after the design code changes (ran_parameters); after the run
+    # is saved, so that a file that cannot be kept costs a warning, not the run
     out = root / _slug(name) / "parameters" / f"{sha}.IN"
-    if not out.exists():
+    try:
+        text = parameters.read_bytes()
+        if out.exists() or text.split(maxsplit=1)[:1] != [FORMAT_NAME.encode()]:
+            return
         out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_bytes(parameters.read_bytes())
+        out.write_bytes(text)
+    except OSError as e:
+        warnings.warn(f"{name}: the parameter file {parameters} was not kept in {out.parent} ({e}); "
+                      "the report cannot compare a changed design with it", RuntimeWarning, stacklevel=2)
 
 
 def ran_parameters(run: OpenFASTRun) -> Path | None:
