@@ -112,8 +112,9 @@ def test_shape_to_target_19ms_15pct_damage(base19):
 def test_shape_to_target_gives_the_same_notches_for_a_nudged_wind_speed(model, v):
     # issue 28 item 4: SLSQP's end moved the notch by 1.7e-7 relative (17 m/s, the width) under a
     # 1e-9 m/s nudge, which the QFT tuning amplified to 2.4e-6 in its controller; refined to the
-    # KKT point the notch moves by what the data do, ~1e-10 relative measured (9e-11 at 17 m/s,
-    # 4e-10 at 15 m/s); the bound keeps 10x room below and 17x below the unrefined end's move
+    # KKT point the notches move by what the data do: 1.2e-9 (15 m/s) and 7e-10 (17 m/s) relative
+    # measured here (two notches each); the bound keeps 8x room above that and is 15x below the
+    # unrefined end's move (1.5e-7 at 17 m/s, the old code failing this test)
     a, b = (spec.shape_to_target(spec.baseline_analysis(model, x), 25.0, quantity="del").notches for x in (v, v - 1e-9))
     assert len(a) == len(b)
     for na, nb in zip(a, b):
