@@ -53,8 +53,8 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 from specdesign import closedloop, spec, turbine, validate, wind  # noqa: E402
-from specdesign.openfast import iea15mw_monopile  # noqa: E402
 from specdesign.export import read_parameters  # noqa: E402
+from specdesign.openfast import iea15mw_monopile  # noqa: E402
 from specdesign.openfast.deck import named_digest  # noqa: E402
 from specdesign.validate.openfast_campaign import ran_parameters  # noqa: E402
 

@@ -34,7 +34,7 @@ def central_jacobian(f: Callable[[np.ndarray], np.ndarray], y: np.ndarray, step:
 def kkt_point(objective: Callable[[np.ndarray], float], constraints: Callable[[np.ndarray], np.ndarray],
               x: np.ndarray, lower: np.ndarray, upper: np.ndarray, *, active_tol: float, feasible_tol: float,
               step_tol: float, iterations: int = 15, limit_tol: float = 1e-5,
-              objective_gradient: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None) -> tuple[np.ndarray, dict]:
+              tie_break: tuple[float, np.ndarray] | None = None) -> tuple[np.ndarray, dict]:
     """The KKT point near a feasible polished ``x``, or ``x`` unchanged when Newton's method does not get there.
 
     The constraints with ``constraints(x) < active_tol`` are the active set, held as equalities;
@@ -60,9 +60,10 @@ def kkt_point(objective: Callable[[np.ndarray], float], constraints: Callable[[n
         Newton steps at most.
     limit_tol : float
         How close to a box limit a parameter counts as on it (parameters' units).
-    objective_gradient : callable, optional
-        (y, free) → ∇f over the free parameters ``y`` (``free`` the mask into ``x``), for an
-        objective part whose gradient is known exactly; default central differences of ``objective``.
+    tie_break : (float, numpy.ndarray), optional
+        (w, anchor): minimise ``objective`` + w·|x − anchor|² (a quadratic that makes a shallow
+        valley's optimum unique), its gradient 2w·(x − anchor) exact: a central difference of it
+        only adds round-off.
 
     Returns
     -------
@@ -92,9 +93,11 @@ def kkt_point(objective: Callable[[np.ndarray], float], constraints: Callable[[n
         return x, info
 
     def grad_f(y):
-        if objective_gradient is not None:
-            return objective_gradient(y, free)
-        return central_jacobian(lambda u: np.array([objective(full(u))]), y)[0]
+        g = central_jacobian(lambda u: np.array([objective(full(u))]), y)[0]
+        if tie_break is None:
+            return g
+        weight, anchor = tie_break
+        return g + 2 * weight * (y - np.asarray(anchor, float)[free])
 
     def jac_a(y):
         return central_jacobian(lambda u: cons(u)[active], y).reshape(int(active.sum()), y.size)

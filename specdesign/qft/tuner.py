@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import spectral
-from .._kkt import central_jacobian, kkt_point
+from .._kkt import kkt_point
 from ..closedloop import closed_map, plant_responses, siso_response
 from .structure import controller_polys, vector_bounds
 
@@ -445,20 +445,9 @@ def kkt_refine(prob: TuningProblem, x: ArrayLike, target: float | None, min_deca
         (parameters not on a limit), ``kkt_residual`` (|∇f − Jᵀλ|, at the end) and ``reason``.
     """
     lo, hi = vector_bounds()
-    x = np.asarray(x, float).copy()
-    anchor = np.asarray(anchor, float)
-
-    def gradient(y, free):  # the tie-break's part exactly: its central difference only adds round-off
-        def f(u):
-            z = x.copy()
-            z[free] = u
-            return np.array([prob.objective(z)])
-
-        return central_jacobian(f, y)[0] + 2 * TIE_BREAK * (y - anchor[free])
-
-    return kkt_point(lambda z: tied_objective(prob, z, anchor), lambda z: prob.constraints(z, target, min_decay),
-                     x, lo, hi, active_tol=ACTIVE_TOL, feasible_tol=FEASIBLE_TOL, step_tol=STEP_TOL,
-                     iterations=iterations, objective_gradient=gradient)
+    return kkt_point(prob.objective, lambda z: prob.constraints(z, target, min_decay), np.asarray(x, float), lo, hi,
+                     active_tol=ACTIVE_TOL, feasible_tol=FEASIBLE_TOL, step_tol=STEP_TOL, iterations=iterations,
+                     tie_break=(TIE_BREAK, anchor))
 
 
 def tune(prob: TuningProblem, x0: ArrayLike, target: float | None, min_decay: float, maxfev: int) -> tuple[np.ndarray, bool]:

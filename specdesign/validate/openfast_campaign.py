@@ -435,9 +435,11 @@ def _archive(root: Path, name: str, parameters: Path, sha: str) -> None:
     # runs: what ran stays readable after the design code changes (ran_parameters); after the run
     # is saved, so that a file that cannot be kept costs a warning, not the run
     out = root / _slug(name) / "parameters" / f"{sha}.IN"
+    if out.exists():
+        return
     try:
         text = parameters.read_bytes()
-        if out.exists() or text.split(maxsplit=1)[:1] != [FORMAT_NAME.encode()]:
+        if text.split(maxsplit=1)[:1] != [FORMAT_NAME.encode()]:
             return
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_bytes(text)
