@@ -28,6 +28,13 @@ libraries' and parameter files' digests and the run settings) and not run again.
   forwarded to Python at DLL_DT = 0.02 s with the turbine's pitch-rate limit;
 - ``MPC-OFlin-rule``: the same with the pitch-activity weight q_Δ chosen by :func:`activity_weight_rule`
   on that model (docs/openfast.md, "The MPC on OpenFAST's linearisation");
+- ``excursion MPC-OFlin-rule``: :class:`specdesign.mpc.HealthMPC` with the reduced-model
+  comparison's excursion penalty (``health_weight`` = 10, the class's T_s = 0.2 s and 6 s horizon)
+  and the rule's q_Δ (the rule's loop gain is the quadratic MPC's law; the excursion term only
+  adds to its cost), on the same linearisations with the blades' collective out-of-plane root
+  moment (``blade_root_my``, RootMyc1-3), which it predicts and reads from avrSWAP(30-32);
+- ``health-aware MPC-OFlin-rule``: :func:`specdesign.mpc.health_aware_mpc` (seed 002's
+  accumulated-moment term, ``stress_weight`` = 30, which derates), the same model and q_Δ;
 - ``H∞``: :func:`specdesign.hinf.design_hinf` at the speed with its defaults (the certified pair
   for the DEL target, pitch only, under the high-frequency gain bound: the reduced-model
   comparison's H∞, docs/comparison.md) on OpenFAST's linearisations, exported as QFT+ATD is;
@@ -69,7 +76,7 @@ from openfast_table3 import (
 
 from specdesign import hinf, turbine, validate
 from specdesign.export import forwarded
-from specdesign.mpc import QuadraticMPC, loop_gain
+from specdesign.mpc import HealthMPC, QuadraticMPC, health_aware_mpc, loop_gain
 from specdesign.openfast import find_openfast, iea15mw_monopile
 
 #: The activity weights the rule tries, smallest first (half decades from the class's 0.1).
@@ -84,7 +91,12 @@ MODULUS_MARGIN, BAND, BAND_GAIN = 0.5, 1.5, 0.5
 #: campaign also ran ROSCO's tower damper; 17 m/s the one below it.
 SPEEDS = (17.0, 19.0)
 #: The controllers the campaign runs, in the order it runs them at each speed.
-CONTROLLERS = ("ROSCO", ROSCO_TD, STRUCTURES["atd"][0], "MPC-OFlin", "MPC-OFlin-rule", "H∞", "H∞+ATD")
+CONTROLLERS = ("ROSCO", ROSCO_TD, STRUCTURES["atd"][0], "MPC-OFlin", "MPC-OFlin-rule", "excursion MPC-OFlin-rule",
+               "health-aware MPC-OFlin-rule", "H∞", "H∞+ATD")
+#: The forwarded MPCs (built by :func:`mpcs`).
+MPCS = ("MPC-OFlin", "MPC-OFlin-rule", "excursion MPC-OFlin-rule", "health-aware MPC-OFlin-rule")
+#: The blade-load MPCs' weights: the reduced-model comparison's (benchmarks/comparison.py).
+EXCURSION_WEIGHT, STRESS_WEIGHT = 10.0, 30.0
 #: The H∞ designs (name: export folder prefix in the store).
 HINF = {"H∞": "export_hinf_", "H∞+ATD": "export_hinf_atd_"}
 #: The sample time (s) and forwarding interval (s, ServoDyn's DLL_DT) of the MPCs.
@@ -110,14 +122,21 @@ def activity_weight_rule(lt, grid=RULE_GRID) -> tuple[float, list]:
     return grid[-1], rows
 
 
-def mpcs(lt, reduced, q_rule) -> dict:
-    """The forwarded MPCs on OpenFAST's linearisation: the class's weights and q_Δ by the rule."""
-    out = {}
+def mpcs(lt, reduced, q_rule, chosen=MPCS) -> dict:
+    """The ``chosen`` forwarded MPCs on OpenFAST's linearisation: the quadratic MPC with the class's
+    weights and with q_Δ by the rule, the excursion and the health-aware MPC with q_Δ by the rule."""
+    made = {}
     for label, q in (("MPC-OFlin", 0.1), ("MPC-OFlin-rule", q_rule)):
-        mpc = QuadraticMPC(lt, ts=TS, activity_weight=q, wind_speeds=lt.wind_speeds,
-                           name=f"quadratic MPC on OpenFAST's linearisation, q_Δ = {q:g}")
-        out[label] = forwarded(mpc, dt=DT, model=reduced, pitch_rate_limit=reduced.pitch_rate_limit)
-    return out
+        made[label] = lambda q=q: QuadraticMPC(lt, ts=TS, activity_weight=q, wind_speeds=lt.wind_speeds,
+                                               name=f"quadratic MPC on OpenFAST's linearisation, q_Δ = {q:g}")
+    made["excursion MPC-OFlin-rule"] = lambda: HealthMPC(
+        lt, health_weight=EXCURSION_WEIGHT, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
+        name=f"excursion MPC on OpenFAST's linearisation, q_Δ = {q_rule:g}")
+    made["health-aware MPC-OFlin-rule"] = lambda: health_aware_mpc(
+        lt, stress_weight=STRESS_WEIGHT, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
+        name=f"health-aware MPC on OpenFAST's linearisation, q_Δ = {q_rule:g}")
+    return {label: forwarded(made[label](), dt=DT, model=reduced, pitch_rate_limit=reduced.pitch_rate_limit)
+            for label in MPCS if label in chosen}
 
 
 def hinf_designs(model, v, qft_atd, chosen) -> dict:
@@ -155,7 +174,7 @@ def main() -> None:
     speeds = [float(x) for x in args.speeds.split(",")]
     t0 = time.monotonic()
     deck, reduced = iea15mw_monopile(), turbine.iea15mw()
-    mpc_names = {"MPC-OFlin", "MPC-OFlin-rule"} & set(chosen)
+    mpc_names = set(MPCS) & set(chosen)
     if mpc_names or args.rule_only:
         lt = openfast_linear_model(deck, reduced)
         q_rule, rows = activity_weight_rule(lt)
@@ -176,7 +195,7 @@ def main() -> None:
     label, prefix = STRUCTURES["atd"]
     design_model = openfast_model(deck, speeds) if {label, "H∞", "H∞+ATD"} & set(chosen) else None
     made = designs(design_model, speeds, args.target, "atd") if {label, "H∞+ATD"} & set(chosen) else {}
-    forwarded_mpcs = mpcs(lt, reduced, q_rule) if mpc_names else {}
+    forwarded_mpcs = mpcs(lt, reduced, q_rule, chosen) if mpc_names else {}
     for v in speeds:
         controllers = {name: c for name, c in forwarded_mpcs.items() if name in chosen}
         if "ROSCO" in chosen:

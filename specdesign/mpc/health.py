@@ -340,7 +340,7 @@ class HealthMPC(SampledController):
             state.pop(k, None)
         return state
 
-    @docstring_of(SampledController, note=("Here the trim state ``x_trim`` (n,), the moment scale ``moment_scale`` (N·m) "
+    @docstring_of(SampledController, note=("Here the trim state ``x_trim`` (n,: the discrete model's ``x0``), the moment scale ``moment_scale`` (N·m) "
                                            "and the prediction model ``lpv`` (:class:`LPVTurbine`), at the run's mean "
                                            "wind speed."))
     def build(self, dm) -> dict:
@@ -350,9 +350,10 @@ class HealthMPC(SampledController):
             lpv = self._lpv
         else:
             lpv = lpv_turbine(self.model, self.ts, self.horizon, wind_speeds=[dm.wind_speed])
-        op = self.model.trim(dm.wind_speed)
         scale = float(abs(dm.y0[dm.rows(["blade_root_my"])[0]]))
-        return {"x_trim": np.asarray(op.x, float), "moment_scale": positive_scalar(scale, "trim blade moment"),
+        # the discrete model's trim state: the plant's, plus the held command when the pitch feeds
+        # through to an output (OpenFAST's linearisations: BldPitch1), as the LPV vertices have it
+        return {"x_trim": np.asarray(dm.x0, float), "moment_scale": positive_scalar(scale, "trim blade moment"),
                 "lpv": lpv}
 
     @docstring_of(SampledController, note="Each run's online blade damage starts at zero (its S-N curve: ``blade_m``, "

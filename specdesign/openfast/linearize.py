@@ -112,9 +112,12 @@ _ALL_DOFS = ("FlapDOF1", "FlapDOF2", "EdgeDOF", "PitchDOF", "TeetDOF", "DrTrDOF"
              "TwFADOF2", "TwSSDOF1", "TwSSDOF2", "PtfmSgDOF", "PtfmSwDOF", "PtfmHvDOF", "PtfmRDOF", "PtfmPDOF",
              "PtfmYDOF")
 #: Module → output channels kept in the OutLists (what DEFAULT_SIGNALS reads, the rotor area
-#: for the rotor radius, and the rotor speed and pitch for the record).
+#: for the rotor radius, and the rotor speed and pitch for the record). The three blades'
+#: out-of-plane root moments form a triplet whose collective part (MBC) is ``blade_root_my``:
+#: the mean a controller reads from avrSWAP(30-32), which an MPC predicting blade loads needs.
 LIN_OUTPUTS = {
-    "ElastoDyn": ("GenSpeed", "RotSpeed", "BldPitch1", "TwrBsMyt", "NcIMUTAxs", "YawBrTDxt", "YawBrTAxp"),
+    "ElastoDyn": ("GenSpeed", "RotSpeed", "BldPitch1", "TwrBsMyt", "NcIMUTAxs", "YawBrTDxt", "YawBrTAxp",
+                  "RootMyc1", "RootMyc2", "RootMyc3"),
     "ServoDyn": ("GenPwr", "GenTq"),
     "AeroDyn": ("RtArea",),
 }

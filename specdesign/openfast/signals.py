@@ -36,7 +36,9 @@ __all__ = ["DEFAULT_SIGNALS", "REQUIRED_SIGNALS", "INPUT_SIGNALS", "AZIMUTH_STAT
 #: nacelle IMU fore-aft acceleration NcIMUTAxs, else YawBrTAxp), ``tower_top_vel`` (the time
 #: derivative of the tower-top fore-aft deflection YawBrTDxt, else TTDspFA: relative to the
 #: tower base, so on a floating turbine without the platform's motion), ``pitch``
-#: (BldPitch1) and ``power`` (GenPwr).
+#: (BldPitch1), ``power`` (GenPwr) and ``blade_root_my`` (the collective, MBC part of the
+#: blades' out-of-plane root moments RootMyc1-3: their mean, as a controller reads it from
+#: avrSWAP(30-32); :data:`specdesign.openfast.linearize.LIN_OUTPUTS` asks OpenFAST for all three).
 DEFAULT_SIGNALS = {
     "wind": ("IfW Extended input: horizontal wind speed", "horizontal wind speed"),
     "pitch_cmd": ("collective blade-pitch command",),
@@ -47,6 +49,7 @@ DEFAULT_SIGNALS = {
     "tower_top_vel": ("d/dt YawBrTDxt", "d/dt TTDspFA"),
     "pitch": ("BldPitch1",),
     "power": ("GenPwr",),
+    "blade_root_my": ("RootMyc[coll]",),
 }
 #: Signals the design loop cannot do without: a default mapping that misses one is an error.
 #: (``tower_top_vel`` is the ATD measurement that the closed-loop analysis of
