@@ -117,7 +117,8 @@ def tower_damping(plant, loop) -> tuple[float, float]:
     return float(abs(p)), float(-p.real / abs(p))
 
 
-def tower_damping_message(name: str, wind_speed: float, zeta: float, zeta_baseline: float) -> str | None:
+def tower_damping_message(name: str, wind_speed: float, zeta: float, zeta_baseline: float, *,
+                          tower_damper: bool = False) -> str | None:
     """The warning's text when ``zeta`` is below :data:`MIN_TOWER_DAMPING_FRACTION` of
     ``zeta_baseline`` (ROSCO's, same plant), else None.
 
@@ -129,6 +130,9 @@ def tower_damping_message(name: str, wind_speed: float, zeta: float, zeta_baseli
         Operating point, m/s.
     zeta, zeta_baseline : float
         The design's and ROSCO's tower-mode damping ratios (-).
+    tower_damper : bool, optional
+        The design already has a tower damper (a nonzero ATD controller): the text then does not
+        advise adding one, but says the design's own leaves the mode under-damped.
 
     Returns
     -------
@@ -141,6 +145,9 @@ def tower_damping_message(name: str, wind_speed: float, zeta: float, zeta_baseli
     return (f"{name} at {wind_speed:g} m/s: the tower mode's damping ratio is {zeta:.3f}, ROSCO's {zeta_baseline:.3f} "
             f"(below {MIN_TOWER_DAMPING_FRACTION:g} of it). The promise counts the tower's response to the rotor-effective "
             "wind only; on a real turbine waves and rotational sampling drive the mode too (OpenFAST, IEA 15 MW: such a "
-            "design gave ROSCO's tower DEL at 19 m/s and limit-cycled at 15 m/s, docs/openfast.md). Add a tower damper "
-            "(qft.design_qft(..., spec=qft.spec_notch(target)), the paper's structure, or ROSCO's TD_Mode) or validate "
-            "in OpenFAST before use.")
+            "design gave ROSCO's tower DEL at 19 m/s and limit-cycled at 15 m/s, docs/openfast.md). "
+            + ("The design's own tower damper leaves the mode this weakly damped: give the tower mode more weight "
+               "(a lower DEL target, a tower specification over the mode) or validate in OpenFAST before use."
+               if tower_damper else
+               "Add a tower damper (qft.design_qft(..., spec=qft.spec_notch(target)), the paper's structure, or ROSCO's "
+               "TD_Mode) or validate in OpenFAST before use."))

@@ -452,7 +452,8 @@ def design_hinf(
                           stacklevel=2)
     # said of the design returned only (the orders and relaxations passed over are not the result)
     weak = closedloop.tower_damping_message("design_hinf", v, design.tower_damping_ratio,
-                                            design.baseline_tower_damping_ratio)
+                                            design.baseline_tower_damping_ratio,
+                                            tower_damper=design.atd_controller is not None)
     if weak is not None:
         warnings.warn(weak, closedloop.TowerDampingWarning, stacklevel=2)
     for said in _carry_messages(design, v, kappa):
