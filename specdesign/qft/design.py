@@ -248,15 +248,21 @@ def _certificate_options(kwargs) -> dict:
 def _design_notch(model, wind_speed, spec, kwargs) -> QFTDesign:
     """:func:`design_qft` with :func:`spec_notch`: the fixed structures against the notch
     specification for each speed relaxation in turn, the first that meets every spec kept."""
-    design = None
+    design, said = None, []
     for relax in spec.speed_relax_db:
-        with warnings.catch_warnings():  # each attempt's own miss is the next rung's business; the last one's is said below
-            warnings.simplefilter("ignore", RuntimeWarning)
+        # each attempt's warnings (an unstable plant case, a weak tower mode) are said of the design
+        # returned only: a rung passed over is not the result; its miss (RuntimeWarning) is said below
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
             design = _design_single(model, wind_speed, spec.target_reduction, speed_relax_db=relax, **kwargs)
         if design.success:
-            return design
-    warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {spec.speed_relax_db[-1]:g} dB): "
-                  f"{design.message}", RuntimeWarning, stacklevel=3)
+            break
+    for w in said:
+        if not issubclass(w.category, RuntimeWarning):
+            warnings.warn(w.message, w.category, stacklevel=3)
+    if not design.success:
+        warnings.warn(f"design_qft at {design.wind_speed:g} m/s (speed spec relaxed up to {spec.speed_relax_db[-1]:g} dB): "
+                      f"{design.message}", RuntimeWarning, stacklevel=3)
     return design
 
 
