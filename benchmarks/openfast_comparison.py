@@ -31,8 +31,9 @@ libraries' and parameter files' digests and the run settings) and not run again.
 - ``excursion MPC-OFlin-rule``: :class:`specdesign.mpc.HealthMPC` with the reduced-model
   comparison's excursion penalty (``health_weight`` = 10, the class's T_s = 0.2 s and 6 s horizon)
   and the rule's q_Δ (the rule's loop gain is the quadratic MPC's law; the excursion term only
-  adds to its cost), on the same linearisations with the blades' collective out-of-plane root
-  moment (``blade_root_my``, RootMyc1-3), which it predicts and reads from avrSWAP(30-32);
+  adds to its cost), on the same linearisations made with the blades' collective out-of-plane root
+  moment (``linearize_deck(..., blade_moments=True)``: ``blade_root_my``, RootMyc1-3), which it
+  predicts and reads from avrSWAP(30-32);
 - ``health-aware MPC-OFlin-rule``: :func:`specdesign.mpc.health_aware_mpc` (seed 002's
   accumulated-moment term, ``stress_weight`` = 30, which derates), the same model and q_Δ;
 - ``H∞``: :func:`specdesign.hinf.design_hinf` at the speed with its defaults (the certified pair
@@ -53,6 +54,7 @@ variance by band.
 """
 from __future__ import annotations
 
+import functools
 import sys
 import time
 from pathlib import Path
@@ -122,18 +124,20 @@ def activity_weight_rule(lt, grid=RULE_GRID) -> tuple[float, list]:
     return grid[-1], rows
 
 
-def mpcs(lt, reduced, q_rule, chosen=MPCS) -> dict:
+def mpcs(lt, lt_blade, reduced, q_rule, chosen=MPCS) -> dict:
     """The ``chosen`` forwarded MPCs on OpenFAST's linearisation: the quadratic MPC with the class's
-    weights and with q_Δ by the rule, the excursion and the health-aware MPC with q_Δ by the rule."""
-    made = {}
+    weights and with q_Δ by the rule (on ``lt``), the excursion and the health-aware MPC with q_Δ by
+    the rule (on ``lt_blade``, the same linearisations with the blades' root moments; a callable
+    giving it, called only when one of them is chosen)."""
+    made, lt_blade = {}, functools.cache(lt_blade)
     for label, q in (("MPC-OFlin", 0.1), ("MPC-OFlin-rule", q_rule)):
         made[label] = lambda q=q: QuadraticMPC(lt, ts=TS, activity_weight=q, wind_speeds=lt.wind_speeds,
                                                name=f"quadratic MPC on OpenFAST's linearisation, q_Δ = {q:g}")
     made["excursion MPC-OFlin-rule"] = lambda: HealthMPC(
-        lt, health_weight=EXCURSION_WEIGHT, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
+        lt_blade(), health_weight=EXCURSION_WEIGHT, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
         name=f"excursion MPC on OpenFAST's linearisation, q_Δ = {q_rule:g}")
     made["health-aware MPC-OFlin-rule"] = lambda: health_aware_mpc(
-        lt, stress_weight=STRESS_WEIGHT, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
+        lt_blade(), stress_weight=STRESS_WEIGHT, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
         name=f"health-aware MPC on OpenFAST's linearisation, q_Δ = {q_rule:g}")
     return {label: forwarded(made[label](), dt=DT, model=reduced, pitch_rate_limit=reduced.pitch_rate_limit)
             for label in MPCS if label in chosen}
@@ -195,7 +199,10 @@ def main() -> None:
     label, prefix = STRUCTURES["atd"]
     design_model = openfast_model(deck, speeds) if {label, "H∞", "H∞+ATD"} & set(chosen) else None
     made = designs(design_model, speeds, args.target, "atd") if {label, "H∞+ATD"} & set(chosen) else {}
-    forwarded_mpcs = mpcs(lt, reduced, q_rule, chosen) if mpc_names else {}
+    # the blade-load MPCs predict the blades' root moment: the same linearisations with it (a
+    # separate cache entry, so the model the quadratic MPCs' stored runs were made with stays theirs)
+    forwarded_mpcs = mpcs(lt, lambda: openfast_linear_model(deck, reduced, blade_moments=True), reduced, q_rule,
+                          chosen) if mpc_names else {}
     for v in speeds:
         controllers = {name: c for name, c in forwarded_mpcs.items() if name in chosen}
         if "ROSCO" in chosen:

@@ -57,11 +57,12 @@ INDICATORS = ("tower_del", "blade_del", "gen_speed_sd", "mean_power", "pitch_sd"
               "rate_limit_time")
 
 
-def openfast_linear_model(deck, model):
+def openfast_linear_model(deck, model, **kwargs):
     """Table 3's design model, OpenFAST's linearisations of ``deck`` (:func:`openfast_table3.openfast_model`,
-    read from ``linearize_deck``'s cache), with ``model``'s pitch limits and rate limit, which a
-    linearisation does not carry: the model the ``oflin`` MPC is built on."""
-    return replace(openfast_model(deck), pitch_min=model.pitch_min, pitch_max=model.pitch_max,
+    read from ``linearize_deck``'s cache; ``kwargs`` go to it, e.g. ``blade_moments=True``), with
+    ``model``'s pitch limits and rate limit, which a linearisation does not carry: the model the
+    ``oflin`` MPC is built on."""
+    return replace(openfast_model(deck, **kwargs), pitch_min=model.pitch_min, pitch_max=model.pitch_max,
                    pitch_rate_limit=model.pitch_rate_limit)
 
 

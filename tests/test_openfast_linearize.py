@@ -77,6 +77,10 @@ def test_case_sets_the_trim_and_linearisation_keys(fst_vt):
     assert (ad["UA_Mod"], ad["DBEMT_Mod"], ad["NacelleDrag"]) == (0, 0, False)
     on = {(m, c) for m, chans in vt["outlist"].items() for c, v in chans.items() if v}
     assert on == {(m, c) for m, chans in LIN_OUTPUTS.items() for c in chans}
+    blade = linearization_case(fst_vt, 19.0, rotor_speed=RATED_SPEED, gen_torque=RATED_TORQUE, initial_pitch=0.29,
+                               blade_moments=True)
+    on_blade = {(m, c) for m, chans in blade["outlist"].items() for c, v in chans.items() if v}
+    assert on_blade - on == {("ElastoDyn", f"RootMyc{b}") for b in "123"}
     assert json.dumps(fst_vt["Fst"], default=str) == before  # the deck's dictionary is left alone
     # no path of the deck's location left in the case (openfast-io makes "unused" absolute):
     # the cache's digest must not depend on where the deck lies
@@ -183,6 +187,19 @@ shutil.copy({str(outb)!r}, pathlib.Path(sys.argv[1]).stem + '.outb')""")
         linearize_deck(deck, [16.0], n_azimuths=1, openfast=nolin, cache=cache, progress=False)
     with pytest.raises(ValueError, match="wind_speeds"):
         linearize_deck(deck, [19.0, 19.0], openfast=fake, cache=cache)
+
+    # the options reach the case OpenFAST runs (trim_damping was accepted and dropped), as a new case
+    before = set(cache.glob("19mps-*"))
+    linearize_deck(deck, [19.0], n_azimuths=1, openfast=fake, cache=cache, progress=False, trim_damping=0.0,
+                   blade_moments=True)
+    (made,) = set(cache.glob("19mps-*")) - before
+    (kdmp,) = [line.split()[0] for line in (made / "lin.fst").read_text().splitlines() if "Twr_Kdmp" in line]
+    assert float(kdmp) == 0.0
+    outlist = (made / "lin_ElastoDyn.dat").read_text()
+    assert all(f'"RootMyc{b}"' in outlist for b in "123")
+    # the shipped sample has the triplet: its collective part is blade_root_my
+    assert "blade_root_my" in linearize_deck(deck, [19.0], n_azimuths=1, openfast=fake, cache=cache,
+                                             progress=False).output_names
 
 
 def test_openfast_runs_with_the_chosen_blas(deck, tmp_path, monkeypatch):

@@ -97,6 +97,7 @@ from .linear_turbine import LinearTurbine
 __all__ = [
     "DEFAULT_DOFS",
     "LIN_OUTPUTS",
+    "BLADE_MOMENT_OUTPUTS",
     "TRIM_TOWER_DAMPING",
     "LinearizationCase",
     "default_lin_cache",
@@ -112,15 +113,18 @@ _ALL_DOFS = ("FlapDOF1", "FlapDOF2", "EdgeDOF", "PitchDOF", "TeetDOF", "DrTrDOF"
              "TwFADOF2", "TwSSDOF1", "TwSSDOF2", "PtfmSgDOF", "PtfmSwDOF", "PtfmHvDOF", "PtfmRDOF", "PtfmPDOF",
              "PtfmYDOF")
 #: Module → output channels kept in the OutLists (what DEFAULT_SIGNALS reads, the rotor area
-#: for the rotor radius, and the rotor speed and pitch for the record). The three blades'
-#: out-of-plane root moments form a triplet whose collective part (MBC) is ``blade_root_my``:
-#: the mean a controller reads from avrSWAP(30-32), which an MPC predicting blade loads needs.
+#: for the rotor radius, and the rotor speed and pitch for the record).
 LIN_OUTPUTS = {
-    "ElastoDyn": ("GenSpeed", "RotSpeed", "BldPitch1", "TwrBsMyt", "NcIMUTAxs", "YawBrTDxt", "YawBrTAxp",
-                  "RootMyc1", "RootMyc2", "RootMyc3"),
+    "ElastoDyn": ("GenSpeed", "RotSpeed", "BldPitch1", "TwrBsMyt", "NcIMUTAxs", "YawBrTDxt", "YawBrTAxp"),
     "ServoDyn": ("GenPwr", "GenTq"),
     "AeroDyn": ("RtArea",),
 }
+#: Added to :data:`LIN_OUTPUTS` by ``blade_moments=True``: the three blades' out-of-plane root
+#: moments, a triplet whose collective part (MBC) is ``blade_root_my``, the mean a controller
+#: reads from avrSWAP(30-32) (an MPC predicting blade loads needs it). Off by default, so that
+#: a linearisation made without them (its cache digest, the models and designs made on it)
+#: stays what it was.
+BLADE_MOMENT_OUTPUTS = {"ElastoDyn": ("RootMyc1", "RootMyc2", "RootMyc3")}
 #: ``Twr_Kdmp`` of the trim (N/(m/s) per tower node): ~30 % of critical on the IEA 15 MW's first
 #: tower fore-aft mode (modal mass 1.24e6 kg at 1.08 rad/s, Σφ² ≈ 4 over ElastoDyn's 20 nodes).
 TRIM_TOWER_DAMPING = 2.0e5
@@ -249,7 +253,7 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
                        n_azimuths: int = 4, dofs: Sequence[str] = DEFAULT_DOFS, tmax: float = 600.0,
                        trim_tol: float | None = None, trim_gain: float | None = None, dt: float | None = None,
                        trim_damping: float = TRIM_TOWER_DAMPING, hydrodynamics: bool = False,
-                       overrides: Mapping | None = None) -> dict:
+                       blade_moments: bool = False, overrides: Mapping | None = None) -> dict:
     """The trim-and-linearise case of a deck at one wind speed, as openfast-io's dictionary.
 
     The module docstring lists what is changed and why. The deck's dictionary is not modified.
@@ -279,6 +283,9 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
         ``Twr_Kdmp``, tower damping during the trim only (N/(m/s) per node; 0 for none).
     hydrodynamics : bool, optional
         Keep the deck's HydroDyn and SeaState (default off).
+    blade_moments : bool, optional
+        Also output the blades' out-of-plane root moments (:data:`BLADE_MOMENT_OUTPUTS`; the
+        model's ``blade_root_my``). Default off.
     overrides : dict, optional
         ``{(module, key): value}`` set last, e.g. ``{("InflowWind", "PLExp"): 0.0}``.
 
@@ -351,9 +358,11 @@ def linearization_case(fst_vt: dict, wind_speed: float, *, rotor_speed: float, g
         vt[kind] = []
 
     _bare_unused_names(vt)
+    kept = {m: LIN_OUTPUTS.get(m, ()) + (BLADE_MOMENT_OUTPUTS.get(m, ()) if blade_moments else ())
+            for m in set(LIN_OUTPUTS) | set(BLADE_MOMENT_OUTPUTS)}
     for module, channels in vt["outlist"].items():
         for ch in channels:
-            channels[ch] = module in LIN_OUTPUTS and ch in LIN_OUTPUTS[module]
+            channels[ch] = ch in kept.get(module, ())
     _apply_overrides(vt, overrides)
     return vt
 
@@ -480,6 +489,7 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 4, dofs: Sequence
                    rotor_speed: float | None = None, gen_torque: float | None = None, initial_pitch=None,
                    tmax: float = 600.0, trim_tol: float | None = None, trim_gain: float | None = None,
                    dt: float | None = None, trim_damping: float = TRIM_TOWER_DAMPING, hydrodynamics: bool = False,
+                   blade_moments: bool = False,
                    overrides: Mapping | None = None,
                    signals: dict | None = None, openfast=None, cache=None, processes: int = 2,
                    timeout: float = 3600.0, nice: int = 0, progress: bool | None = None,
@@ -503,7 +513,7 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 4, dofs: Sequence
         a three-bladed rotor; module docstring).
     dofs : sequence of str, optional
         ElastoDyn DOFs kept (default :data:`DEFAULT_DOFS`).
-    rotor_speed, gen_torque, initial_pitch, tmax, trim_tol, trim_gain, dt, trim_damping, hydrodynamics, overrides
+    rotor_speed, gen_torque, initial_pitch, tmax, trim_tol, trim_gain, dt, trim_damping, hydrodynamics, blade_moments, overrides
         As :func:`write_linearization_case` and :func:`linearization_case`.
     signals : dict, optional
         Overrides of :data:`specdesign.openfast.signals.DEFAULT_SIGNALS`.
@@ -559,7 +569,8 @@ def linearize_deck(fst_path, wind_speeds, *, n_azimuths: int = 4, dofs: Sequence
     show = sys.stderr.isatty() if progress is None else bool(progress)
     vt = _read_deck(deck)
     options = {"n_azimuths": n_azimuths, "dofs": dofs, "tmax": tmax, "trim_tol": trim_tol, "trim_gain": trim_gain, "dt": dt,
-                   "hydrodynamics": hydrodynamics, "overrides": overrides}
+               "trim_damping": trim_damping, "hydrodynamics": hydrodynamics, "blade_moments": blade_moments,
+               "overrides": overrides}
 
     todo, done = [], {}
     for v in speeds:

@@ -38,7 +38,7 @@ __all__ = ["DEFAULT_SIGNALS", "REQUIRED_SIGNALS", "INPUT_SIGNALS", "AZIMUTH_STAT
 #: tower base, so on a floating turbine without the platform's motion), ``pitch``
 #: (BldPitch1), ``power`` (GenPwr) and ``blade_root_my`` (the collective, MBC part of the
 #: blades' out-of-plane root moments RootMyc1-3: their mean, as a controller reads it from
-#: avrSWAP(30-32); :data:`specdesign.openfast.linearize.LIN_OUTPUTS` asks OpenFAST for all three).
+#: avrSWAP(30-32); ``linearize_deck(..., blade_moments=True)`` asks OpenFAST for all three).
 DEFAULT_SIGNALS = {
     "wind": ("IfW Extended input: horizontal wind speed", "horizontal wind speed"),
     "pitch_cmd": ("collective blade-pitch command",),
