@@ -95,9 +95,9 @@ from .install import OpenFASTInstall, find_openfast, openfast_version
 from .linear_turbine import LinearTurbine
 
 __all__ = [
+    "BLADE_MOMENT_OUTPUTS",
     "DEFAULT_DOFS",
     "LIN_OUTPUTS",
-    "BLADE_MOMENT_OUTPUTS",
     "TRIM_TOWER_DAMPING",
     "LinearizationCase",
     "default_lin_cache",

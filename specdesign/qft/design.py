@@ -248,7 +248,7 @@ def _certificate_options(kwargs) -> dict:
 def _design_notch(model, wind_speed, spec, kwargs) -> QFTDesign:
     """:func:`design_qft` with :func:`spec_notch`: the fixed structures against the notch
     specification for each speed relaxation in turn, the first that meets every spec kept."""
-    design, said = None, []
+    design = None
     for relax in spec.speed_relax_db:
         # each attempt's warnings (an unstable plant case, a weak tower mode) are said of the design
         # returned only: a rung passed over is not the result; its miss (RuntimeWarning) is said below
