@@ -101,13 +101,16 @@ def test_design_qft_reports_and_warns_on_the_tower_mode(model):
     assert np.isfinite(atd.baseline_tower_damping_ratio)
 
 
-def test_a_design_with_its_own_tower_damper_is_not_told_to_add_one(model):
-    # the paper's structure at 15 m/s leaves the mode at ζ 0.072 against ROSCO's 0.106 (measured
-    # 2026-11-28, benchmarks/nonlinearity.py's designs): it warns, and the advice is about its damper
+def test_a_design_with_its_own_tower_damper_is_not_told_to_add_one(model, monkeypatch):
+    # no design of the paper's structure at the default target leaves the mode below the fraction
+    # (the 15 m/s warning benchmarks printed, ζ 0.072 against ROSCO's 0.106, came from a speed
+    # relaxation design_qft passed over): the fraction is raised so that the 19 m/s design, which
+    # has its tower damper, warns; its advice is about that damper, not to add one
     from specdesign import qft
+    monkeypatch.setattr(modes, "MIN_TOWER_DAMPING_FRACTION", 100.0)
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
-        d = qft.design_qft(model, 15.0, spec=qft.spec_notch())
+        d = qft.design_qft(model, 19.0, spec=qft.spec_notch(25.0))
     assert d.atd_controller is not None
     hits = [str(r.message) for r in rec if issubclass(r.category, closedloop.TowerDampingWarning)]
     assert len(hits) == 1 and "own tower damper" in hits[0] and "spec_notch" not in hits[0]
