@@ -15,6 +15,7 @@ import control as ct
 import numpy as np
 
 from loopshaping import qft as lqft
+from loopshaping.freqresp import is_zero
 
 from ..closedloop import (
     UNSTABLE_CONTROLLER_RATE,
@@ -275,11 +276,6 @@ class QFTDesign:
         return f"tower mode ζ {self.tower_damping_ratio:.3f} (ROSCO {self.baseline_tower_damping_ratio:.3f})"
 
 
-def _nonzero(c) -> bool:
-    """A controller that is there and not identically zero (a pitch-only design's ATD is 0 or None)."""
-    return c is not None and bool(np.any(np.asarray(ct.tf(c).num[0][0]) != 0))
-
-
 def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_spec, speed_spec, shaping, promise,
                     parameters, options, checks=None) -> QFTDesign:
     """Check a pair of controllers against a tuning problem's specifications and record the design.
@@ -369,7 +365,7 @@ def assemble_design(model, prob, cb, ca, wdense, t, performance, *, base, tower_
     message = "all specifications met" if success else "; ".join(problems)
     if not success:
         warnings.warn(f"design_qft at {v:g} m/s: {message}", RuntimeWarning, stacklevel=3)
-    weak = tower_damping_message("design_qft", v, zeta, zeta_rosco, tower_damper=_nonzero(ca))
+    weak = tower_damping_message("design_qft", v, zeta, zeta_rosco, tower_damper=not is_zero(ca))
     if weak is not None:
         warnings.warn(weak, TowerDampingWarning, stacklevel=3)
     return QFTDesign(
