@@ -68,6 +68,9 @@ BANDS = (("wind 0.05-0.6", 0.05, 0.6), ("0.6-0.85", 0.6, 0.85), ("tower mode 0.8
 #: Poles of the closed loop counted as the tower mode's (rad/s): around the IEA 15 MW monopile's
 #: first fore-aft mode (1.07-1.1 rad/s in OpenFAST's linearisations and runs).
 TOWER_MODE_BAND = (0.85, 1.4)
+#: From here up (rad/s: the 3P band's lower edge) the pitch rate's variance is counted as spent
+#: at 3P and above, where no design of the workbench aims to act.
+PITCH_RATE_SPLIT = 2.2
 DEG = 180.0 / math.pi
 #: The baseline's name in the damping table and Fig. 8 (its linear loop is ROSCO's PI placed on
 #: OpenFAST's rotor model; in the runs, ROSCO's compiled DISCON).
@@ -132,6 +135,18 @@ def band_variance(omega, psd, lo, hi) -> float:
     return float(np.trapezoid(psd[m], omega[m])) if m.sum() > 1 else float("nan")
 
 
+def pitch_psd(run):
+    """(ω rad/s, the pitch angle's Welch PSD rad²·s/rad) of an OpenFAST run: stored by the
+    campaign since 2026-11-28 (``OPENFAST_SPECTRA``); for an earlier run, from its kept series with
+    the campaign's own Welch settings; None when it has neither (never filled in)."""
+    if "pitch" in run.welch:
+        return run.omega, run.welch["pitch"]
+    if "pitch" in run.series:
+        st = run.meta["settings"]
+        return validate.welch_psd(run.series["pitch"], st["record_dt"], st["nperseg"])
+    return None
+
+
 def _cell_stats(runs, base, name, v, m):
     b = {r.seed: r for r in runs if r.controller == base and r.wind_speed == v}
     d = {r.seed: r for r in runs if r.controller == name and r.wind_speed == v}
@@ -150,7 +165,22 @@ def _cell_stats(runs, base, name, v, m):
         vb = np.mean([band_variance(b[s].omega, b[s].welch["tower_base_my"], lo, hi) for s in seeds])
         vd = np.mean([band_variance(d[s].omega, d[s].welch["tower_base_my"], lo, hi) for s in seeds])
         out["band", label] = (vb, vd)
+    # the pitch's own spectrum, on the seeds both runs have it for (the actuator's cost by band)
+    pitch = {s: (pitch_psd(b[s]), pitch_psd(d[s])) for s in seeds}
+    out["pitch seeds"] = [s for s, (pb, pd) in pitch.items() if pb is not None and pd is not None]
+    for label, lo, hi in BANDS:
+        out["pitch", label] = tuple(np.mean([band_variance(*pitch[s][i], lo, hi) * DEG**2 for s in out["pitch seeds"]])
+                                    if out["pitch seeds"] else float("nan") for i in (0, 1))
+    # the pitch rate's variance is ∫ ω²·S dω: its share at 3P and above, where the tower gains nothing
+    out["rate share"] = tuple(np.mean([band_variance(w, w**2 * p, PITCH_RATE_SPLIT, np.inf) / band_variance(w, w**2 * p, 0.0, np.inf)
+                                       for w, p in (pitch[s][i] for s in out["pitch seeds"])])
+                              if out["pitch seeds"] else float("nan") for i in (0, 1))
     return out
+
+
+def _ratio(r) -> str:
+    """A variance ratio to 3 significant digits without an exponent (×0.273, ×4.38, ×2409)."""
+    return f"{r:.0f}" if r >= 100 else f"{r:.3g}"
 
 
 def _pm(st, key, n, digits=1) -> str:
@@ -217,6 +247,20 @@ def report(folder, runs, baseline="ROSCO", m=4.0) -> str:
             vb, vd = st["band", label]
             cells.append(f"{vb / 1e12:.3g} → {vd / 1e12:.3g} (×{vd / vb:.2f})")
         lines.append(f"| {v:g} | {name} | " + " | ".join(cells) + " |")
+    pitched = [(v, name, st) for v, name, st in bands if st["pitch seeds"]]
+    if pitched:
+        # issue 28: where in frequency the actuator works, 3P and above included (the pitch
+        # spectrum is kept by the campaign since 2026-11-28, before only with seed 0's series)
+        lines += ["", (f"Pitch angle variance by band, mean over the seeds both runs recorded its spectrum for "
+                       f"(deg²); {baseline} → design:"), ""]
+        head = ("| wind (m/s) | controller | seeds | " + " | ".join(f"{b[0]} rad/s" for b in BANDS)
+                + f" | pitch-rate variance at ≥ {PITCH_RATE_SPLIT:g} rad/s (%): {baseline} / design |")
+        lines += [head, "|" + "---|" * (head.count("|") - 1)]
+        for v, name, st in pitched:
+            cells = [f"{st['pitch', label][0]:.3g} → {st['pitch', label][1]:.3g} "
+                     f"(×{_ratio(st['pitch', label][1] / st['pitch', label][0])})" for label, _, _ in BANDS]
+            cells.append(f"{100 * st['rate share'][0]:.0f} / {100 * st['rate share'][1]:.0f}")
+            lines.append(f"| {v:g} | {name} | {', '.join(map(str, st['pitch seeds']))} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 

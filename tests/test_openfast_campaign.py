@@ -3,6 +3,7 @@ binary .outb of known signals): the Campaign record, the transient cut and SI un
 against indicators computed directly on the same signals, a failed run reported with its case,
 seed and OpenFAST's tail while the rest is kept, resuming without rerunning, refusing a folder
 of another campaign, and the dispatch from run_campaign(plant=Deck)."""
+import dataclasses
 import math
 import shutil
 
@@ -14,7 +15,7 @@ pytest.importorskip("openfast_io")
 
 from specdesign.openfast import Deck, iea15mw_monopile
 from specdesign.openfast.deck import named_digest
-from specdesign.validate import indicators, read_openfast_runs, run_campaign
+from specdesign.validate import indicators, read_openfast_runs, run_campaign, welch_psd
 from specdesign.validate.openfast_campaign import run_openfast_campaign
 
 # The fake OpenFAST: reads TMax and DT_Out from the .fst, the seed from the wind file's name,
@@ -187,7 +188,7 @@ def test_a_deck_counts_by_every_file_it_names_not_by_its_place(tmp_path, fake):
         run_openfast_campaign({"A": ctrl}, [19.0], [0], deck=copies[1], **kw)
 
 
-def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake):
+def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake, benchmark_script):
     # read_openfast_runs gives back what run_openfast_campaign stored, value for value and
     # spectrum for spectrum; a run whose result.npz is not written yet (a run in progress) is
     # not counted; a folder that is not there is named; the series of the kept seeds (the first
@@ -211,6 +212,22 @@ def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake):
             assert set(r.series) >= {"tower_base_my", "gen_speed", "pitch", "power"}
         else:
             assert r.series == {}
+        # the pitch angle's own Welch spectrum is kept for every run, series kept or not (the
+        # actuator's cost at 3P and above): that of the fake's pitch after the transient, in rad
+        w, gain = 1.0 + 0.1 * r.seed, {"A": 1.0, "B": 0.5}[r.controller]
+        pitch = np.radians(15 + gain * np.sin(0.3 * w * (10.0 + np.arange(800) * 0.05)))
+        omega, want = welch_psd(pitch, 0.05)
+        assert_allclose(r.omega, omega, rtol=0)
+        assert_allclose(r.welch["pitch"], want, rtol=1e-9, atol=1e-12 * want.max())
+    # a run stored before the pitch spectrum was kept: openfast_report.py computes it from the
+    # kept series with the run's own Welch settings, the same as stored; without series, none
+    pitch_psd = benchmark_script("openfast_report").pitch_psd
+    for r in runs:
+        older = dataclasses.replace(r, welch={k: a for k, a in r.welch.items() if k != "pitch"})
+        if r.seed == 0:
+            assert_allclose(pitch_psd(older)[1], r.welch["pitch"], rtol=0, atol=0)
+        else:
+            assert pitch_psd(older) is None
     (tmp_path / "camp" / "B" / "19mps_seed2" / "result.npz").unlink()
     assert len(read_openfast_runs(tmp_path / "camp")) == 3
     with pytest.raises(FileNotFoundError, match="campaign's folder"):

@@ -39,12 +39,15 @@ from .metrics import INDICATORS, indicators
 from .stats import seeds_from, welch_psd
 from .store import fingerprint
 
-__all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES", "OpenFASTRun",
-           "read_openfast_runs", "ran_parameters"]
+__all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES", "OPENFAST_SPECTRA",
+           "OpenFASTRun", "read_openfast_runs", "ran_parameters"]
 
 #: OpenFAST channel → workbench series of an OpenFAST campaign (SI after reading).
 OPENFAST_SERIES = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power",
                    "RootMyb1": "blade_root_my"}
+#: Outputs whose Welch spectra an OpenFAST run keeps: the campaign's, and the pitch angle's own,
+#: for the actuator's cost at 3P and above (issue 28: the reduced model has no 3P to show).
+OPENFAST_SPECTRA = SPECTRA + ("pitch",)
 
 
 @dataclass(frozen=True)
@@ -540,7 +543,7 @@ def _post(case: Case, out, settings, meta, keep: bool, wind, rate_limit: float |
     rec = {k: a[0, i0:i0 + n] for k, a in series.items()}
     ind = indicators({k: a[None] for k, a in rec.items()}, dt, settings["m"], pitch_rate_limit=rate_limit).as_dict()
     res = {f"value_{k}": np.asarray(ind[k][0], float) for k in INDICATORS}
-    for k in SPECTRA:
+    for k in OPENFAST_SPECTRA:
         omega, p = welch_psd(rec[k], dt, settings["nperseg"])
         res[f"welch_{k}"] = p
     res["omega"] = omega
