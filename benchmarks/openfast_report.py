@@ -77,7 +77,8 @@ DEG = 180.0 / math.pi
 BASELINE = "ROSCO"
 #: ROSCO with its tower damper (``openfast_table3.py --rosco-td``): the second baseline of issue 31.
 SECOND_BASELINE = "ROSCO+TD"
-_COLOURS = {"ROSCO": "tab:blue", "ROSCO+TD": "tab:purple", "QFT": "tab:red", "QFT+ATD": "tab:green"}
+_COLOURS = {"ROSCO": "tab:blue", "ROSCO+TD": "tab:purple", "QFT": "tab:red", "QFT+ATD": "tab:green",
+            "QFT+ATD+3P": "tab:olive"}
 
 
 def openfast_times(run) -> tuple[float, float]:

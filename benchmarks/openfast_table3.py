@@ -70,7 +70,8 @@ def rosco_td_discon(discon_in, folder) -> Path:
 
 
 #: The designs a campaign can run: controller name, export folder prefix.
-STRUCTURES = {"certificate": ("QFT", "export_"), "atd": ("QFT+ATD", "export_atd_")}
+STRUCTURES = {"certificate": ("QFT", "export_"), "atd": ("QFT+ATD", "export_atd_"),
+              "atd_3p": ("QFT+ATD+3P", "export_atd3p_")}
 
 
 def designs(model, speeds, target, structure="certificate") -> dict:
@@ -81,12 +82,14 @@ def designs(model, speeds, target, structure="certificate") -> dict:
     the design reduced from its certificate; pitch only). ``"atd"``: the paper's structure, the
     fixed PI + notch + low-pass pitch controller and a first-order tower damper (ATD) on the
     tower-top velocity tuned against the notch specification with the DEL target
-    (``qft.spec_notch(target)``); its promise is the notch specification's."""
+    (``qft.spec_notch(target)``); its promise is the notch specification's. ``"atd_3p"``: the
+    same with a notch at 3P on both measurements (``qft.three_p_notch(model)``), tuned with it."""
     res = {}
     for v in speeds:
         t = time.monotonic()
-        if structure == "atd":
-            d = qft.design_qft(model, v, spec=qft.spec_notch(target))
+        if structure in ("atd", "atd_3p"):
+            notch = {"measurement_filter": qft.three_p_notch(model)} if structure == "atd_3p" else {}
+            d = qft.design_qft(model, v, spec=qft.spec_notch(target), **notch)
             promise = float(d.row()["promised_del_pct"])  # the relaxed specification the design meets
         else:
             pair = feasibility.specification_for_target(model, v, target)

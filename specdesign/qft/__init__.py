@@ -77,6 +77,8 @@ continuously with the data, so the design does not jump when the wind speed move
 :func:`loopshaping.qft.bounds` for the final controllers and the design is checked on a dense
 grid over all cases with :func:`loopshaping.check.check`; frequencies where the dense check
 fails are added to the design set and the tuning repeated (up to ``refine`` times).
+With ``measurement_filter`` (e.g. :func:`three_p_notch`) both structures are multiplied by a fixed
+filter on the measurements, which the tuner sees.
 """
 from __future__ import annotations
 
@@ -92,6 +94,7 @@ from .design import (
 )
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign
 from .specs import SPEED_RELAX_DB, QFTSpecification, spec_from_certified, spec_from_pair, spec_notch
+from .structure import three_p_notch
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 
 __all__ = [
@@ -103,6 +106,7 @@ __all__ = [
     "spec_from_certified",
     "spec_from_pair",
     "spec_notch",
+    "three_p_notch",
     "design_schedule",
     "held_lift",
     "check_design_speed",

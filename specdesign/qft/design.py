@@ -43,7 +43,7 @@ from .certificate import design_from_certificate
 from .checks import fine_pitch_lift, loop_checks, spec_ratio, spec_roots
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign, assemble_design
 from .specs import SPEED_RELAX_DB, QFTSpecification, spec_from_certified
-from .structure import controllers, from_vector, rosco_start
+from .structure import controllers, filter_polys, from_vector, rosco_start
 from .tuner import TuningProblem, tune
 
 if TYPE_CHECKING:
@@ -155,6 +155,11 @@ def design_qft(model: TurbineModel, wind_speed: float, target_reduction: float =
             pitch off fine pitch for the torque law's speed deficit by at most its
             ``pitch_switch`` (``specification_for_target(held_below_rated=True)``;
             :func:`held_lift`). :func:`design_schedule` sets it for its lowest speed.
+        measurement_filter : control.TransferFunction, optional
+            A fixed filter on both measurements (generator speed and tower-top velocity),
+            e.g. :func:`three_p_notch`: both structures are tuned with it and returned with it
+            (SISO, proper, stable, finite nonzero gain at 0). In OpenFAST it keeps 3P out of the
+            pitch, which the linear model does not show (docs/openfast.md).
         refine : int, default 2
             Rounds adding the dense check's failing frequencies to the design set.
         maxfev : int, default 3000
@@ -354,7 +359,7 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
                    design_omega=None, dense_omega=None, speed_relax_db=3.0, tower_relax_db=TOWER_RELAX_DB,
                    tower_relax_omega=TOWER_RELAX_OMEGA,
                    max_sensitivity=DESIGN_MAX_SENSITIVITY, min_decay=MIN_DECAY_RATE, keep_below=KEEP_BELOW, refine=2, maxfev=3000,
-                   max_hf_gain_ratio=MAX_HF_GAIN_RATIO) -> QFTDesign:
+                   max_hf_gain_ratio=MAX_HF_GAIN_RATIO, measurement_filter=None) -> QFTDesign:
     """One design with a fixed speed-spec relaxation; see :func:`design_qft`."""
     from .. import spec as sp
 
@@ -367,6 +372,7 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
     if not max_sensitivity > 1:
         raise ValueError(f"max_sensitivity={max_sensitivity!r} must be > 1 (|1/(1+L)| bound)")
     positive_scalar(min_decay, "min_decay")
+    filt = filter_polys(measurement_filter)
     offsets = np.atleast_1d(np.asarray(template_offsets, float))
     wd = DEFAULT_DESIGN_OMEGA.copy() if design_omega is None else lqft.check_grid(design_omega, "design_omega")
     wdense = np.logspace(np.log10(0.005), np.log10(20.0), 600) if dense_omega is None else lqft.check_grid(dense_omega, "dense_omega")
@@ -395,7 +401,7 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
     if bound is not None:  # the bound's check includes its band's ends and 3P
         wdense = merge_frequencies(wdense, hf_check_omega(model, wdense))
     prob = TuningProblem(model, v, speeds, nom, wd, tower_shaping, speed_relax_db, max_sensitivity, base,
-                         speed_shaping=speed_shaping, controller_bound=bound)
+                         speed_shaping=speed_shaping, controller_bound=bound, measurement_filter=filt)
     # Sharp features of the specs (the lightly damped tower-mode poles and zeros of every case's
     # ROSCO loop) are design frequencies and dense-check points too: a bound that holds on
     # both sides of a narrow dip of W can still fail inside it.
@@ -417,7 +423,7 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
     rounds = 0
     while True:
         x, feasible = tune(prob, x, None if given is not None else t, min_decay, maxfev)
-        cb, ca = controllers(x, v)
+        cb, ca = controllers(x, v, filt)
         pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs = loop_checks(prob, cb, ca, wdense)
         bad = [w for chk in (pitch_check, atd_check) for name in chk.names for w in [chk.worst(name)] if w[1] < 0]
         # more design frequencies cannot rescue a design that already fails on the ones it has
@@ -435,7 +441,8 @@ def _design_single(model, wind_speed, target_reduction=TARGET_REDUCTION, *, give
                            options=dict(spec_reduction=spec_reduction, template_offsets=tuple(offsets),
                                         speed_relax_db=speed_relax_db, tower_relax_db=tower_relax_db,
                                         tower_relax_omega=tower_relax_omega, max_sensitivity=max_sensitivity,
-                                        min_decay=min_decay, refine_rounds=rounds, max_hf_gain_ratio=kappa),
+                                        min_decay=min_decay, refine_rounds=rounds, max_hf_gain_ratio=kappa,
+                                        measurement_filter=None if filt is None else tuple(map(tuple, filt))),
                            checks=(pitch_check, atd_check, pitch_t, atd_t, pitch_specs, atd_specs))
 
 

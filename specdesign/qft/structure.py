@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 __all__ = ["PARAMETER_NAMES", "LOG_SCALED", "LOWER", "UPPER", "to_vector", "from_vector", "controller_polys",
-           "controllers", "rosco_start", "vector_bounds"]
+           "controllers", "rosco_start", "vector_bounds", "three_p_notch", "filter_polys"]
 
 #: Names of the 11 parameters, in the order of the vector x.
 PARAMETER_NAMES = ("k", "z", "omega_n", "zeta_n", "omega_d", "zeta_d", "omega_f", "zeta_f", "k_atd", "z_atd", "p_atd")
@@ -92,13 +92,17 @@ def from_vector(x: ArrayLike) -> dict[str, float]:
     return out
 
 
-def controller_polys(x: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def controller_polys(x: ArrayLike, measurement_filter: tuple | None = None
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Numerator and denominator polynomials of C_β and C_atd for a parameter vector.
 
     Parameters
     ----------
     x : array_like
         Parameter vector, shape (11,) (:func:`to_vector`).
+    measurement_filter : (numpy.ndarray, numpy.ndarray), optional
+        Numerator and denominator (descending powers of s) of a fixed filter F(s) on both
+        measurements (e.g. :func:`three_p_notch`): both controllers are multiplied by it.
 
     Returns
     -------
@@ -122,10 +126,14 @@ def controller_polys(x: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
     db = np.polymul(np.polymul([1.0, 0.0], [1.0, 2 * p["zeta_d"] * wd, wd * wd]), [1.0, 2 * p["zeta_f"] * wf, wf * wf])
     na = p["k_atd"] * np.array([1.0 / p["z_atd"], 1.0])
     da = np.array([1.0 / p["p_atd"], 1.0])
+    if measurement_filter is not None:
+        fn, fd = measurement_filter
+        nb, db, na, da = np.polymul(nb, fn), np.polymul(db, fd), np.polymul(na, fn), np.polymul(da, fd)
     return nb, db, na, da
 
 
-def controllers(x: ArrayLike, v: float) -> tuple[ct.TransferFunction, ct.TransferFunction]:
+def controllers(x: ArrayLike, v: float, measurement_filter: tuple | None = None
+                ) -> tuple[ct.TransferFunction, ct.TransferFunction]:
     """The two controllers of a parameter vector as named python-control transfer functions.
 
     Parameters
@@ -134,6 +142,8 @@ def controllers(x: ArrayLike, v: float) -> tuple[ct.TransferFunction, ct.Transfe
         Parameter vector, shape (11,) (:func:`to_vector`).
     v : float
         Wind speed of the design, m/s (only used in the systems' names).
+    measurement_filter : (numpy.ndarray, numpy.ndarray), optional
+        A fixed filter on both measurements, included in both controllers (:func:`controller_polys`).
 
     Returns
     -------
@@ -151,7 +161,7 @@ def controllers(x: ArrayLike, v: float) -> tuple[ct.TransferFunction, ct.Transfe
     >>> cb.name, ca.name, ca.input_labels
     ('QFT_pitch@19mps', 'QFT_ATD@19mps', ['tower_top_vel'])
     """
-    nb, db, na, da = controller_polys(x)
+    nb, db, na, da = controller_polys(x, measurement_filter)
     tag = f"{v:g}mps".replace(".", "p")
     cb = ct.tf(nb, db, inputs="gen_speed", outputs="pitch_cmd", name=f"QFT_pitch@{tag}")
     ca = ct.tf(na / da[0], da / da[0], inputs="tower_top_vel", outputs="pitch_cmd", name=f"QFT_ATD@{tag}")
@@ -220,3 +230,101 @@ def vector_bounds() -> tuple[np.ndarray, np.ndarray]:
     ((11,), True)
     """
     return np.where(LOG_SCALED, np.log(LOWER), LOWER), np.where(LOG_SCALED, np.log(UPPER), UPPER)
+
+
+def three_p_notch(model, depth_db: float = 20.0, zeta_pole: float = 0.5) -> ct.TransferFunction:
+    """A notch at the rotor's 3P on the measurements, F(s) = (s² + 2ζ_z ω s + ω²)/(s² + 2ζ_p ω s + ω²).
+
+    In OpenFAST the rotational sampling of the turbulence puts 3P into generator speed and
+    tower-top motion, which the linear models lack; a controller with gain there turns it into
+    pitch activity that buys nothing for the tower (docs/openfast.md: 53-82 % of QFT+ATD's
+    pitch-rate variance is at 3P and above). ROSCO's own answer is the same filter on its
+    measurements (its ``F_NotchType``). Unit gain at 0 and ∞.
+
+    Parameters
+    ----------
+    model : specdesign.turbine.TurbineModel or specdesign.openfast.LinearTurbine
+        The turbine: ω = 3·``rated_rotor_speed`` (rad/s), the rotor speed the pitch loop holds.
+    depth_db : float, default 20.0
+        Attenuation at ω, dB (> 0): ζ_z = ζ_p·10^(−depth/20).
+    zeta_pole : float, default 0.5
+        ζ_p, the notch's width (0 < ζ_p ≤ 1): 0.5 attenuates the 3P band 2.2-2.6 rad/s of the
+        IEA 15 MW by ≥ 13 dB, at ≈ 27° of phase lag at its tower mode (1.1 rad/s).
+
+    Returns
+    -------
+    control.TransferFunction
+        F, named ``3P_notch``.
+
+    Raises
+    ------
+    ValueError
+        ``model`` has no finite ``rated_rotor_speed``, or ``depth_db``/``zeta_pole`` out of range.
+
+    Examples
+    --------
+    >>> from specdesign.qft import three_p_notch
+    >>> from specdesign.turbine import iea15mw
+    >>> f = three_p_notch(iea15mw())
+    >>> w3 = 3 * iea15mw().rated_rotor_speed
+    >>> round(float(abs(f(1j * w3))), 6), round(float(abs(f(0))), 6)
+    (0.1, 1.0)
+    """
+    w3 = 3.0 * float(getattr(model, "rated_rotor_speed", np.nan))
+    if not (np.isfinite(w3) and w3 > 0):
+        raise ValueError(f"model has no finite rated_rotor_speed ({w3 / 3!r} rad/s): pass a turbine that has one, "
+                         "or a filter of your own as measurement_filter")
+    if not (np.isfinite(depth_db) and depth_db > 0):
+        raise ValueError(f"depth_db={depth_db!r} must be a finite attenuation > 0 dB")
+    if not (0 < zeta_pole <= 1):
+        raise ValueError(f"zeta_pole={zeta_pole!r} must be in (0, 1] (the notch's width)")
+    zeta_zero = zeta_pole * 10 ** (-depth_db / 20)
+    return ct.tf([1.0, 2 * zeta_zero * w3, w3 * w3], [1.0, 2 * zeta_pole * w3, w3 * w3], name="3P_notch")
+
+
+def filter_polys(measurement_filter, name: str = "measurement_filter") -> tuple[np.ndarray, np.ndarray] | None:
+    """A fixed measurement filter as (numerator, denominator) polynomials, checked at the door.
+
+    Parameters
+    ----------
+    measurement_filter : control.LTI or None
+        SISO, continuous, proper, stable, with a finite nonzero gain at 0 (it multiplies the
+        integral action).
+    name : str
+        The argument's name in the messages.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray) or None
+        Descending powers of s, the denominator monic; None for None.
+
+    Raises
+    ------
+    TypeError
+        Not a python-control system.
+    ValueError
+        Not SISO, discrete, improper, unstable, or with a zero or infinite gain at 0.
+    """
+    if measurement_filter is None:
+        return None
+    if not isinstance(measurement_filter, ct.LTI):
+        raise TypeError(f"{name} must be a control.TransferFunction or StateSpace (e.g. qft.three_p_notch(model)), "
+                        f"got {type(measurement_filter).__name__}")
+    if measurement_filter.ninputs != 1 or measurement_filter.noutputs != 1:
+        raise ValueError(f"{name} must be SISO (one filter on each measurement), got "
+                         f"{measurement_filter.noutputs}×{measurement_filter.ninputs}")
+    if not measurement_filter.isctime(strict=True):
+        raise ValueError(f"{name} must be continuous-time (dt=0): the tuner works in s")
+    f = ct.tf(measurement_filter)
+    num, den = np.trim_zeros(np.asarray(f.num[0][0], float), "f"), np.trim_zeros(np.asarray(f.den[0][0], float), "f")
+    if num.size > den.size:
+        raise ValueError(f"{name} is improper (numerator degree {num.size - 1} > denominator {den.size - 1}): "
+                         "add poles above the band")
+    poles = np.roots(den)
+    if poles.size and poles.real.max() >= 0:
+        raise ValueError(f"{name} has poles at or right of the imaginary axis ({poles[poles.real >= 0]}): "
+                         "a measurement filter must be stable")
+    dc = num[-1] / den[-1] if den[-1] != 0 else np.inf
+    if not (np.isfinite(dc) and dc != 0):
+        raise ValueError(f"{name} has gain {float(dc)!r} at 0: it multiplies the integral action, so it must be finite and nonzero")
+    return num / den[0], den / den[0]

@@ -81,6 +81,9 @@ class TuningProblem:
         (ω → allowed |C_β(jω)| in rad per rad/s, (low, high) band in rad/s): the high-frequency
         gain bound the pitch controller must meet (:func:`specdesign.feasibility.hf_gain_bound`),
         checked on the dense grid with the loops' specifications; None: none.
+    measurement_filter : (numpy.ndarray, numpy.ndarray), optional
+        A fixed filter on both measurements, part of both controllers in every evaluation
+        (:func:`specdesign.qft.structure.controller_polys`); None: none.
 
     Attributes
     ----------
@@ -118,7 +121,8 @@ class TuningProblem:
     def __init__(self, model: TurbineModel, v: float, speeds: Sequence[float], nominal: int, design_omega: ArrayLike,
                  tower_shaping: Callable[[np.ndarray], np.ndarray], speed_relax_db: float, max_sensitivity: float,
                  base: Baseline, speed_shaping: Callable[[np.ndarray], np.ndarray] | None = None,
-                 response_method: str = "python-control", controller_bound: tuple | None = None) -> None:
+                 response_method: str = "python-control", controller_bound: tuple | None = None,
+                 measurement_filter: tuple | None = None) -> None:
         from ..spec import baseline_controllers
 
         self.v, self.speeds, self.nom = v, speeds, nominal
@@ -130,6 +134,7 @@ class TuningProblem:
         self.speed_shaping = speed_shaping  # callable ω → W_Ω/T^ROSCO_{Ω,w} (nominal), or None: speed_gain
         self.ms = max_sensitivity
         self.controller_bound = controller_bound
+        self.measurement_filter = measurement_filter  # (num, den) of a fixed filter in both controllers, or None
         self.base = base
         self.wf, self.S = base.omega, base.wind_psd
         self.Rf = plant_responses(self.plants, self.wf, method=response_method)
@@ -207,7 +212,7 @@ class TuningProblem:
             margin (pitch loop closed), margin at the actuator; with ``controller_bound`` a
             sixth row, 20·log10(bound/|C_β|) (the same for every case; 100 dB outside its band).
         """
-        nb, db, na, da = controller_polys(x)
+        nb, db, na, da = controller_polys(x, self.measurement_filter)
         s = 1j * self.wd[:, None]
         c = np.polyval(nb, s) / np.polyval(db, s)
         k = np.polyval(na, s) / np.polyval(da, s)
@@ -245,7 +250,7 @@ class TuningProblem:
         """
         from scipy.signal import tf2ss
 
-        nb, db, na, da = controller_polys(x)
+        nb, db, na, da = controller_polys(x, self.measurement_filter)
         A1, B1, C1, D1 = tf2ss(nb, db)
         A2, B2, C2, D2 = tf2ss(na, da)
         n1, n2 = A1.shape[0], A2.shape[0]
@@ -283,7 +288,7 @@ class TuningProblem:
         key = np.asarray(x, float).tobytes()
         if getattr(self, "_perf_key", None) == key:  # the objective and the constraints ask for the same x
             return self._perf
-        nb, db, na, da = controller_polys(x)
+        nb, db, na, da = controller_polys(x, self.measurement_filter)
         s = 1j * self.wf[:, None]
         c = np.polyval(nb, s) / np.polyval(db, s)
         k = np.polyval(na, s) / np.polyval(da, s)
