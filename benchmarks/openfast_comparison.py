@@ -24,6 +24,9 @@ libraries' and parameter files' digests and the run settings) and not run again.
 - ``QFT+ATD+3P``: the same design with a notch at 3P on both measurements
   (``qft.three_p_notch``, tuned with it: ``design_qft(..., measurement_filter=...)``), which keeps
   the rotational sampling's 3P out of the pitch (docs/openfast.md, the pitch's band table);
+- ``QFT+ATD+3P+LP``: the same with a second-order low-pass at ``openfast_table3.ROLLOFF`` rad/s
+  on the measurements too (``qft.three_p_notch(model) * qft.rolloff(ROLLOFF)``), for what lies
+  above 3P;
 - ``MPC-OFlin``: :class:`specdesign.mpc.QuadraticMPC` (ts = 0.1 s, horizon 5 s, the class's weights)
   whose prediction model and LPV Kalman filter are OpenFAST's linearisations of the deck at
   15-25 m/s (:func:`openfast_forward_variants.openfast_linear_model`; no pitch actuator, as the
@@ -96,7 +99,9 @@ MODULUS_MARGIN, BAND, BAND_GAIN = 0.5, 1.5, 0.5
 #: campaign also ran ROSCO's tower damper; 17 m/s the one below it.
 SPEEDS = (17.0, 19.0)
 #: The controllers the campaign runs, in the order it runs them at each speed.
-CONTROLLERS = ("ROSCO", ROSCO_TD, STRUCTURES["atd"][0], STRUCTURES["atd_3p"][0], "MPC-OFlin", "MPC-OFlin-rule", "excursion MPC-OFlin-rule",
+#: The fixed-structure QFT designs a comparison can run (``openfast_table3.STRUCTURES``' keys).
+FIXED = ("atd", "atd_3p", "atd_3p_lp")
+CONTROLLERS = ("ROSCO", ROSCO_TD, *(STRUCTURES[st][0] for st in FIXED), "MPC-OFlin", "MPC-OFlin-rule", "excursion MPC-OFlin-rule",
                "health-aware MPC-OFlin-rule", "H∞", "H∞+ATD")
 #: The forwarded MPCs (built by :func:`mpcs`).
 MPCS = ("MPC-OFlin", "MPC-OFlin-rule", "excursion MPC-OFlin-rule", "health-aware MPC-OFlin-rule")
@@ -199,11 +204,9 @@ def main() -> None:
     # Table 3's designs: on OpenFAST's linearisations, named and exported as openfast_table3.py does
     # (only what a chosen controller needs is designed, exported or written: a library another
     # campaign's runs have loaded is never touched for nothing)
-    label, prefix = STRUCTURES["atd"]
-    label_3p, prefix_3p = STRUCTURES["atd_3p"]
-    design_model = openfast_model(deck, speeds) if {label, label_3p, "H∞", "H∞+ATD"} & set(chosen) else None
-    made = designs(design_model, speeds, args.target, "atd") if {label, "H∞+ATD"} & set(chosen) else {}
-    made_3p = designs(design_model, speeds, args.target, "atd_3p") if label_3p in chosen else {}
+    fixed = [st for st in FIXED if STRUCTURES[st][0] in chosen or (st == "atd" and "H∞+ATD" in chosen)]
+    design_model = openfast_model(deck, speeds) if fixed or "H∞" in chosen else None
+    made = {st: designs(design_model, speeds, args.target, st) for st in fixed}
     # the blade-load MPCs predict the blades' root moment: the same linearisations with it (a
     # separate cache entry, so the model the quadratic MPCs' stored runs were made with stays theirs)
     forwarded_mpcs = mpcs(lt, lambda: openfast_linear_model(deck, reduced, blade_moments=True), reduced, q_rule,
@@ -214,12 +217,12 @@ def main() -> None:
             controllers["ROSCO"] = discon_in
         if ROSCO_TD in chosen:
             controllers[ROSCO_TD] = rosco_td_discon(discon_in, out)
-        if label in chosen:
-            controllers[label] = export_design(made[v]["design"], out / f"{prefix}{v:g}", f"{label} {v:g} m/s", reduced)
-        if label_3p in chosen:
-            controllers[label_3p] = export_design(made_3p[v]["design"], out / f"{prefix_3p}{v:g}", f"{label_3p} {v:g} m/s",
-                                                  reduced)
-        for name, d in hinf_designs(design_model, v, made.get(v, {}).get("design"), chosen).items():
+        for st in fixed:
+            label, prefix = STRUCTURES[st]
+            if label in chosen:
+                controllers[label] = export_design(made[st][v]["design"], out / f"{prefix}{v:g}", f"{label} {v:g} m/s",
+                                                   reduced)
+        for name, d in hinf_designs(design_model, v, made.get("atd", {}).get(v, {}).get("design"), chosen).items():
             controllers[name] = export_design(d, out / f"{HINF[name]}{v:g}", f"{name} {v:g} m/s", reduced)
         controllers = {name: controllers[name] for name in CONTROLLERS if name in controllers}  # the run order
         validate.run_campaign(controllers, [v], args.seeds, plant=deck, duration=args.duration,

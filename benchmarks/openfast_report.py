@@ -54,6 +54,7 @@ import numpy as np  # noqa: E402
 
 from specdesign import closedloop, spec, turbine, validate, wind  # noqa: E402
 from specdesign.export import read_parameters  # noqa: E402
+from specdesign.export.parameters import SAME_DESIGN_RTOL  # noqa: E402
 from specdesign.openfast import iea15mw_monopile  # noqa: E402
 from specdesign.openfast.deck import named_digest  # noqa: E402
 from specdesign.validate.openfast_campaign import ran_parameters  # noqa: E402
@@ -280,16 +281,6 @@ def campaign_designs(runs, target=25.0):
               f"this code's design exports another: the damping table, the linear predictions and Table 3's "
               f"prediction rows are this code's design, the rainflow rows the runs' (rerun the campaign)", file=sys.stderr)
     return model, made
-
-
-#: Largest relative change of the exported controller's responses (DisconParameters.response_change)
-#: at which runs of an earlier export still count as runs of this code's design: a change of the
-#: design code's last digits (a refinement that makes it reproducible, 1e-7 to 1e-6 here) does not
-#: make a 600 s OpenFAST run another experiment; a new design (1e-1 and more) does. Measured: the
-#: 25 m/s QFT+ATD design after the notch shaper's KKT refinement, 3.1e-6 from the export its runs
-#: ran, run again on seed 0 gave every indicator within 1.2e-6 relative of the stored run (tower
-#: DEL 6.6e-7, pitch-rate SD 1.2e-6; 2026-11-28).
-SAME_DESIGN_RTOL = 1e-5
 
 
 def stale_designs(runs, made, same_rtol=SAME_DESIGN_RTOL) -> list:

@@ -33,6 +33,17 @@ def test_the_three_p_notch_has_its_depth_at_3p_and_unit_gain_away_from_it(model)
     assert np.max(20 * np.log10(np.abs(f(1j * band)))) <= -13.0
 
 
+def test_the_rolloff_is_a_unit_gain_second_order_low_pass():
+    # ω²/(s² + 2ζω s + ω²): |F(j·2.5ω)| = 1/√((1 − 6.25)² + (2·0.7071·2.5)²) = 1/√39.8 by hand
+    f = qft.rolloff(4.0)
+    assert_allclose(abs(f(0)), 1.0, rtol=1e-12)
+    assert_allclose(abs(f(10j)), 1 / np.sqrt((1 - 6.25) ** 2 + (2 * 2**-0.5 * 2.5) ** 2), rtol=1e-12)
+    assert_allclose(np.angle(f(4j), deg=True), -90.0, atol=1e-9)
+    for bad in (dict(omega=0.0), dict(omega=np.nan), dict(omega=4.0, zeta=-0.1)):
+        with pytest.raises(ValueError, match=next(iter(k for k, v in bad.items() if not (np.isfinite(v) and v > 0)))):
+            qft.rolloff(**bad)
+
+
 def test_both_controllers_are_the_structures_times_the_filter(model):
     # controller_polys with a filter equals the unfiltered structures times F, evaluated apart
     x = rosco_start(rosco_baseline(model, 19.0))

@@ -7,6 +7,7 @@ import dataclasses
 import math
 import shutil
 
+import control as ct
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -40,6 +41,12 @@ _FAKE_OPENFAST = '''\
           "TwrBsMyt": ("(kN-m)", 1e5 + gain * 2e4 * np.sin(1.1 * w * t) + 5e3 * np.sin(2.4 * t)),
           "RootMyb1": ("(kN-m)", 3e4 + 8e3 * np.sin(0.8 * t + seed)), "YawBrTAxp": ("(m/s^2)", 0.1 * np.sin(t))}}
 '''
+
+
+@pytest.fixture(scope="module")
+def model():
+    from specdesign.turbine import iea15mw
+    return iea15mw()
 
 
 @pytest.fixture
@@ -127,6 +134,38 @@ def test_the_exported_parameter_file_a_run_ran_is_kept_once_by_its_digest(tmp_pa
     n_calls = len(calls.read_text().split())
     run_openfast_campaign(ctrls, [19.0], [0, 1], **kw)
     assert len(calls.read_text().split()) == n_calls and kept.is_file()
+
+def test_a_resumed_campaign_counts_runs_of_the_same_design_exported_again(tmp_path, fake, model):
+    # another machine's OpenFAST linearises with other round-off: Table 3's designs made again
+    # moved by 2.4e-9 to 1.3e-7, so their files' digests changed and the store refused every run
+    # (run.json differs). A file within SAME_DESIGN_RTOL of the kept one (responses, not bytes)
+    # is the same design: its runs count, said by a warning, and the new file is not kept under
+    # the runs' digest; a changed design is still refused, its distance said
+    from specdesign.export import discon_parameters, write_parameters
+    from specdesign.export.parameters import SAME_DESIGN_RTOL
+
+    inst, calls, lib = fake
+    p = discon_parameters(ct.tf([-2.0, -0.9, -0.1], [1.0, 1.2, 0.0]), model=model)
+
+    def exported(tag, scale):
+        path = write_parameters(dataclasses.replace(p, C=p.C * scale, D=p.D * scale), tmp_path / f"{tag}.IN")
+        return Exported(lib, path)
+
+    kw = dict(deck=iea15mw_monopile(), duration=20.0, transient=5.0, record_dt=0.05, install=inst, processes=1,
+              folder=tmp_path / "camp", initial_conditions=False)
+    first = run_openfast_campaign({"QFT+ATD": exported("a", 1.0)}, [19.0], [0, 1], **kw)
+    n_calls = len(calls.read_text().split())
+    moved = exported("b", 1 + 1e-7)  # responses 1e-7 apart (linear in C, D: tests/test_export.py)
+    with pytest.warns(RuntimeWarning, match=r"earlier export of this design \(responses 1\.0e-07 relative apart"):
+        again = run_openfast_campaign({"QFT+ATD": moved}, [19.0], [0, 1], **kw)
+    assert len(calls.read_text().split()) == n_calls
+    assert_allclose(again.values["tower_del"], first.values["tower_del"], rtol=0)
+    kept = sorted(p_.name for p_ in (tmp_path / "camp" / "QFT_ATD" / "parameters").glob("*.IN"))
+    assert kept == [f"{named_digest(tmp_path / 'a.IN')}.IN"]
+    far = exported("c", 1 + 10 * SAME_DESIGN_RTOL)
+    with pytest.raises(ValueError, match=r"run\.json differs; its controller's responses are 0\.0001 relative"):
+        run_openfast_campaign({"QFT+ATD": far}, [19.0], [0, 1], **kw)
+
 
 def test_a_controller_named_outside_ascii_runs_under_an_ascii_folder(tmp_path, fake):
     # OpenFAST opens its case files by name: "H∞+ATD" runs as Hinf_ATD, and is read back by its name

@@ -94,7 +94,7 @@ from .design import (
 )
 from .result import DEFAULT_DESIGN_OMEGA, QFTDesign
 from .specs import SPEED_RELAX_DB, QFTSpecification, spec_from_certified, spec_from_pair, spec_notch
-from .structure import three_p_notch
+from .structure import rolloff, three_p_notch
 from .torque_design import TorqueDesign, design_torque, torque_general_form
 
 __all__ = [
@@ -107,6 +107,7 @@ __all__ = [
     "spec_from_pair",
     "spec_notch",
     "three_p_notch",
+    "rolloff",
     "design_schedule",
     "held_lift",
     "check_design_speed",

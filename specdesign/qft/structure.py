@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 __all__ = ["PARAMETER_NAMES", "LOG_SCALED", "LOWER", "UPPER", "to_vector", "from_vector", "controller_polys",
-           "controllers", "rosco_start", "vector_bounds", "three_p_notch", "filter_polys"]
+           "controllers", "rosco_start", "vector_bounds", "three_p_notch", "rolloff", "filter_polys"]
 
 #: Names of the 11 parameters, in the order of the vector x.
 PARAMETER_NAMES = ("k", "z", "omega_n", "zeta_n", "omega_d", "zeta_d", "omega_f", "zeta_f", "k_atd", "z_atd", "p_atd")
@@ -280,6 +280,44 @@ def three_p_notch(model, depth_db: float = 20.0, zeta_pole: float = 0.5) -> ct.T
         raise ValueError(f"zeta_pole={zeta_pole!r} must be in (0, 1] (the notch's width)")
     zeta_zero = zeta_pole * 10 ** (-depth_db / 20)
     return ct.tf([1.0, 2 * zeta_zero * w3, w3 * w3], [1.0, 2 * zeta_pole * w3, w3 * w3], name="3P_notch")
+
+
+def rolloff(omega: float, zeta: float = 2**-0.5) -> ct.TransferFunction:
+    """A second-order low-pass on the measurements, ω²/(s² + 2ζω s + ω²) (unit gain at 0).
+
+    The 3P notch leaves what lies above 3P: in OpenFAST the paper's structure with it still spends
+    41 % of its pitch-rate variance at 5-20 rad/s (the lead-lag ATD's gain is flat there,
+    docs/openfast.md). Multiply it in: ``qft.three_p_notch(model) * qft.rolloff(4.0)``.
+
+    Parameters
+    ----------
+    omega : float
+        Corner frequency, rad/s (> 0; above the tower mode and 3P, e.g. 4 rad/s on the IEA 15 MW:
+        −16 dB at 10 rad/s, 23° of phase lag at the tower mode, 1.1 rad/s).
+    zeta : float, default 1/√2
+        Damping ratio (> 0; Butterworth by default).
+
+    Returns
+    -------
+    control.TransferFunction
+        The filter, named ``rolloff``.
+
+    Raises
+    ------
+    ValueError
+        ``omega`` or ``zeta`` not finite and positive.
+
+    Examples
+    --------
+    >>> from specdesign.qft import rolloff
+    >>> f = rolloff(4.0)
+    >>> round(float(abs(f(0))), 6), round(float(20 * np.log10(abs(f(10j)))), 1)
+    (1.0, -16.0)
+    """
+    for name, val in (("omega", omega), ("zeta", zeta)):
+        if not (np.isfinite(val) and val > 0):
+            raise ValueError(f"{name}={val!r} must be finite and > 0 ({'rad/s' if name == 'omega' else '-'})")
+    return ct.tf([omega * omega], [1.0, 2 * zeta * omega, omega * omega], name="rolloff")
 
 
 def filter_polys(measurement_filter, name: str = "measurement_filter") -> tuple[np.ndarray, np.ndarray] | None:

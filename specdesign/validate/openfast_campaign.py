@@ -10,6 +10,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import hashlib
 import json
+import math
 import os
 import sys
 import tempfile
@@ -23,7 +24,7 @@ from tqdm.auto import tqdm
 
 from ..controller.discon_file import read_discon
 from ..export.forward import Forwarded, ForwardServer
-from ..export.parameters import FORMAT_NAME
+from ..export.parameters import FORMAT_NAME, SAME_DESIGN_RTOL, read_parameters
 from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, named_digest, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
@@ -327,11 +328,9 @@ def run_openfast_campaign(controllers: Mapping, wind_speeds, seeds, *, deck: Dec
     results, todo = {}, []
     for run in runs:
         meta = _meta(run, discon[run[0]], settings)
-        done = _load(root, run, meta)
+        done = _load(root, run, meta, discon[run[0]])
         if done is not None:
             results[run] = done
-            if not isinstance(discon[run[0]], Forwarded):  # the same digest: the file that ran, kept if it was not
-                _archive(root, run[0], Path(discon[run[0]].parameters), meta["parameters_sha"])
         else:
             todo.append((run, meta))
     show = sys.stderr.isatty() if progress is None else bool(progress)
@@ -511,16 +510,40 @@ def _same(a: dict, b: dict) -> bool:
     return all(a.get(k) == b.get(k) for k in keys) and settings(a) == settings(b)
 
 
-def _load(root: Path, run, meta):
-    """A finished run's results, or None; a run of other settings there is refused."""
+def _controller_change(root: Path, run, old: dict, meta: dict, controller) -> float:
+    """How far the exported controller a stored run ran is from ``controller`` (relative,
+    :meth:`~specdesign.export.DisconParameters.response_change`), when that is all that differs
+    between ``old`` and ``meta`` and the file it ran is kept; else inf."""
+    if isinstance(controller, Forwarded) or not _same(old, dict(meta, parameters_sha=old.get("parameters_sha"))):
+        return math.inf
+    kept = root / _slug(run[0]) / "parameters" / f"{old.get('parameters_sha')}.IN"
+    try:
+        return read_parameters(kept).response_change(read_parameters(controller.parameters))
+    except (OSError, ValueError):  # not kept, or not the workbench's format (ROSCO's own file)
+        return math.inf
+
+
+def _load(root: Path, run, meta, controller):
+    """A finished run's results, or None; a run of other settings there is refused. A run of
+    an exported controller within :data:`~specdesign.export.parameters.SAME_DESIGN_RTOL` of
+    ``controller`` (the same design exported again, its last digits moved: another machine's
+    linearisation) counts as its run, said by a warning. The parameter file of a run found with
+    the same digest is kept if it was not (:func:`_archive`)."""
     f = _run_folder(root, run)
     js, npz = f / "run.json", f / "result.npz"
     if not (js.is_file() and npz.is_file()):
         return None
     old = json.loads(js.read_text())
     if not _same(old, meta):
-        raise ValueError(f"{f} holds a run of other settings or another controller under the name {run[0]!r} "
-                         "(run.json differs): use another folder, or delete that run to redo it")
+        change = _controller_change(root, run, old, meta, controller)
+        if not change <= SAME_DESIGN_RTOL:
+            apart = f"; its controller's responses are {change:.2g} relative from this one's" if np.isfinite(change) else ""
+            raise ValueError(f"{f} holds a run of other settings or another controller under the name {run[0]!r} "
+                             f"(run.json differs{apart}): use another folder, or delete that run to redo it")
+        warnings.warn(f"{f}: ran an earlier export of this design (responses {change:.1e} relative apart, within "
+                      f"{SAME_DESIGN_RTOL:g}): counted as its run", RuntimeWarning, stacklevel=3)
+    elif not isinstance(controller, Forwarded):  # the file that ran, kept if it was not
+        _archive(root, run[0], Path(controller.parameters), meta["parameters_sha"])
     return _read_result(npz)
 
 
