@@ -362,7 +362,7 @@ def filter_polys(measurement_filter, name: str = "measurement_filter") -> tuple[
     if poles.size and poles.real.max() >= 0:
         raise ValueError(f"{name} has poles at or right of the imaginary axis ({poles[poles.real >= 0]}): "
                          "a measurement filter must be stable")
-    dc = num[-1] / den[-1] if den[-1] != 0 else np.inf
-    if not (np.isfinite(dc) and dc != 0):
+    dc = num[-1] / den[-1]  # den[-1] ≠ 0: no pole at 0 passed the stability check
+    if dc == 0:
         raise ValueError(f"{name} has gain {float(dc)!r} at 0: it multiplies the integral action, so it must be finite and nonzero")
     return num / den[0], den / den[0]

@@ -432,11 +432,16 @@ def _rate_limit(deck: Deck) -> float | None:
     return None if entry is None else float(entry.values[0])
 
 
+def _kept_file(root: Path, name: str, sha: str) -> Path:
+    """Where the campaign keeps the parameter file of digest ``sha`` that ``name``'s runs ran."""
+    return root / _slug(name) / "parameters" / f"{sha}.IN"
+
+
 def _archive(root: Path, name: str, parameters: Path, sha: str) -> None:
     # a parameter file of the workbench's format, kept once per controller and digest beside its
     # runs: what ran stays readable after the design code changes (ran_parameters); after the run
     # is saved, so that a file that cannot be kept costs a warning, not the run
-    out = root / _slug(name) / "parameters" / f"{sha}.IN"
+    out = _kept_file(root, name, sha)
     if out.exists():
         return
     try:
@@ -516,9 +521,9 @@ def _controller_change(root: Path, run, old: dict, meta: dict, controller) -> fl
     between ``old`` and ``meta`` and the file it ran is kept; else inf."""
     if isinstance(controller, Forwarded) or not _same(old, dict(meta, parameters_sha=old.get("parameters_sha"))):
         return math.inf
-    kept = root / _slug(run[0]) / "parameters" / f"{old.get('parameters_sha')}.IN"
     try:
-        return read_parameters(kept).response_change(read_parameters(controller.parameters))
+        kept = read_parameters(_kept_file(root, run[0], old.get("parameters_sha")))
+        return kept.response_change(read_parameters(controller.parameters))
     except (OSError, ValueError):  # not kept, or not the workbench's format (ROSCO's own file)
         return math.inf
 
