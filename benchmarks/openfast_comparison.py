@@ -42,6 +42,13 @@ libraries' and parameter files' digests and the run settings) and not run again.
   predicts and reads from avrSWAP(30-32);
 - ``health-aware MPC-OFlin-rule``: :func:`specdesign.mpc.health_aware_mpc` (seed 002's
   accumulated-moment term, ``stress_weight`` = 30, which derates), the same model and q_Δ;
+- ``economic MPC-OFlin-rule``: :class:`specdesign.mpc.EconomicMPC` (seed 000's Eq. 4 surrogate,
+  T_s = 0.2 s, N = 50: the reduced-model comparison's) on the quadratic MPC's model and the rule's
+  q_Δ, its tower-base term fitted (:func:`specdesign.mpc.fatigue_terms_from_records`, 10 s
+  windows, priced relative) on ROSCO's OpenFAST records in Table 3's store at
+  :data:`ECON_FIT_SPEEDS` (:func:`economic_terms`: no evaluated wind in the fit); the blade term of the reduced-model comparison is left out: the
+  records keep blade 1's root moment (RootMyb1), not the collective out-of-plane moment
+  (RootMyc) the linearisation predicts;
 - ``H∞``: :func:`specdesign.hinf.design_hinf` at the speed with its defaults (the certified pair
   for the DEL target, pitch only, under the high-frequency gain bound: the reduced-model
   comparison's H∞, docs/comparison.md) on OpenFAST's linearisations, exported as QFT+ATD is;
@@ -84,7 +91,14 @@ from openfast_table3 import (
 
 from specdesign import hinf, turbine, validate
 from specdesign.export import forwarded
-from specdesign.mpc import HealthMPC, QuadraticMPC, health_aware_mpc, loop_gain
+from specdesign.mpc import (
+    EconomicMPC,
+    HealthMPC,
+    QuadraticMPC,
+    fatigue_terms_from_records,
+    health_aware_mpc,
+    loop_gain,
+)
 from specdesign.openfast import find_openfast, iea15mw_monopile
 
 #: The activity weights the rule tries, smallest first (half decades from the class's 0.1).
@@ -102,18 +116,39 @@ SPEEDS = (17.0, 19.0)
 #: The fixed-structure QFT designs a comparison can run (``openfast_table3.STRUCTURES``' keys).
 FIXED = ("atd", "atd_3p", "atd_3p_lp")
 CONTROLLERS = ("ROSCO", ROSCO_TD, *(STRUCTURES[st][0] for st in FIXED), "MPC-OFlin", "MPC-OFlin-rule",
-               "excursion MPC-OFlin-rule", "health-aware MPC-OFlin-rule", "H∞", "H∞+ATD")
+               "excursion MPC-OFlin-rule", "health-aware MPC-OFlin-rule", "economic MPC-OFlin-rule", "H∞", "H∞+ATD")
 #: Run only when named: H∞+ATD (unstable, sign-reversed on OpenFAST's linearisations) and the
 #: roll-off variant (run at 19 m/s only: docs/openfast.md).
 NOT_BY_DEFAULT = ("H∞+ATD", STRUCTURES["atd_3p_lp"][0])
 #: The forwarded MPCs (built by :func:`mpcs`).
-MPCS = ("MPC-OFlin", "MPC-OFlin-rule", "excursion MPC-OFlin-rule", "health-aware MPC-OFlin-rule")
+MPCS = ("MPC-OFlin", "MPC-OFlin-rule", "excursion MPC-OFlin-rule", "health-aware MPC-OFlin-rule",
+        "economic MPC-OFlin-rule")
 #: The blade-load MPCs' weights: the reduced-model comparison's (benchmarks/comparison.py).
 EXCURSION_WEIGHT, STRESS_WEIGHT = 10.0, 30.0
 #: The H∞ designs (name: export folder prefix in the store).
 HINF = {"H∞": "export_hinf_", "H∞+ATD": "export_hinf_atd_"}
 #: The sample time (s) and forwarding interval (s, ServoDyn's DLL_DT) of the MPCs.
 TS, DT = 0.1, 0.02
+#: The economic MPC's sample time (s) and horizon (steps): the reduced-model comparison's.
+ECON_TS, ECON_HORIZON = 0.2, 50
+#: The speeds (m/s) of ROSCO's OpenFAST runs whose kept records fit the economic MPC's tower term:
+#: Table 3's that are not the comparison's (:data:`SPEEDS`), so that no evaluated wind is in the fit.
+ECON_FIT_SPEEDS = (15.0, 21.0, 23.0, 25.0)
+
+
+def economic_terms(runs) -> tuple:
+    """The economic MPC's priced tower-base term, fitted on the kept tower-base moment records of
+    ROSCO's OpenFAST ``runs`` at :data:`ECON_FIT_SPEEDS` (Table 3's store: its seed-0 runs keep
+    their series) in windows of its horizon (ECON_TS · ECON_HORIZON s), priced relative."""
+    fit = [r for r in runs if r.controller == "ROSCO" and r.wind_speed in ECON_FIT_SPEEDS and "tower_base_my" in r.series]
+    if not fit:
+        raise SystemExit(f"the economic MPC's fit needs ROSCO's kept records at {ECON_FIT_SPEEDS} m/s in {STORE}: "
+                         "run openfast_table3.py --plant openfast first")
+    dts = {r.meta["settings"]["record_dt"] for r in fit}
+    if len(dts) != 1:
+        raise SystemExit(f"ROSCO's kept records are sampled at several intervals {sorted(dts)} s")
+    return fatigue_terms_from_records({"tower_base_my": [r.series["tower_base_my"] for r in fit]}, dts.pop(),
+                                      ECON_TS * ECON_HORIZON)
 
 
 def activity_weight_rule(lt, grid=RULE_GRID) -> tuple[float, list]:
@@ -135,11 +170,12 @@ def activity_weight_rule(lt, grid=RULE_GRID) -> tuple[float, list]:
     return grid[-1], rows
 
 
-def mpcs(lt, lt_blade, reduced, q_rule, chosen=MPCS) -> dict:
+def mpcs(lt, lt_blade, reduced, q_rule, terms, chosen=MPCS) -> dict:
     """The ``chosen`` forwarded MPCs on OpenFAST's linearisation: the quadratic MPC with the class's
     weights and with q_Δ by the rule (on ``lt``), the excursion and the health-aware MPC with q_Δ by
     the rule (on ``lt_blade``, the same linearisations with the blades' root moments; a callable
-    giving it, called only when one of them is chosen)."""
+    giving it, called only when one of them is chosen), the economic MPC with q_Δ by the rule on
+    ``lt`` priced by ``terms`` (a callable giving them, called only when it is chosen)."""
     made, lt_blade = {}, functools.cache(lt_blade)
     for label, q in (("MPC-OFlin", 0.1), ("MPC-OFlin-rule", q_rule)):
         made[label] = lambda q=q: QuadraticMPC(lt, ts=TS, activity_weight=q, wind_speeds=lt.wind_speeds,
@@ -150,6 +186,9 @@ def mpcs(lt, lt_blade, reduced, q_rule, chosen=MPCS) -> dict:
     made["health-aware MPC-OFlin-rule"] = lambda: health_aware_mpc(
         lt_blade(), stress_weight=STRESS_WEIGHT, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
         name=f"health-aware MPC on OpenFAST's linearisation, q_Δ = {q_rule:g}")
+    made["economic MPC-OFlin-rule"] = lambda: EconomicMPC(
+        lt, terms(), ts=ECON_TS, horizon=ECON_HORIZON, activity_weight=q_rule, wind_speeds=lt.wind_speeds,
+        name=f"economic MPC on OpenFAST's linearisation, q_Δ = {q_rule:g}")
     return {label: forwarded(made[label](), dt=DT, model=reduced, pitch_rate_limit=reduced.pitch_rate_limit)
             for label in MPCS if label in chosen}
 
@@ -214,7 +253,7 @@ def main() -> None:
     # the blade-load MPCs predict the blades' root moment: the same linearisations with it (a
     # separate cache entry, so the model the quadratic MPCs' stored runs were made with stays theirs)
     forwarded_mpcs = mpcs(lt, lambda: openfast_linear_model(deck, reduced, blade_moments=True), reduced, q_rule,
-                          chosen) if mpc_names else {}
+                          lambda: economic_terms(validate.read_openfast_runs(STORE / "runs")), chosen) if mpc_names else {}
     for v in speeds:
         controllers = {name: c for name, c in forwarded_mpcs.items() if name in chosen}
         if "ROSCO" in chosen:

@@ -28,6 +28,7 @@ from specdesign.mpc import (
     discretize_turbine,
     economic_open_loop,
     economic_problem,
+    fatigue_terms_from_records,
     fit_fatigue_terms,
     pitch_wind_estimate,
     preview_demonstrations,
@@ -252,6 +253,43 @@ def test_fitted_tower_surrogate_is_convex_and_near_gaussian(terms):
     # Gaussian loads of one spectral shape give a = m/2 = 2 (fatigue.VarianceDamageFit); the
     # seed paper fitted 2.19 for m = 4: a convex Var^a needs a >= 1
     assert t.fit.m == 4.0 and 1.5 < t.fit.a < 2.6
+
+
+def test_terms_from_records_are_the_simulated_fit_on_the_same_records(model, terms):
+    # fit_fatigue_terms's records made by hand (ROSCO at 19 m/s, classes A-C, seed 1, 200 s): the
+    # records-taking fit must give its terms exactly; a tail shorter than a window is left out
+    runs = [simulate(model, rosco_baseline(model, 19.0), [19.0], seeds=[1], duration=200.0, turbulence_class=c)
+            for c in "ABC"]
+    recs = [r["tower_base_my"][0, 0] for r in runs]
+    dt = runs[0].dt
+    (t,) = fatigue_terms_from_records({"tower_base_my": recs}, dt, 20.0, prices={"tower_base_my": 1.0})
+    assert t == terms[0]
+    tail = [np.r_[x, x[:5]] for x in recs]  # 5 samples more: not a window
+    assert fatigue_terms_from_records({"tower_base_my": tail}, dt, 20.0, prices={"tower_base_my": 1.0}) == (t,)
+    # relative price (the default): π = 1/D(Var_ref), Var_ref the windows' mean variance
+    (rel,) = fatigue_terms_from_records({"tower_base_my": recs}, dt, 20.0)
+    n = round(20.0 / dt)
+    ref = np.mean([np.var(x[i:i + n]) for x in recs for i in range(0, x.size - n + 1, n)])
+    np.testing.assert_allclose(rel.reference_variance, ref, rtol=1e-12)
+    np.testing.assert_allclose(rel.price * rel.fit.predict(ref), 1.0, rtol=1e-12)
+
+
+def test_terms_from_records_refuse_what_they_cannot_fit(model):
+    x = np.random.default_rng(0).standard_normal(1000)
+    with pytest.raises(ValueError, match="records is empty"):
+        fatigue_terms_from_records({}, 0.1, 10.0)
+    with pytest.raises(ValueError, match="Wöhler"):
+        fatigue_terms_from_records({"rotor_azimuth": [x]}, 0.1, 10.0)
+    with pytest.raises(ValueError, match="whole number"):
+        fatigue_terms_from_records({"tower_base_my": [x]}, 0.1, 10.05)
+    with pytest.raises(ValueError, match="at least two"):
+        fatigue_terms_from_records({"tower_base_my": [x[:150]]}, 0.1, 10.0)
+    with pytest.raises(ValueError, match=r"records\['tower_base_my'\]\[1\]"):
+        fatigue_terms_from_records({"tower_base_my": [x, np.r_[x[:-1], np.nan]]}, 0.1, 10.0)
+    with pytest.raises(ValueError, match="price exactly"):
+        fatigue_terms_from_records({"tower_base_my": [x]}, 0.1, 10.0, prices={"blade_root_my": 1.0})
+    with pytest.raises(ValueError, match="dt"):
+        fatigue_terms_from_records({"tower_base_my": [x]}, -0.1, 10.0)
 
 
 def test_open_loop_optimum_value_is_the_cost_of_its_trajectory(model, terms):

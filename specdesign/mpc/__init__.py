@@ -9,7 +9,7 @@ Layout
 - :mod:`specdesign.mpc.base`: the linearised turbine discretised by zero-order hold, the
   Kalman filter (states and wind estimate), the sampled loop (:class:`SampledController`).
 - :mod:`specdesign.mpc.quadratic`: :class:`QuadraticMPC`.
-- :mod:`specdesign.mpc.economic`: :func:`fit_fatigue_terms`, :func:`surrogate_cost`,
+- :mod:`specdesign.mpc.economic`: :func:`fit_fatigue_terms`, :func:`fatigue_terms_from_records`, :func:`surrogate_cost`,
   :func:`economic_open_loop`, :class:`EconomicMPC`.
 - :mod:`specdesign.mpc.cloning`: :func:`demonstrations`, :class:`CloningRegressor`,
   :class:`ClonedController`, :class:`OpenLoopPlayback`.
@@ -58,6 +58,7 @@ from .economic import (
                    OpenLoopResult,
                    economic_open_loop,
                    economic_problem,
+                   fatigue_terms_from_records,
                    fit_fatigue_terms,
                    solve_cone,
                    surrogate_cost,
@@ -93,6 +94,7 @@ __all__ = [
     "EconomicMPC",
     "FatigueTerm",
     "fit_fatigue_terms",
+    "fatigue_terms_from_records",
     "surrogate_cost",
     "solve_cone",
     "economic_problem",

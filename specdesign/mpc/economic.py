@@ -46,7 +46,7 @@ from ..wind import RECORD_LENGTH
 from .base import MEASURED, DiscreteTurbine, discretize_turbine
 from .sampled import SampledController
 
-__all__ = ["solve_cone", "FatigueTerm", "fit_fatigue_terms", "surrogate_cost", "economic_problem",
+__all__ = ["solve_cone", "FatigueTerm", "fit_fatigue_terms", "fatigue_terms_from_records", "surrogate_cost", "economic_problem",
            "economic_open_loop", "OpenLoopResult", "EconomicMPC", "WOHLER"]
 
 #: Wöhler exponents of the priced components: steel tower, glass-fibre blade root, and the
@@ -111,7 +111,8 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
     ROSCO's PI (:func:`specdesign.turbine.rosco_baseline`) runs at ``wind_speed`` on the IEC
     turbulence ``classes`` × ``seeds``; every record is cut into windows of ``window`` seconds
     (the horizon the cost is applied over: D is a damage per window) and
-    :func:`specdesign.fatigue.fit_variance_damage` fits ln(L_ult^m D) = a ln Var + b on them.
+    :func:`specdesign.fatigue.fit_variance_damage` fits ln(L_ult^m D) = a ln Var + b on them
+    (:func:`fatigue_terms_from_records`, which takes records made elsewhere, e.g. OpenFAST's).
 
     Parameters
     ----------
@@ -156,30 +157,91 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
     if window > duration / 2:
         raise ValueError(f"window={window} s must be at most half of duration={duration} s (two records per run)")
     names = tuple(model.output_names)
-    relative = prices is None
-    if relative:
-        prices = {o: 1.0 for o in (("tower_base_my", "blade_root_my") if outputs is None else outputs)
-                  if o in names or outputs is not None}
-    for out in prices:
+    if prices is None:
+        outputs = [o for o in ("tower_base_my", "blade_root_my") if o in names] if outputs is None else list(outputs)
+    for out in (outputs if prices is None else prices):
         if out not in names:
             raise ValueError(f"priced output {out!r} is not an output of the model {names}")
-        if out not in WOHLER:
-            raise ValueError(f"priced output {out!r} has no Wöhler exponent; known: {WOHLER}")
-    ultimate = {} if ultimate is None else dict(ultimate)
+    _check_wohler(outputs if prices is None else prices)
     runs = [simulate(model, rosco_baseline(model, wind_speed), [wind_speed], seeds=list(seeds), duration=duration,
                      turbulence_class=c) for c in classes]
-    dt = runs[0].dt
-    n = int(round(window / dt))
+    records = {out: [r[out][0, s] for r in runs for s in range(len(seeds))]
+               for out in (outputs if prices is None else prices)}
+    return fatigue_terms_from_records(records, runs[0].dt, window, prices=prices, ultimate=ultimate)
+
+
+def _check_wohler(names) -> None:
+    for out in names:
+        if out not in WOHLER:
+            raise ValueError(f"priced output {out!r} has no Wöhler exponent; known: {WOHLER}")
+
+
+def fatigue_terms_from_records(records, dt: float, window: float, *, prices: dict | None = None,
+                               ultimate: dict | None = None) -> tuple:
+    """Fit the variance-damage surrogate of each priced load on given load histories.
+
+    Every record is cut into consecutive windows of ``window`` seconds (a remainder shorter
+    than a window is left out) and :func:`specdesign.fatigue.fit_variance_damage` fits
+    ln(L_ult^m D) = a ln Var + b on the windows. :func:`fit_fatigue_terms` makes its records by
+    simulating ROSCO on the reduced model; this takes any, e.g. ROSCO's records in OpenFAST.
+
+    Parameters
+    ----------
+    records : dict
+        Output → sequence of 1-D load histories (load units, SI) sampled every ``dt``; the
+        outputs priced. Each output needs a Wöhler exponent in :data:`WOHLER`.
+    dt : float
+        Sample interval of the records (s).
+    window : float
+        Window of the fit (s), that of the optimisation horizon; a whole number of samples
+        (to 1e-9 relative).
+    prices : dict, optional
+        Output → π, currency per unit damage, for every output of ``records``. Default: each
+        priced 1/D_ref (D_ref its predicted damage at the windows' mean variance), so J̃_fat =
+        Σ D_i/D_ref,i weighs each component's damage relative to the records'.
+    ultimate : dict, optional
+        Output → L_ult (load units; default 1.0).
+
+    Returns
+    -------
+    tuple of FatigueTerm
+        One per output of ``records``, in its order.
+
+    Raises
+    ------
+    ValueError
+        Empty ``records``, an output without a Wöhler exponent, a record that is not 1-D and
+        finite, ``prices`` not naming exactly the recorded outputs, a window that is not a whole
+        number of samples, fewer than two windows, or a fitted exponent a < 1 (Var^a not
+        convex: module docstring).
+    """
+    dt, window = positive_scalar(dt, "dt"), positive_scalar(window, "window")
+    records = dict(records)
+    if not records:
+        raise ValueError("records is empty: pass {output: [load history, ...]} for the outputs to price")
+    _check_wohler(records)
+    if prices is not None and set(prices) != set(records):
+        raise ValueError(f"prices names {sorted(prices)}, records {sorted(records)}: price exactly the recorded outputs")
+    n = round(window / dt)
+    if n < 2 or abs(n * dt - window) > 1e-9 * window:
+        raise ValueError(f"window={window} s is not a whole number (>= 2) of samples of dt={dt} s")
+    ultimate = {} if ultimate is None else dict(ultimate)
     terms = []
-    for out, price in prices.items():
-        recs = [r[out][0, s, i:i + n] for r in runs for s in range(len(seeds))
-                for i in range(0, r[out].shape[-1] - n + 1, n)]
+    for out, histories in records.items():
+        recs = []
+        for k, x in enumerate(histories):
+            x = np.asarray(x, float)
+            if x.ndim != 1 or not np.all(np.isfinite(x)):
+                raise ValueError(f"records[{out!r}][{k}] must be a 1-D finite history, got shape {x.shape}")
+            recs += [x[i:i + n] for i in range(0, x.size - n + 1, n)]
+        if len(recs) < 2:
+            raise ValueError(f"records[{out!r}] holds {len(recs)} window(s) of {window} s: at least two are needed")
         fit = fit_variance_damage(recs, WOHLER[out], ultimate=float(ultimate.get(out, 1.0)))
         if fit.a < 1:
             raise ValueError(f"the fitted exponent a={fit.a:.3f} of {out!r} is below 1: Var^a is not convex "
                              "(module docstring); fit on more varied records or another window")
         ref = float(np.mean([np.var(x) for x in recs]))
-        terms.append(FatigueTerm(out, fit, 1.0 / float(fit.predict(ref)) if relative else float(price), ref))
+        terms.append(FatigueTerm(out, fit, 1.0 / float(fit.predict(ref)) if prices is None else float(prices[out]), ref))
     return tuple(terms)
 
 
