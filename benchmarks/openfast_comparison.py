@@ -16,6 +16,9 @@ libraries' and parameter files' digests and the run settings) and not run again.
 - ``ROSCO``: ROSCO's compiled DISCON with the deck's DISCON.IN (its tower damper off, as shipped);
 - ``ROSCO+TD``: the same with ROSCO's fore-aft tower damper on (``TD_Mode = 1``, ``FA_KI`` by the
   rule of ``benchmarks/openfast_table3.py``'s :func:`rosco_td_discon`);
+- ``ROSCO+TD+3P``: ROSCO+TD with ROSCO's own notch filter at 3P on the generator speed and the
+  tower-top acceleration (``F_GenSpdNotch_N``, ``F_TwrTopNotch_N``), the filter QFT+ATD+3P is
+  tuned with (``openfast_table3.rosco_notch_values``): the baseline of that design;
 - ``QFT+ATD``: the paper's structure (PI + notch + low-pass and a tower damper on the tower-top
   velocity) designed per speed to the DEL target on OpenFAST's linearisations of the deck (the
   model the MPCs below predict with: both sides know the plant equally) and exported as a DISCON
@@ -80,11 +83,13 @@ from openfast_forward_variants import openfast_linear_model
 from openfast_report import report
 from openfast_table3 import (
     ROSCO_TD,
+    ROSCO_TD_3P,
     STORE,
     STRUCTURES,
     campaign_arguments,
     designs,
     export_design,
+    measurement_filter,
     openfast_model,
     rosco_td_discon,
 )
@@ -115,7 +120,7 @@ SPEEDS = (17.0, 19.0)
 #: The controllers the campaign runs, in the order it runs them at each speed.
 #: The fixed-structure QFT designs a comparison can run (``openfast_table3.STRUCTURES``' keys).
 FIXED = ("atd", "atd_3p", "atd_3p_lp")
-CONTROLLERS = ("ROSCO", ROSCO_TD, *(STRUCTURES[st][0] for st in FIXED), "MPC-OFlin", "MPC-OFlin-rule",
+CONTROLLERS = ("ROSCO", ROSCO_TD, ROSCO_TD_3P, *(STRUCTURES[st][0] for st in FIXED), "MPC-OFlin", "MPC-OFlin-rule",
                "excursion MPC-OFlin-rule", "health-aware MPC-OFlin-rule", "economic MPC-OFlin-rule", "H∞", "H∞+ATD")
 #: Run only when named: H∞+ATD (unstable, sign-reversed on OpenFAST's linearisations) and the
 #: roll-off variant (run at 19 m/s only: docs/openfast.md).
@@ -248,7 +253,7 @@ def main() -> None:
     # (only what a chosen controller needs is designed, exported or written: a library another
     # campaign's runs have loaded is never touched for nothing)
     fixed = [st for st in FIXED if STRUCTURES[st][0] in chosen or (st == "atd" and "H∞+ATD" in chosen)]
-    design_model = openfast_model(deck, speeds) if fixed or "H∞" in chosen else None
+    design_model = openfast_model(deck, speeds) if fixed or {"H∞", ROSCO_TD_3P} & set(chosen) else None
     made = {st: designs(design_model, speeds, args.target, st) for st in fixed}
     # the blade-load MPCs predict the blades' root moment: the same linearisations with it (a
     # separate cache entry, so the model the quadratic MPCs' stored runs were made with stays theirs)
@@ -260,6 +265,8 @@ def main() -> None:
             controllers["ROSCO"] = discon_in
         if ROSCO_TD in chosen:
             controllers[ROSCO_TD] = rosco_td_discon(discon_in, out)
+        if ROSCO_TD_3P in chosen:
+            controllers[ROSCO_TD_3P] = rosco_td_discon(discon_in, out, measurement_filter(design_model, "atd_3p"))
         for st in fixed:
             label, prefix = STRUCTURES[st]
             if label in chosen:

@@ -58,16 +58,39 @@ def openfast_model(deck, speeds=(), **kwargs):
 
 #: The second baseline's name in the campaign: ROSCO with its tower damper (``--rosco-td``).
 ROSCO_TD = "ROSCO+TD"
+#: ROSCO+TD with ROSCO's notch at 3P on its measurements (:func:`rosco_td_discon` with a notch).
+ROSCO_TD_3P = "ROSCO+TD+3P"
 
 
-def rosco_td_discon(discon_in, folder) -> Path:
+def rosco_td_discon(discon_in, folder, notch=None) -> Path:
     """The deck's DISCON.IN with ROSCO's fore-aft tower damper on (``TD_Mode = 1``), ``FA_KI``
     from :func:`specdesign.rosco.tune_tower_damper` on the reduced model (the smallest gain giving
     the first tower mode ζ = 0.2 at every above-rated speed with ROSCO's PI: the rule of
-    ``benchmarks/tower_damper.py`` and docs/comparison.md), written into ``folder``."""
+    ``benchmarks/tower_damper.py`` and docs/comparison.md), written into ``folder``. With a
+    ``notch`` (a :func:`specdesign.qft.three_p_notch`), ROSCO's own notch filter on both the
+    generator speed and the tower-top acceleration it reads, the same filter
+    (:func:`rosco_notch_values`): ROSCO+TD+3P, the baseline of the QFT+ATD+3P designs."""
     damper = rosco.tune_tower_damper(turbine.iea15mw())
     Path(folder).mkdir(parents=True, exist_ok=True)
-    return rosco.write_discon(discon_in, Path(folder) / "ROSCO_TD_DISCON.IN", **damper.discon_values())
+    if notch is None:
+        return rosco.write_discon(discon_in, Path(folder) / "ROSCO_TD_DISCON.IN", **damper.discon_values())
+    return rosco.write_discon(discon_in, Path(folder) / "ROSCO_TD_3P_DISCON.IN", **damper.discon_values(),
+                              **rosco_notch_values(notch))
+
+
+def rosco_notch_values(notch) -> dict:
+    """The DISCON.IN entries of ROSCO's notch filter (Filters.f90: (s² + 2ωβ_num s + ω²)/(s² +
+    2ωβ_den s + ω²), F_NotchFreqs in rad/s) equal to ``notch``, put on the generator speed and the
+    tower-top acceleration; ValueError when ``notch`` is not of that form."""
+    num, den = (np.atleast_1d(np.squeeze(c)) for c in (notch.num[0][0], notch.den[0][0]))
+    if num.size != 3 or den.size != 3 or not np.isclose(num[0], den[0]) or not np.isclose(num[2], den[2]) \
+            or den[2] <= 0:
+        raise ValueError(f"notch {notch} is not (s² + 2ωβ_num s + ω²)/(s² + 2ωβ_den s + ω²): ROSCO cannot carry it")
+    num, den = num / num[0], den / den[0]
+    w = float(np.sqrt(den[2]))
+    return {"F_NumNotchFilts": 1, "F_NotchFreqs": f"{w:.8f}", "F_NotchBetaNum": f"{num[1] / (2 * w):.8f}",
+            "F_NotchBetaDen": f"{den[1] / (2 * w):.8f}", "F_GenSpdNotch_N": 1, "F_GenSpdNotch_Ind": 1,
+            "F_TwrTopNotch_N": 1, "F_TwrTopNotch_Ind": 1}
 
 
 #: The designs a campaign can run: controller name, export folder prefix.

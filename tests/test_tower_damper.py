@@ -116,3 +116,39 @@ def test_openfast_second_baseline_is_the_deck_discon_with_the_tuned_damper(tmp_p
     changed = {k for k in before if before[k].values != after[k].values}
     # the damper's entries, and the quoted file names made absolute (PerfFileName)
     assert changed - {"PerfFileName"} == set(damper.discon_values())
+
+
+def test_openfast_notched_baseline_carries_the_designs_3p_notch(tmp_path, model, damper, benchmark_script):
+    # benchmarks/openfast_comparison.py's ROSCO+TD+3P: ROSCO+TD with ROSCO's notch filter set to the
+    # filter QFT+ATD+3P is tuned with. Oracle: ROSCO's own discrete coefficients (Filters.f90,
+    # NotchFilter: the bilinear transform with K = 2/DT written out) from the written entries
+    # against scipy's bilinear transform of qft.three_p_notch.
+    import scipy.signal
+
+    from specdesign import qft
+    from specdesign.openfast import iea15mw_monopile
+    from specdesign.rosco import read_discon
+
+    t3 = benchmark_script("openfast_table3")
+    deck = iea15mw_monopile()
+    source = deck.fst.with_name(f"{deck.name}_DISCON.IN")
+    notch = qft.three_p_notch(model)
+    written = t3.rosco_td_discon(source, tmp_path, notch)
+    before, after = read_discon(source)[0], read_discon(written)[0]
+    changed = {k for k in before if before[k].values != after[k].values}
+    assert changed - {"PerfFileName"} == set(damper.discon_values()) | set(t3.rosco_notch_values(notch))
+    value = {k: float(after[k].values[0]) for k in ("F_NotchFreqs", "F_NotchBetaNum", "F_NotchBetaDen")}
+    assert {k: int(after[k].values[0]) for k in ("F_NumNotchFilts", "F_GenSpdNotch_N", "F_GenSpdNotch_Ind",
+                                                 "F_TwrTopNotch_N", "F_TwrTopNotch_Ind")} == dict.fromkeys(
+        ("F_NumNotchFilts", "F_GenSpdNotch_N", "F_GenSpdNotch_Ind", "F_TwrTopNotch_N", "F_TwrTopNotch_Ind"), 1)
+    w, bn, bd, dt = value["F_NotchFreqs"], value["F_NotchBetaNum"], value["F_NotchBetaDen"], 0.01
+    k = 2.0 / dt
+    norm = k**2 + 2 * w * bd * k + w**2
+    rosco_b = np.array([k**2 + 2 * w * bn * k + w**2, 2 * w**2 - 2 * k**2, k**2 - 2 * w * bn * k + w**2]) / norm
+    rosco_a = np.array([norm, 2 * w**2 - 2 * k**2, k**2 - 2 * w * bd * k + w**2]) / norm
+    b, a = scipy.signal.bilinear(np.squeeze(notch.num[0][0]), np.squeeze(notch.den[0][0]), fs=1 / dt)
+    # the entries are written with 8 decimals: ~1e-8 relative on ω and the β's
+    np.testing.assert_allclose(rosco_b, b / a[0], rtol=1e-7)
+    np.testing.assert_allclose(rosco_a, a / a[0], rtol=1e-7)
+    with pytest.raises(ValueError, match="ROSCO cannot carry it"):
+        t3.rosco_notch_values(qft.rolloff(4.0, 0.7))
