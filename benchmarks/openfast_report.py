@@ -53,11 +53,10 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 from specdesign import closedloop, spec, turbine, validate, wind  # noqa: E402
-from specdesign.export import read_parameters  # noqa: E402
 from specdesign.export.parameters import SAME_DESIGN_RTOL  # noqa: E402
 from specdesign.openfast import iea15mw_monopile  # noqa: E402
 from specdesign.openfast.deck import named_digest  # noqa: E402
-from specdesign.validate.openfast_campaign import ran_parameters  # noqa: E402
+from specdesign.validate.openfast_campaign import kept_change, ran_parameters  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))  # the campaign's script beside this one
 # its store, model and design step: the controllers it ran
@@ -299,9 +298,8 @@ def stale_designs(runs, made, same_rtol=SAME_DESIGN_RTOL) -> list:
                 export = export_design(entry["design"], Path(tmp) / f"{label}{v:g}", f"{label} {v:g} m/s", reduced)
                 if not ran or named_digest(export.parameters) in ran:
                     continue
-                now = read_parameters(export.parameters)
                 kept = {r.meta["parameters_sha"]: ran_parameters(r) for r in mine}
-                change = max(math.inf if f is None else read_parameters(f).response_change(now) for f in kept.values())
+                change = max(kept_change(f, export.parameters) for f in kept.values())
                 if change > same_rtol:
                     out.append((label, v, ran))
                 else:

@@ -167,6 +167,24 @@ def test_a_resumed_campaign_counts_runs_of_the_same_design_exported_again(tmp_pa
         run_openfast_campaign({"QFT+ATD": far}, [19.0], [0, 1], **kw)
 
 
+def test_kept_change_is_the_response_distance_or_inf(tmp_path, model):
+    # the one comparison the campaign's resume and openfast_report.stale_designs share: responses
+    # (C, D scaled by 1 + 1e-7 move every response by 1e-7: tests/test_export.py), inf when the
+    # kept file is absent or not the workbench's format (ROSCO's own DISCON.IN)
+    from specdesign.export import discon_parameters, write_parameters
+    from specdesign.validate.openfast_campaign import kept_change
+
+    p = discon_parameters(ct.tf([-2.0, -0.9, -0.1], [1.0, 1.2, 0.0]), model=model)
+    a = write_parameters(p, tmp_path / "a.IN")
+    b = write_parameters(dataclasses.replace(p, C=p.C * (1 + 1e-7), D=p.D * (1 + 1e-7)), tmp_path / "b.IN")
+    assert kept_change(a, a) == 0.0
+    assert kept_change(a, b) == pytest.approx(1e-7, rel=1e-3)
+    assert kept_change(None, a) == float("inf")
+    assert kept_change(tmp_path / "missing.IN", a) == float("inf")
+    rosco_in = iea15mw_monopile().fst.with_name("IEA-15-240-RWT-Monopile_DISCON.IN")
+    assert kept_change(rosco_in, a) == float("inf")
+
+
 def test_a_controller_named_outside_ascii_runs_under_an_ascii_folder(tmp_path, fake):
     # OpenFAST opens its case files by name: "H∞+ATD" runs as Hinf_ATD, and is read back by its name
     inst, _, lib = fake

@@ -41,7 +41,7 @@ from .stats import seeds_from, welch_psd
 from .store import fingerprint
 
 __all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_SERIES", "OPENFAST_SPECTRA",
-           "OpenFASTRun", "read_openfast_runs", "ran_parameters"]
+           "OpenFASTRun", "read_openfast_runs", "ran_parameters", "kept_change"]
 
 #: OpenFAST channel → workbench series of an OpenFAST campaign (SI after reading).
 OPENFAST_SERIES = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power",
@@ -476,6 +476,32 @@ def ran_parameters(run: OpenFASTRun) -> Path | None:
     return f if f.is_file() else None
 
 
+def kept_change(kept, parameters) -> float:
+    """How far the controller of a kept parameter file is from that of ``parameters``: the largest
+    relative change of a response (:meth:`~specdesign.export.DisconParameters.response_change`).
+
+    Parameters
+    ----------
+    kept : str, pathlib.Path or None
+        The file a run ran (:func:`ran_parameters`), None when the store did not keep it.
+    parameters : str or pathlib.Path
+        A parameter file of :func:`specdesign.export.export_discon` (the controller about to run).
+
+    Returns
+    -------
+    float
+        The change, ``inf`` when ``kept`` is None, missing or not the workbench's format (ROSCO's
+        own file), or when a field other than the controller differs; compare it with
+        :data:`~specdesign.export.parameters.SAME_DESIGN_RTOL`.
+    """
+    if kept is None:
+        return math.inf
+    try:
+        return read_parameters(kept).response_change(read_parameters(parameters))
+    except (OSError, ValueError):
+        return math.inf
+
+
 def _slug(name: str) -> str:
     """``name`` as an ASCII file name: "H∞+ATD" → "Hinf_ATD" (OpenFAST's Fortran opens the case's files by name)."""
     name = name.replace("∞", "inf")
@@ -521,11 +547,7 @@ def _controller_change(root: Path, run, old: dict, meta: dict, controller) -> fl
     between ``old`` and ``meta`` and the file it ran is kept; else inf."""
     if isinstance(controller, Forwarded) or not _same(old, dict(meta, parameters_sha=old.get("parameters_sha"))):
         return math.inf
-    try:
-        kept = read_parameters(_kept_file(root, run[0], old.get("parameters_sha")))
-        return kept.response_change(read_parameters(controller.parameters))
-    except (OSError, ValueError):  # not kept, or not the workbench's format (ROSCO's own file)
-        return math.inf
+    return kept_change(_kept_file(root, run[0], old.get("parameters_sha")), controller.parameters)
 
 
 def _load(root: Path, run, meta, controller):
