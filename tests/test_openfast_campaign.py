@@ -276,6 +276,9 @@ def test_a_campaign_folder_is_read_as_far_as_it_got(tmp_path, fake, benchmark_sc
         omega, want = welch_psd(pitch, 0.05)
         assert_allclose(r.omega, omega, rtol=0)
         assert_allclose(r.welch["pitch"], want, rtol=1e-9, atol=1e-12 * want.max())
+        # and the tower-top acceleration's (the tower damper's input): the fake's 0.1 sin(t) m/s²
+        _, want = welch_psd(0.1 * np.sin(10.0 + np.arange(800) * 0.05), 0.05)
+        assert_allclose(r.welch["tower_top_acc"], want, rtol=1e-9, atol=1e-12 * want.max())
     # a run stored before the pitch spectrum was kept: openfast_report.py computes it from the
     # kept series with the run's own Welch settings, the same as stored; without series, none
     pitch_psd = benchmark_script("openfast_report").pitch_psd

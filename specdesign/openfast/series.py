@@ -15,7 +15,7 @@ __all__ = ["OPENFAST_CHANNELS", "series_from_openfast"]
 #: OpenFAST channel → workbench output name.
 OPENFAST_CHANNELS = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power"}
 #: SI unit each workbench series must arrive in (read_outputs converts rpm, deg, kN·m, kW, …)
-_SERIES_UNITS = {"gen_speed": "rad/s", "tower_base_my": "N·m", "pitch": "rad", "power": "W"}
+_SERIES_UNITS = {"gen_speed": "rad/s", "tower_base_my": "N·m", "pitch": "rad", "power": "W", "tower_top_acc": "m/s^2"}
 
 
 def series_from_openfast(outputs: OpenFASTOutput | Iterable[OpenFASTOutput],

@@ -45,10 +45,12 @@ __all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_S
 
 #: OpenFAST channel → workbench series of an OpenFAST campaign (SI after reading).
 OPENFAST_SERIES = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power",
-                   "RootMyb1": "blade_root_my"}
-#: Outputs whose Welch spectra an OpenFAST run keeps: the campaign's, and the pitch angle's own,
-#: for the actuator's cost at 3P and above (issue 28: the reduced model has no 3P to show).
-OPENFAST_SPECTRA = SPECTRA + ("pitch",)
+                   "RootMyb1": "blade_root_my", "YawBrTAxp": "tower_top_acc"}
+#: Outputs whose Welch spectra an OpenFAST run keeps: the campaign's, the pitch angle's own, for
+#: the actuator's cost at 3P and above (issue 28: the reduced model has no 3P to show), and the
+#: tower-top fore-aft acceleration's, the tower damper's input, to tell which measurement carries
+#: the pitch's content above 3P (runs made before 2026-11-28 18:30 UTC lack it).
+OPENFAST_SPECTRA = SPECTRA + ("pitch", "tower_top_acc")
 
 
 @dataclass(frozen=True)
