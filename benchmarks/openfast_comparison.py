@@ -49,9 +49,9 @@ libraries' and parameter files' digests and the run settings) and not run again.
   T_s = 0.2 s, N = 50: the reduced-model comparison's) on the quadratic MPC's model and the rule's
   q_Δ, its tower-base term fitted (:func:`specdesign.mpc.fatigue_terms_from_records`, 10 s
   windows, priced relative) on ROSCO's OpenFAST records in Table 3's store at
-  :data:`ECON_FIT_SPEEDS` (:func:`economic_terms`: no evaluated wind in the fit); the blade term of the reduced-model comparison is left out: the
-  records keep blade 1's root moment (RootMyb1), not the collective out-of-plane moment
-  (RootMyc) the linearisation predicts;
+  :data:`ECON_FIT_SPEEDS` (:func:`economic_terms`: no evaluated wind in the fit); the blade term
+  of the reduced-model comparison is left out: the records keep blade 1's root moment
+  (RootMyb1), not the collective out-of-plane moment (RootMyc) the linearisation predicts;
 - ``H∞``: :func:`specdesign.hinf.design_hinf` at the speed with its defaults (the certified pair
   for the DEL target, pitch only, under the high-frequency gain bound: the reduced-model
   comparison's H∞, docs/comparison.md) on OpenFAST's linearisations, exported as QFT+ATD is;
