@@ -16,9 +16,10 @@ libraries' and parameter files' digests and the run settings) and not run again.
 - ``ROSCO``: ROSCO's compiled DISCON with the deck's DISCON.IN (its tower damper off, as shipped);
 - ``ROSCO+TD``: the same with ROSCO's fore-aft tower damper on (``TD_Mode = 1``, ``FA_KI`` by the
   rule of ``benchmarks/openfast_table3.py``'s :func:`rosco_td_discon`);
-- ``ROSCO+TD+3P``: ROSCO+TD with ROSCO's own notch filter at 3P on the generator speed and the
-  tower-top acceleration (``F_GenSpdNotch_N``, ``F_TwrTopNotch_N``), the filter QFT+ATD+3P is
-  tuned with (``openfast_table3.rosco_notch_values``): the baseline of that design;
+- ``ROSCO+TD+3P``: ROSCO+TD with ROSCO's own notch filter at 3P (``F_GenSpdNotch_N``,
+  ``F_TwrTopNotch_N``), the filter QFT+ATD+3P is tuned with (``openfast_table3.rosco_notch_values``):
+  ROSCO's answer to that design. ROSCO 2.10.6 notches the generator speed with it, not the tower
+  damper's input (its tower-top notch filters the floating feedback's signal only);
 - ``QFT+ATD``: the paper's structure (PI + notch + low-pass and a tower damper on the tower-top
   velocity) designed per speed to the DEL target on OpenFAST's linearisations of the deck (the
   model the MPCs below predict with: both sides know the plant equally) and exported as a DISCON

@@ -67,9 +67,12 @@ def rosco_td_discon(discon_in, folder, notch=None) -> Path:
     from :func:`specdesign.rosco.tune_tower_damper` on the reduced model (the smallest gain giving
     the first tower mode ζ = 0.2 at every above-rated speed with ROSCO's PI: the rule of
     ``benchmarks/tower_damper.py`` and docs/comparison.md), written into ``folder``. With a
-    ``notch`` (a :func:`specdesign.qft.three_p_notch`), ROSCO's own notch filter on both the
-    generator speed and the tower-top acceleration it reads, the same filter
-    (:func:`rosco_notch_values`): ROSCO+TD+3P, the baseline of the QFT+ATD+3P designs."""
+    ``notch`` (a :func:`specdesign.qft.three_p_notch`), ROSCO's own notch filter set to it
+    (:func:`rosco_notch_values`): ROSCO+TD+3P, ROSCO's answer to what QFT+ATD+3P does. ROSCO
+    (2.10.6, Filters.f90 ``PreFilterMeasuredSignals``) applies it to the generator speed; its
+    tower-top notch filters only the floating feedback's signals (``FA_AccF``), while the tower
+    damper (``ForeAftDamping``) integrates the high-passed raw acceleration: the damper's path
+    stays unnotched."""
     damper = rosco.tune_tower_damper(turbine.iea15mw())
     Path(folder).mkdir(parents=True, exist_ok=True)
     if notch is None:
@@ -81,7 +84,8 @@ def rosco_td_discon(discon_in, folder, notch=None) -> Path:
 def rosco_notch_values(notch) -> dict:
     """The DISCON.IN entries of ROSCO's notch filter (Filters.f90: (s² + 2ωβ_num s + ω²)/(s² +
     2ωβ_den s + ω²), F_NotchFreqs in rad/s) equal to ``notch``, put on the generator speed and the
-    tower-top acceleration; ValueError when ``notch`` is not of that form."""
+    tower-top acceleration (which ROSCO's tower damper does not read: :func:`rosco_td_discon`);
+    ValueError when ``notch`` is not of that form."""
     num, den = (np.atleast_1d(np.squeeze(c)) for c in (notch.num[0][0], notch.den[0][0]))
     if num.size != 3 or den.size != 3 or not np.isclose(num[0], den[0]) or not np.isclose(num[2], den[2]) \
             or den[2] <= 0:

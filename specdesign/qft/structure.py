@@ -238,8 +238,9 @@ def three_p_notch(model, depth_db: float = 20.0, zeta_pole: float = 0.5) -> ct.T
     In OpenFAST the rotational sampling of the turbulence puts 3P into generator speed and
     tower-top motion, which the linear models lack; a controller with gain there turns it into
     pitch activity that buys nothing for the tower (docs/openfast.md: 53-82 % of QFT+ATD's
-    pitch-rate variance is at 3P and above). ROSCO's own answer is the same filter on its
-    measurements (its ``F_NotchType``). Unit gain at 0 and ∞.
+    pitch-rate variance is at 3P and above). ROSCO offers the same filter on its generator-speed
+    measurement (``F_NotchFreqs``, ``F_GenSpdNotch_N``; its tower-top notch does not reach its
+    tower damper). Unit gain at 0 and ∞.
 
     Parameters
     ----------
