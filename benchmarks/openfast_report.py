@@ -622,6 +622,36 @@ def _fig10(runs, preds, folder, baseline=BASELINE, m=4.0, reduced=None):
     print(f"wrote {path}", file=sys.stderr)
 
 
+#: The bands of :func:`pitch_sources` (rad/s): the control band, the tower mode, 3P and what lies above.
+SOURCE_BANDS = ((0.05, 0.6), (0.6, 1.5), (1.5, 2.2), (2.2, 2.6), (2.6, 5.0), (5.0, 20.0))
+
+
+def pitch_sources(runs, made) -> str:
+    """Where a tower-damper design's pitch rate comes from, per band: the pitch-rate variance the
+    run measured beside |C_β|²·S_Ω (through the generator speed) and |C_atd/jω|²·S_a (through the
+    tower-top acceleration, integrated to the velocity the damper reads; its 0.05 rad/s high-pass
+    aside), from the run's Welch spectra and the design's two controllers (``made``, as
+    :func:`campaign_designs` makes them). Cross terms are left out, so the two need not add up to
+    the measured variance. Runs made before the campaign kept the acceleration's spectrum are
+    skipped (issue 28: which measurement carries the pitch above 3P)."""
+    lines = [("| wind (m/s) | controller | seed | band (rad/s) | pitch-rate variance (deg²/s²) | through the generator "
+              "speed | through the tower-top acceleration |"), "|---|---|---|---|---|---|---|"]
+    for r in runs:
+        entry = made.get(r.controller, {}).get(r.wind_speed)
+        d = entry and entry["design"]
+        if d is None or getattr(d, "atd_controller", None) is None or "tower_top_acc" not in r.welch:
+            continue
+        w = r.omega[1:]
+        cb, ca = closedloop.siso_response(d.pitch_controller, w), closedloop.siso_response(d.atd_controller, w)
+        parts = (r.welch["pitch"][1:], np.abs(cb) ** 2 * r.welch["gen_speed"][1:],
+                 np.abs(ca / (1j * w)) ** 2 * r.welch["tower_top_acc"][1:])
+        for lo, hi in SOURCE_BANDS:
+            cells = [DEG**2 * band_variance(w, w**2 * x, lo, hi) for x in parts]
+            lines.append(f"| {r.wind_speed:g} | {r.controller} | {r.seed} | {lo:g}-{hi:g} | "
+                         + " | ".join(f"{c:.3g}" for c in cells) + " |")
+    return "\n".join(lines) if len(lines) > 2 else "No run with the tower-top acceleration's spectrum and a tower damper."
+
+
 def _row_tables(lines) -> list:
     """(header, first row, end) of every table keyed by wind speed and controller in ``lines``."""
     found, i = [], 0
@@ -679,6 +709,9 @@ def main() -> None:
                     help="also write the (wind, controller) tables into PAGE (docs/openfast.md): each row replaced "
                          "by the store's or inserted; rows the store does not give are kept and listed; with --table3, "
                          "each design's Table 3 block replaced whole")
+    ap.add_argument("--pitch-sources", action="store_true",
+                    help="also the tower-damper designs' pitch rate by band, measured and through each measurement "
+                         "(runs with the tower-top acceleration's spectrum; designs again)")
     ap.add_argument("--figures", default=None,
                     help="folder for Fig. 9 from OpenFAST (19 m/s, seed 0, where its series were kept) and, with "
                          "--damping, Fig. 8 per speed and Fig. 10")
@@ -693,6 +726,8 @@ def main() -> None:
     print(printed[0])
     if args.figures is not None:
         fig9(runs, Path(args.figures))
+    if args.pitch_sources:
+        print("\n" + pitch_sources(runs, campaign_designs(runs)[1]))
     if args.damping or args.table3:
         model, made = campaign_designs(runs)
         reduced = reduced_model_changes(made, runs) if args.table3 else None

@@ -314,3 +314,38 @@ def test_run_campaign_dispatches_to_openfast(tmp_path, fake):
     assert (tmp_path / "s" / "A" / "19mps_seed3" / "run.json").is_file()
     with pytest.raises(TypeError, match="export_discon"):
         run_campaign({"lti": object()}, [19.0], [3], plant=iea15mw_monopile(), openfast={"install": inst})
+
+
+def test_pitch_sources_split_the_pitch_rate_by_measurement(benchmark_script, tmp_path):
+    # openfast_report.pitch_sources: a run whose pitch is exactly C_β acting on the generator speed
+    # (S_β = |C_β|² S_Ω, no acceleration) reads all of its pitch-rate variance "through the
+    # generator speed" and none through the acceleration, band by band; the acceleration's part
+    # is |C_atd/jω|² S_a; a run without the acceleration's spectrum (made before it was kept) is
+    # skipped. Band integrals by hand (trapezoid of ω² S on the band's grid points); the table prints
+    # 3 significant digits, hence rel 5e-3.
+    from specdesign.validate.openfast_campaign import OpenFASTRun
+
+    rep = benchmark_script("openfast_report")
+    w = np.linspace(0.0, 31.4, 1025)
+    cb, ca = ct.tf([-2.0, -0.5], [1.0, 0.8]), ct.tf([0.3, 0.0], [1.0, 2.0])
+    s_om = 1e-4 / (1 + (w / 3.0) ** 2)
+    gb = np.abs(np.squeeze(cb(1j * w))) ** 2
+    welch = {"gen_speed": s_om, "pitch": gb * s_om, "tower_top_acc": np.zeros_like(w)}
+    run = OpenFASTRun("QFT+ATD+3P", 19.0, 0, {}, w, welch, {}, tmp_path)
+    design = type("D", (), {"pitch_controller": cb, "atd_controller": ca})()
+    made = {"QFT+ATD+3P": {19.0: {"design": design}}}
+    rows = [r.split(" | ") for r in rep.pitch_sources([run], made).splitlines()[2:]]
+    assert len(rows) == len(rep.SOURCE_BANDS)
+    for (lo, hi), row in zip(rep.SOURCE_BANDS, rows):
+        m = (w >= lo) & (w < hi)
+        want = rep.DEG**2 * np.trapezoid((w**2 * gb * s_om)[m], w[m])
+        measured, speed, acc = (float(c.strip(" |")) for c in row[4:7])
+        assert measured == pytest.approx(want, rel=5e-3) and speed == pytest.approx(want, rel=5e-3) and acc == 0.0
+    s_a = np.full_like(w, 1e-3)
+    run_a = dataclasses.replace(run, welch=dict(welch, tower_top_acc=s_a))
+    row = rep.pitch_sources([run_a], made).splitlines()[-1].split(" | ")
+    m = (w >= 5.0) & (w < 20.0)
+    want = rep.DEG**2 * np.trapezoid((w**2 * np.abs(np.squeeze(ca(1j * w)) / (1j * w)) ** 2 * s_a)[m], w[m])
+    assert float(row[6].strip(" |")) == pytest.approx(want, rel=5e-3)
+    older = dataclasses.replace(run, welch={k: a for k, a in welch.items() if k != "tower_top_acc"})
+    assert rep.pitch_sources([older], made).startswith("No run")
