@@ -149,24 +149,25 @@ def fit_fatigue_terms(model, wind_speed: float, window: float, *, seeds=(1, 2, 3
     Raises
     ------
     ValueError
-        For an output the model does not have, one without a Wöhler exponent, or a window
-        longer than ``duration``.
+        For an output the model does not have, one without a Wöhler exponent, a window
+        longer than half of ``duration`` or not a whole number of the records' samples.
     """
     window = positive_scalar(window, "window")
     duration = positive_scalar(duration, "duration")
     if window > duration / 2:
         raise ValueError(f"window={window} s must be at most half of duration={duration} s (two records per run)")
     names = tuple(model.output_names)
-    if prices is None:
-        outputs = [o for o in ("tower_base_my", "blade_root_my") if o in names] if outputs is None else list(outputs)
-    for out in (outputs if prices is None else prices):
+    if prices is not None:
+        priced = list(prices)
+    else:
+        priced = [o for o in ("tower_base_my", "blade_root_my") if o in names] if outputs is None else list(outputs)
+    for out in priced:
         if out not in names:
             raise ValueError(f"priced output {out!r} is not an output of the model {names}")
-    _check_wohler(outputs if prices is None else prices)
+    _check_wohler(priced)
     runs = [simulate(model, rosco_baseline(model, wind_speed), [wind_speed], seeds=list(seeds), duration=duration,
                      turbulence_class=c) for c in classes]
-    records = {out: [r[out][0, s] for r in runs for s in range(len(seeds))]
-               for out in (outputs if prices is None else prices)}
+    records = {out: [r[out][0, s] for r in runs for s in range(len(seeds))] for out in priced}
     return fatigue_terms_from_records(records, runs[0].dt, window, prices=prices, ultimate=ultimate)
 
 
