@@ -260,14 +260,12 @@ def main() -> None:
     # separate cache entry, so the model the quadratic MPCs' stored runs were made with stays theirs)
     forwarded_mpcs = mpcs(lt, lambda: openfast_linear_model(deck, reduced, blade_moments=True), reduced, q_rule,
                           lambda: economic_terms(validate.read_openfast_runs(STORE / "runs")), chosen) if mpc_names else {}
+    # ROSCO's parameter files are the same at every speed: written once
+    roscos = {"ROSCO": lambda: discon_in, ROSCO_TD: lambda: rosco_td_discon(discon_in, out),
+              ROSCO_TD_3P: lambda: rosco_td_discon(discon_in, out, measurement_filter(design_model, "atd_3p"))}
+    roscos = {name: make() for name, make in roscos.items() if name in chosen}
     for v in speeds:
-        controllers = {name: c for name, c in forwarded_mpcs.items() if name in chosen}
-        if "ROSCO" in chosen:
-            controllers["ROSCO"] = discon_in
-        if ROSCO_TD in chosen:
-            controllers[ROSCO_TD] = rosco_td_discon(discon_in, out)
-        if ROSCO_TD_3P in chosen:
-            controllers[ROSCO_TD_3P] = rosco_td_discon(discon_in, out, measurement_filter(design_model, "atd_3p"))
+        controllers = {name: c for name, c in forwarded_mpcs.items() if name in chosen} | roscos
         for st in fixed:
             label, prefix = STRUCTURES[st]
             if label in chosen:

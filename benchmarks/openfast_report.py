@@ -726,10 +726,11 @@ def main() -> None:
     print(printed[0])
     if args.figures is not None:
         fig9(runs, Path(args.figures))
-    if args.pitch_sources:
-        print("\n" + pitch_sources(runs, campaign_designs(runs)[1]))
-    if args.damping or args.table3:
+    if args.pitch_sources or args.damping or args.table3:
         model, made = campaign_designs(runs)
+    if args.pitch_sources:
+        print("\n" + pitch_sources(runs, made))
+    if args.damping or args.table3:
         reduced = reduced_model_changes(made, runs) if args.table3 else None
         damping, preds = linear_side(runs, model, made, figures=args.figures if args.damping else None, reduced=reduced)
         if args.damping:

@@ -28,7 +28,7 @@ from ..export.parameters import FORMAT_NAME, SAME_DESIGN_RTOL, read_parameters
 from ..fatigue import TOWER_M
 from ..openfast.deck import CAMPAIGN_CHANNELS, Case, Deck, OpenFASTRunError, named_digest, run_case, wave_seed_for, write_case
 from ..openfast.install import OpenFASTInstall, check_deck_version, find_openfast
-from ..openfast.series import series_from_openfast
+from ..openfast.series import OPENFAST_CHANNELS, series_from_openfast
 from ..openfast.turbsim import TURBSIM_GRID, turbsim_field
 from ..rosco.discon import rosco_library
 from ..simulate import SimulationResult
@@ -44,8 +44,7 @@ __all__ = ["run_openfast_campaign", "DisconController", "as_discon", "OPENFAST_S
            "OpenFASTRun", "read_openfast_runs", "ran_parameters", "kept_change"]
 
 #: OpenFAST channel → workbench series of an OpenFAST campaign (SI after reading).
-OPENFAST_SERIES = {"GenSpeed": "gen_speed", "TwrBsMyt": "tower_base_my", "BldPitch1": "pitch", "GenPwr": "power",
-                   "RootMyb1": "blade_root_my", "YawBrTAxp": "tower_top_acc"}
+OPENFAST_SERIES = {**OPENFAST_CHANNELS, "RootMyb1": "blade_root_my", "YawBrTAxp": "tower_top_acc"}
 #: Outputs whose Welch spectra an OpenFAST run keeps: the campaign's, the pitch angle's own, for
 #: the actuator's cost at 3P and above (issue 28: the reduced model has no 3P to show), and the
 #: tower-top fore-aft acceleration's, the tower damper's input, to tell which measurement carries
