@@ -153,8 +153,12 @@ def economic_terms(runs) -> tuple:
     dts = {r.meta["settings"]["record_dt"] for r in fit}
     if len(dts) != 1:
         raise SystemExit(f"ROSCO's kept records are sampled at several intervals {sorted(dts)} s")
-    return fatigue_terms_from_records({"tower_base_my": [r.series["tower_base_my"] for r in fit]}, dts.pop(),
-                                      ECON_TS * ECON_HORIZON)
+    terms = fatigue_terms_from_records({"tower_base_my": [r.series["tower_base_my"] for r in fit]}, dts.pop(),
+                                       ECON_TS * ECON_HORIZON)
+    for t in terms:
+        print(f"economic MPC's {t.output} term on ROSCO's OpenFAST records at {', '.join(f'{v:g}' for v in ECON_FIT_SPEEDS)} "
+              f"m/s: a = {t.fit.a:.2f}, b = {t.fit.b:.2f}, residual SD {t.fit.residual_std:.2f} (ln D)")
+    return terms
 
 
 def activity_weight_rule(lt, grid=RULE_GRID) -> tuple[float, list]:

@@ -632,10 +632,12 @@ def pitch_sources(runs, made) -> str:
     tower-top acceleration, integrated to the velocity the damper reads; its 0.05 rad/s high-pass
     aside), from the run's Welch spectra and the design's two controllers (``made``, as
     :func:`campaign_designs` makes them). Cross terms are left out, so the two need not add up to
-    the measured variance. Runs made before the campaign kept the acceleration's spectrum are
-    skipped (issue 28: which measurement carries the pitch above 3P)."""
+    the measured variance; the last column is where the generator speed's spectrum peaks in the
+    band. Runs made before the campaign kept the acceleration's spectrum are skipped (issue 28:
+    which measurement carries the pitch above 3P)."""
     lines = [("| wind (m/s) | controller | seed | band (rad/s) | pitch-rate variance (deg²/s²) | through the generator "
-              "speed | through the tower-top acceleration |"), "|---|---|---|---|---|---|---|"]
+              "speed | through the tower-top acceleration | generator-speed spectrum's peak (rad/s) |"),
+             "|---|---|---|---|---|---|---|---|"]
     for r in runs:
         entry = made.get(r.controller, {}).get(r.wind_speed)
         d = entry and entry["design"]
@@ -647,8 +649,10 @@ def pitch_sources(runs, made) -> str:
                  np.abs(ca / (1j * w)) ** 2 * r.welch["tower_top_acc"][1:])
         for lo, hi in SOURCE_BANDS:
             cells = [DEG**2 * band_variance(w, w**2 * x, lo, hi) for x in parts]
+            band = (w >= lo) & (w < hi)
+            peak = w[band][np.argmax(r.welch["gen_speed"][1:][band])]
             lines.append(f"| {r.wind_speed:g} | {r.controller} | {r.seed} | {lo:g}-{hi:g} | "
-                         + " | ".join(f"{c:.3g}" for c in cells) + " |")
+                         + " | ".join(f"{c:.3g}" for c in cells) + f" | {peak:.2f} |")
     return "\n".join(lines) if len(lines) > 2 else "No run with the tower-top acceleration's spectrum and a tower damper."
 
 

@@ -341,6 +341,8 @@ def test_pitch_sources_split_the_pitch_rate_by_measurement(benchmark_script, tmp
         want = rep.DEG**2 * np.trapezoid((w**2 * gb * s_om)[m], w[m])
         measured, speed, acc = (float(c.strip(" |")) for c in row[4:7])
         assert measured == pytest.approx(want, rel=5e-3) and speed == pytest.approx(want, rel=5e-3) and acc == 0.0
+        # the generator speed's spectrum falls with ω: its peak in a band is the band's first grid point
+        assert float(row[7].strip(" |")) == pytest.approx(w[m][0], abs=5e-3)
     s_a = np.full_like(w, 1e-3)
     run_a = dataclasses.replace(run, welch=dict(welch, tower_top_acc=s_a))
     row = rep.pitch_sources([run_a], made).splitlines()[-1].split(" | ")
